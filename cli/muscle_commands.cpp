@@ -1,0 +1,182 @@
+// armsim muscle steady | sweep | trial: the muscle alone, both path ends fixed.
+#include "cli/commands.h"
+#include "experiments/plot.h"
+#include "muscles/muscle_file.h"
+#include "muscles/param_file.h"
+#include "muscles/simbody_isometric.h"
+
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <memory>
+
+namespace armsim::cli {
+
+void MuscleOptions::add(CLI::App& app) {
+    app.add_option("--muscle", file, "muscle parameter file (path, or name under assets/)")->capture_default_str();
+    app.add_option("--slow-units", slowUnits, "number of slow motor units (default: from the file)");
+    app.add_option("--fast-units", fastUnits, "number of fast motor units (default: from the file)");
+    app.add_option("--mass", mass, "muscle mass M [kg] (default: from the file)");
+    app.add_option("--tendon-length", tendonLength, "optimal tendon length L0T [m] (default: from the file)");
+    app.add_option("--max-path", maxPathLength, "path length at the anatomical limit P_max [m]");
+}
+
+VirtualMuscle MuscleOptions::build() const {
+    MuscleParameters p = loadMuscleParameters(findAsset(file));
+    if (slowUnits >= 0) p.numSlowUnits = slowUnits;
+    if (fastUnits >= 0) p.numFastUnits = fastUnits;
+    if (mass != 0) p.mass = mass;
+    if (tendonLength != 0) p.optimalTendonLength = tendonLength;
+    if (maxPathLength != 0) p.maxPathLength = maxPathLength;
+    try {
+        return VirtualMuscle(p);
+    } catch (const FieldError& e) {
+        throw InputError(std::string("muscle '") + p.name + "' (" + file + " with command-line overrides): " + e.what());
+    }
+}
+
+void printProgress(const std::string& label, int done, int total) {
+    constexpr int kWidth = 30;
+    const int filled = total > 0 ? done * kWidth / total : kWidth;
+    std::fprintf(stderr, "\r%-28s [%s%s] %d/%d", label.c_str(), std::string(filled, '#').c_str(),
+                 std::string(kWidth - filled, ' ').c_str(), done, total);
+    if (done >= total) std::fprintf(stderr, "\n");
+    std::fflush(stderr);
+}
+
+namespace {
+
+void checkActivation(double U) { checkField("--activation", U, Bound::closed(0, 1)); }
+
+}  // namespace
+
+void addMuscleCommands(CLI::App& app) {
+    CLI::App* muscle = app.add_subcommand("muscle", "the muscle alone, path ends fixed (steady solve, sweeps, trials)");
+    muscle->require_subcommand(1);
+
+    // steady ---------------------------------------------------------------------------------
+    {
+        auto opts = std::make_shared<MuscleOptions>();
+        auto path = std::make_shared<double>(0.375);
+        auto U = std::make_shared<double>(1.0);
+        CLI::App* c = muscle->add_subcommand("steady", "steady isometric force at one path length and activation");
+        opts->add(*c);
+        c->add_option("--path", *path, "path length P [m]")->capture_default_str();
+        c->add_option("--activation", *U, "activation U in [0, 1]")->capture_default_str();
+        c->callback([=] {
+            checkActivation(*U);
+            const VirtualMuscle m = opts->build();
+            const SteadyState s = m.calcSteadyState(*path, *U);
+            if (!s.converged) throw SimulationError(s.message);
+            std::printf("muscle            %s\n", m.getParameters().name.c_str());
+            std::printf("path length       %.6f m\nactivation        %.4f\n", *path, *U);
+            std::printf("force Fse         %.4f N  (F0 = %.3f N)\n", s.force, m.getF0());
+            std::printf("fascicle length   %.6f m  (L = %.6f L0)\n", s.fascicleLength, s.L);
+            std::printf("tendon length     %.6f m\n", *path - s.fascicleLength);
+        });
+    }
+
+    // sweep ----------------------------------------------------------------------------------
+    {
+        auto opts = std::make_shared<MuscleOptions>();
+        auto from = std::make_shared<double>(0.27), to = std::make_shared<double>(0.43);
+        auto step = std::make_shared<double>(0.0025);
+        auto U = std::make_shared<double>(1.0);
+        auto out = std::make_shared<std::string>("out/force_length.csv");
+        auto plot = std::make_shared<std::string>();
+        CLI::App* c = muscle->add_subcommand("sweep", "steady force over a range of path lengths (force-length)");
+        opts->add(*c);
+        c->add_option("--from", *from, "first path length [m]")->capture_default_str();
+        c->add_option("--to", *to, "last path length [m] (at most P_max)")->capture_default_str();
+        c->add_option("--step", *step, "path length step [m]")->capture_default_str();
+        c->add_option("--activation", *U, "activation U in [0, 1]")->capture_default_str();
+        c->add_option("--out", *out, "CSV output")->capture_default_str();
+        c->add_option("--plot", *plot, "PNG plot output (optional)");
+        c->callback([=] {
+            checkActivation(*U);
+            checkField("--step", *step, Bound::positive("m"));
+            if (!(*to >= *from)) throw InputError("--to must not be below --from");
+            const VirtualMuscle m = opts->build();
+            m.checkPathLength(*from);
+            m.checkPathLength(*to);
+            Table t({"path_length_m", "activation", "force_N", "fascicle_length_m", "converged"});
+            const int n = int(std::floor((*to - *from) / *step + 1e-9)) + 1;
+            std::vector<double> x, y;
+            for (int i = 0; i < n; ++i) {
+                const double P = std::min(*to, *from + i * *step);
+                const SteadyState s = m.calcSteadyState(P, *U);
+                t.appendRow({P, *U, s.converged ? s.force : NAN, s.converged ? s.fascicleLength : NAN,
+                             s.converged ? 1.0 : 0.0});
+                if (s.converged) {
+                    x.push_back(100 * P);
+                    y.push_back(s.force);
+                }
+            }
+            t.writeCsv(*out);
+            std::printf("wrote %s (%d path lengths)\n", out->c_str(), n);
+            if (!plot->empty()) {
+                PlotSpec spec;
+                spec.title = m.getParameters().name + ": steady force vs path length";
+                spec.xLabel = "path length (cm)";
+                spec.yLabel = "force Fse (N)";
+                spec.series.push_back({"U = " + std::to_string(*U).substr(0, 4), x, y});
+                writePlotPng(*plot, spec);
+                std::printf("wrote %s\n", plot->c_str());
+            }
+        });
+    }
+
+    // trial ----------------------------------------------------------------------------------
+    {
+        auto opts = std::make_shared<MuscleOptions>();
+        auto settings = std::make_shared<MuscleIsometricSettings>();
+        auto U = std::make_shared<double>(1.0);
+        auto onset = std::make_shared<double>(0.0);
+        auto rise = std::make_shared<double>(0.0);
+        auto out = std::make_shared<std::string>("out/muscle_trial.csv");
+        auto plot = std::make_shared<std::string>();
+        auto trace = std::make_shared<std::string>();
+        CLI::App* c = muscle->add_subcommand("trial", "isometric time integration (CPodes) at a fixed path length");
+        opts->add(*c);
+        c->add_option("--path", settings->pathLength, "path length P [m]")->capture_default_str();
+        c->add_option("--activation", *U, "activation level after onset, in [0, 1]")->capture_default_str();
+        c->add_option("--onset", *onset, "activation onset time [s] (0 before it)")->capture_default_str();
+        c->add_option("--rise", *rise, "rise time of the activation ramp [s] (0 = step)")->capture_default_str();
+        c->add_option("--activation-trace", *trace,
+                      "CSV with columns time_s,activation: a sampled U(t) instead of --activation/--onset");
+        c->add_option("--duration", settings->duration, "simulated time [s]")->capture_default_str();
+        c->add_option("--rate", settings->sampleRate, "output samples per second [Hz]")->capture_default_str();
+        c->add_option("--accuracy", settings->integration.accuracy, "integrator relative accuracy")->capture_default_str();
+        c->add_flag("--steady-start", settings->startSteady, "start from the steady state at U(0)");
+        c->add_option("--out", *out, "CSV output")->capture_default_str();
+        c->add_option("--plot", *plot, "PNG plot of force and activation (optional)");
+        c->callback([=] {
+            checkActivation(*U);
+            checkField("--onset", *onset, Bound::nonNegative("s"));
+            checkField("--rise", *rise, Bound::nonNegative("s"));
+            const VirtualMuscle m = opts->build();
+            MuscleIsometricSettings s = *settings;
+            if (!trace->empty()) s.activation = loadActivationTrace(*trace);
+            else if (*rise > 0) s.activation = ActivationProfile::ramp(*onset, *onset + *rise, 0.0, *U);
+            else if (*onset > 0) s.activation = ActivationProfile::step(*onset, 0.0, *U);
+            else s.activation = ActivationProfile::constant(*U);
+            IntegrationStats stats;
+            const Table t = runMuscleIsometric(m, s, &stats);
+            t.writeCsv(*out);
+            const int last = t.getNumRows() - 1;
+            std::printf("final force %.4f N at t = %.3f s (%d steps, %d restarts); wrote %s\n", t.get(last, "force_N"),
+                        t.get(last, "time_s"), stats.steps, stats.restarts, out->c_str());
+            if (!plot->empty()) {
+                PlotSpec spec;
+                spec.title = m.getParameters().name + ": isometric trial at P = " + std::to_string(100 * s.pathLength).substr(0, 5) + " cm";
+                spec.xLabel = "time (s)";
+                spec.yLabel = "force Fse (N)";
+                spec.series.push_back({"force", t.getColumn("time_s"), t.getColumn("force_N")});
+                writePlotPng(*plot, spec);
+                std::printf("wrote %s\n", plot->c_str());
+            }
+        });
+    }
+}
+
+}  // namespace armsim::cli

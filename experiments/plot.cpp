@@ -1,0 +1,140 @@
+#include "experiments/plot.h"
+
+#include "muscles/param_file.h"
+
+#include <plplot/plplot.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <mutex>
+#include <stdexcept>
+#include <unistd.h>
+
+namespace armsim {
+
+namespace {
+
+std::mutex plplotMutex;  // PLplot keeps global state
+
+// Palette (colour map 0): 0 background, 1 axes/text, then the series colours.
+constexpr int kPalette[][3] = {{255, 255, 255}, {0, 0, 0},     {31, 119, 180}, {214, 39, 40},
+                               {44, 160, 44},   {255, 127, 14}, {148, 103, 189}, {127, 127, 127},
+                               {23, 190, 207},  {0, 0, 0}};
+
+void dataRange(const std::vector<double>& v, bool log, double& lo, double& hi) {
+    for (double a : v)
+        if (std::isfinite(a) && (!log || a > 0)) {
+            const double b = log ? std::log10(a) : a;
+            lo = std::min(lo, b);
+            hi = std::max(hi, b);
+        }
+}
+
+}  // namespace
+
+void writePlotPng(const std::string& path, const PlotSpec& spec) {
+    if (spec.series.empty()) throw std::invalid_argument("plot '" + spec.title + "': no series");
+    if (spec.width < 100 || spec.height < 100) throw std::invalid_argument("plot size below 100 pixels");
+    double x0 = std::numeric_limits<double>::infinity(), x1 = -x0, y0 = x0, y1 = -x0;
+    for (const auto& s : spec.series) {
+        if (s.x.size() != s.y.size())
+            throw std::invalid_argument("plot series '" + s.label + "': x and y differ in length");
+        dataRange(s.x, false, x0, x1);
+        dataRange(s.y, spec.logY, y0, y1);
+    }
+    if (!(x1 >= x0) || !(y1 >= y0)) throw std::invalid_argument("plot '" + spec.title + "': no finite data");
+    auto pad = [](double& lo, double& hi) {
+        const double span = hi > lo ? hi - lo : std::max(1.0, std::abs(lo));
+        lo -= 0.04 * span;
+        hi += 0.04 * span;
+    };
+    pad(x0, x1);
+    pad(y0, y1);
+    auto limit = [](double given, double fallback, bool log) {
+        return std::isnan(given) ? fallback : (log ? std::log10(given) : given);
+    };
+    x0 = limit(spec.xMin, x0, false);
+    x1 = limit(spec.xMax, x1, false);
+    y0 = limit(spec.yMin, y0, spec.logY);
+    y1 = limit(spec.yMax, y1, spec.logY);
+
+    namespace fs = std::filesystem;
+    const fs::path target(path);
+    std::error_code ec;
+    if (target.has_parent_path()) fs::create_directories(target.parent_path(), ec);
+    const std::string tmp = path + ".tmp." + std::to_string(::getpid()) + ".png";
+    if (!std::ofstream(tmp))  // PLplot exits the process on a file it cannot open: check first
+        throw InputError(path + ": cannot write plot (is the directory writable?)");
+    {
+        std::lock_guard<std::mutex> lock(plplotMutex);
+        PLINT stream = 0;
+        plmkstrm(&stream);
+        plsdev("pngcairo");
+        plsfnam(tmp.c_str());
+        plspage(0, 0, spec.width, spec.height, 0, 0);
+        for (int i = 0; i < 10; ++i) plscol0(i, kPalette[i][0], kPalette[i][1], kPalette[i][2]);
+        plinit();
+        plcol0(1);
+        plschr(0, 1.1);
+        plenv(x0, x1, y0, y1, 0, spec.logY ? 20 : 2);  // 2: grid lines; 20: log y with grid
+        pllab(spec.xLabel.c_str(), spec.yLabel.c_str(), spec.title.c_str());
+
+        std::vector<PLINT> opts, colors, lineStyles, markerColors;
+        std::vector<PLFLT> widths, scales;
+        std::vector<PLINT> markerCounts;
+        std::vector<const char*> texts, symbols;
+        for (const auto& s : spec.series) {
+            const int color = 2 + (s.color % 8);
+            std::vector<PLFLT> xs, ys;
+            for (std::size_t i = 0; i < s.x.size(); ++i)
+                if (std::isfinite(s.x[i]) && std::isfinite(s.y[i]) && (!spec.logY || s.y[i] > 0)) {
+                    xs.push_back(s.x[i]);
+                    ys.push_back(spec.logY ? std::log10(s.y[i]) : s.y[i]);
+                }
+            plcol0(color);
+            plwidth(2.0);
+            if (s.markers) plstring(PLINT(xs.size()), xs.data(), ys.data(), "#(728)");
+            else if (xs.size() > 1) plline(PLINT(xs.size()), xs.data(), ys.data());
+            if (s.label.empty()) continue;
+            opts.push_back(s.markers ? PL_LEGEND_SYMBOL : PL_LEGEND_LINE);
+            colors.push_back(color);
+            lineStyles.push_back(1);
+            widths.push_back(2.0);
+            markerColors.push_back(color);
+            scales.push_back(1.0);
+            markerCounts.push_back(1);
+            texts.push_back(s.label.c_str());
+            symbols.push_back("#(728)");
+        }
+        if (!texts.empty()) {
+            plcol0(1);
+            PLFLT legendWidth, legendHeight;
+            std::vector<PLINT> textColors(texts.size(), 1), zeros(texts.size(), 0);
+            std::vector<PLFLT> zerosF(texts.size(), 0.0);
+            const bool top = spec.legend == PlotSpec::Legend::TopLeft || spec.legend == PlotSpec::Legend::TopRight;
+            const bool left = spec.legend == PlotSpec::Legend::TopLeft || spec.legend == PlotSpec::Legend::BottomLeft;
+            const PLINT position = PL_POSITION_INSIDE | (top ? PL_POSITION_TOP : PL_POSITION_BOTTOM) |
+                                   (left ? PL_POSITION_LEFT : PL_POSITION_RIGHT);
+            pllegend(&legendWidth, &legendHeight, PL_LEGEND_BACKGROUND | PL_LEGEND_BOUNDING_BOX, position, 0.02, 0.02,
+                     0.1, 0, 1, 1, 0, 0, PLINT(texts.size()), opts.data(), 1.0, 1.0, 2.0, 1.0,
+                     textColors.data(), texts.data(), zeros.data(), zeros.data(), zerosF.data(), zerosF.data(),
+                     colors.data(), lineStyles.data(), widths.data(), markerColors.data(), scales.data(),
+                     markerCounts.data(), symbols.data());
+        }
+        plend1();
+    }
+    if (!fs::exists(tmp) || fs::file_size(tmp, ec) == 0) {
+        fs::remove(tmp, ec);
+        throw InputError(path + ": the plot could not be written (PLplot pngcairo driver failed)");
+    }
+    fs::rename(tmp, target, ec);
+    if (ec) {
+        fs::remove(tmp, ec);
+        throw InputError(path + ": cannot write plot: " + ec.message());
+    }
+}
+
+}  // namespace armsim

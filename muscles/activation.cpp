@@ -1,0 +1,81 @@
+#include "muscles/activation.h"
+
+#include "muscles/param_file.h"
+#include "muscles/table.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace armsim {
+
+ActivationProfile::ActivationProfile() : times_{0.0}, values_{0.0} {}
+
+ActivationProfile::ActivationProfile(std::vector<double> times, std::vector<double> values,
+                                     const std::string& what)
+    : times_(std::move(times)), values_(std::move(values)) {
+    if (times_.empty() || times_.size() != values_.size())
+        throw InputError(what + ": expected as many times as values and at least one point (got " +
+                         std::to_string(times_.size()) + " times, " + std::to_string(values_.size()) +
+                         " values)");
+    for (std::size_t k = 0; k < times_.size(); ++k) {
+        const std::string at = what + " point " + std::to_string(k);
+        if (!std::isfinite(times_[k])) throw InputError(at + ": time is not finite");
+        if (k > 0 && times_[k] < times_[k - 1])
+            throw InputError(at + ": time " + std::to_string(times_[k]) + " s is before the previous " +
+                             std::to_string(times_[k - 1]) + " s: expected nondecreasing times");
+        checkField(at + " activation", values_[k], Bound::closed(0, 1));
+    }
+}
+
+ActivationProfile ActivationProfile::constant(double U) { return ActivationProfile({0.0}, {U}); }
+
+ActivationProfile ActivationProfile::step(double t0, double U0, double U1) {
+    return ActivationProfile({t0, t0}, {U0, U1}, "step activation");
+}
+
+ActivationProfile ActivationProfile::ramp(double t0, double t1, double U0, double U1) {
+    if (!(t1 > t0)) throw InputError("ramp activation: end time must be after start time");
+    return ActivationProfile({t0, t1}, {U0, U1}, "ramp activation");
+}
+
+ActivationProfile ActivationProfile::pulse(double tOn, double riseTime, double level, double tOff) {
+    checkField("rise time", riseTime, Bound::nonNegative("s"));
+    if (!(tOff >= tOn + riseTime))
+        throw InputError("activation pulse: off time " + std::to_string(tOff) +
+                         " s must come after the rise ends at " + std::to_string(tOn + riseTime) + " s");
+    return ActivationProfile({tOn, tOn + riseTime, tOff, tOff + riseTime}, {0.0, level, level, 0.0},
+                             "activation pulse");
+}
+
+double ActivationProfile::getValue(double t) const {
+    // First point with time > t; U is right-continuous at steps.
+    const auto it = std::upper_bound(times_.begin(), times_.end(), t);
+    if (it == times_.begin()) return values_.front();
+    if (it == times_.end()) return values_.back();
+    const std::size_t k = std::size_t(it - times_.begin());
+    const double t0 = times_[k - 1], t1 = times_[k];
+    const double w = (t - t0) / (t1 - t0);
+    return values_[k - 1] + w * (values_[k] - values_[k - 1]);
+}
+
+double ActivationProfile::getMaxValue() const { return *std::max_element(values_.begin(), values_.end()); }
+
+ActivationProfile loadActivationTrace(const std::string& csvPath) {
+    const Table t = Table::readCsv(csvPath);
+    for (const char* c : {"time_s", "activation"})
+        if (!t.hasColumn(c))
+            throw InputError(csvPath + ": no column '" + c + "' (expected columns time_s,activation)");
+    if (t.getNumRows() == 0) throw InputError(csvPath + ": no data rows");
+    const std::vector<double> time = t.getColumn("time_s"), U = t.getColumn("activation");
+    for (int i = 0; i < t.getNumRows(); ++i) {
+        const std::string at = csvPath + ":" + std::to_string(t.getSourceLine(i));
+        if (!(U[i] >= 0 && U[i] <= 1))
+            throw InputError(at + ": activation = " + std::to_string(U[i]) + ": expected in [0, 1]");
+        if (i > 0 && !(time[i] >= time[i - 1]))
+            throw InputError(at + ": time_s = " + std::to_string(time[i]) + " is before the previous row's " +
+                             std::to_string(time[i - 1]) + ": expected nondecreasing times");
+    }
+    return ActivationProfile(time, U, csvPath);
+}
+
+}  // namespace armsim

@@ -1,0 +1,129 @@
+#include "muscles/muscle_file.h"
+
+#include "muscles/param_file.h"
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+
+#ifndef ARMSIM_ASSET_DIR
+#define ARMSIM_ASSET_DIR "assets"
+#endif
+
+namespace armsim {
+
+std::string getAssetDirectory() {
+    const char* env = std::getenv("ARMSIM_ASSETS");
+    return env && *env ? env : ARMSIM_ASSET_DIR;
+}
+
+std::string findAsset(const std::string& name) {
+    if (std::filesystem::exists(name)) return name;
+    const std::string inAssets = getAssetDirectory() + "/" + name;
+    if (std::filesystem::exists(inAssets)) return inAssets;
+    throw InputError(name + ": no such file (looked here and in " + getAssetDirectory() + ")");
+}
+
+namespace {
+
+FibreType readFibreType(const ParamNode& n, const std::string& name) {
+    FibreType t;
+    t.name = name;
+    const Bound any = Bound::any();
+    t.beta = n.getNumber("beta", any);
+    t.omega = n.getNumber("omega", any);
+    t.rho = n.getNumber("rho", any);
+    t.Vmax = n.getNumber("Vmax", any);
+    t.cV0 = n.getNumber("cV0", any);
+    t.cV1 = n.getNumber("cV1", any);
+    t.bV = n.getNumber("bV", any);
+    t.aV0 = n.getNumber("aV0", any);
+    t.aV1 = n.getNumber("aV1", any);
+    t.aV2 = n.getNumber("aV2", any);
+    t.af = n.getNumber("af", any);
+    t.nf0 = n.getNumber("nf0", any);
+    t.nf1 = n.getNumber("nf1", any);
+    t.Tf1 = n.getNumber("Tf1", any);
+    t.Tf2 = n.getNumber("Tf2", any);
+    t.Tf3 = n.getNumber("Tf3", any);
+    t.Tf4 = n.getNumber("Tf4", any);
+    t.aS1 = n.getNumber("aS1", any, 1.0);
+    t.aS2 = n.getNumber("aS2", any, 1.0);
+    t.TS = n.getNumber("TS", any, 1.0);
+    t.cY = n.getNumber("cY", any, 0.0);
+    t.VY = n.getNumber("VY", any, 1.0);
+    t.TY = n.getNumber("TY", any, 1.0);
+    n.finish();
+    n.rethrowWithLocation([&] { t.validate(n.path("")); });
+    return t;
+}
+
+}  // namespace
+
+void loadFibreTypes(const std::string& path, FibreType& slow, FibreType& fast, MuscleCoefficients& c) {
+    const ParamNode root = ParamNode::loadFile(path);
+    root.getString("source", "");
+    slow = readFibreType(root.child("slow"), "slow");
+    fast = readFibreType(root.child("fast"), "fast");
+    const ParamNode w = root.child("whole_muscle");
+    const Bound any = Bound::any();
+    c.c1 = w.getNumber("c1", any);
+    c.k1 = w.getNumber("k1", any);
+    c.Lr1 = w.getNumber("Lr1", any);
+    c.eta = w.getNumber("eta", any);
+    c.c2 = w.getNumber("c2", any);
+    c.k2 = w.getNumber("k2", any);
+    c.Lr2 = w.getNumber("Lr2", any);
+    c.cT = w.getNumber("cT", any);
+    c.kT = w.getNumber("kT", any);
+    c.LrT = w.getNumber("LrT", any);
+    c.Ur = w.getNumber("Ur", any);
+    c.fmin = w.getNumber("fmin", any);
+    c.fmax = w.getNumber("fmax", any);
+    c.sigma = w.getNumber("sigma", any);
+    c.density = w.getNumber("density", any);
+    w.finish();
+    w.rethrowWithLocation([&] { c.validate("whole_muscle"); });
+    root.finish();
+}
+
+MuscleParameters loadMuscleParameters(const std::string& path) {
+    const ParamNode root = ParamNode::loadFile(path);
+    MuscleParameters p;
+    const Bound any = Bound::any();
+    p.name = root.getString("name");
+    root.getString("source", "");
+    p.mass = root.getNumber("mass", any);
+    p.optimalFascicleLength = root.getNumber("optimal_fascicle_length", any);
+    p.optimalTendonLength = root.getNumber("optimal_tendon_length", any);
+    p.maxPathLength = root.getNumber("max_path_length", any);
+
+    const ParamNode fr = root.child("fibre_fractions");
+    p.slowFraction = fr.getNumber("slow", Bound::closed(0, 1));
+    const double fastFraction = fr.getNumber("fast", Bound::closed(0, 1));
+    constexpr double kFractionSumTol = 1e-9;
+    if (std::abs(p.slowFraction + fastFraction - 1.0) > kFractionSumTol)
+        throw InputError(fr.where("fast") + ": fibre_fractions slow + fast = " +
+                         std::to_string(p.slowFraction + fastFraction) + ": expected 1 (they share the PCSA)");
+    fr.finish();
+
+    const ParamNode mu = root.child("motor_units");
+    p.numSlowUnits = mu.getInt("slow", 0, 1000);
+    p.numFastUnits = mu.getInt("fast", 0, 1000);
+    p.apportioning = mu.getChoice("apportioning", {"thesis", "equal"}, "thesis") == "equal"
+                         ? Apportioning::Equal : Apportioning::Thesis;
+    mu.finish();
+
+    std::string typesFile = root.getString("fibre_types");
+    const std::string relative = root.getDirectory().empty() ? typesFile : root.getDirectory() + "/" + typesFile;
+    if (std::filesystem::exists(relative)) typesFile = relative;
+    else if (!std::filesystem::exists(typesFile))
+        throw InputError(root.where("fibre_types") + ": field 'fibre_types' = '" + typesFile +
+                         "': no such file (relative paths are taken from the muscle file's directory)");
+    loadFibreTypes(typesFile, p.slow, p.fast, p.coefficients);
+    root.finish();
+    root.rethrowWithLocation([&] { p.validate(); });
+    return p;
+}
+
+}  // namespace armsim

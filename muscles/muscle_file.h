@@ -1,0 +1,23 @@
+// Reading muscle parameter files (assets/muscles/*.yaml). Framework-free.
+#pragma once
+
+#include "muscles/virtual_muscle.h"
+
+#include <string>
+
+namespace armsim {
+
+/// Directory of the shipped assets: $ARMSIM_ASSETS if set, else the source tree's assets/.
+std::string getAssetDirectory();
+/// Resolves name against the asset directory unless it is an existing path.
+std::string findAsset(const std::string& name);
+
+/// Reads a fibre-type file: slow and fast coefficient sets and the whole-muscle coefficients.
+void loadFibreTypes(const std::string& path, FibreType& slow, FibreType& fast, MuscleCoefficients& c);
+
+/// Reads a muscle file (morphometry, fibre fractions, motor units, and a reference to its fibre-type
+/// file, relative to the muscle file). Unknown keys and out-of-bound values throw InputError naming
+/// file, line, field, value and bound.
+MuscleParameters loadMuscleParameters(const std::string& path);
+
+}  // namespace armsim

@@ -1,0 +1,160 @@
+#include "muscles/muscle_force.h"
+
+#include "muscles/param_file.h"
+
+#include <cmath>
+#include <sstream>
+
+using namespace SimTK;
+
+namespace armsim {
+
+class VirtualMuscleForce::Impl : public Force::Custom::Implementation {
+public:
+    Impl(SubsystemIndex forces, std::shared_ptr<const VirtualMuscle> muscle, const MobilizedBody& origin,
+         const Vec3& originStation, const MobilizedBody& insertion, const Vec3& insertionStation,
+         ActivationProfile activation)
+        : forces_(forces), muscle_(std::move(muscle)), origin_(origin), insertion_(insertion),
+          originStation_(originStation), insertionStation_(insertionStation),
+          activation_(std::move(activation)) {}
+
+    const VirtualMuscle& muscle() const { return *muscle_; }
+    const ActivationProfile& activation() const { return activation_; }
+
+    void realizeTopology(State& s) const override {
+        const Vector zInit(muscle_->getNumStates(), 0.0);
+        firstZ_ = s.allocateZ(forces_, zInit);
+    }
+
+    Vec3 originInGround(const State& s) const { return origin_.findStationLocationInGround(s, originStation_); }
+    Vec3 insertionInGround(const State& s) const {
+        return insertion_.findStationLocationInGround(s, insertionStation_);
+    }
+    double pathLength(const State& s) const { return (insertionInGround(s) - originInGround(s)).norm(); }
+    const double* z(const State& s) const { return &s.getZ(forces_)[firstZ_]; }
+
+    void realizeDynamics(const State& s) const override {
+        Vector& zdot = s.updZDot(forces_);
+        muscle_->calcStateDerivative(pathLength(s), activation_.getValue(s.getTime()), z(s), &zdot[firstZ_]);
+    }
+
+    void calcForce(const State& s, Vector_<SpatialVec>& bodyForces, Vector_<Vec3>&, Vector&) const override {
+        const Vec3 pA = originInGround(s), pB = insertionInGround(s);
+        const Vec3 d = pB - pA;
+        const double P = d.norm();
+        const Vec3 f = (muscle_->calcForce(P, z(s)) / P) * d;  // pulls the origin towards the insertion
+        origin_.applyForceToBodyPoint(s, originStation_, f, bodyForces);
+        insertion_.applyForceToBodyPoint(s, insertionStation_, -f, bodyForces);
+    }
+
+    Real calcPotentialEnergy(const State&) const override { return 0; }
+
+    void calcDecorativeGeometryAndAppend(const State& s, Stage stage,
+                                         Array_<DecorativeGeometry>& geometry) const override {
+        if (stage != Stage::Position) return;
+        const MuscleOutputs out = muscle_->calcOutputs(pathLength(s), activation_.getValue(s.getTime()), z(s));
+        geometry.push_back(DecorativeLine(originInGround(s), insertionInGround(s))
+                               .setColor(calcActivationColor(out.activeFraction))
+                               .setLineThickness(3.0 + 5.0 * out.activeFraction));
+    }
+
+    SubsystemIndex forces_;
+    std::shared_ptr<const VirtualMuscle> muscle_;
+    MobilizedBody origin_, insertion_;
+    Vec3 originStation_, insertionStation_;
+    ActivationProfile activation_;
+    mutable ZIndex firstZ_;  // topology-stage cache
+};
+
+VirtualMuscleForce::VirtualMuscleForce(GeneralForceSubsystem& forces, std::shared_ptr<const VirtualMuscle> muscle,
+                                       const MobilizedBody& originBody, const Vec3& originStation,
+                                       const MobilizedBody& insertionBody, const Vec3& insertionStation,
+                                       ActivationProfile activation)
+    : Force::Custom(forces, new Impl(forces.getMySubsystemIndex(), std::move(muscle), originBody, originStation,
+                                     insertionBody, insertionStation, std::move(activation))) {}
+
+const VirtualMuscleForce::Impl& VirtualMuscleForce::getImpl() const {
+    return dynamic_cast<const Impl&>(getImplementation());
+}
+
+const VirtualMuscle& VirtualMuscleForce::getMuscle() const { return getImpl().muscle(); }
+const ActivationProfile& VirtualMuscleForce::getActivationProfile() const { return getImpl().activation(); }
+
+double VirtualMuscleForce::getPathLength(const State& s) const { return getImpl().pathLength(s); }
+
+UnitVec3 VirtualMuscleForce::getPathDirection(const State& s) const {
+    return UnitVec3(getImpl().insertionInGround(s) - getImpl().originInGround(s));
+}
+
+double VirtualMuscleForce::getActivation(const State& s) const {
+    return getImpl().activation().getValue(s.getTime());
+}
+
+double VirtualMuscleForce::getForce(const State& s) const {
+    return getMuscle().calcForce(getPathLength(s), getImpl().z(s));
+}
+
+double VirtualMuscleForce::getFascicleLength(const State& s) const {
+    return getImpl().z(s)[VirtualMuscle::kL] * getMuscle().getParameters().optimalFascicleLength;
+}
+
+double VirtualMuscleForce::getFascicleVelocity(const State& s) const {
+    return getImpl().z(s)[VirtualMuscle::kV] * getMuscle().getParameters().optimalFascicleLength;
+}
+
+MuscleOutputs VirtualMuscleForce::calcOutputs(const State& s) const {
+    return getMuscle().calcOutputs(getPathLength(s), getActivation(s), getImpl().z(s));
+}
+
+std::vector<double> VirtualMuscleForce::getMuscleStates(const State& s) const {
+    const double* z = getImpl().z(s);
+    return std::vector<double>(z, z + getMuscle().getNumStates());
+}
+
+void VirtualMuscleForce::setMuscleStates(State& s, const std::vector<double>& y) const {
+    SimTK_APIARGCHECK_ALWAYS(int(y.size()) == getMuscle().getNumStates(), "VirtualMuscleForce",
+                             "setMuscleStates", "wrong number of muscle states");
+    Vector& z = s.updZ(getImpl().forces_);
+    for (int i = 0; i < int(y.size()); ++i) z[getImpl().firstZ_ + i] = y[i];
+}
+
+void VirtualMuscleForce::setInitialMuscleStates(State& s) const {
+    const auto& sys = getForceSubsystem().getSystem();
+    sys.realize(s, Stage::Position);
+    setMuscleStates(s, getMuscle().calcInitialState(getPathLength(s)));
+}
+
+void VirtualMuscleForce::setSteadyMuscleStates(State& s) const {
+    const auto& sys = getForceSubsystem().getSystem();
+    sys.realize(s, Stage::Position);
+    const SteadyState ss = getMuscle().calcSteadyState(getPathLength(s), getActivation(s));
+    if (!ss.converged) throw SimulationError(ss.message);
+    setMuscleStates(s, ss.states);
+}
+
+void VirtualMuscleForce::checkMuscleStates(const State& s) const {
+    const VirtualMuscle& m = getMuscle();
+    const double* z = getImpl().z(s);
+    for (int i = 0; i < m.getNumStates(); ++i)
+        if (!std::isfinite(z[i])) {
+            std::ostringstream msg;
+            msg << "t = " << s.getTime() << " s: muscle '" << m.getParameters().name << "' state "
+                << m.getStateNames()[i] << " is " << z[i] << " (not finite)";
+            throw SimulationError(msg.str());
+        }
+    const double L = z[VirtualMuscle::kL];
+    if (!(L > 0) || !(L < m.getNfLimit())) {
+        std::ostringstream msg;
+        msg << "t = " << s.getTime() << " s: muscle '" << m.getParameters().name << "' fascicle length L = " << L
+            << " L0 left the model's range (0, " << m.getNfLimit()
+            << ") L0; beyond it the activation-frequency exponent nf is not positive (spec 4)";
+        throw SimulationError(msg.str());
+    }
+}
+
+Vec3 VirtualMuscleForce::calcActivationColor(double a) {
+    a = std::min(1.0, std::max(0.0, a));
+    return Vec3(0.15 + 0.8 * a, 0.25 * (1 - a) + 0.1, 0.85 * (1 - a) + 0.1);
+}
+
+}  // namespace armsim

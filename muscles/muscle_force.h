@@ -1,0 +1,69 @@
+// The Simbody adapter of the Virtual Muscle: a Force::Custom that owns the muscle states as Simbody
+// continuous (z) states and applies Fse along a straight path between a station on each of two bodies.
+#pragma once
+
+#include "muscles/activation.h"
+#include "muscles/simbody.h"
+#include "muscles/virtual_muscle.h"
+
+#include <memory>
+#include <vector>
+
+namespace armsim {
+
+/// A Virtual Muscle acting along the straight line from an origin station to an insertion station.
+///
+/// The muscle's states (VirtualMuscle::getNumStates(), all of order 1) are allocated as z states in
+/// realizeTopology and their derivatives written in realizeDynamics; the force Fse pulls the two
+/// stations together. Activation U(t) comes from an ActivationProfile evaluated at the state's time.
+/// Path length P is taken from the station positions (m) and must stay inside (0, P_max].
+///
+/// Like every Simbody handle this class has no data members; the implementation holds the model.
+class VirtualMuscleForce : public SimTK::Force::Custom {
+public:
+    VirtualMuscleForce() = default;
+    VirtualMuscleForce(SimTK::GeneralForceSubsystem& forces, std::shared_ptr<const VirtualMuscle> muscle,
+                       const SimTK::MobilizedBody& originBody, const SimTK::Vec3& originStation,
+                       const SimTK::MobilizedBody& insertionBody, const SimTK::Vec3& insertionStation,
+                       ActivationProfile activation);
+
+    const VirtualMuscle& getMuscle() const;
+    const ActivationProfile& getActivationProfile() const;
+
+    /// Path length P between the stations [m] (Stage::Position).
+    double getPathLength(const SimTK::State& s) const;
+    /// Unit vector from origin to insertion in Ground (Stage::Position).
+    SimTK::UnitVec3 getPathDirection(const SimTK::State& s) const;
+    /// Activation U at the state's time [1].
+    double getActivation(const SimTK::State& s) const;
+    /// Muscle (series-elastic) force Fse [N] (Stage::Position).
+    double getForce(const SimTK::State& s) const;
+    /// Fascicle length L L0 [m] and velocity V L0 [m/s] (positive = lengthening).
+    double getFascicleLength(const SimTK::State& s) const;
+    double getFascicleVelocity(const SimTK::State& s) const;
+    /// All derived outputs (Fse, Fce, per-unit Af and fenv, ...) (Stage::Position).
+    MuscleOutputs calcOutputs(const SimTK::State& s) const;
+
+    /// The muscle's slice of the state vector.
+    std::vector<double> getMuscleStates(const SimTK::State& s) const;
+    void setMuscleStates(SimTK::State& s, const std::vector<double>& y) const;
+    /// Sets the spec-5 initial state for the current path length (Stage::Position realized here).
+    void setInitialMuscleStates(SimTK::State& s) const;
+    /// Sets the steady isometric state at the current path length and activation at the state's
+    /// time; throws SimulationError if the steady solve finds no equilibrium.
+    void setSteadyMuscleStates(SimTK::State& s) const;
+
+    /// Throws SimulationError naming the time, the muscle and the state element if a muscle state is
+    /// not finite or the fascicle has left the model's validity range (nf > 0, L > 0). Call at step
+    /// boundaries.
+    void checkMuscleStates(const SimTK::State& s) const;
+
+    /// Colour of the path line as a function of the PCSA-weighted activation (blue at rest, red at 1).
+    static SimTK::Vec3 calcActivationColor(double activeFraction);
+
+    class Impl;
+private:
+    const Impl& getImpl() const;
+};
+
+}  // namespace armsim

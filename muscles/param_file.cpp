@@ -1,0 +1,276 @@
+#include "muscles/param_file.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <unistd.h>
+
+namespace armsim {
+
+namespace {
+std::string formatNumber(double v) {
+    char buf[32];
+    const auto r = std::to_chars(buf, buf + sizeof buf, v);  // shortest round-trip form
+    return std::string(buf, r.ptr);
+}
+}  // namespace
+
+FieldError::FieldError(std::string field, const std::string& message)
+    : InputError("field '" + field + "' " + message), field_(std::move(field)), detail_(message) {}
+
+bool Bound::contains(double v) const {
+    if (!std::isfinite(v)) return false;
+    if (loOpen ? !(v > lo) : !(v >= lo)) return false;
+    if (hiOpen ? !(v < hi) : !(v <= hi)) return false;
+    return true;
+}
+
+std::string Bound::describe() const {
+    const bool hasLo = lo > -1e299, hasHi = hi < 1e299;
+    std::string s;
+    if (hasLo && hasHi)
+        s = std::string("in ") + (loOpen ? "(" : "[") + formatNumber(lo) + ", " + formatNumber(hi) +
+            (hiOpen ? ")" : "]");
+    else if (hasLo)
+        s = std::string(loOpen ? "> " : ">= ") + formatNumber(lo);
+    else if (hasHi)
+        s = std::string(hiOpen ? "< " : "<= ") + formatNumber(hi);
+    else
+        s = "a finite number";
+    if (unit && *unit) s += std::string(" (") + unit + ")";
+    return s;
+}
+
+void checkField(const std::string& field, double value, const Bound& bound) {
+    if (!bound.contains(value))
+        throw FieldError(field, "= " + formatNumber(value) + ": expected " + bound.describe());
+}
+
+struct ParamNode::Impl {
+    std::string source;
+    std::string prefix;   // dotted path of this mapping
+    YAML::Node node;
+    std::shared_ptr<std::set<std::string>> used = std::make_shared<std::set<std::string>>();
+};
+
+ParamNode::ParamNode(std::shared_ptr<Impl> impl) : impl_(std::move(impl)) {}
+ParamNode::ParamNode(const ParamNode&) = default;
+ParamNode& ParamNode::operator=(const ParamNode&) = default;
+ParamNode::~ParamNode() = default;
+
+ParamNode ParamNode::loadString(const std::string& text, const std::string& sourceName) {
+    auto impl = std::make_shared<Impl>();
+    impl->source = sourceName;
+    try {
+        impl->node = YAML::Load(text);
+    } catch (const YAML::Exception& e) {
+        throw InputError(sourceName + ":" + std::to_string(e.mark.line + 1) + ": invalid YAML: " + e.msg);
+    }
+    if (!impl->node.IsMap())
+        throw InputError(sourceName + ":1: expected a mapping of 'key: value' lines at the top level");
+    return ParamNode(impl);
+}
+
+ParamNode ParamNode::loadFile(const std::string& path) {
+    std::ifstream in(path);
+    if (!in) throw InputError(path + ": cannot open file (does it exist and is it readable?)");
+    std::stringstream buf;
+    buf << in.rdbuf();
+    return loadString(buf.str(), path);
+}
+
+const YAML::Node& ParamNode::node() const { return impl_->node; }
+const std::string& ParamNode::getSourceName() const { return impl_->source; }
+
+std::string ParamNode::getDirectory() const {
+    return std::filesystem::path(impl_->source).parent_path().string();
+}
+
+std::string ParamNode::path(const std::string& key) const {
+    if (impl_->prefix.empty()) return key;
+    if (key.empty()) return impl_->prefix;
+    return impl_->prefix + "." + key;
+}
+
+std::string ParamNode::where(const std::string& key) const {
+    int line = node().Mark().line;
+    if (!key.empty()) {
+        for (auto it = node().begin(); it != node().end(); ++it)
+            if (it->first.as<std::string>() == key) { line = it->first.Mark().line; break; }
+    }
+    return impl_->source + ":" + std::to_string(line + 1);
+}
+
+bool ParamNode::has(const std::string& key) const { return bool(node()[key]); }
+
+YAML::Node ParamNode::requireKey(const std::string& key) const {
+    YAML::Node n = node()[key];
+    if (!n) throw InputError(where() + ": missing required field '" + path(key) + "'");
+    impl_->used->insert(key);
+    return n;
+}
+
+ParamNode ParamNode::child(const std::string& key) const {
+    YAML::Node n = requireKey(key);
+    if (!n.IsMap()) throw InputError(where(key) + ": field '" + path(key) + "' must be a mapping");
+    auto impl = std::make_shared<Impl>();
+    impl->source = impl_->source;
+    impl->prefix = path(key);
+    impl->node = n;
+    return ParamNode(impl);
+}
+
+static double toNumber(const YAML::Node& n, const std::string& where, const std::string& field) {
+    if (!n.IsScalar()) throw InputError(where + ": field '" + field + "' must be a number");
+    try {
+        return n.as<double>();
+    } catch (const YAML::Exception&) {
+        throw InputError(where + ": field '" + field + "' = '" + n.Scalar() + "': expected a number");
+    }
+}
+
+double ParamNode::getNumber(const std::string& key, const Bound& bound) const {
+    double v = toNumber(requireKey(key), where(key), path(key));
+    try {
+        checkField(path(key), v, bound);
+    } catch (const FieldError& e) {
+        throw InputError(where(key) + ": " + e.what());
+    }
+    return v;
+}
+
+double ParamNode::getNumber(const std::string& key, const Bound& bound, double defaultValue) const {
+    return has(key) ? getNumber(key, bound) : defaultValue;
+}
+
+int ParamNode::getInt(const std::string& key, int lo, int hi) const {
+    double v = getNumber(key, Bound::closed(lo, hi));
+    if (v != std::floor(v))
+        throw InputError(where(key) + ": field '" + path(key) + "' = " + formatNumber(v) +
+                         ": expected a whole number");
+    return int(v);
+}
+
+int ParamNode::getInt(const std::string& key, int lo, int hi, int defaultValue) const {
+    return has(key) ? getInt(key, lo, hi) : defaultValue;
+}
+
+bool ParamNode::getBool(const std::string& key, bool defaultValue) const {
+    if (!has(key)) return defaultValue;
+    YAML::Node n = requireKey(key);
+    try {
+        return n.as<bool>();
+    } catch (const YAML::Exception&) {
+        throw InputError(where(key) + ": field '" + path(key) + "' = '" + n.Scalar() +
+                         "': expected true or false");
+    }
+}
+
+std::string ParamNode::getString(const std::string& key) const {
+    YAML::Node n = requireKey(key);
+    if (!n.IsScalar()) throw InputError(where(key) + ": field '" + path(key) + "' must be a string");
+    return n.Scalar();
+}
+
+std::string ParamNode::getString(const std::string& key, const std::string& defaultValue) const {
+    return has(key) ? getString(key) : defaultValue;
+}
+
+std::string ParamNode::getChoice(const std::string& key, const std::vector<std::string>& allowed,
+                                 const std::string& defaultValue) const {
+    std::string v = getString(key, defaultValue);
+    for (const auto& a : allowed)
+        if (a == v) return v;
+    std::string list;
+    for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
+    throw InputError(where(key) + ": field '" + path(key) + "' = '" + v + "': expected one of " + list);
+}
+
+std::vector<double> ParamNode::getNumbers(const std::string& key, const Bound& bound) const {
+    YAML::Node n = requireKey(key);
+    if (!n.IsSequence())
+        throw InputError(where(key) + ": field '" + path(key) + "' must be a list of numbers");
+    std::vector<double> out;
+    for (std::size_t i = 0; i < n.size(); ++i) {
+        const std::string field = path(key) + "[" + std::to_string(i) + "]";
+        const std::string at = impl_->source + ":" + std::to_string(n[i].Mark().line + 1);
+        double v = toNumber(n[i], at, field);
+        try {
+            checkField(field, v, bound);
+        } catch (const FieldError& e) {
+            throw InputError(at + ": " + e.what());
+        }
+        out.push_back(v);
+    }
+    return out;
+}
+
+std::vector<std::string> ParamNode::getKeys() const {
+    std::vector<std::string> keys;
+    for (auto it = node().begin(); it != node().end(); ++it) keys.push_back(it->first.as<std::string>());
+    return keys;
+}
+
+void ParamNode::finish() const {
+    for (auto it = node().begin(); it != node().end(); ++it) {
+        const std::string key = it->first.as<std::string>();
+        if (!impl_->used->count(key))
+            throw InputError(impl_->source + ":" + std::to_string(it->first.Mark().line + 1) +
+                             ": unknown field '" + path(key) + "' (misspelt, or not a field here)");
+    }
+}
+
+void ParamNode::throwLocated(const FieldError& e) const {
+    // Walk the dotted field path as far as the file has it, and report that line.
+    std::string field = e.getField();
+    if (!impl_->prefix.empty() && field.rfind(impl_->prefix + ".", 0) == 0)
+        field = field.substr(impl_->prefix.size() + 1);
+    YAML::Node n = node();
+    int line = n.Mark().line;
+    std::stringstream parts(field);
+    std::string part;
+    while (std::getline(parts, part, '.')) {
+        if (!n.IsMap()) break;
+        bool found = false;
+        for (auto it = n.begin(); it != n.end(); ++it)
+            if (it->first.as<std::string>() == part) {
+                line = it->first.Mark().line;
+                n = it->second;
+                found = true;
+                break;
+            }
+        if (!found) break;
+    }
+    throw InputError(impl_->source + ":" + std::to_string(line + 1) + ": field '" + path(field) + "' " +
+                     e.getDetail());
+}
+
+void writeFileAtomically(const std::string& path, const std::string& text) {
+    namespace fs = std::filesystem;
+    const fs::path target(path);
+    std::error_code ec;
+    if (target.has_parent_path()) fs::create_directories(target.parent_path(), ec);
+    const fs::path tmp = target.string() + ".tmp." + std::to_string(::getpid());
+    {
+        std::ofstream out(tmp, std::ios::binary);
+        if (!out) throw InputError(path + ": cannot write (is the directory writable?)");
+        out << text;
+        out.flush();
+        if (!out) {
+            fs::remove(tmp, ec);
+            throw InputError(path + ": write failed (disk full?)");
+        }
+    }
+    fs::rename(tmp, target, ec);
+    if (ec) {
+        fs::remove(tmp, ec);
+        throw InputError(path + ": cannot replace file: " + ec.message());
+    }
+}
+
+}  // namespace armsim

@@ -1,0 +1,103 @@
+#include "muscles/table.h"
+
+#include "muscles/param_file.h"
+
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+namespace armsim {
+
+Table::Table(std::vector<std::string> columnNames) : names_(std::move(columnNames)) {}
+
+int Table::findColumn(const std::string& name) const {
+    for (int i = 0; i < getNumColumns(); ++i)
+        if (names_[i] == name) return i;
+    throw std::invalid_argument("table has no column '" + name + "'");
+}
+
+bool Table::hasColumn(const std::string& name) const {
+    for (const auto& n : names_)
+        if (n == name) return true;
+    return false;
+}
+
+void Table::appendRow(std::vector<double> row) {
+    if (row.size() != names_.size())
+        throw std::invalid_argument("table row has " + std::to_string(row.size()) + " values, expected " +
+                                    std::to_string(names_.size()));
+    rows_.push_back(std::move(row));
+}
+
+std::vector<double> Table::getColumn(const std::string& name) const {
+    const int c = findColumn(name);
+    std::vector<double> out;
+    out.reserve(rows_.size());
+    for (const auto& r : rows_) out.push_back(r[c]);
+    return out;
+}
+
+std::string Table::toCsv(int digits) const {
+    std::ostringstream s;
+    s.precision(digits);
+    for (int i = 0; i < getNumColumns(); ++i) s << (i ? "," : "") << names_[i];
+    s << '\n';
+    for (const auto& r : rows_) {
+        for (std::size_t i = 0; i < r.size(); ++i) s << (i ? "," : "") << r[i];
+        s << '\n';
+    }
+    return s.str();
+}
+
+void Table::writeCsv(const std::string& path, int digits) const { writeFileAtomically(path, toCsv(digits)); }
+
+Table Table::readCsv(const std::string& path) {
+    std::ifstream in(path);
+    if (!in) throw InputError(path + ": cannot open file (does it exist and is it readable?)");
+    auto split = [](const std::string& line) {
+        std::vector<std::string> cells;
+        std::stringstream s(line);
+        std::string cell;
+        while (std::getline(s, cell, ',')) {
+            const auto b = cell.find_first_not_of(" \t\r"), e = cell.find_last_not_of(" \t\r");
+            cells.push_back(b == std::string::npos ? "" : cell.substr(b, e - b + 1));
+        }
+        if (!line.empty() && line.back() == ',') cells.push_back("");
+        return cells;
+    };
+    Table t;
+    std::string line;
+    int lineNo = 0;
+    bool header = true;
+    while (std::getline(in, line)) {
+        ++lineNo;
+        if (!line.empty() && line.back() == '\r') line.pop_back();
+        if (line.find_first_not_of(" \t") == std::string::npos || line[line.find_first_not_of(" \t")] == '#')
+            continue;
+        const std::vector<std::string> cells = split(line);
+        if (header) {
+            t.names_ = cells;
+            header = false;
+            continue;
+        }
+        const std::string at = path + ":" + std::to_string(lineNo);
+        if (cells.size() != t.names_.size())
+            throw InputError(at + ": " + std::to_string(cells.size()) + " values, expected " +
+                             std::to_string(t.names_.size()) + " (one per header column)");
+        std::vector<double> row;
+        for (std::size_t i = 0; i < cells.size(); ++i) {
+            char* end = nullptr;
+            const double v = std::strtod(cells[i].c_str(), &end);
+            if (cells[i].empty() || end != cells[i].c_str() + cells[i].size())
+                throw InputError(at + ": column '" + t.names_[i] + "' = '" + cells[i] + "': expected a number");
+            row.push_back(v);
+        }
+        t.rows_.push_back(std::move(row));
+        t.lines_.push_back(lineNo);
+    }
+    if (header) throw InputError(path + ": empty file (expected a header line of column names)");
+    return t;
+}
+
+}  // namespace armsim

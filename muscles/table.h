@@ -1,0 +1,43 @@
+// A numeric results table (time series, sweeps) with CSV output. Framework-free.
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace armsim {
+
+/// Named columns of doubles, one row per sample. Column names carry their unit as a suffix
+/// ("time_s", "force_N", "activation"), so a CSV header is self-describing.
+class Table {
+public:
+    Table() = default;
+    explicit Table(std::vector<std::string> columnNames);
+
+    const std::vector<std::string>& getColumnNames() const { return names_; }
+    int getNumColumns() const { return int(names_.size()); }
+    int getNumRows() const { return int(rows_.size()); }
+    /// Index of a column; throws std::invalid_argument naming the column if absent.
+    int findColumn(const std::string& name) const;
+    bool hasColumn(const std::string& name) const;
+    /// Appends a row; throws std::invalid_argument if its size differs from the column count.
+    void appendRow(std::vector<double> row);
+    const std::vector<double>& getRow(int i) const { return rows_[i]; }
+    double get(int row, const std::string& column) const { return rows_[row][findColumn(column)]; }
+    std::vector<double> getColumn(const std::string& name) const;
+    /// CSV text: a header line of column names, then rows with up to `digits` significant digits.
+    std::string toCsv(int digits = 10) const;
+    /// Writes toCsv() to path atomically (temporary + rename).
+    void writeCsv(const std::string& path, int digits = 10) const;
+    /// Reads a CSV file with a header line and numeric cells (empty lines and lines starting with
+    /// '#' are skipped). Throws InputError naming file, line and column for a malformed cell.
+    static Table readCsv(const std::string& path);
+    /// Line in the source file of data row i (1-based), for messages; 0 when not read from a file.
+    int getSourceLine(int row) const { return row < int(lines_.size()) ? lines_[row] : 0; }
+
+private:
+    std::vector<std::string> names_;
+    std::vector<std::vector<double>> rows_;
+    std::vector<int> lines_;
+};
+
+}  // namespace armsim

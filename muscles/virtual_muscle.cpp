@@ -1,0 +1,425 @@
+#include "muscles/virtual_muscle.h"
+
+#include "muscles/param_file.h"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+namespace armsim {
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+/// Lower bound on nf inside the derivative (spec 4: nf must stay positive). Runs stop with an error
+/// before L reaches the nf limit (see VirtualMuscle::getNfLimit); this only keeps trial steps finite.
+constexpr double kNfFloor = 0.05;
+/// Lower bound on L inside 1/L terms, for trial steps of the integrator only.
+constexpr double kLFloor = 1e-3;
+/// Lowest fascicle length (/ L0) the steady solve brackets from.
+constexpr double kSteadyLmin = 1e-3;
+/// Root-finder tolerance on L (/ L0) for the steady solve.
+constexpr double kSteadyTolL = 1e-13;
+
+std::string fmt(double v) {
+    char buf[32];
+    const auto r = std::to_chars(buf, buf + sizeof buf, v);  // shortest round-trip form
+    return std::string(buf, r.ptr);
+}
+
+}  // namespace
+
+// ---- Validation ---------------------------------------------------------------------------------
+
+double FibreType::calcNfZeroLength() const {
+    // nf0 + nf1 (1/L - 1) = 0  <=>  L = nf1 / (nf1 - nf0), reached only when nf1 > nf0.
+    return nf1 > nf0 ? nf1 / (nf1 - nf0) : kInf;
+}
+
+void FibreType::validate(const std::string& p) const {
+    const std::string q = p + ".";
+    checkField(q + "beta", beta, Bound::positive());
+    checkField(q + "omega", omega, Bound::positive());
+    checkField(q + "rho", rho, Bound::positive());
+    checkField(q + "Vmax", Vmax, {-1e300, 0, false, true, "L0/s"});
+    checkField(q + "cV0", cV0, Bound::any());
+    checkField(q + "cV1", cV1, Bound::any());
+    checkField(q + "bV", bV, Bound::positive("L0/s"));
+    checkField(q + "aV0", aV0, Bound::any());
+    checkField(q + "aV1", aV1, Bound::any());
+    checkField(q + "aV2", aV2, Bound::any());
+    checkField(q + "af", af, Bound::positive("f0.5"));
+    checkField(q + "nf0", nf0, Bound::positive());
+    checkField(q + "nf1", nf1, Bound::any());
+    checkField(q + "Tf1", Tf1, Bound::positive("s"));
+    checkField(q + "Tf2", Tf2, Bound::nonNegative("s"));
+    checkField(q + "Tf3", Tf3, Bound::positive("s"));
+    checkField(q + "Tf4", Tf4, Bound::nonNegative("s"));
+    checkField(q + "aS1", aS1, Bound::positive());
+    checkField(q + "aS2", aS2, Bound::positive());
+    checkField(q + "TS", TS, Bound::positive("s"));
+    checkField(q + "cY", cY, Bound::closed(0, 1));
+    checkField(q + "VY", VY, Bound::positive("L0/s"));
+    checkField(q + "TY", TY, Bound::positive("s"));
+}
+
+void MuscleCoefficients::validate(const std::string& p) const {
+    const std::string q = p + ".";
+    checkField(q + "c1", c1, Bound::nonNegative());
+    checkField(q + "k1", k1, Bound::positive());
+    checkField(q + "Lr1", Lr1, Bound::positive());
+    checkField(q + "eta", eta, Bound::nonNegative("F0 s/L0"));
+    checkField(q + "c2", c2, {-1e300, 0, false, false, ""});
+    checkField(q + "k2", k2, Bound::any());
+    checkField(q + "Lr2", Lr2, Bound::positive());
+    checkField(q + "cT", cT, Bound::positive());
+    checkField(q + "kT", kT, Bound::positive());
+    checkField(q + "LrT", LrT, Bound::positive());
+    checkField(q + "Ur", Ur, {0, 1, true, false, ""});
+    checkField(q + "fmin", fmin, Bound::positive("f0.5"));
+    checkField(q + "fmax", fmax, {fmin, 1e300, true, false, "f0.5, above fmin"});
+    checkField(q + "sigma", sigma, Bound::positive("N/m^2"));
+    checkField(q + "density", density, Bound::positive("kg/m^3"));
+}
+
+void MuscleParameters::validate() const {
+    checkField("mass", mass, Bound::positive("kg"));
+    checkField("optimal_fascicle_length", optimalFascicleLength, Bound::positive("m"));
+    checkField("optimal_tendon_length", optimalTendonLength, Bound::positive("m"));
+    checkField("max_path_length", maxPathLength, Bound::positive("m"));
+    checkField("fibre_fractions.slow", slowFraction, Bound::closed(0, 1));
+    checkField("motor_units.slow", numSlowUnits, Bound::closed(0, 1000));
+    checkField("motor_units.fast", numFastUnits, Bound::closed(0, 1000));
+    slow.validate("fibre_types.slow");
+    fast.validate("fibre_types.fast");
+    coefficients.validate("coefficients");
+    const double LTstar = calcTendonLengthAtLimit(coefficients);
+    const double minPmax = LTstar * optimalTendonLength;
+    checkField("max_path_length", maxPathLength,
+               {minPmax, 1e300, true, false, "m; P_max must exceed LTstar * L0T so that Lmax > 0"});
+}
+
+// ---- Elements -----------------------------------------------------------------------------------
+
+double softplus(double x) { return x > 0 ? x + std::log1p(std::exp(-x)) : std::log1p(std::exp(x)); }
+
+double calcForceLength(const FibreType& t, double L) {
+    return std::exp(-std::pow(std::abs((std::pow(L, t.beta) - 1.0) / t.omega), t.rho));
+}
+
+double calcForceVelocity(const FibreType& t, double V, double L) {
+    if (V <= 0) return (t.Vmax - V) / (t.Vmax + (t.cV0 + t.cV1 * L) * V);
+    return (t.bV - (t.aV0 + t.aV1 * L + t.aV2 * L * L) * V) / (t.bV + V);
+}
+
+double calcPassiveStretch(const MuscleCoefficients& c, double L, double V, double Lmax) {
+    return c.c1 * c.k1 * softplus((L / Lmax - c.Lr1) / c.k1) + c.eta * V;
+}
+
+double calcPassiveCompression(const MuscleCoefficients& c, double L) {
+    return std::min(0.0, c.c2 * (std::exp(c.k2 * (L - c.Lr2)) - 1.0));
+}
+
+double calcSeriesElastic(const MuscleCoefficients& c, double LT) {
+    return c.cT * c.kT * softplus((LT - c.LrT) / c.kT);
+}
+
+double calcNf(const FibreType& t, double L) { return t.nf0 + t.nf1 * (1.0 / L - 1.0); }
+
+double calcActivationFrequency(const FibreType& t, double feffScaled, double nf) {
+    if (feffScaled <= 0) return 0.0;
+    return 1.0 - std::exp(-std::pow(feffScaled / (t.af * nf), nf));
+}
+
+double calcEnvelopeFrequency(const MuscleCoefficients& c, double threshold, double U) {
+    if (U < threshold) return 0.0;
+    return c.fmin + (c.fmax - c.fmin) * (U - threshold) / (1.0 - threshold);
+}
+
+std::vector<MotorUnit> calcRecruitment(int numSlow, int numFast, double slowFraction, double Ur,
+                                       Apportioning apportioning) {
+    double fs = slowFraction;
+    if (numSlow == 0) fs = 0.0;
+    if (numFast == 0 && numSlow > 0) fs = 1.0;
+    std::vector<MotorUnit> units;
+    auto addType = [&](int N, double F, bool slow) {
+        const double denom = 0.5 * (3.0 * N * N + N);  // sum_{n=1..N} (N + n)
+        for (int i = 1; i <= N; ++i) {
+            MotorUnit u;
+            u.slow = slow;
+            u.fraction = apportioning == Apportioning::Thesis ? F * (N + i) / denom : F / N;
+            units.push_back(u);
+        }
+    };
+    addType(numSlow, fs, true);
+    addType(numFast, 1.0 - fs, false);
+    double cumulative = 0;
+    for (auto& u : units) {
+        cumulative += u.fraction;
+        u.threshold = Ur * cumulative;
+    }
+    if (!units.empty()) units.back().threshold = Ur;  // exact, not accumulated round-off
+    return units;
+}
+
+double calcPassiveForceAtLimit(const MuscleCoefficients& c) {
+    return c.c1 * c.k1 * softplus((1.0 - c.Lr1) / c.k1);
+}
+
+double calcTendonLengthAtLimit(const MuscleCoefficients& c) {
+    const double PF = calcPassiveForceAtLimit(c);
+    return c.kT * std::log(std::expm1(PF / (c.cT * c.kT))) + c.LrT;
+}
+
+std::pair<double, double> calcInitialLengthConstants(const MuscleCoefficients& c) {
+    return {c.LrT + c.kT * std::log(c.c1 * c.k1 / (c.cT * c.kT)) - c.kT * c.Lr1 / c.k1, c.kT / c.k1};
+}
+
+// ---- VirtualMuscle ------------------------------------------------------------------------------
+
+VirtualMuscle::VirtualMuscle(MuscleParameters params) : params_(std::move(params)) {
+    params_.validate();
+    const auto& c = params_.coefficients;
+    const double L0 = params_.optimalFascicleLength;
+    F0_ = c.sigma * params_.mass / (c.density * L0);
+    Lmax_ = (params_.maxPathLength - calcTendonLengthAtLimit(c) * params_.optimalTendonLength) / L0;
+    units_ = calcRecruitment(params_.numSlowUnits, params_.numFastUnits, params_.slowFraction, c.Ur,
+                             params_.apportioning);
+
+    bool anySlow = false, anyFast = false;
+    for (const auto& u : units_) (u.slow ? anySlow : anyFast) = true;
+    nfLimit_ = kInf;
+    if (anySlow) nfLimit_ = std::min(nfLimit_, params_.slow.calcNfZeroLength());
+    if (anyFast) nfLimit_ = std::min(nfLimit_, params_.fast.calcNfZeroLength());
+
+    int n = 2;
+    if (anySlow && params_.slow.hasYield()) yieldSlow_ = n++;
+    if (anyFast && params_.fast.hasYield()) yieldFast_ = n++;
+    unitBase_ = n;
+    n += 2 * getNumUnits();
+    sagIndex_.assign(units_.size(), -1);
+    for (int u = 0; u < getNumUnits(); ++u)
+        if ((units_[u].slow ? params_.slow : params_.fast).hasSag()) sagIndex_[u] = n++;
+    numStates_ = n;
+}
+
+std::vector<std::string> VirtualMuscle::getStateNames() const {
+    std::vector<std::string> names(numStates_);
+    names[kL] = "L";
+    names[kV] = "V";
+    if (yieldSlow_ >= 0) names[yieldSlow_] = "Y_slow";
+    if (yieldFast_ >= 0) names[yieldFast_] = "Y_fast";
+    for (int u = 0; u < getNumUnits(); ++u) {
+        names[getFintIndex(u)] = "fint_" + std::to_string(u + 1);
+        names[getFeffIndex(u)] = "feff_" + std::to_string(u + 1);
+        if (sagIndex_[u] >= 0) names[sagIndex_[u]] = "S_" + std::to_string(u + 1);
+    }
+    return names;
+}
+
+void VirtualMuscle::checkPathLength(double P) const {
+    if (!(P > 0) || !std::isfinite(P))
+        throw InputError("path length = " + fmt(P) + " m: expected > 0");
+    if (P > params_.maxPathLength)
+        throw InputError("path length = " + fmt(P) + " m exceeds max_path_length (P_max) = " +
+                         fmt(params_.maxPathLength) + " m of muscle '" + params_.name +
+                         "': expected a path no longer than the anatomical limit");
+}
+
+double VirtualMuscle::calcInitialFascicleLength(double P) const {
+    const auto [a, b] = calcInitialLengthConstants(params_.coefficients);
+    const double L0 = params_.optimalFascicleLength, L0T = params_.optimalTendonLength;
+    return (P - a * L0T) / (L0 * (1.0 + b * L0T / (Lmax_ * L0)));
+}
+
+std::vector<double> VirtualMuscle::calcInitialState(double P) const {
+    std::vector<double> y(numStates_, 0.0);
+    y[kL] = calcInitialFascicleLength(P);
+    if (!(y[kL] > 0))
+        throw InputError("path length = " + fmt(P) + " m is too short for muscle '" + params_.name +
+                         "': the initial fascicle length would be " + fmt(y[kL]) + " L0 (expected > 0)");
+    if (yieldSlow_ >= 0) y[yieldSlow_] = 1.0;
+    if (yieldFast_ >= 0) y[yieldFast_] = 1.0;
+    for (int u = 0; u < getNumUnits(); ++u)
+        if (sagIndex_[u] >= 0) y[sagIndex_[u]] = (units_[u].slow ? params_.slow : params_.fast).aS1;
+    return y;
+}
+
+double VirtualMuscle::calcForce(double P, const double* y) const {
+    const double LT = (P - params_.optimalFascicleLength * y[kL]) / params_.optimalTendonLength;
+    return F0_ * calcSeriesElastic(params_.coefficients, LT);
+}
+
+void VirtualMuscle::calcStateDerivative(double P, double U, const double* y, double* ydot,
+                                        MuscleOutputs* out) const {
+    const auto& c = params_.coefficients;
+    const double L = y[kL], V = y[kV];
+    const double Ls = std::max(L, kLFloor);
+    const double LT = (P - params_.optimalFascicleLength * L) / params_.optimalTendonLength;
+    const double fse = calcSeriesElastic(c, LT);
+
+    // Per fibre type: FL * FV + Fpe2, nf and yield.
+    const double fpe2 = calcPassiveCompression(c, L);
+    struct TypeTerms { double active, nf, Y; double sum = 0; };
+    auto typeTerms = [&](const FibreType& t, int yieldIndex) {
+        TypeTerms tt;
+        tt.active = calcForceLength(t, L) * calcForceVelocity(t, V, L) + fpe2;
+        tt.nf = std::max(calcNf(t, Ls), kNfFloor);
+        tt.Y = yieldIndex >= 0 ? y[yieldIndex] : 1.0;
+        if (yieldIndex >= 0)
+            ydot[yieldIndex] = (1.0 - t.cY * (1.0 - std::exp(-std::abs(V) / t.VY)) - tt.Y) / t.TY;
+        return tt;
+    };
+    TypeTerms slow = typeTerms(params_.slow, yieldSlow_);
+    TypeTerms fast = typeTerms(params_.fast, yieldFast_);
+
+    if (out) {
+        out->Af.resize(units_.size());
+        out->fenv.resize(units_.size());
+    }
+    for (int u = 0; u < getNumUnits(); ++u) {
+        const MotorUnit& mu = units_[u];
+        const FibreType& t = mu.slow ? params_.slow : params_.fast;
+        TypeTerms& tt = mu.slow ? slow : fast;
+        const double fenv = calcEnvelopeFrequency(c, mu.threshold, U);
+        const double fint = y[getFintIndex(u)], feff = y[getFeffIndex(u)];
+        const int si = sagIndex_[u];
+        const double S = si >= 0 ? y[si] : 1.0;
+        const double Af = calcActivationFrequency(t, tt.Y * S * feff, tt.nf);
+        const double Tf = fint >= feff ? t.Tf1 * L * L + t.Tf2 * fenv : (t.Tf3 + t.Tf4 * Af) / Ls;
+        ydot[getFintIndex(u)] = (fenv - fint) / Tf;
+        ydot[getFeffIndex(u)] = (fint - feff) / Tf;
+        if (si >= 0) ydot[si] = ((feff < 0.1 ? t.aS1 : t.aS2) - S) / t.TS;
+        tt.sum += Af * mu.fraction;
+        if (out) {
+            out->Af[u] = Af;
+            out->fenv[u] = fenv;
+        }
+    }
+    const double fce = std::max(0.0, calcPassiveStretch(c, L, V, Lmax_) + slow.sum * slow.active +
+                                         fast.sum * fast.active);
+    ydot[kL] = V;
+    ydot[kV] = (fse - fce) * F0_ / (getNodeMass() * params_.optimalFascicleLength);
+    if (out) {
+        out->Fse = F0_ * fse;
+        out->Fce = F0_ * fce;
+        out->L = L;
+        out->V = V;
+        out->LT = LT;
+        out->activeFraction = slow.sum + fast.sum;
+    }
+}
+
+MuscleOutputs VirtualMuscle::calcOutputs(double P, double U, const double* y) const {
+    MuscleOutputs out;
+    std::vector<double> ydot(numStates_);
+    calcStateDerivative(P, U, y, ydot.data(), &out);
+    return out;
+}
+
+double VirtualMuscle::calcSteadyImbalance(double P, double U, double L) const {
+    const auto& c = params_.coefficients;
+    const double LT = (P - params_.optimalFascicleLength * L) / params_.optimalTendonLength;
+    const double fpe2 = calcPassiveCompression(c, L);
+    const double nfS = calcNf(params_.slow, L), nfF = calcNf(params_.fast, L);
+    double sumS = 0, sumF = 0;
+    for (const MotorUnit& mu : units_) {
+        const FibreType& t = mu.slow ? params_.slow : params_.fast;
+        const double fenv = calcEnvelopeFrequency(c, mu.threshold, U);
+        const double S = t.hasSag() ? (fenv < 0.1 ? t.aS1 : t.aS2) : 1.0;
+        (mu.slow ? sumS : sumF) += calcActivationFrequency(t, S * fenv, mu.slow ? nfS : nfF) * mu.fraction;
+    }
+    double fce = calcPassiveStretch(c, L, 0.0, Lmax_);
+    if (sumS > 0) fce += sumS * (calcForceLength(params_.slow, L) + fpe2);
+    if (sumF > 0) fce += sumF * (calcForceLength(params_.fast, L) + fpe2);
+    return calcSeriesElastic(c, LT) - std::max(0.0, fce);
+}
+
+SteadyState VirtualMuscle::calcSteadyState(double P, double U) const {
+    checkPathLength(P);
+    if (!(U >= 0 && U <= 1)) throw InputError("activation U = " + fmt(U) + ": expected in [0, 1]");
+    SteadyState result;
+    const double L0 = params_.optimalFascicleLength;
+    const bool nfBound = nfLimit_ * (1.0 - 1e-9) < P / L0;
+    double a = kSteadyLmin, b = nfBound ? nfLimit_ * (1.0 - 1e-9) : P / L0;
+    double fa = calcSteadyImbalance(P, U, a), fb = calcSteadyImbalance(P, U, b);
+    result.evaluations = 2;
+    if (!(fa > 0) || !(fb < 0)) {
+        std::ostringstream msg;
+        if (nfBound && fb >= 0)
+            msg << "no steady state at path " << P << " m: the tendon would need a fascicle longer than "
+                << nfLimit_ << " L0, where the activation-frequency exponent nf reaches 0 (spec 4)";
+        else
+            msg << "no steady state at path " << P << " m: the tendon is slack for every fascicle "
+                << "length in (0, P/L0]; the path is too short for this muscle";
+        result.message = msg.str();
+        return result;
+    }
+    // Brent's method (Brent 1973, "Algorithms for Minimization without Derivatives", ch. 4).
+    double c = a, fc = fa, d = b - a, e = d;
+    for (int iter = 0; iter < 200; ++iter) {
+        if ((fb > 0) == (fc > 0)) { c = a; fc = fa; d = e = b - a; }
+        if (std::abs(fc) < std::abs(fb)) { a = b; b = c; c = a; fa = fb; fb = fc; fc = fa; }
+        const double tol = 2.0 * std::numeric_limits<double>::epsilon() * std::abs(b) + 0.5 * kSteadyTolL;
+        const double m = 0.5 * (c - b);
+        if (std::abs(m) <= tol || fb == 0.0) {
+            result.converged = true;
+            break;
+        }
+        if (std::abs(e) >= tol && std::abs(fa) > std::abs(fb)) {
+            double p, q, r, s = fb / fa;
+            if (a == c) {
+                p = 2.0 * m * s;
+                q = 1.0 - s;
+            } else {
+                q = fa / fc;
+                r = fb / fc;
+                p = s * (2.0 * m * q * (q - r) - (b - a) * (r - 1.0));
+                q = (q - 1.0) * (r - 1.0) * (s - 1.0);
+            }
+            if (p > 0) q = -q; else p = -p;
+            if (2.0 * p < std::min(3.0 * m * q - std::abs(tol * q), std::abs(e * q))) {
+                e = d;
+                d = p / q;
+            } else {
+                d = m;
+                e = m;
+            }
+        } else {
+            d = m;
+            e = m;
+        }
+        a = b;
+        fa = fb;
+        b += std::abs(d) > tol ? d : (m > 0 ? tol : -tol);
+        fb = calcSteadyImbalance(P, U, b);
+        ++result.evaluations;
+    }
+    if (!result.converged) {
+        result.message = "steady solve did not converge in 200 iterations at path " + fmt(P) + " m";
+        return result;
+    }
+    result.L = b;
+    result.fascicleLength = b * L0;
+    const double LT = (P - L0 * b) / params_.optimalTendonLength;
+    result.force = F0_ * calcSeriesElastic(params_.coefficients, LT);
+
+    std::vector<double>& y = result.states;
+    y.assign(numStates_, 0.0);
+    y[kL] = b;
+    if (yieldSlow_ >= 0) y[yieldSlow_] = 1.0;
+    if (yieldFast_ >= 0) y[yieldFast_] = 1.0;
+    for (int u = 0; u < getNumUnits(); ++u) {
+        const double fenv = calcEnvelopeFrequency(params_.coefficients, units_[u].threshold, U);
+        y[getFintIndex(u)] = y[getFeffIndex(u)] = fenv;
+        if (sagIndex_[u] >= 0) {
+            const FibreType& t = units_[u].slow ? params_.slow : params_.fast;
+            y[sagIndex_[u]] = fenv < 0.1 ? t.aS1 : t.aS2;
+        }
+    }
+    return result;
+}
+
+}  // namespace armsim

@@ -1,0 +1,243 @@
+// Virtual Muscle 4.0 ("natural discrete" recruitment) as plain functions of parameters and scalars.
+// The definition is ../shared/spec/virtual-muscle.md (Cheng, Brown & Loeb 2000; Brown & Loeb 2000;
+// Song, Raphael, Lan & Loeb 2008; Zhang 2009 thesis ch. 4). No Simbody, GL or OpenCV here: the
+// Simbody adapter is muscles/muscle_force.h.
+//
+// Notation (spec section 1). Lengths are SI (m) at every boundary; the equations work in the
+// normalised quantities below, so no cm appear anywhere in the code.
+//
+// | paper   | code                    | meaning                                              | unit     |
+// |---------|-------------------------|------------------------------------------------------|----------|
+// | P       | pathLength              | musculotendon path length, origin to insertion       | m        |
+// | P_max   | maxPathLength           | path length at the anatomical limit                  | m        |
+// | M       | mass                    | wet belly mass                                       | kg       |
+// | L0      | optimalFascicleLength   | optimal fascicle length                              | m        |
+// | L0T     | optimalTendonLength     | series-elastic length at F0                          | m        |
+// | L       | L                       | fascicle length / L0                                 | 1        |
+// | V       | V                       | fascicle velocity, positive = lengthening            | L0/s     |
+// | LT      | LT                      | series-elastic length / L0T                          | 1        |
+// | Lmax    | getLmax()               | fascicle length at P_max, normalised (spec 5)        | 1        |
+// | U       | U                       | neural activation                                    | 1        |
+// | F0      | getF0()                 | maximal isometric force = sigma * M / (rho * L0)     | N        |
+// | p_u     | MotorUnit::fraction     | PCSA fraction of unit u                              | 1        |
+// | thr_u   | MotorUnit::threshold    | recruitment threshold of unit u                      | 1        |
+// | fenv    | calcEnvelopeFrequency   | envelope firing frequency                            | f0.5     |
+// | fint    | state                   | intermediate firing frequency (rise/fall filter)     | f0.5     |
+// | feff    | state                   | effective firing frequency                           | f0.5     |
+// | Af      | calcActivationFrequency | activation-frequency relation of a unit              | 1        |
+// | S       | state                   | sag (fibre types with sag: human fast)               | 1        |
+// | Y       | state                   | yield (fibre types with yield: human slow)           | 1        |
+// | FL, FV  | calcForceLength, ...    | force-length, force-velocity                         | 1        |
+// | Fpe1/2  | calcPassiveStretch, ... | passive elements, normalised to F0                   | 1        |
+// | Fce     | Outputs::Fce            | contractile-element force                            | N        |
+// | Fse     | Outputs::Fse            | series-elastic force = the muscle's output force     | N        |
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace armsim {
+
+/// Coefficients of one fibre type (spec section 2; thesis Table 4.1; VM 4.0 human database).
+struct FibreType {
+    std::string name;     ///< "slow" or "fast"
+    double beta = 0;      ///< force-length exponent beta [1]
+    double omega = 0;     ///< force-length width omega [1]
+    double rho = 0;       ///< force-length roundness rho [1]
+    double Vmax = 0;      ///< maximal shortening velocity, negative [L0/s]
+    double cV0 = 0;       ///< shortening FV coefficient cV0 [1]
+    double cV1 = 0;       ///< shortening FV coefficient cV1 [1]
+    double bV = 0;        ///< lengthening FV coefficient bV [L0/s]
+    double aV0 = 0;       ///< lengthening FV coefficient aV0 [1]
+    double aV1 = 0;       ///< lengthening FV coefficient aV1 [1]
+    double aV2 = 0;       ///< lengthening FV coefficient aV2 [1]
+    double af = 0;        ///< activation-frequency scale af [f0.5]
+    double nf0 = 0;       ///< activation-frequency exponent at L = 1, nf0 [1]
+    double nf1 = 0;       ///< length dependence of the exponent, nf1 [1]
+    double Tf1 = 0;       ///< rise time constant, length term Tf1 [s]
+    double Tf2 = 0;       ///< rise time constant, frequency term Tf2 [s]
+    double Tf3 = 0;       ///< fall time constant Tf3 [s]
+    double Tf4 = 0;       ///< fall time constant, activation term Tf4 [s]
+    double aS1 = 1;       ///< sag target while feff < 0.1 (1 with aS2 = 1: no sag) [1]
+    double aS2 = 1;       ///< sag target while feff >= 0.1 [1]
+    double TS = 1;        ///< sag time constant [s]
+    double cY = 0;        ///< yield magnitude (0: no yield) [1]
+    double VY = 1;        ///< yield velocity scale [L0/s]
+    double TY = 1;        ///< yield time constant [s]
+
+    bool hasSag() const { return aS1 != 1.0 || aS2 != 1.0; }
+    bool hasYield() const { return cY != 0.0; }
+    /// Fascicle length at which nf = nf0 + nf1 (1/L - 1) reaches 0 (infinity if it never does).
+    double calcNfZeroLength() const;
+    /// Throws FieldError ("<prefix>.<field>") for a value outside its documented bound.
+    void validate(const std::string& prefix) const;
+};
+
+/// Whole-muscle coefficients (spec section 2).
+struct MuscleCoefficients {
+    double c1 = 0;        ///< PE1 scale c1 [1]
+    double k1 = 0;        ///< PE1 curvature k1 [1]
+    double Lr1 = 0;       ///< PE1 rest length Lr1, relative to Lmax [1]
+    double eta = 0;       ///< PE1 viscosity eta [F0 s/L0]
+    double c2 = 0;        ///< PE2 (thick-filament compression) scale c2, negative [1]
+    double k2 = 0;        ///< PE2 curvature k2, negative [1]
+    double Lr2 = 0;       ///< PE2 rest length Lr2 [1]
+    double cT = 0;        ///< series-elastic scale cT [1]
+    double kT = 0;        ///< series-elastic curvature kT [1]
+    double LrT = 0;       ///< series-elastic rest length LrT [1]
+    double Ur = 0;        ///< activation at which every unit is recruited [1]
+    double fmin = 0;      ///< firing frequency at recruitment [f0.5]
+    double fmax = 0;      ///< firing frequency at U = 1 [f0.5]
+    double sigma = 0;     ///< specific tension [N/m^2] (spec: 31.8 N/cm^2)
+    double density = 0;   ///< muscle density [kg/m^3] (spec: 1.06 g/cm^3)
+
+    void validate(const std::string& prefix) const;
+};
+
+/// How a fibre type's PCSA fraction is split among its units.
+enum class Apportioning {
+    Thesis,  ///< p_i = F_type (N + i) / sum_{n=1..N} (N + n) (thesis eq. 4.11/4.12)
+    Equal    ///< p_i = F_type / N
+};
+
+/// Everything that defines one muscle (model: immutable once built).
+struct MuscleParameters {
+    std::string name;                   ///< e.g. "biceps long head"
+    double mass = 0;                    ///< M, wet belly mass [kg] (thesis Table 4.2)
+    double optimalFascicleLength = 0;   ///< L0 [m] (thesis Table 4.2)
+    double optimalTendonLength = 0;     ///< L0T [m] (thesis Table 4.2)
+    double maxPathLength = 0;           ///< P_max, path at the anatomical limit [m]
+    double slowFraction = 0;            ///< F_slow, PCSA fraction of slow fibres [1] (Table 4.3)
+    int numSlowUnits = 3;               ///< Ns (thesis default 3)
+    int numFastUnits = 3;               ///< Nf (thesis default 3)
+    Apportioning apportioning = Apportioning::Thesis;
+    FibreType slow;                     ///< slow fibre coefficients
+    FibreType fast;                     ///< fast fibre coefficients
+    MuscleCoefficients coefficients;    ///< whole-muscle coefficients
+
+    /// Throws FieldError naming the field, its value and the violated bound.
+    void validate() const;
+};
+
+// ---- Elements (spec section 4), plain functions -------------------------------------------------
+
+/// softplus(x) = ln(exp(x) + 1), evaluated without overflow.
+double softplus(double x);
+/// FL(L) = exp(-|(L^beta - 1) / omega|^rho).
+double calcForceLength(const FibreType& t, double L);
+/// FV(V, L): shortening (V <= 0) and lengthening (V > 0) branches; FV(0, L) = 1.
+double calcForceVelocity(const FibreType& t, double V, double L);
+/// Fpe1(L, V) = c1 k1 ln(exp((L/Lmax - Lr1)/k1) + 1) + eta V, normalised to F0.
+double calcPassiveStretch(const MuscleCoefficients& c, double L, double V, double Lmax);
+/// Fpe2(L) = min(0, c2 (exp(k2 (L - Lr2)) - 1)), normalised to F0.
+double calcPassiveCompression(const MuscleCoefficients& c, double L);
+/// Fse(LT) / F0 = cT kT ln(exp((LT - LrT)/kT) + 1).
+double calcSeriesElastic(const MuscleCoefficients& c, double LT);
+/// nf(L) = nf0 + nf1 (1/L - 1).
+double calcNf(const FibreType& t, double L);
+/// Af = 1 - exp(-((Y S feff) / (af nf))^nf); 0 for feff <= 0.
+double calcActivationFrequency(const FibreType& t, double feffScaled, double nf);
+/// fenv of a unit with threshold thr at activation U (0 below threshold).
+double calcEnvelopeFrequency(const MuscleCoefficients& c, double threshold, double U);
+
+/// One motor unit of a built muscle.
+struct MotorUnit {
+    bool slow = true;         ///< fibre type
+    double fraction = 0;      ///< p_u, PCSA fraction [1]
+    double threshold = 0;     ///< thr_u = Ur * sum_{j <= u} p_j [1]
+};
+
+/// Per-unit PCSA fractions and thresholds for Ns + Nf units (spec section 3). With no units of a
+/// type, that type's PCSA goes to the other type (the muscle keeps F0; thesis Table 7.4 rows).
+std::vector<MotorUnit> calcRecruitment(int numSlow, int numFast, double slowFraction,
+                                       double Ur, Apportioning apportioning);
+
+/// Quantities derived from the state, for output and drawing.
+struct MuscleOutputs {
+    double Fse = 0;              ///< series-elastic (output) force [N]
+    double Fce = 0;              ///< contractile-element force [N]
+    double L = 0;                ///< fascicle length / L0 [1]
+    double V = 0;                ///< fascicle velocity [L0/s]
+    double LT = 0;               ///< tendon length / L0T [1]
+    double activeFraction = 0;   ///< sum_u Af_u p_u: PCSA-weighted activation [1]
+    std::vector<double> Af;      ///< per unit activation-frequency Af_u [1]
+    std::vector<double> fenv;    ///< per unit envelope firing frequency [f0.5]
+};
+
+/// The steady isometric state at constant P and U (spec section 6).
+struct SteadyState {
+    bool converged = false;      ///< false: no equilibrium; message says why
+    std::string message;         ///< why it failed (empty on success)
+    double force = 0;            ///< Fse = Fce [N]
+    double L = 0;                ///< fascicle length / L0 [1]
+    double fascicleLength = 0;   ///< L * L0 [m]
+    int evaluations = 0;         ///< residual evaluations the root finder used
+    std::vector<double> states;  ///< full state vector, ready for a time integration
+};
+
+/// A built Virtual Muscle: validated parameters plus derived constants (F0, Lmax, units, state
+/// layout). Immutable and cheap to copy; safe to share between threads.
+///
+/// State vector (all entries of order 1, as CPodes needs): [L, V, Y per type with yield,
+/// (fint, feff) per unit, S per unit whose type has sag].
+class VirtualMuscle {
+public:
+    explicit VirtualMuscle(MuscleParameters params);
+
+    const MuscleParameters& getParameters() const { return params_; }
+    const std::vector<MotorUnit>& getUnits() const { return units_; }
+    int getNumUnits() const { return int(units_.size()); }
+    int getNumStates() const { return numStates_; }
+    double getF0() const { return F0_; }
+    double getLmax() const { return Lmax_; }
+    /// Mass of the muscle mass node, M / 2 [kg].
+    double getNodeMass() const { return 0.5 * params_.mass; }
+    /// Largest fascicle length (/ L0) at which every present fibre type keeps nf > 0.
+    double getNfLimit() const { return nfLimit_; }
+    /// Names of the state entries ("L", "V", "Y_slow", "fint_3", ...).
+    std::vector<std::string> getStateNames() const;
+
+    // State layout.
+    static constexpr int kL = 0;
+    static constexpr int kV = 1;
+    int getYieldIndex(bool slow) const { return slow ? yieldSlow_ : yieldFast_; }  ///< -1: none
+    int getFintIndex(int u) const { return unitBase_ + 2 * u; }
+    int getFeffIndex(int u) const { return unitBase_ + 2 * u + 1; }
+    int getSagIndex(int u) const { return sagIndex_[u]; }  ///< -1: none
+
+    /// Throws InputError unless 0 < P <= P_max.
+    void checkPathLength(double pathLength) const;
+    /// L(0) of spec section 5 (approximate passive equilibrium at path P).
+    double calcInitialFascicleLength(double pathLength) const;
+    /// Initial state of spec section 5 at path P.
+    std::vector<double> calcInitialState(double pathLength) const;
+    /// Output force Fse [N] at path P for state y.
+    double calcForce(double pathLength, const double* y) const;
+    /// dy/dt at path P, activation U. Optionally fills outputs.
+    void calcStateDerivative(double pathLength, double U, const double* y, double* ydot,
+                             MuscleOutputs* outputs = nullptr) const;
+    /// Outputs at path P, activation U for state y.
+    MuscleOutputs calcOutputs(double pathLength, double U, const double* y) const;
+    /// Steady isometric state at path P and activation U: solves Fse(L) = Fce(L, V = 0).
+    /// Never throws for a missing equilibrium: returns converged = false with the reason.
+    SteadyState calcSteadyState(double pathLength, double U) const;
+
+private:
+    /// (Fse - Fce) / F0 in the steady state at fascicle length L (V = 0, feff = fenv, Y = 1).
+    double calcSteadyImbalance(double pathLength, double U, double L) const;
+    MuscleParameters params_;
+    std::vector<MotorUnit> units_;
+    double F0_ = 0, Lmax_ = 0, nfLimit_ = 0;
+    int numStates_ = 0, unitBase_ = 0, yieldSlow_ = -1, yieldFast_ = -1;
+    std::vector<int> sagIndex_;
+};
+
+/// Passive force at the anatomical limit, PF / F0 (spec section 5).
+double calcPassiveForceAtLimit(const MuscleCoefficients& c);
+/// LTstar: tendon length carrying PF (spec section 5; 0.956877 for the spec coefficients).
+double calcTendonLengthAtLimit(const MuscleCoefficients& c);
+/// The two constants of the initial-length formula (spec section 5):
+/// first = LrT + kT ln(c1 k1 / (cT kT)) - kT Lr1 / k1 (0.8542867), second = kT / k1 (0.1021739).
+std::pair<double, double> calcInitialLengthConstants(const MuscleCoefficients& c);
+
+}  // namespace armsim

@@ -1,0 +1,33 @@
+#!/usr/bin/env bash
+# Installs the Debian 12 packages armsim builds and runs with. Idempotent: packages already present
+# are skipped; a held dpkg lock is waited for instead of failing; sudo is used when not root.
+set -euo pipefail
+
+packages=(
+  build-essential cmake pkg-config
+  libsimbody-dev libeigen3-dev libceres-dev libopencv-dev libosmesa6-dev
+  libgtest-dev libgmock-dev libbenchmark-dev libyaml-cpp-dev libcli11-dev nlohmann-json3-dev
+  libplplot-dev plplot-driver-cairo libfftw3-dev
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "setup: all ${#packages[@]} packages present"
+  exit 0
+fi
+
+sudo_cmd=()
+if [ "$(id -u)" -ne 0 ]; then
+  command -v sudo >/dev/null || { echo "setup: not root and no sudo; install: ${missing[*]}" >&2; exit 1; }
+  sudo_cmd=(sudo)
+fi
+
+# apt-get waits up to 10 minutes for a lock another dpkg/apt process holds.
+apt_opts=(-o DPkg::Lock::Timeout=600 -y -q)
+echo "setup: installing ${missing[*]}"
+export DEBIAN_FRONTEND=noninteractive
+"${sudo_cmd[@]}" apt-get "${apt_opts[@]}" update
+"${sudo_cmd[@]}" apt-get "${apt_opts[@]}" install --no-install-recommends "${missing[@]}"

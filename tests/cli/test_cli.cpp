@@ -1,0 +1,121 @@
+// The armsim command end to end: exit codes, messages, and files written whole or not at all.
+#include "muscles/table.h"
+
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <string>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct CommandResult {
+    int exitCode;
+    std::string output;  // stdout and stderr
+};
+
+CommandResult runArmsim(const std::string& args) {
+    const std::string cmd = std::string(ARMSIM_EXE) + " " + args + " 2>&1";
+    std::unique_ptr<FILE, int (*)(FILE*)> pipe(popen(cmd.c_str(), "r"), pclose);
+    std::string out;
+    std::array<char, 4096> buf;
+    while (std::fgets(buf.data(), int(buf.size()), pipe.get())) out += buf.data();
+    const int status = pclose(pipe.release());
+    return {WEXITSTATUS(status), out};
+}
+
+fs::path freshDir(const std::string& name) {
+    const fs::path d = fs::temp_directory_path() / ("armsim_cli_" + name + "_" + std::to_string(::getpid()));
+    fs::remove_all(d);
+    fs::create_directories(d);
+    return d;
+}
+
+}  // namespace
+
+TEST(Cli, SteadyPrintsTheSteadyForce) {
+    const CommandResult r = runArmsim("muscle steady --path 0.40 --activation 1");
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    EXPECT_NE(r.output.find("force Fse"), std::string::npos) << r.output;
+}
+
+TEST(Cli, SweepWritesACsvWhoseForcesMatchTheSteadyCommand) {
+    const fs::path d = freshDir("sweep");
+    const CommandResult r = runArmsim("muscle sweep --from 0.36 --to 0.40 --step 0.02 --out " + (d / "fl.csv").string() +
+                            " --plot " + (d / "fl.png").string());
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    const armsim::Table t = armsim::Table::readCsv((d / "fl.csv").string());
+    ASSERT_EQ(t.getNumRows(), 3);
+    EXPECT_NEAR(t.get(2, "path_length_m"), 0.40, 1e-12);
+    const CommandResult s = runArmsim("muscle steady --path 0.40");
+    char expected[64];
+    std::snprintf(expected, sizeof expected, "%.4f N", t.get(2, "force_N"));
+    EXPECT_NE(s.output.find(expected), std::string::npos) << expected << " not in " << s.output;
+    EXPECT_GT(fs::file_size(d / "fl.png"), 1000u);
+}
+
+TEST(Cli, BadMuscleFileGivesANamedErrorAndNonZeroExit) {
+    const fs::path d = freshDir("badfile");
+    const std::string assets = std::string(ARMSIM_ASSET_DIR) + "/muscles/";
+    fs::copy_file(assets + "human_fibre_types.yaml", d / "human_fibre_types.yaml");
+    std::ifstream in(assets + "biceps_long_head.yaml");
+    std::ofstream out(d / "m.yaml");
+    for (std::string line; std::getline(in, line);) out << (line.rfind("mass:", 0) == 0 ? "mass: -1" : line) << "\n";
+    out.close();
+    const CommandResult r = runArmsim("muscle steady --muscle " + (d / "m.yaml").string());
+    EXPECT_EQ(r.exitCode, 2);
+    EXPECT_NE(r.output.find("m.yaml:6"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("'mass'"), std::string::npos) << r.output;
+}
+
+TEST(Cli, BadValuesGiveNamedErrors) {
+    CommandResult r = runArmsim("muscle steady --activation 1.5");
+    EXPECT_EQ(r.exitCode, 2);
+    EXPECT_NE(r.output.find("--activation"), std::string::npos) << r.output;
+    r = runArmsim("muscle steady --path 0.50");
+    EXPECT_EQ(r.exitCode, 2);
+    EXPECT_NE(r.output.find("P_max"), std::string::npos) << r.output;
+    r = runArmsim("muscle steady --mass -0.2");
+    EXPECT_EQ(r.exitCode, 2);
+    EXPECT_NE(r.output.find("mass"), std::string::npos) << r.output;
+    r = runArmsim("muscle trial --duration -1 --out /tmp/never.csv");
+    EXPECT_EQ(r.exitCode, 2);
+    EXPECT_NE(r.output.find("duration"), std::string::npos) << r.output;
+    r = runArmsim("muscle steady --no-such-option");
+    EXPECT_NE(r.exitCode, 0);
+}
+
+TEST(Cli, NoEquilibriumIsReportedNotInvented) {
+    const CommandResult r = runArmsim("muscle steady --path 0.05");
+    EXPECT_EQ(r.exitCode, 3);
+    EXPECT_NE(r.output.find("no steady state"), std::string::npos) << r.output;
+}
+
+TEST(Cli, FailedRunLeavesNoHalfWrittenOutput) {
+    const fs::path d = freshDir("nowrite");
+    // A trace with a bad row: the run fails before anything is written.
+    std::ofstream(d / "trace.csv") << "time_s,activation\n0,0\n0.1,abc\n";
+    const CommandResult r = runArmsim("muscle trial --activation-trace " + (d / "trace.csv").string() + " --out " +
+                            (d / "out.csv").string());
+    EXPECT_EQ(r.exitCode, 2);
+    EXPECT_NE(r.output.find("trace.csv:3"), std::string::npos) << r.output;
+    EXPECT_FALSE(fs::exists(d / "out.csv"));
+    for (const auto& e : fs::directory_iterator(d)) EXPECT_EQ(e.path().filename().string().find(".tmp"), std::string::npos);
+}
+
+TEST(Cli, TrialWithASampledTraceFollowsIt) {
+    const fs::path d = freshDir("trace");
+    std::ofstream(d / "trace.csv") << "time_s,activation\n0,0\n0.2,0\n0.2,1\n0.5,1\n";
+    const CommandResult r = runArmsim("muscle trial --duration 0.5 --path 0.40 --activation-trace " + (d / "trace.csv").string() +
+                            " --out " + (d / "out.csv").string());
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    const armsim::Table t = armsim::Table::readCsv((d / "out.csv").string());
+    EXPECT_EQ(t.getNumRows(), 501);
+    EXPECT_EQ(t.get(199, "activation"), 0.0);
+    EXPECT_EQ(t.get(200, "activation"), 1.0);
+}
