@@ -1,0 +1,111 @@
+#include "model/arm_parameters.h"
+
+#include "muscles/param_file.h"
+
+namespace armsim {
+
+void ArmParameters::validate() const {
+    const double reach = (forearmLength + handLength) / forearmLength;  // fingertip in forearm lengths
+    checkField("body.mass", bodyMass, Bound::positive("kg"));
+    checkField("body.height", bodyHeight, Bound::positive("m"));
+
+    checkField("upper_arm.length", upperArmLength, Bound::positive("m"));
+    checkField("upper_arm.mass_fraction", upperArmMassFraction, Bound::open(0, 1));
+    checkField("upper_arm.com_fraction", upperArmComFraction, Bound::open(0, 1));
+    checkField("upper_arm.gyration_fraction", upperArmGyrationFraction, Bound::positive());
+
+    checkField("forearm_hand.forearm_length", forearmLength, Bound::positive("m"));
+    checkField("forearm_hand.hand_length", handLength, Bound::positive("m"));
+    checkField("forearm_hand.mass_fraction", forearmHandMassFraction, Bound::open(0, 1));
+    checkField("forearm_hand.com_fraction", forearmHandComFraction,
+               Bound{0, reach, true, false, "forearm lengths, elbow to fingertip"});
+    checkField("forearm_hand.gyration_fraction", forearmHandGyrationFraction, Bound::positive());
+    checkField("forearm_hand.hand_com_fraction", handComFraction,
+               Bound{1, reach, false, false, "forearm lengths, wrist to fingertip"});
+
+    checkField("biceps.insertion_distance", insertionDistance, Bound{0, forearmLength, true, false, "m"});
+    checkField("biceps.origin_distance", originDistance,
+               Bound{insertionDistance, 1e300, true, false, "m, must exceed insertion_distance"});
+
+    checkField("transducer.strap_distance", strapDistance,
+               Bound{0, forearmLength + handLength, true, false, "m, on the forearm or hand"});
+    checkField("transducer.range", transducerRange, Bound::positive("N"));
+
+    checkField("elbow.min_angle_deg", minElbowAngleDeg, Bound::open(0, 180, "deg"));
+    checkField("elbow.max_angle_deg", maxElbowAngleDeg,
+               Bound{minElbowAngleDeg, 180, true, false, "deg, above min_angle_deg"});
+    checkField("elbow.stop_stiffness", stopStiffness, Bound::positive("N m/rad"));
+    checkField("elbow.stop_dissipation", stopDissipation, Bound::nonNegative("s/rad"));
+
+    checkField("gravity", gravity, Bound::nonNegative("m/s^2"));
+    checkField("hand_load", handLoad, Bound::nonNegative("kg"));
+}
+
+ArmParameters ArmParameters::scaled(double newBodyMass, double newBodyHeight) const {
+    checkField("body.mass", newBodyMass, Bound::positive("kg"));
+    checkField("body.height", newBodyHeight, Bound::positive("m"));
+    ArmParameters p = *this;
+    const double s = newBodyHeight / bodyHeight;
+    p.bodyMass = newBodyMass;
+    p.bodyHeight = newBodyHeight;
+    p.upperArmLength *= s;
+    p.forearmLength *= s;
+    p.handLength *= s;
+    p.originDistance *= s;
+    p.insertionDistance *= s;
+    p.strapDistance *= s;
+    return p;
+}
+
+ArmParameters loadArmParameters(const std::string& path) {
+    const ParamNode root = ParamNode::loadFile(path);
+    const Bound any = Bound::any();
+    ArmParameters p;
+    root.getString("source", "");
+
+    const ParamNode body = root.child("body");
+    p.bodyMass = body.getNumber("mass", any);
+    p.bodyHeight = body.getNumber("height", any);
+    body.finish();
+
+    const ParamNode upper = root.child("upper_arm");
+    p.upperArmLength = upper.getNumber("length", any);
+    p.upperArmMassFraction = upper.getNumber("mass_fraction", any);
+    p.upperArmComFraction = upper.getNumber("com_fraction", any);
+    p.upperArmGyrationFraction = upper.getNumber("gyration_fraction", any);
+    upper.finish();
+
+    const ParamNode fore = root.child("forearm_hand");
+    p.forearmLength = fore.getNumber("forearm_length", any);
+    p.handLength = fore.getNumber("hand_length", any);
+    p.forearmHandMassFraction = fore.getNumber("mass_fraction", any);
+    p.forearmHandComFraction = fore.getNumber("com_fraction", any);
+    p.forearmHandGyrationFraction = fore.getNumber("gyration_fraction", any);
+    p.handComFraction = fore.getNumber("hand_com_fraction", any);
+    fore.finish();
+
+    const ParamNode biceps = root.child("biceps");
+    p.originDistance = biceps.getNumber("origin_distance", any);
+    p.insertionDistance = biceps.getNumber("insertion_distance", any);
+    biceps.finish();
+
+    const ParamNode transducer = root.child("transducer");
+    p.strapDistance = transducer.getNumber("strap_distance", any);
+    p.transducerRange = transducer.getNumber("range", any);
+    transducer.finish();
+
+    const ParamNode elbow = root.child("elbow");
+    p.minElbowAngleDeg = elbow.getNumber("min_angle_deg", any);
+    p.maxElbowAngleDeg = elbow.getNumber("max_angle_deg", any);
+    p.stopStiffness = elbow.getNumber("stop_stiffness", any);
+    p.stopDissipation = elbow.getNumber("stop_dissipation", any);
+    elbow.finish();
+
+    p.gravity = root.getNumber("gravity", any);
+    p.handLoad = root.getNumber("hand_load", any);
+    root.finish();
+    root.rethrowWithLocation([&] { p.validate(); });
+    return p;
+}
+
+}  // namespace armsim

@@ -1,0 +1,71 @@
+// Video and still-image output through OpenCV. Files are written whole or not at all: frames go to a
+// hidden temporary beside the target ("<dir>/.<name>.tmp-<pid>-<n>.<ext>") that close() renames into
+// place; a failure, discard() or destruction before close() removes the temporary. The target's
+// directory must already exist (it is not created).
+#pragma once
+
+#include <opencv2/core.hpp>
+
+#include <memory>
+#include <string>
+
+namespace armsim {
+
+/// Encoding settings of a video file.
+struct VideoSettings {
+    double fps = 30;              ///< frame rate (1/s), in (0, 240]
+    int width = 1280;             ///< frame width (px), even, in [16, 4096]
+    int height = 720;             ///< frame height (px), even, in [16, 4096]
+    std::string codec = "h264";   ///< "h264" or "avc1" (H.264 in .mp4) or "mjpg" (Motion JPEG in .avi)
+
+    /// Throws FieldError naming the field (fps, width, height, codec), its value and what was expected.
+    void validate() const;
+};
+
+/// Writes BGR frames to a video file through cv::VideoWriter (FFmpeg backend). Encoding runs on a
+/// worker thread owned by the writer, so rendering the next frame overlaps encoding this one: write()
+/// copies the frame into a queue of at most 3 frames and blocks while it is full. Use one writer from
+/// one thread at a time.
+class VideoWriter {
+public:
+    VideoWriter();
+    /// Discards an unfinished video (removes its temporary).
+    ~VideoWriter();
+    /// A moved-from writer may only be destroyed or assigned to.
+    VideoWriter(VideoWriter&&) noexcept;
+    /// Discards the unfinished video this writer had, if any, and takes over other's.
+    VideoWriter& operator=(VideoWriter&&) noexcept;
+    VideoWriter(const VideoWriter&) = delete;
+    VideoWriter& operator=(const VideoWriter&) = delete;
+
+    /// Validates settings and path before anything is written, then opens the encoder on the
+    /// temporary. Throws InputError (FieldError for settings) naming the setting or path, the value
+    /// and what was expected: bad size, fps or codec; a path whose extension does not suit the codec
+    /// (.mp4 for h264/avc1, .avi for mjpg); a missing or unwritable directory; a path that is a
+    /// directory; or an encoder that cannot be opened. Closes (discards) a video already open.
+    void open(const std::string& path, const VideoSettings& settings);
+    /// Appends one frame: CV_8UC3 BGR of exactly the opened size, else InputError. An encoder failure
+    /// discards the video and throws InputError here or in close().
+    void write(const cv::Mat& frame);
+    /// Finishes the file and renames it to the path given to open() (replacing an existing file).
+    /// Throws InputError if no frame was written or the file cannot be finished; nothing is left then.
+    void close();
+    /// Abandons the video: removes the temporary; the target path is untouched.
+    void discard();
+
+    bool isOpen() const;
+    int getNumFramesWritten() const;
+    const std::string& getPath() const;           ///< target path given to open()
+    const std::string& getTemporaryPath() const;  ///< where frames go until close()
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+};
+
+/// Writes frame (CV_8UC1, CV_8UC3 BGR or CV_8UC4 BGRA) to a .png path atomically (temporary, then
+/// rename). Throws InputError naming the path for a wrong extension, missing or unwritable
+/// directory, empty frame or failed encoding; nothing is left behind on failure.
+void writePng(const std::string& path, const cv::Mat& frame);
+
+}  // namespace armsim

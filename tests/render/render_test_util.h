@@ -1,0 +1,60 @@
+// Helpers shared by the render tests: a scratch directory and pixel predicates.
+#pragma once
+
+#include "render/renderer.h"
+
+#include <opencv2/core.hpp>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace armsim::test {
+
+/// A fresh empty directory, removed with its contents on destruction.
+class ScratchDir {
+public:
+    ScratchDir() {
+        std::string pattern = (std::filesystem::temp_directory_path() / "armsim-render-XXXXXX").string();
+        path_ = ::mkdtemp(pattern.data()) ? pattern : std::string();
+    }
+    ~ScratchDir() {
+        std::error_code ec;
+        if (!path_.empty()) std::filesystem::remove_all(path_, ec);
+    }
+    ScratchDir(const ScratchDir&) = delete;
+    ScratchDir& operator=(const ScratchDir&) = delete;
+    const std::string& path() const { return path_; }
+    std::string file(const std::string& name) const { return path_ + "/" + name; }
+    /// Names of all entries (including hidden temporaries).
+    std::vector<std::string> list() const {
+        std::vector<std::string> names;
+        for (const auto& e : std::filesystem::directory_iterator(path_)) names.push_back(e.path().filename());
+        return names;
+    }
+
+private:
+    std::string path_;
+};
+
+/// The BGR value OpenGL stores for an RGB colour whose channels are multiples of 1/255.
+inline cv::Vec3b toBgr8(const SimTK::Vec3& rgb) {
+    return {uchar(std::lround(255 * rgb[2])), uchar(std::lround(255 * rgb[1])), uchar(std::lround(255 * rgb[0]))};
+}
+
+/// The pixel that contains the projection of p_G.
+inline cv::Point pixelOf(const RenderSettings& s, const SimTK::Vec3& p_G) {
+    const SimTK::Vec2 p = projectToPixel(s.camera, s.width, s.height, p_G);
+    return {int(std::floor(p[0])), int(std::floor(p[1]))};
+}
+
+/// True if channel c (0 = B, 1 = G, 2 = R) exceeds both others by at least margin.
+inline bool dominates(const cv::Vec3b& bgr, int c, int margin) {
+    for (int k = 0; k < 3; ++k)
+        if (k != c && int(bgr[c]) - int(bgr[k]) < margin) return false;
+    return true;
+}
+
+}  // namespace armsim::test
