@@ -1,0 +1,133 @@
+#include "identification/observations.h"
+
+#include "muscles/param_file.h"
+#include "muscles/table.h"
+
+#include <cmath>
+#include <set>
+#include <sstream>
+#include <tuple>
+
+namespace armsim {
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+std::string fmt(double v) {
+    std::ostringstream s;
+    s.precision(10);
+    s << v;
+    return s.str();
+}
+
+}  // namespace
+
+int ObservationSet::countDistinctPoints() const {
+    std::set<std::pair<double, double>> distinct;
+    for (const Observation& o : points) distinct.insert({o.pathLength, o.activation});
+    return int(distinct.size());
+}
+
+std::string ObservationSet::where(int i) const {
+    if (i >= 0 && i < int(points.size()) && points[i].line > 0)
+        return source + ":" + std::to_string(points[i].line);
+    return source + (i >= 0 ? " (point " + std::to_string(i + 1) + ")" : "");
+}
+
+double calcThesisPathLength(double theta) {
+    const double A = kThesisOriginDistance, B = kThesisInsertionDistance;
+    return std::sqrt(A * A + B * B - 2.0 * A * B * std::cos(theta));
+}
+
+void validateObservations(const ObservationSet& set) {
+    std::set<std::tuple<int, int, double, double>> seen;
+    for (int i = 0; i < int(set.points.size()); ++i) {
+        const Observation& o = set.points[i];
+        const std::string at = set.where(i);
+        auto fail = [&](const std::string& field, double v, const std::string& expected) {
+            throw InputError(at + ": " + field + " = " + fmt(v) + ": expected " + expected);
+        };
+        if (!std::isfinite(o.force)) fail("force_N", o.force, "a finite number");
+        if (o.force < 0) fail("force_N", o.force, ">= 0 (a measured muscle force cannot be negative)");
+        if (!std::isfinite(o.pathLength) || !(o.pathLength > 0))
+            fail("path length [m]", o.pathLength, "a finite value > 0");
+        if (!std::isfinite(o.activation) || o.activation < 0 || o.activation > 1)
+            fail("activation", o.activation, "in [0, 1]");
+        if (!seen.insert({o.subject, o.trial, o.pathLength, o.activation}).second)
+            throw InputError(at + ": duplicate point: path " + fmt(o.pathLength) + " m, activation " +
+                             fmt(o.activation) + ", trial " + std::to_string(o.trial) + ", subject " +
+                             std::to_string(o.subject) +
+                             " appear earlier: expected each point once (give repeated trials a "
+                             "`trial` column, or average them)");
+    }
+}
+
+ObservationSet readObservations(const std::string& path, const ObservationOptions& options) {
+    const Table t = Table::readCsv(path);
+    static const std::set<std::string> known = {"path_m", "path_cm", "angle_deg", "force_N",
+                                                "trial", "subject", "activation"};
+    for (const std::string& c : t.getColumnNames())
+        if (!known.count(c))
+            throw InputError(path + ": unknown column '" + c +
+                             "': expected path_m | path_cm | angle_deg, force_N, and optionally trial, "
+                             "subject, activation");
+    const int nPath = t.hasColumn("path_m") + t.hasColumn("path_cm") + t.hasColumn("angle_deg");
+    if (nPath != 1)
+        throw InputError(path + ": " + std::to_string(nPath) +
+                         " position columns: expected exactly one of path_m, path_cm, angle_deg");
+    if (!t.hasColumn("force_N")) throw InputError(path + ": missing column 'force_N'");
+    if (t.getNumRows() == 0) throw InputError(path + ": no data rows");
+    if (t.hasColumn("angle_deg") && !options.pathFromAngle)
+        throw InputError(path + ": angle_deg given but no angle-to-path conversion was supplied");
+
+    ObservationSet set;
+    set.source = path;
+    for (int r = 0; r < t.getNumRows(); ++r) {
+        const std::string at = path + ":" + std::to_string(t.getSourceLine(r));
+        auto fail = [&](const std::string& column, double v, const std::string& expected) {
+            throw InputError(at + ": column '" + column + "' = " + fmt(v) + ": expected " + expected);
+        };
+        auto integer = [&](const std::string& column) {
+            if (!t.hasColumn(column)) return 0;
+            const double v = t.get(r, column);
+            if (!std::isfinite(v) || v != std::floor(v) || std::abs(v) > 1e9)
+                fail(column, v, "an integer");
+            return int(v);
+        };
+        Observation o;
+        o.line = t.getSourceLine(r);
+        o.trial = integer("trial");
+        o.subject = integer("subject");
+        if (options.subject >= 0 && o.subject != options.subject) continue;
+        o.force = t.get(r, "force_N");
+        if (!std::isfinite(o.force)) fail("force_N", o.force, "a finite number");
+        if (o.force < 0) fail("force_N", o.force, ">= 0 (a measured muscle force cannot be negative)");
+        if (t.hasColumn("activation")) {
+            o.activation = t.get(r, "activation");
+            if (!std::isfinite(o.activation) || o.activation < 0 || o.activation > 1)
+                fail("activation", o.activation, "in [0, 1]");
+        }
+        if (t.hasColumn("angle_deg")) {
+            const double deg = t.get(r, "angle_deg");
+            if (!std::isfinite(deg) || !(deg > 0) || deg > 180)
+                fail("angle_deg", deg, "in (0, 180] (included elbow angle, 180 = extended)");
+            o.angle = deg * kPi / 180.0;
+            o.pathLength = options.pathFromAngle(o.angle);
+            if (!std::isfinite(o.pathLength) || !(o.pathLength > 0))
+                fail("angle_deg", deg, "an angle whose path length is > 0 (got " + fmt(o.pathLength) + " m)");
+        } else {
+            const bool cm = t.hasColumn("path_cm");
+            const double v = t.get(r, cm ? "path_cm" : "path_m");
+            if (!std::isfinite(v) || !(v > 0)) fail(cm ? "path_cm" : "path_m", v, "a finite value > 0");
+            o.pathLength = cm ? v * 0.01 : v;
+        }
+        set.points.push_back(o);
+    }
+    if (set.points.empty())
+        throw InputError(path + ": no data rows for subject " + std::to_string(options.subject));
+    validateObservations(set);
+    return set;
+}
+
+}  // namespace armsim

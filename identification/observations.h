@@ -1,0 +1,64 @@
+// Measured muscle forces for identification: one Observation per (path length, activation, force),
+// read from CSV and validated once. Framework-free.
+#pragma once
+
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace armsim {
+
+/// One measured isometric force.
+struct Observation {
+    double pathLength = 0;   ///< musculotendon path length P [m]
+    double activation = 1;   ///< neural activation U [1], 0..1 (MVC data: 1)
+    double force = 0;        ///< measured muscle force [N]
+    double angle = 0.0 / 0.0;  ///< included elbow angle theta [rad] when the file gave one, else NaN
+    int trial = 0;           ///< trial number (CSV column `trial`; 0 when absent)
+    int subject = 0;         ///< subject number (CSV column `subject`; 0 when absent)
+    int line = 0;            ///< line in the source file (0: not read from a file)
+};
+
+/// A set of observations and where they came from (for messages).
+struct ObservationSet {
+    std::string source;                 ///< file name, or a description for built-in data
+    std::vector<Observation> points;
+
+    /// Number of distinct (path length, activation) pairs.
+    int countDistinctPoints() const;
+    /// "file:line" of point i (the source alone when it has no line).
+    std::string where(int i) const;
+};
+
+/// Path length [m] as a function of the included elbow angle theta [rad].
+using PathFromAngle = std::function<double(double angleRad)>;
+
+/// Origin distance A of the thesis geometry [m] (thesis 5.2.2 after van Zuylen 1988).
+constexpr double kThesisOriginDistance = 0.37;
+/// Insertion distance B of the thesis geometry [m] (thesis 5.2.2).
+constexpr double kThesisInsertionDistance = 0.06;
+
+/// The thesis's straight-line biceps, P(theta) = sqrt(A^2 + B^2 - 2 A B cos theta), with A = 0.37 m and
+/// B = 0.06 m (P(90 deg) = 37.48 cm, the thesis's "37.5 cm"; P(180 deg) = 43 cm). The default angle to
+/// path conversion; the Simbody arm (model/) can inject its own.
+double calcThesisPathLength(double angleRad);
+
+/// How to read a force file.
+struct ObservationOptions {
+    PathFromAngle pathFromAngle = calcThesisPathLength;  ///< used for an `angle_deg` column
+    int subject = -1;    ///< keep only this subject (-1: keep all)
+};
+
+/// Reads a CSV force file (Table::readCsv: header line, '#' comment lines). Columns: exactly one of
+/// `path_m`, `path_cm`, `angle_deg` (included elbow angle, 180 = extended), then `force_N`, and
+/// optionally `trial`, `subject`, `activation` (default 1). Unknown columns are errors.
+/// Throws InputError naming file, line, column and value for: a non-finite value, a negative force,
+/// a path <= 0, an angle outside (0, 180] deg, an activation outside [0, 1], a non-integer trial or
+/// subject, and a duplicate point (same subject, trial, path and activation as an earlier line).
+ObservationSet readObservations(const std::string& path, const ObservationOptions& options = {});
+
+/// Validates an in-memory set with the same rules as readObservations (InputError naming source,
+/// line or index, field and value).
+void validateObservations(const ObservationSet& set);
+
+}  // namespace armsim
