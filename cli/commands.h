@@ -1,11 +1,14 @@
-// Sub-commands of the armsim command. Each add* function registers its CLI11 sub-command; the
-// callbacks throw InputError / SimulationError, which main() turns into a message and exit code.
+// Sub-commands of the armsim command. Each cli/*_command.cpp registers its sub-command and, if it
+// contributes to the main job (`armsim run`), a main-job step, with the registrars below; main()
+// needs no edit when a command is added. Callbacks throw InputError / SimulationError, which main()
+// turns into a message and an exit code.
 #pragma once
 
 #include "muscles/virtual_muscle.h"
 
 #include <CLI/CLI.hpp>
 
+#include <functional>
 #include <string>
 
 namespace armsim::cli {
@@ -19,12 +22,31 @@ struct MuscleOptions {
     double tendonLength = 0;                              ///< override L0T [m] (0: from the file)
     double maxPathLength = 0;                             ///< override P_max [m] (0: from the file)
     void add(CLI::App& app);
-    /// Loads the file and applies the overrides (validated by the VirtualMuscle constructor).
+    /// Loads the file and applies the overrides, validated.
+    MuscleParameters loadParameters() const;
+    /// loadParameters() built into a VirtualMuscle.
     VirtualMuscle build() const;
 };
 
-void addMuscleCommands(CLI::App& app);
-void addRunCommand(CLI::App& app);
+/// Adds a sub-command to the armsim app. Registered at static-initialisation time.
+struct CommandRegistrar {
+    CommandRegistrar(int order, std::function<void(CLI::App&)> add);
+};
+
+/// Settings every main-job step receives.
+struct MainJobContext {
+    std::string outDir = "out";  ///< where results go
+    int jobs = 2;                ///< worker threads
+    MuscleOptions muscle;        ///< the subject's biceps
+};
+
+/// A step of `armsim run`; steps run in ascending order.
+struct MainJobStepRegistrar {
+    MainJobStepRegistrar(int order, std::string name, std::function<void(const MainJobContext&)> run);
+};
+
+/// Adds every registered command to app (called by main).
+void addRegisteredCommands(CLI::App& app);
 
 /// Prints a one-line progress bar to stderr ("label [#####     ] 5/10").
 void printProgress(const std::string& label, int done, int total);

@@ -7,8 +7,7 @@
 int main(int argc, char** argv) {
     CLI::App app{"armsim: a Simbody elbow with a Virtual Muscle biceps (simulate, identify, render)"};
     app.require_subcommand(1);
-    armsim::cli::addMuscleCommands(app);
-    armsim::cli::addRunCommand(app);
+    armsim::cli::addRegisteredCommands(app);
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {

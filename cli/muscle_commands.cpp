@@ -21,7 +21,7 @@ void MuscleOptions::add(CLI::App& app) {
     app.add_option("--max-path", maxPathLength, "path length at the anatomical limit P_max [m]");
 }
 
-VirtualMuscle MuscleOptions::build() const {
+MuscleParameters MuscleOptions::loadParameters() const {
     MuscleParameters p = loadMuscleParameters(findAsset(file));
     if (slowUnits >= 0) p.numSlowUnits = slowUnits;
     if (fastUnits >= 0) p.numFastUnits = fastUnits;
@@ -29,26 +29,22 @@ VirtualMuscle MuscleOptions::build() const {
     if (tendonLength != 0) p.optimalTendonLength = tendonLength;
     if (maxPathLength != 0) p.maxPathLength = maxPathLength;
     try {
-        return VirtualMuscle(p);
+        p.validate();
+        return p;
     } catch (const FieldError& e) {
         throw InputError(std::string("muscle '") + p.name + "' (" + file + " with command-line overrides): " + e.what());
     }
 }
 
-void printProgress(const std::string& label, int done, int total) {
-    constexpr int kWidth = 30;
-    const int filled = total > 0 ? done * kWidth / total : kWidth;
-    std::fprintf(stderr, "\r%-28s [%s%s] %d/%d", label.c_str(), std::string(filled, '#').c_str(),
-                 std::string(kWidth - filled, ' ').c_str(), done, total);
-    if (done >= total) std::fprintf(stderr, "\n");
-    std::fflush(stderr);
-}
+VirtualMuscle MuscleOptions::build() const { return VirtualMuscle(loadParameters()); }
 
 namespace {
 
 void checkActivation(double U) { checkField("--activation", U, Bound::closed(0, 1)); }
 
 }  // namespace
+
+namespace {
 
 void addMuscleCommands(CLI::App& app) {
     CLI::App* muscle = app.add_subcommand("muscle", "the muscle alone, path ends fixed (steady solve, sweeps, trials)");
@@ -178,5 +174,9 @@ void addMuscleCommands(CLI::App& app) {
         });
     }
 }
+
+const CommandRegistrar registerMuscle(10, addMuscleCommands);
+
+}  // namespace
 
 }  // namespace armsim::cli

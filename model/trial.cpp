@@ -20,6 +20,16 @@ void checkElbowAngle(const std::string& field, double theta, const ArmParameters
     checkField(field, radToDeg(theta), Bound::closed(arm.minElbowAngleDeg, arm.maxElbowAngleDeg, "deg"));
 }
 
+std::vector<std::string> withStateColumns(std::vector<std::string> names, const VirtualMuscle& m) {
+    for (const std::string& n : m.getStateNames()) names.push_back(kStateColumnPrefix + n);
+    return names;
+}
+
+void appendMuscleStates(std::vector<double>& row, const VirtualMuscleForce& biceps, const State& s) {
+    const std::vector<double> y = biceps.getMuscleStates(s);
+    row.insert(row.end(), y.begin(), y.end());
+}
+
 double mean(const std::vector<double>& v, std::size_t from) {
     double s = 0;
     for (std::size_t i = from; i < v.size(); ++i) s += v[i];
@@ -27,6 +37,22 @@ double mean(const std::vector<double>& v, std::size_t from) {
 }
 
 }  // namespace
+
+void setStateFromTrialRow(const BicepsArm& model, const Table& table, int row, State& state) {
+    const ArmModel& arm = model.getArm();
+    state.setTime(table.get(row, "time_s"));
+    arm.setElbowAngle(state, degToRad(table.get(row, "elbow_angle_deg")));
+    arm.setElbowAngularVelocity(state, degToRad(table.get(row, "elbow_velocity_degps")));
+    std::vector<double> y;
+    for (const std::string& n : model.getMuscle().getStateNames()) {
+        const std::string column = kStateColumnPrefix + n;
+        if (!table.hasColumn(column))
+            throw InputError("trial table has no column '" + column +
+                             "': it was not written by armsim trial, or for another muscle composition");
+        y.push_back(table.get(row, column));
+    }
+    model.getBiceps().setMuscleStates(state, y);
+}
 
 // ---- Isometric ----------------------------------------------------------------------------------
 
@@ -68,10 +94,11 @@ IsometricTrialResult runIsometricTrial(const ArmSetup& setup, const IsometricTri
     sum.tareTorque = arm.calcHoldingTorque(state);
     sum.restForce = biceps.getForce(state);
 
-    result.series = Table({"time_s", "activation", "muscle_force_N", "fascicle_length_m", "fascicle_velocity_mps",
-                           "holding_torque_Nm", "muscle_torque_Nm", "strap_force_N", "saturated",
-                           "force_moment_arm_N", "force_fixed_ratio_N", "error_moment_arm_pct",
-                           "error_fixed_ratio_pct"});
+    result.series = Table(withStateColumns(
+        {"time_s", "activation", "elbow_angle_deg", "elbow_velocity_degps", "muscle_force_N", "fascicle_length_m",
+         "fascicle_velocity_mps", "holding_torque_Nm", "muscle_torque_Nm", "strap_force_N", "saturated",
+         "force_moment_arm_N", "force_fixed_ratio_N", "error_moment_arm_pct", "error_fixed_ratio_pct"},
+        model.getMuscle()));
     const double h = sum.momentArm;
     sum.stats = simulateSampled(
         system, state, settings.getDuration(), settings.sampleRate, profile.getBreakpoints(), settings.integration,
@@ -87,10 +114,12 @@ IsometricTrialResult runIsometricTrial(const ArmSetup& setup, const IsometricTri
             const double byMomentArm = calcBicepsForceFromTorque(strap * ap.strapDistance, h);
             const double byFixedRatio = calcBicepsForceFixedRatio(strap, settings.elbowAngle, kPi / 2);
             auto pct = [F](double estimate) { return F > 0 ? 100 * (estimate - F) / F : NAN; };
-            result.series.appendRow({s.getTime(), biceps.getActivation(s), F, biceps.getFascicleLength(s),
-                                     biceps.getFascicleVelocity(s), torque, muscleTorque, strap,
-                                     saturated ? 1.0 : 0.0, byMomentArm, byFixedRatio, pct(byMomentArm),
-                                     pct(byFixedRatio)});
+            std::vector<double> row{s.getTime(), biceps.getActivation(s), radToDeg(settings.elbowAngle), 0.0, F,
+                                    biceps.getFascicleLength(s), biceps.getFascicleVelocity(s), torque,
+                                    muscleTorque, strap, saturated ? 1.0 : 0.0, byMomentArm, byFixedRatio,
+                                    pct(byMomentArm), pct(byFixedRatio)};
+            appendMuscleStates(row, biceps, s);
+            result.series.appendRow(std::move(row));
         },
         [&](const State& s) { biceps.checkMuscleStates(s); });
 
@@ -180,8 +209,10 @@ Table runFreeMovement(const ArmSetup& setup, const FreeMovementSettings& setting
     if (settings.startSteady) biceps.setSteadyMuscleStates(state);
     else biceps.setInitialMuscleStates(state);
 
-    Table t({"time_s", "activation", "elbow_angle_deg", "elbow_velocity_degps", "path_length_m", "moment_arm_m",
-             "muscle_force_N", "fascicle_length_m", "fascicle_velocity_mps", "active_fraction"});
+    Table t(withStateColumns({"time_s", "activation", "elbow_angle_deg", "elbow_velocity_degps", "path_length_m",
+                              "moment_arm_m", "muscle_force_N", "fascicle_length_m", "fascicle_velocity_mps",
+                              "active_fraction"},
+                             model.getMuscle()));
     const IntegrationStats st = simulateSampled(
         system, state, settings.duration, settings.sampleRate, settings.activation.getBreakpoints(),
         settings.integration,
@@ -189,9 +220,11 @@ Table runFreeMovement(const ArmSetup& setup, const FreeMovementSettings& setting
             system.realize(s, Stage::Position);
             const MuscleOutputs o = biceps.calcOutputs(s);
             const double L0 = model.getMuscle().getParameters().optimalFascicleLength;
-            t.appendRow({s.getTime(), biceps.getActivation(s), radToDeg(arm.getElbowAngle(s)),
-                         radToDeg(arm.getElbowAngularVelocity(s)), arm.calcPathLength(s), arm.calcMomentArm(s), o.Fse,
-                         o.L * L0, o.V * L0, o.activeFraction});
+            std::vector<double> row{s.getTime(), biceps.getActivation(s), radToDeg(arm.getElbowAngle(s)),
+                                    radToDeg(arm.getElbowAngularVelocity(s)), arm.calcPathLength(s),
+                                    arm.calcMomentArm(s), o.Fse, o.L * L0, o.V * L0, o.activeFraction};
+            appendMuscleStates(row, biceps, s);
+            t.appendRow(std::move(row));
         },
         [&](const State& s) { biceps.checkMuscleStates(s); });
     if (stats) *stats = st;

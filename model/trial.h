@@ -16,6 +16,14 @@ namespace armsim {
 
 class ParamNode;
 
+/// Trial tables end with one column per muscle state, named this prefix + the state's name
+/// ("state_L", "state_feff_3"), so a recorded trial can be replayed exactly (rendering, analysis).
+inline const std::string kStateColumnPrefix = "state_";
+
+/// Sets time, elbow angle and velocity, and every muscle state of `state` from one row of a trial
+/// table (isometric or free movement). Throws InputError if a state column is missing.
+void setStateFromTrialRow(const BicepsArm& model, const Table& table, int row, SimTK::State& state);
+
 /// An isometric trial: elbow locked at theta; rest (muscle off, transducer tared), activation rises
 /// to the target (step or ramp), held; sampled at sampleRate.
 struct IsometricTrialSettings {
@@ -53,11 +61,12 @@ struct IsometricSummary {
 };
 
 struct IsometricTrialResult {
-    /// Columns: time_s, activation, muscle_force_N, fascicle_length_m, fascicle_velocity_mps,
+    /// Columns: time_s, activation, elbow_angle_deg, elbow_velocity_degps (0: locked),
+    /// muscle_force_N, fascicle_length_m, fascicle_velocity_mps,
     /// holding_torque_Nm (raw lock torque, + = flexion), muscle_torque_Nm (tared, + = flexion),
     /// strap_force_N (transducer reading, clipped to its range), saturated (0/1),
     /// force_moment_arm_N, force_fixed_ratio_N, error_moment_arm_pct, error_fixed_ratio_pct
-    /// (errors of the estimates against the true muscle force).
+    /// (errors of the estimates against the true muscle force), then the muscle states.
     Table series;
     IsometricSummary summary;
 };
@@ -88,7 +97,7 @@ struct FreeMovementSettings {
 
 /// Columns: time_s, activation, elbow_angle_deg, elbow_velocity_degps (+ = extending),
 /// path_length_m, moment_arm_m, muscle_force_N, fascicle_length_m, fascicle_velocity_mps,
-/// active_fraction.
+/// active_fraction, then the muscle states.
 Table runFreeMovement(const ArmSetup& setup, const FreeMovementSettings& settings, IntegrationStats* stats = nullptr);
 
 /// Reads trial settings from a YAML mapping (keys: elbow_angle_deg, activation, rest, rise, hold,

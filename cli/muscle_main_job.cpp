@@ -109,20 +109,11 @@ void runStep(const VirtualMuscle& m, const std::string& outDir) {
                 final, m.calcSteadyState(0.375, 1.0).force, 1000 * t90, stats.steps);
 }
 
-}  // namespace
+const MainJobStepRegistrar registerForceLength(10, "Muscle force-length (steady solve vs integration)",
+                                                [](const MainJobContext& c) { runForceLength(c.muscle.build(), c.outDir); });
+const MainJobStepRegistrar registerStep(20, "Muscle step activation",
+                                        [](const MainJobContext& c) { runStep(c.muscle.build(), c.outDir); });
 
-void addRunCommand(CLI::App& app) {
-    auto outDir = std::make_shared<std::string>("out");
-    auto opts = std::make_shared<MuscleOptions>();
-    CLI::App* c = app.add_subcommand("run", "the main job on built-in defaults (results and plots in --out)");
-    c->add_option("--out", *outDir, "output directory")->capture_default_str();
-    opts->add(*c);
-    c->callback([=] {
-        const VirtualMuscle m = opts->build();
-        runForceLength(m, *outDir);
-        runStep(m, *outDir);
-        std::printf("\nResults in %s/: force_length.csv/.png, step_activation.csv/.png\n", outDir->c_str());
-    });
-}
+}  // namespace
 
 }  // namespace armsim::cli

@@ -1,0 +1,74 @@
+#include "cli/commands.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <memory>
+#include <vector>
+
+namespace armsim::cli {
+
+namespace {
+
+struct Command {
+    int order;
+    std::function<void(CLI::App&)> add;
+};
+struct Step {
+    int order;
+    std::string name;
+    std::function<void(const MainJobContext&)> run;
+};
+
+std::vector<Command>& commands() {
+    static std::vector<Command> c;
+    return c;
+}
+std::vector<Step>& steps() {
+    static std::vector<Step> s;
+    return s;
+}
+
+}  // namespace
+
+CommandRegistrar::CommandRegistrar(int order, std::function<void(CLI::App&)> add) {
+    commands().push_back({order, std::move(add)});
+}
+
+MainJobStepRegistrar::MainJobStepRegistrar(int order, std::string name,
+                                           std::function<void(const MainJobContext&)> run) {
+    steps().push_back({order, std::move(name), std::move(run)});
+}
+
+void printProgress(const std::string& label, int done, int total) {
+    constexpr int kWidth = 30;
+    const int filled = total > 0 ? done * kWidth / total : kWidth;
+    std::fprintf(stderr, "\r%-28s [%s%s] %d/%d", label.c_str(), std::string(filled, '#').c_str(),
+                 std::string(kWidth - filled, ' ').c_str(), done, total);
+    if (done >= total) std::fprintf(stderr, "\n");
+    std::fflush(stderr);
+}
+
+void addRegisteredCommands(CLI::App& app) {
+    auto& c = commands();
+    std::stable_sort(c.begin(), c.end(), [](const Command& a, const Command& b) { return a.order < b.order; });
+    for (const auto& cmd : c) cmd.add(app);
+
+    // armsim run: every registered main-job step, in order.
+    auto ctx = std::make_shared<MainJobContext>();
+    CLI::App* run = app.add_subcommand("run", "the main job on built-in defaults (results and plots in --out)");
+    run->add_option("--out", ctx->outDir, "output directory")->capture_default_str();
+    run->add_option("--jobs", ctx->jobs, "worker threads")->capture_default_str()->check(CLI::Range(1, 64));
+    ctx->muscle.add(*run);
+    run->callback([ctx] {
+        auto& s = steps();
+        std::stable_sort(s.begin(), s.end(), [](const Step& a, const Step& b) { return a.order < b.order; });
+        for (const auto& step : s) {
+            std::printf("\n== %s ==\n", step.name.c_str());
+            std::fflush(stdout);
+            step.run(*ctx);
+        }
+        std::printf("\nAll results are in %s/\n", ctx->outDir.c_str());
+    });
+}
+
+}  // namespace armsim::cli
