@@ -87,7 +87,15 @@ IntegrationStats simulateSampled(const MultibodySystem& system, State& state, do
             for (int i = 0; i < y.size(); ++i)
                 y[i] = c0 * ya[i] + c1 * h * yda[i] + c2 * yb[i] + c3 * h * ydb[i];
             scratch.setTime(t);
-            scratch.updY() = y;
+            // Write q and u only when they moved (a locked joint keeps them), so the scratch state
+            // keeps its position-level cache and a sample costs less to realize.
+            const int nq = scratch.getNQ(), nu = scratch.getNU(), nz = scratch.getNZ();
+            bool qMoved = false, uMoved = false;
+            for (int i = 0; i < nq; ++i) qMoved = qMoved || y[i] != scratch.getQ()[i];
+            for (int i = 0; i < nu; ++i) uMoved = uMoved || y[nq + i] != scratch.getU()[i];
+            if (qMoved) scratch.updQ() = y(0, nq);
+            if (uMoved) scratch.updU() = y(nq, nu);
+            scratch.updZ() = y(nq + nu, nz);
             sample(scratch);
             ++next;
         }
