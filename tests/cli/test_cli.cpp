@@ -119,3 +119,30 @@ TEST(Cli, TrialWithASampledTraceFollowsIt) {
     EXPECT_EQ(t.get(199, "activation"), 0.0);
     EXPECT_EQ(t.get(200, "activation"), 1.0);
 }
+
+TEST(Cli, TrialWritesTheSeriesAndRejectsBadSettings) {
+    const fs::path d = freshDir("trial");
+    CommandResult r = runArmsim("trial --angle 90 --hold 0.5 --rest 0.2 --rate 200 --out " + (d / "t.csv").string());
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    const armsim::Table t = armsim::Table::readCsv((d / "t.csv").string());
+    EXPECT_EQ(t.getNumRows(), 141);  // 0.7 s at 200 Hz, both ends
+    EXPECT_TRUE(t.hasColumn("strap_force_N"));
+    EXPECT_TRUE(t.hasColumn("state_feff_6"));
+
+    r = runArmsim("trial --angle 30 --out " + (d / "bad.csv").string());
+    EXPECT_EQ(r.exitCode, 2);
+    EXPECT_NE(r.output.find("elbow_angle_deg"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("[40, 180]"), std::string::npos) << r.output;
+    r = runArmsim("trial --hold -1 --out " + (d / "bad.csv").string());
+    EXPECT_EQ(r.exitCode, 2);
+    EXPECT_NE(r.output.find("hold"), std::string::npos) << r.output;
+    r = runArmsim("trial --activation 2 --out " + (d / "bad.csv").string());
+    EXPECT_EQ(r.exitCode, 2);
+    EXPECT_NE(r.output.find("activation"), std::string::npos) << r.output;
+    std::ofstream(d / "s.yaml") << "type: isometric\nelbow_angle_deg: 90\nduraton: 3\n";
+    r = runArmsim("trial --settings " + (d / "s.yaml").string() + " --out " + (d / "bad.csv").string());
+    EXPECT_EQ(r.exitCode, 2);
+    EXPECT_NE(r.output.find("s.yaml:3"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("duraton"), std::string::npos) << r.output;
+    EXPECT_FALSE(fs::exists(d / "bad.csv"));
+}
