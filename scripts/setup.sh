@@ -25,9 +25,19 @@ if [ "$(id -u)" -ne 0 ]; then
   sudo_cmd=(sudo)
 fi
 
-# apt-get waits up to 10 minutes for a lock another dpkg/apt process holds.
+# Another apt/dpkg process (unattended upgrades, a second shell) may hold the locks: wait for it
+# (up to 10 minutes) instead of failing. DPkg::Lock::Timeout covers the dpkg lock itself.
+wait_for_package_manager() {
+  for _ in $(seq 1 120); do
+    if ! pgrep -x 'apt-get|apt|dpkg|unattended-upgr' >/dev/null 2>&1; then return 0; fi
+    echo "setup: another package manager is running; waiting for it to finish..."
+    sleep 5
+  done
+}
 apt_opts=(-o DPkg::Lock::Timeout=600 -y -q)
 echo "setup: installing ${missing[*]}"
 export DEBIAN_FRONTEND=noninteractive
+wait_for_package_manager
 "${sudo_cmd[@]}" apt-get "${apt_opts[@]}" update
+wait_for_package_manager
 "${sudo_cmd[@]}" apt-get "${apt_opts[@]}" install --no-install-recommends "${missing[@]}"
