@@ -22,7 +22,7 @@ fi
 sudo_cmd=()
 if [ "$(id -u)" -ne 0 ]; then
   command -v sudo >/dev/null || { echo "setup: not root and no sudo; install: ${missing[*]}" >&2; exit 1; }
-  sudo_cmd=(sudo)
+  sudo_cmd=(sudo env DEBIAN_FRONTEND=noninteractive)
 fi
 
 # Another apt/dpkg process (unattended upgrades, a second shell) may hold the locks: wait for it
