@@ -102,9 +102,9 @@ IntegrationStats simulateSampled(const MultibodySystem& system, State& state, do
     };
 
     IntegrationStats stats;
-    system.realize(state, Stage::Acceleration);
-    checkFinite(state);
     if (check) check(state);
+    checkFinite(state);
+    system.realize(state, Stage::Acceleration);
     sample(state);
     long next = 1;
     for (double segmentEnd : cuts) {
@@ -116,7 +116,19 @@ IntegrationStats simulateSampled(const MultibodySystem& system, State& state, do
         ya = a.getY();
         yda = a.getYDot();
         while (integ.getTime() < segmentEnd - eps) {
-            const Integrator::SuccessfulStepStatus status = integ.stepTo(segmentEnd, segmentEnd);
+            Integrator::SuccessfulStepStatus status;
+            try {
+                status = integ.stepTo(segmentEnd, segmentEnd);
+            } catch (const std::exception& e) {
+                // CPodes gives up (e.g. repeated error-test or Newton failures): say when, and the last
+                // good state's validity, rather than an internal error.
+                const State& last = integ.getState();
+                if (check) check(last);
+                checkFinite(last);
+                std::ostringstream msg;
+                msg << "t = " << last.getTime() << " s: the integrator failed: " << e.what();
+                throw SimulationError(msg.str());
+            }
             if (status == Integrator::EndOfSimulation || status == Integrator::InvalidSuccessfulStepStatus) {
                 std::ostringstream msg;
                 msg << "t = " << integ.getTime() << " s: integration stopped: "
@@ -124,9 +136,9 @@ IntegrationStats simulateSampled(const MultibodySystem& system, State& state, do
                 throw SimulationError(msg.str());
             }
             const State& b = integ.getState();
-            system.realize(b, Stage::Acceleration);
+            if (check) check(b);  // element-specific checks first: they name the muscle and state
             checkFinite(b);
-            if (check) check(b);
+            system.realize(b, Stage::Acceleration);
             yb = b.getY();
             ydb = b.getYDot();
             const bool atBreakpoint = b.getTime() >= segmentEnd - eps && segmentEnd < tEnd;

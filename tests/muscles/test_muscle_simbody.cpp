@@ -183,3 +183,19 @@ TEST(MuscleIsometric, BadSettingsAreRejected) {
     settings.sampleRate = 0;
     EXPECT_THROW(runMuscleIsometric(m, settings), InputError);
 }
+
+TEST(MuscleIsometric, ARunBeyondTheNfLimitStopsWithANamedErrorNotNaN) {
+    MuscleParameters p = bicepsLongHead();
+    p.maxPathLength = 0.9;
+    const VirtualMuscle m(p);
+    MuscleIsometricSettings settings;
+    settings.pathLength = 0.9;  // the fascicle starts far beyond L = 1.73 L0
+    settings.duration = 0.5;
+    try {
+        runMuscleIsometric(m, settings);
+        ADD_FAILURE() << "no error";
+    } catch (const SimulationError& e) {
+        EXPECT_NE(std::string(e.what()).find("t = 0 s"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("nf"), std::string::npos) << e.what();
+    }
+}
