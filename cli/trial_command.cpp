@@ -5,6 +5,9 @@
 #include "model/trial.h"
 #include "muscles/muscle_file.h"
 #include "muscles/param_file.h"
+#ifdef ARMSIM_WITH_RENDER
+#include "render/trial_video.h"
+#endif
 
 #include <cstdio>
 #include <memory>
@@ -21,7 +24,7 @@ struct TrialOptions {
     double angleDeg = 90, activation = 1.0, rest = 0.5, rise = 0.0, hold = 3.0;
     double initialAngleDeg = 150, initialVelocityDegps = 0, onset = 0.2, duration = 2.0, load = 0.0;
     double rate = 1000, accuracy = 1e-4;
-    std::string out = "out/trial.csv", plot;
+    std::string out = "out/trial.csv", plot, video;
 };
 
 ArmSetup loadSetup(const MuscleOptions& muscle, const std::string& armFile) {
@@ -31,7 +34,22 @@ ArmSetup loadSetup(const MuscleOptions& muscle, const std::string& armFile) {
     return s;
 }
 
+// --video: renders the written table (a replay of the trial).
+void renderVideo(const TrialOptions& o, const ArmSetup& setup, const Table& table, double handLoad) {
+#ifdef ARMSIM_WITH_RENDER
+    TrialVideoSettings v;
+    v.videoPath = o.video;
+    v.tableName = o.out;
+    v.scene.handLoad = handLoad;
+    const TrialVideoResult r = renderTrialVideo(setup, table, v, [](int d, int n) { printProgress("video", d, n); });
+    std::printf("wrote %s (%d frames)\n", r.videoPath.c_str(), r.frames);
+#endif
+}
+
 void runTrialCommand(const TrialOptions& o) {
+#ifndef ARMSIM_WITH_RENDER
+    if (!o.video.empty()) throw InputError("--video: this armsim was built without the renderer (-DARMSIM_RENDER=OFF)");
+#endif
     const ArmSetup setup = loadSetup(o.muscle, o.armFile);
     std::string type = o.type;
     IsometricTrialSettings iso;
@@ -69,6 +87,7 @@ void runTrialCommand(const TrialOptions& o) {
     if (type == "isometric") {
         const IsometricTrialResult r = runIsometricTrial(setup, iso);
         r.series.writeCsv(o.out);
+        if (!o.video.empty()) renderVideo(o, setup, r.series, 0);
         const IsometricSummary& s = r.summary;
         std::printf("isometric trial at %.1f deg: path %.2f cm, moment arm %.2f cm\n", radToDeg(s.elbowAngle),
                     100 * s.pathLength, 100 * s.momentArm);
@@ -90,6 +109,7 @@ void runTrialCommand(const TrialOptions& o) {
         IntegrationStats stats;
         const Table t = runFreeMovement(setup, free, &stats);
         t.writeCsv(o.out);
+        if (!o.video.empty()) renderVideo(o, setup, t, free.handLoad);
         std::printf("free movement: elbow %.1f -> %.1f deg in %.2f s (%d integrator steps)\n",
                     t.get(0, "elbow_angle_deg"), t.get(t.getNumRows() - 1, "elbow_angle_deg"), free.duration,
                     stats.steps);
@@ -126,6 +146,7 @@ void addTrialCommand(CLI::App& app) {
     c->add_option("--accuracy", o->accuracy, "integrator relative accuracy")->capture_default_str();
     c->add_option("--out", o->out, "CSV output")->capture_default_str();
     c->add_option("--plot", o->plot, "PNG plot (optional)");
+    c->add_option("--video", o->video, "video of the trial (.mp4, H.264), rendered from the written table (optional)");
     c->callback([o] { runTrialCommand(*o); });
 }
 

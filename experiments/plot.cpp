@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -31,6 +32,43 @@ void dataRange(const std::vector<double>& v, bool log, double& lo, double& hi) {
             lo = std::min(lo, b);
             hi = std::max(hi, b);
         }
+}
+
+/// Temporary PNG path beside `path`, created empty (PLplot exits the process on a file it cannot open,
+/// so writability is checked here first).
+std::string beginPng(const std::string& path) {
+    namespace fs = std::filesystem;
+    const fs::path target(path);
+    std::error_code ec;
+    if (target.has_parent_path()) fs::create_directories(target.parent_path(), ec);
+    const std::string tmp = path + ".tmp." + std::to_string(::getpid()) + ".png";
+    if (!std::ofstream(tmp)) throw InputError(path + ": cannot write plot (is the directory writable?)");
+    return tmp;
+}
+
+/// Renames the finished temporary PNG into place, or removes it and throws.
+void finishPng(const std::string& tmp, const std::string& path) {
+    namespace fs = std::filesystem;
+    std::error_code ec;
+    if (!fs::exists(tmp) || fs::file_size(tmp, ec) == 0) {
+        fs::remove(tmp, ec);
+        throw InputError(path + ": the plot could not be written (PLplot pngcairo driver failed)");
+    }
+    fs::rename(tmp, path, ec);
+    if (ec) {
+        fs::remove(tmp, ec);
+        throw InputError(path + ": cannot write plot: " + ec.message());
+    }
+}
+
+/// Starts a PLplot stream on the pngcairo device writing tmp, with the series palette.
+void startStream(const std::string& tmp, int width, int height) {
+    PLINT stream = 0;
+    plmkstrm(&stream);
+    plsdev("pngcairo");
+    plsfnam(tmp.c_str());
+    plspage(0, 0, width, height, 0, 0);
+    for (int i = 0; i < 10; ++i) plscol0(i, kPalette[i][0], kPalette[i][1], kPalette[i][2]);
 }
 
 }  // namespace
@@ -61,21 +99,10 @@ void writePlotPng(const std::string& path, const PlotSpec& spec) {
     y0 = limit(spec.yMin, y0, spec.logY);
     y1 = limit(spec.yMax, y1, spec.logY);
 
-    namespace fs = std::filesystem;
-    const fs::path target(path);
-    std::error_code ec;
-    if (target.has_parent_path()) fs::create_directories(target.parent_path(), ec);
-    const std::string tmp = path + ".tmp." + std::to_string(::getpid()) + ".png";
-    if (!std::ofstream(tmp))  // PLplot exits the process on a file it cannot open: check first
-        throw InputError(path + ": cannot write plot (is the directory writable?)");
+    const std::string tmp = beginPng(path);
     {
         std::lock_guard<std::mutex> lock(plplotMutex);
-        PLINT stream = 0;
-        plmkstrm(&stream);
-        plsdev("pngcairo");
-        plsfnam(tmp.c_str());
-        plspage(0, 0, spec.width, spec.height, 0, 0);
-        for (int i = 0; i < 10; ++i) plscol0(i, kPalette[i][0], kPalette[i][1], kPalette[i][2]);
+        startStream(tmp, spec.width, spec.height);
         plinit();
         plcol0(1);
         plschr(0, 1.1);
@@ -126,15 +153,93 @@ void writePlotPng(const std::string& path, const PlotSpec& spec) {
         }
         plend1();
     }
-    if (!fs::exists(tmp) || fs::file_size(tmp, ec) == 0) {
-        fs::remove(tmp, ec);
-        throw InputError(path + ": the plot could not be written (PLplot pngcairo driver failed)");
+    finishPng(tmp, path);
+}
+
+void writeHeatMapPng(const std::string& path, const HeatMapSpec& spec) {
+    const std::size_t nx = spec.x.size(), ny = spec.y.size();
+    if (nx == 0 || ny == 0 || spec.z.size() != nx * ny)
+        throw std::invalid_argument("heat map '" + spec.title + "': need nx, ny >= 1 and nx * ny values");
+    if (spec.width < 100 || spec.height < 100) throw std::invalid_argument("plot size below 100 pixels");
+    auto spacing = [&](const std::vector<double>& v, const char* axis) {
+        const double d = v.size() > 1 ? (v.back() - v.front()) / double(v.size() - 1) : 1.0;
+        for (std::size_t i = 1; i < v.size(); ++i)
+            if (!(std::abs(v[i] - v[i - 1] - d) <= 1e-9 * std::max(1.0, std::abs(d))) || !(d > 0))
+                throw std::invalid_argument(std::string("heat map: ") + axis + " centres must be increasing and evenly spaced");
+        return d;
+    };
+    const double dx = spacing(spec.x, "x"), dy = spacing(spec.y, "y");
+    double zmin = std::numeric_limits<double>::infinity(), zmax = -zmin;
+    for (double v : spec.z)
+        if (std::isfinite(v)) {
+            zmin = std::min(zmin, v);
+            zmax = std::max(zmax, v);
+        }
+    if (!(zmax >= zmin)) throw std::invalid_argument("heat map '" + spec.title + "': no finite data");
+    if (zmax == zmin) zmax = zmin + 1;
+    const double x0 = spec.x.front() - dx / 2, x1 = spec.x.back() + dx / 2;
+    const double y0 = spec.y.front() - dy / 2, y1 = spec.y.back() + dy / 2;
+
+    // Image rows: blank (NaN) cells get a value outside [zmin, zmax], which plimagefr skips.
+    std::vector<std::vector<PLFLT>> rows(nx, std::vector<PLFLT>(ny));
+    std::vector<PLFLT*> image(nx);
+    for (std::size_t i = 0; i < nx; ++i) {
+        for (std::size_t j = 0; j < ny; ++j) {
+            const double v = spec.z[i * ny + j];
+            rows[i][j] = std::isfinite(v) ? v : zmax + 10 * (zmax - zmin);
+        }
+        image[i] = rows[i].data();
     }
-    fs::rename(tmp, target, ec);
-    if (ec) {
-        fs::remove(tmp, ec);
-        throw InputError(path + ": cannot write plot: " + ec.message());
+
+    const std::string tmp = beginPng(path);
+    {
+        std::lock_guard<std::mutex> lock(plplotMutex);
+        startStream(tmp, spec.width, spec.height);
+        // Colour map 1: dark blue -> teal -> yellow (viridis-like), linear in RGB.
+        PLFLT pos[] = {0.0, 0.5, 1.0}, r[] = {0.27, 0.13, 0.99}, g[] = {0.00, 0.57, 0.91}, b[] = {0.33, 0.55, 0.14};
+        plscmap1n(256);
+        plscmap1l(1, 3, pos, r, g, b, nullptr);
+        plinit();
+        plcol0(1);
+        plschr(0, 1.1);
+        pladv(0);
+        plvpor(0.12, 0.80, 0.12, 0.90);
+        plwind(x0, x1, y0, y1);
+        plimagefr(image.data(), PLINT(nx), PLINT(ny), x0, x1, y0, y1, zmin, zmax, zmin, zmax, nullptr, nullptr);
+        plcol0(1);
+        plbox("bcnst", 0, 0, "bcnstv", 0, 0);
+        pllab(spec.xLabel.c_str(), spec.yLabel.c_str(), spec.title.c_str());
+        if (spec.cellLabels) {
+            plschr(0, 0.75);
+            char text[64];
+            for (std::size_t i = 0; i < nx; ++i)
+                for (std::size_t j = 0; j < ny; ++j) {
+                    const double v = spec.z[i * ny + j];
+                    if (!std::isfinite(v)) continue;
+                    std::snprintf(text, sizeof text, "%.*f", spec.labelDecimals, v);
+                    plcol0((v - zmin) / (zmax - zmin) > 0.6 ? 9 : 0);  // black on light cells, white on dark
+                    plptex(spec.x[i], spec.y[j], 1, 0, 0.5, text);
+                }
+            plschr(0, 1.1);
+        }
+        plcol0(1);
+        PLFLT barWidth, barHeight;
+        const char* axisOpts[] = {"bcvtm"};
+        const char* labels[] = {spec.zLabel.c_str()};
+        PLINT labelOpts[] = {PL_COLORBAR_LABEL_RIGHT};
+        PLFLT ticks[] = {0.0};
+        PLINT subTicks[] = {0};
+        constexpr int kBarValues = 101;
+        PLFLT values[kBarValues];
+        for (int k = 0; k < kBarValues; ++k) values[k] = zmin + (zmax - zmin) * k / (kBarValues - 1);
+        const PLFLT* valueRows[] = {values};
+        PLINT nValues[] = {kBarValues};
+        plcolorbar(&barWidth, &barHeight, PL_COLORBAR_IMAGE | PL_COLORBAR_LABEL_RIGHT,
+                   PL_POSITION_RIGHT | PL_POSITION_OUTSIDE | PL_POSITION_VIEWPORT, 0.02, 0.0, 0.04, 1.0, 0, 1, 1,
+                   0.0, 0.0, 0, 0.0, 1, labelOpts, labels, 1, axisOpts, ticks, subTicks, nValues, valueRows);
+        plend1();
     }
+    finishPng(tmp, path);
 }
 
 }  // namespace armsim

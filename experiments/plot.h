@@ -1,5 +1,5 @@
-// PNG line plots of results (force-length curves, time courses, convergence) through PLplot's
-// cairo driver. Framework-free apart from PLplot; safe to call from several threads (serialised).
+// PNG line plots of results (force-length curves, time courses, convergence) and heat maps through
+// PLplot's cairo driver. Framework-free apart from PLplot; safe to call from several threads (serialised).
 #pragma once
 
 #include <string>
@@ -30,5 +30,22 @@ struct PlotSpec {
 /// Writes the plot as a PNG file, whole or not at all (temporary + rename). Throws InputError naming
 /// the path if it cannot be written, std::invalid_argument for an empty or malformed spec.
 void writePlotPng(const std::string& path, const PlotSpec& spec);
+
+/// A heat map of z over a regular grid of cells (e.g. force over slow x fast motor-unit counts).
+struct HeatMapSpec {
+    std::string title;
+    std::string xLabel, yLabel;   ///< axis labels with units
+    std::string zLabel;           ///< colour-bar label with units, e.g. "force (N)"
+    std::vector<double> x;        ///< cell centres along x: nx >= 1 values, increasing, evenly spaced
+    std::vector<double> y;        ///< cell centres along y: ny >= 1 values, increasing, evenly spaced
+    std::vector<double> z;        ///< nx * ny values, z[i * ny + j] at (x[i], y[j]); NaN = blank cell
+    bool cellLabels = true;       ///< print each cell's value in it
+    int labelDecimals = 0;        ///< decimals of the cell labels
+    int width = 1000, height = 800;   ///< pixels
+};
+
+/// Writes the heat map (colour map: dark blue -> yellow, with a colour bar) as a PNG file, whole or not
+/// at all. Throws like writePlotPng.
+void writeHeatMapPng(const std::string& path, const HeatMapSpec& spec);
 
 }  // namespace armsim

@@ -53,6 +53,7 @@ FibreType readFibreType(const ParamNode& n, const std::string& name) {
     t.cY = n.getNumber("cY", any, 0.0);
     t.VY = n.getNumber("VY", any, 1.0);
     t.TY = n.getNumber("TY", any, 1.0);
+    t.f05 = n.getNumber("f05", Bound::positive("pps"), 0.0);  // optional: only the synthetic EMG needs it
     n.finish();
     n.rethrowWithLocation([&] { t.validate(n.path("")); });
     return t;

@@ -63,6 +63,7 @@ void FibreType::validate(const std::string& p) const {
     checkField(q + "cY", cY, Bound::closed(0, 1));
     checkField(q + "VY", VY, Bound::positive("L0/s"));
     checkField(q + "TY", TY, Bound::positive("s"));
+    if (f05 != 0.0) checkField(q + "f05", f05, Bound::positive("pps, or 0 = not given"));
 }
 
 void MuscleCoefficients::validate(const std::string& p) const {

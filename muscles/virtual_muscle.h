@@ -64,6 +64,10 @@ struct FibreType {
     double cY = 0;        ///< yield magnitude (0: no yield) [1]
     double VY = 1;        ///< yield velocity scale [L0/s]
     double TY = 1;        ///< yield time constant [s]
+    /// f0.5: firing rate at which a unit of this type gives half its maximal isometric force at L = 1
+    /// [pps]; fenv, fint, feff are in its units. Not used by the force model; 0 = not given (the
+    /// synthetic EMG, which turns fenv into spike trains, requires it).
+    double f05 = 0;
 
     bool hasSag() const { return aS1 != 1.0 || aS2 != 1.0; }
     bool hasYield() const { return cY != 0.0; }

@@ -446,7 +446,7 @@ struct OffscreenRenderer::Impl {
     OSMesaContext context = nullptr;
     std::vector<unsigned char> buffer;  // RGBA, top row first
     MeshCache meshes;
-    std::vector<Primitive> primitives;
+    std::vector<Primitive> primitives, topPrimitives;
     cv::Mat downsampled;                // RGBA at output size, reused
     float maxLineWidth = 1;
 
@@ -557,36 +557,47 @@ struct OffscreenRenderer::Impl {
         glPolygonMode(GL_FRONT_AND_BACK, GL_FILL);
     }
 
-    cv::Mat render(const SimTK::SimbodyMatterSubsystem* matter, const SimTK::State* state,
-                   const SimTK::Array_<SimTK::DecorativeGeometry>& geometry,
-                   const std::vector<SimTK::DecorativeGeometry>& extra) {
-        primitives.clear();
-        GeometryCollector collector(matter, state, meshes, settings.defaultLineThickness, primitives);
-        for (const auto& g : geometry) g.implementGeometry(collector);
-        for (const auto& g : extra) g.implementGeometry(collector);
-
-        makeCurrent();
-        const Camera& cam = settings.camera;
-        const Mat4 view = calcViewMatrix(cam);
-        setupScene(calcProjectionMatrix(cam, double(settings.width) / settings.height), view);
-
-        // Opaque first, then translucent back to front without depth writes.
+    // Opaque first, then translucent back to front without depth writes.
+    void drawLayer(const std::vector<Primitive>& layer, const Mat4& view) {
         std::vector<std::pair<double, const Primitive*>> translucent;
-        for (const Primitive& p : primitives) {
+        for (const Primitive& p : layer) {
             if (p.color[3] < 1)
                 translucent.emplace_back(apply(view, p.anchor_G)[2], &p);
             else
                 draw(p);
         }
-        if (!translucent.empty()) {
-            std::stable_sort(translucent.begin(), translucent.end(),
-                             [](const auto& a, const auto& b) { return a.first < b.first; });
-            glEnable(GL_BLEND);
-            glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
-            glDepthMask(GL_FALSE);
-            for (const auto& t : translucent) draw(*t.second);
-            glDepthMask(GL_TRUE);
-            glDisable(GL_BLEND);
+        if (translucent.empty()) return;
+        std::stable_sort(translucent.begin(), translucent.end(),
+                         [](const auto& a, const auto& b) { return a.first < b.first; });
+        glEnable(GL_BLEND);
+        glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
+        glDepthMask(GL_FALSE);
+        for (const auto& t : translucent) draw(*t.second);
+        glDepthMask(GL_TRUE);
+        glDisable(GL_BLEND);
+    }
+
+    // Draws geometry and extra, then (after clearing depth) onTop.
+    cv::Mat render(const SimTK::SimbodyMatterSubsystem* matter, const SimTK::State* state,
+                   const SimTK::Array_<SimTK::DecorativeGeometry>& geometry,
+                   const std::vector<SimTK::DecorativeGeometry>& extra,
+                   const SimTK::Array_<SimTK::DecorativeGeometry>& onTop = {}) {
+        primitives.clear();
+        topPrimitives.clear();
+        GeometryCollector collector(matter, state, meshes, settings.defaultLineThickness, primitives);
+        for (const auto& g : geometry) g.implementGeometry(collector);
+        for (const auto& g : extra) g.implementGeometry(collector);
+        GeometryCollector topCollector(matter, state, meshes, settings.defaultLineThickness, topPrimitives);
+        for (const auto& g : onTop) g.implementGeometry(topCollector);
+
+        makeCurrent();
+        const Camera& cam = settings.camera;
+        const Mat4 view = calcViewMatrix(cam);
+        setupScene(calcProjectionMatrix(cam, double(settings.width) / settings.height), view);
+        drawLayer(primitives, view);
+        if (!topPrimitives.empty()) {
+            glClear(GL_DEPTH_BUFFER_BIT);
+            drawLayer(topPrimitives, view);
         }
         glFinish();
 
@@ -618,6 +629,14 @@ cv::Mat OffscreenRenderer::renderFrame(const SimTK::MultibodySystem& system, con
     for (SimTK::Stage stage = SimTK::Stage::Topology; stage <= state.getSystemStage(); ++stage)
         system.calcDecorativeGeometryAndAppend(state, stage, geometry);
     return impl_->render(&system.getMatterSubsystem(), &state, geometry, extra);
+}
+
+cv::Mat OffscreenRenderer::renderLayers(const SimTK::MultibodySystem& system, const SimTK::State& state,
+                                        const SimTK::Array_<SimTK::DecorativeGeometry>& geometry,
+                                        const SimTK::Array_<SimTK::DecorativeGeometry>& onTop) {
+    if (state.getSystemStage() < SimTK::Stage::Position)
+        throw std::logic_error("OffscreenRenderer::renderLayers: realize the state to Stage::Position first");
+    return impl_->render(&system.getMatterSubsystem(), &state, geometry, {}, onTop);
 }
 
 cv::Mat OffscreenRenderer::renderGeometry(const std::vector<SimTK::DecorativeGeometry>& geometry) {

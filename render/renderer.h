@@ -95,6 +95,16 @@ public:
     /// Draws only the given geometry (all bodyId must be 0: there are no bodies to attach it to).
     cv::Mat renderGeometry(const std::vector<SimTK::DecorativeGeometry>& geometry);
 
+    /// Draws a caller-chosen set of decorations placed by the bodies of system in state (realized
+    /// to Stage::Position at least; bodyId as in renderFrame), in two layers: `geometry` first, then
+    /// `onTop` after clearing the depth buffer, so the second layer is visible through the first
+    /// (e.g. a muscle path that runs inside a limb's volume). Use it to select or restyle what a
+    /// system emits (collect with calcDecorativeGeometryAndAppend). Throws InputError for a bad
+    /// body id and std::logic_error for a state below Stage::Position.
+    cv::Mat renderLayers(const SimTK::MultibodySystem& system, const SimTK::State& state,
+                         const SimTK::Array_<SimTK::DecorativeGeometry>& geometry,
+                         const SimTK::Array_<SimTK::DecorativeGeometry>& onTop = {});
+
     const RenderSettings& getSettings() const;
 
 private:

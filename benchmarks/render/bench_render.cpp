@@ -1,9 +1,12 @@
 // Throughput of the offscreen video pipeline on the test pendulum at 1280x720: rendering alone (by
 // supersampling factor), the overlay, H.264 encoding alone, and the whole render + overlay + encode
-// loop. Target: >= 60 frames per second for the whole loop. Times are wall-clock (llvmpipe and x264
-// use worker threads), so "fps" counters are real frames per second.
+// loop; and a trial video: replay of a recorded free-movement table into the arm, overlay, H.264.
+// Target: >= 60 frames per second for the whole loop. Times are wall-clock (llvmpipe and x264 use
+// worker threads), so "fps" counters are real frames per second.
 #include "render/overlay.h"
+#include "model/trial.h"
 #include "render/renderer.h"
+#include "render/trial_video.h"
 #include "render/video.h"
 #include "tests/render/pendulum_scene.h"
 
@@ -125,6 +128,34 @@ void BM_RenderOverlayEncodeH264_720p(benchmark::State& state) {
     state.counters["fps"] = benchmark::Counter(double(state.iterations()), benchmark::Counter::kIsRate);
 }
 BENCHMARK(BM_RenderOverlayEncodeH264_720p)
+    ->ArgName("supersample")->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond);
+
+// A trial video as `armsim trial --video` makes it: a 2 s free movement recorded at 1000 Hz, replayed
+// row by row (setStateFromTrialRow) at the video's frame times, drawn with the overlay (text and two
+// live plots) and encoded as H.264, 1280x720, 30 fps. The frames cycle through the trial.
+void BM_TrialReplayH264_720p(benchmark::State& state) {
+    const ArmSetup setup = ArmSetup::loadDefault();
+    FreeMovementSettings free;
+    free.activation = ActivationProfile::step(0.2, 0.0, 1.0);
+    const Table table = runFreeMovement(setup, free);
+    TrialVideoSettings v;
+    v.render.width = kWidth;
+    v.render.height = kHeight;
+    v.render.supersample = int(state.range(0));
+    TrialRenderer renderer(setup, table, v);
+    Scratch scratch;
+    VideoWriter writer;
+    writer.open(scratch.dir + "/trial.mp4", {v.fps, kWidth, kHeight, "h264"});
+    const int frames = renderer.getNumFrames();
+    int k = 0;
+    for (auto _ : state) {
+        writer.write(renderer.renderRow(renderer.findRow(renderer.getFrameTime(k))));
+        k = (k + 1) % frames;
+    }
+    writer.close();
+    state.counters["fps"] = benchmark::Counter(double(state.iterations()), benchmark::Counter::kIsRate);
+}
+BENCHMARK(BM_TrialReplayH264_720p)
     ->ArgName("supersample")->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond);
 
 }  // namespace

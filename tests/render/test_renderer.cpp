@@ -237,6 +237,30 @@ TEST(OffscreenRenderer, DrawsGeometryOfEveryStageTheStateReached) {
     EXPECT_TRUE(test::dominates(atDynamics, 2, kDominanceMargin)) << atDynamics;
 }
 
+TEST(OffscreenRenderer, OnTopLayerShowsThroughSolidsAndOneLayerEqualsRenderFrame) {
+    PendulumScene scene;
+    const RenderSettings s = pendulumSettings();
+    OffscreenRenderer renderer(s);
+    const double q = 0.3;
+    const SimTK::State state = scene.makeState(q, 0);   // blue line, ending at the bob's centre
+    SimTK::Array_<SimTK::DecorativeGeometry> all, solids, line;
+    for (SimTK::Stage stage = SimTK::Stage::Topology; stage <= state.getSystemStage(); ++stage)
+        scene.getSystem().calcDecorativeGeometryAndAppend(state, stage, all);
+    for (const auto& g : all) (SimTK::DecorativeLine::isInstanceOf(g) ? line : solids).push_back(g);
+    ASSERT_EQ(line.size(), 1u);
+    // A point on the line inside the bob's silhouette: the bob hides it unless the line is on top.
+    const Vec3 bob = PendulumScene::bobCentre(q);
+    const Vec3 inBob = bob + 0.5 * PendulumGeometry::kBobRadius * (PendulumGeometry::anchor() - bob).normalize();
+    const cv::Point p = test::pixelOf(s, inBob);
+    const cv::Mat oneLayer = renderer.renderLayers(scene.getSystem(), state, all);
+    const cv::Mat layered = renderer.renderLayers(scene.getSystem(), state, solids, line);
+    EXPECT_TRUE(isBobColoured(oneLayer.at<cv::Vec3b>(p))) << oneLayer.at<cv::Vec3b>(p);
+    EXPECT_TRUE(test::dominates(layered.at<cv::Vec3b>(p), 0, kDominanceMargin)) << layered.at<cv::Vec3b>(p);
+    EXPECT_EQ(cv::norm(oneLayer, renderer.renderFrame(scene.getSystem(), state), cv::NORM_INF), 0);
+    SimTK::State unrealized = scene.getSystem().getDefaultState();
+    EXPECT_THROW(renderer.renderLayers(scene.getSystem(), unrealized, all), std::logic_error);
+}
+
 TEST(OffscreenRenderer, IsDeterministicAcrossCallsRenderersAndThreads) {
     PendulumScene scene;
     const RenderSettings s = pendulumSettings();

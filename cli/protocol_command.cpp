@@ -1,0 +1,115 @@
+// armsim protocol: runs an experiment protocol file (assets/protocols/*.yaml); and the thesis MVC
+// protocol as a main-job step.
+#include "cli/commands.h"
+#include "experiments/protocol.h"
+#include "muscles/muscle_file.h"
+#include "muscles/param_file.h"
+
+#include <cmath>
+#include <cstdio>
+#include <memory>
+
+namespace armsim::cli {
+
+namespace {
+
+struct ProtocolOptions {
+    std::string file;
+    std::string out;
+    int jobs = 2;
+};
+
+void printFit(const char* label, const QuadraticFit& q, const char* xUnit, double xScale, const char* reference) {
+    std::printf("  %-34s peak %7.1f N at %6.1f %s (R^2 %.4f)%s\n", label, q.peakY, xScale * q.peakX, xUnit,
+                q.fit.rSquared, reference);
+}
+
+void printResult(const Protocol& p, const ProtocolResult& r, const std::string& outDir) {
+    if (r.trials.getNumRows() > 0) {
+        const Table& s = r.summary;
+        std::printf("  angle  level   n  activation  muscle F (N)        measured F (N)     fixed ratio (N)%s\n",
+                    p.emgEnabled ? "  EMG RMS (mV)      MNF (Hz)  MDF (Hz)" : "");
+        for (int i = 0; i < s.getNumRows(); ++i) {
+            std::printf("  %5.0f  %4.0f%%  %2.0f  %10.4f  %7.2f +- %-7.2f  %7.2f +- %-7.2f  %8.2f",
+                        s.get(i, "elbow_angle_deg"), s.get(i, "level_pct_mvc"), s.get(i, "n"),
+                        s.get(i, "activation_mean"), s.get(i, "muscle_force_N_mean"), s.get(i, "muscle_force_N_sd"),
+                        s.get(i, "force_measured_N_mean"), s.get(i, "force_measured_N_sd"),
+                        s.get(i, "force_fixed_ratio_N_mean"));
+            if (p.emgEnabled)
+                std::printf("  %6.3f +- %-6.3f  %8.1f  %8.1f", 1000 * s.get(i, "emg_rms_V_mean"),
+                            1000 * s.get(i, "emg_rms_V_sd"), s.get(i, "emg_mnf_Hz_mean"), s.get(i, "emg_mdf_Hz_mean"));
+            std::printf("\n");
+        }
+    }
+    const auto fit = [&](const char* key) { return r.quadraticFits.find(key); };
+    if (p.kind == ProtocolKind::Mvc) {
+        std::printf("  quadratic force-angle fits (thesis: 603.3 N at 101.2 deg):\n");
+        if (auto it = fit("muscle_force"); it != r.quadraticFits.end())
+            printFit("true muscle force", it->second, "deg", 1, "");
+        if (auto it = fit("force_measured"); it != r.quadraticFits.end())
+            printFit("transducer / moment arm (tared)", it->second, "deg", 1, "");
+        if (auto it = fit("force_fixed_ratio"); it != r.quadraticFits.end())
+            printFit("thesis fixed-ratio estimate", it->second, "deg", 1, "");
+    }
+    if (r.emgToActivation) {
+        const auto& c = r.emgToActivation->coefficients;
+        std::printf("  EMG-to-activation map: U = %.4f %+.4f e %+.4f e^2 (e = EMG RMS / MVC EMG RMS; R^2 %.4f)\n", c[0],
+                    c[1], c[2], r.emgToActivation->rSquared);
+    }
+    if (auto it = fit("muscle_alone_peak"); it != r.quadraticFits.end())
+        printFit("force-length, muscle alone", it->second, "cm", 100, "  (thesis: ~600 N at 40-41 cm)");
+    if (auto it = fit("arm_peak"); it != r.quadraticFits.end())
+        printFit("force-length, in the arm", it->second, "cm", 100, "");
+    if (r.composition.getNumRows() > 0) {
+        for (int i = 0; i < r.composition.getNumRows(); ++i)
+            if (r.composition.get(i, "slow_units") == 3 && r.composition.get(i, "fast_units") == 3)
+                std::printf("  3 slow + 3 fast units: %.2f N (thesis Table 7.4: 346.13 N)\n",
+                            r.composition.get(i, "force_N"));
+        std::printf("  %d compositions; table in composition_matrix.csv, heat map composition_heatmap.png\n",
+                    r.composition.getNumRows());
+    }
+    if (!outDir.empty()) std::printf("  wrote %zu files to %s/\n", r.files.size(), outDir.c_str());
+}
+
+std::string defaultOut(const Protocol& p) { return "out/" + p.name; }
+
+void runProtocolCommand(const ProtocolOptions& o) {
+    const Protocol protocol = readProtocol(findAsset(o.file));
+    const ArmSetup subject = loadProtocolSubject(protocol);
+    const std::string out = o.out.empty() ? defaultOut(protocol) : o.out;
+    std::printf("protocol %s (%s): %s\n", protocol.name.c_str(), getProtocolKindName(protocol.kind).c_str(),
+                protocol.description.c_str());
+    std::fflush(stdout);
+    const ProtocolResult r =
+        runProtocol(protocol, subject, {out, o.jobs, [&](int d, int n) { printProgress(protocol.name, d, n); }});
+    printResult(protocol, r, out);
+}
+
+void addProtocolCommand(CLI::App& app) {
+    auto o = std::make_shared<ProtocolOptions>();
+    CLI::App* c = app.add_subcommand("protocol", "run an experiment protocol (YAML file, e.g. protocols/mvc_force_angle.yaml)");
+    c->add_option("file", o->file, "protocol file (path, or name under assets/)")->required();
+    c->add_option("--out", o->out, "run directory (default out/<protocol name>); an earlier run there is replaced");
+    c->add_option("--jobs", o->jobs, "worker threads (results do not depend on it)")->capture_default_str()->check(CLI::Range(1, 64));
+    c->callback([o] { runProtocolCommand(*o); });
+}
+
+/// Main job: the thesis MVC protocol (five angles x three repetitions, synthetic EMG).
+void runMvcProtocol(const MainJobContext& ctx) {
+    const Protocol protocol = readProtocol(findAsset("protocols/mvc_force_angle.yaml"));
+    ArmSetup subject = loadProtocolSubject(protocol);
+    subject.biceps = ctx.muscle.loadParameters();
+    const std::string out = ctx.outDir + "/protocol_mvc";
+    const ProtocolResult r =
+        runProtocol(protocol, subject, {out, ctx.jobs, [](int d, int n) { printProgress("MVC protocol trials", d, n); }});
+    printResult(protocol, r, out);
+    std::printf("  plots: %s/force_angle.png, force_length.png, emg_trial.png\n", out.c_str());
+}
+
+const CommandRegistrar registerProtocol(30, addProtocolCommand);
+const MainJobStepRegistrar registerMvcProtocol(35, "Protocol: thesis MVC force-angle (5 angles x 3 repetitions, EMG)",
+                                               runMvcProtocol);
+
+}  // namespace
+
+}  // namespace armsim::cli

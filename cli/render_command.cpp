@@ -1,0 +1,168 @@
+// armsim render: a video and/or PNG still of a recorded trial (replayed from its table); and the
+// main-job step that leaves an MVC video, a free-movement video and a still in the output directory.
+#include "cli/commands.h"
+#include "model/geometry.h"
+#include "model/trial.h"
+#include "muscles/muscle_file.h"
+#include "muscles/param_file.h"
+
+#ifdef ARMSIM_WITH_RENDER
+#include "render/trial_video.h"
+
+#include <cstdio>
+#include <future>
+#include <memory>
+#endif
+
+namespace armsim::cli {
+
+namespace {
+
+#ifdef ARMSIM_WITH_RENDER
+
+struct RenderOptions {
+    MuscleOptions muscle;
+    std::string armFile = "arm/default_male.yaml";
+    std::string table, out, still, renderSettingsFile;
+    double stillAt = 0, fps = 30, speed = 1, load = 0, arrowScale = 0;
+    int width = 1280, height = 720, supersample = 2;
+    std::string codec = "h264", colorBy = "activation", arrow = "auto";
+    bool noOverlay = false, noFloor = false, fixedThickness = false;
+    CLI::Option* stillAtOption = nullptr;
+    CLI::Option* widthOption = nullptr;
+    CLI::Option* heightOption = nullptr;
+};
+
+ArmSetup loadSetup(const MuscleOptions& muscle, const std::string& armFile) {
+    ArmSetup s;
+    s.arm = loadArmParameters(findAsset(armFile));
+    s.biceps = muscle.loadParameters();
+    return s;
+}
+
+void runRenderCommand(const RenderOptions& o) {
+    TrialVideoSettings v;
+    if (!o.renderSettingsFile.empty()) {
+        const ParamNode node = ParamNode::loadFile(o.renderSettingsFile);
+        v.autoCamera = !node.has("camera");
+        v.render = readRenderSettings(node);
+    }
+    if (o.renderSettingsFile.empty() || o.widthOption->count()) v.render.width = o.width;
+    if (o.renderSettingsFile.empty() || o.heightOption->count()) v.render.height = o.height;
+    if (o.renderSettingsFile.empty()) v.render.supersample = o.supersample;
+    v.fps = o.fps;
+    v.codec = o.codec;
+    v.playbackSpeed = o.speed;
+    v.overlay = !o.noOverlay;
+    v.scene.muscleColoring = o.colorBy == "force" ? MuscleColoring::Force : MuscleColoring::Activation;
+    v.scene.thicknessFollows = !o.fixedThickness;
+    v.scene.forceArrow = o.arrow == "strap"    ? ForceArrowKind::Strap
+                         : o.arrow == "muscle" ? ForceArrowKind::Muscle
+                         : o.arrow == "none"   ? ForceArrowKind::None
+                                               : ForceArrowKind::Auto;
+    v.scene.arrowScale = o.arrowScale;
+    v.scene.floor = !o.noFloor;
+    v.scene.handLoad = o.load;
+    v.videoPath = o.out;
+    if (o.stillAtOption->count()) v.stillTime = o.stillAt;
+    v.stillPath = o.still;
+    v.tableName = o.table;
+    if (v.videoPath.empty() && !v.stillTime)
+        throw InputError("armsim render: nothing to write: expected --out VIDEO and/or --still-at T --still FILE.png");
+    v.validate();  // before the table is read
+
+    const ArmSetup setup = loadSetup(o.muscle, o.armFile);
+    const Table table = Table::readCsv(o.table);
+    const TrialVideoResult r =
+        renderTrialVideo(setup, table, v, [](int d, int n) { printProgress("rendering", d, n); });
+    if (!r.stillPath.empty()) std::printf("wrote %s (still at t = %.3f s)\n", r.stillPath.c_str(), *v.stillTime);
+    if (!r.videoPath.empty())
+        std::printf("wrote %s (%d frames, %dx%d, %g fps, %s)\n", r.videoPath.c_str(), r.frames, v.render.width,
+                    v.render.height, v.fps, v.codec.c_str());
+}
+
+void addRenderCommand(CLI::App& app) {
+    auto o = std::make_shared<RenderOptions>();
+    CLI::App* c = app.add_subcommand("render", "video and/or PNG still of a recorded trial table (armsim trial CSV)");
+    c->add_option("table", o->table, "trial table written by armsim trial (CSV with state_* columns)")
+        ->required()->check(CLI::ExistingFile);
+    c->add_option("--out", o->out, "video file: .mp4 (h264) or .avi (mjpg)");
+    c->add_option("--fps", o->fps, "video frames per second")->capture_default_str();
+    o->widthOption = c->add_option("--width", o->width, "frame width [px], even")->capture_default_str();
+    o->heightOption = c->add_option("--height", o->height, "frame height [px], even")->capture_default_str();
+    c->add_option("--codec", o->codec, "h264 | mjpg")->capture_default_str();
+    c->add_option("--speed", o->speed, "trial seconds per video second (1 = the trial's time scale)")
+        ->capture_default_str();
+    c->add_option("--supersample", o->supersample, "anti-aliasing factor 1-4 (1 = off)")->capture_default_str();
+    c->add_option("--render-settings", o->renderSettingsFile,
+                  "YAML render settings (width, height, supersample, background, lighting, camera {...}); "
+                  "without a camera key the sagittal camera is used");
+    o->stillAtOption = c->add_option("--still-at", o->stillAt, "trial time of a PNG still [s]");
+    c->add_option("--still", o->still, "PNG file of the still");
+    c->add_option("--color-by", o->colorBy, "biceps colour follows: activation | force")
+        ->capture_default_str()->check(CLI::IsMember({"activation", "force"}));
+    c->add_flag("--fixed-thickness", o->fixedThickness, "biceps line thickness does not follow the colour");
+    c->add_option("--arrow", o->arrow, "force arrow: auto (strap if isometric, else muscle) | strap | muscle | none")
+        ->capture_default_str()->check(CLI::IsMember({"auto", "strap", "muscle", "none"}));
+    c->add_option("--arrow-scale", o->arrowScale,
+                  "arrow length per newton [m/N] (0: a round scale, the peak force within 15 cm)")
+        ->capture_default_str();
+    c->add_option("--load", o->load, "mass held in the hand [kg], drawn as a ball (as given to armsim trial)");
+    c->add_flag("--no-floor", o->noFloor, "no floor (with 10 cm ticks)");
+    c->add_flag("--no-overlay", o->noOverlay, "no text panel and plots");
+    c->add_option("--arm", o->armFile, "arm parameter file of the trial's subject")->capture_default_str();
+    o->muscle.add(*c);
+    c->callback([o] { runRenderCommand(*o); });
+}
+
+/// Main job: one MVC video (isometric at 90 deg), one free-movement video, and a still of the MVC.
+void runTrialVideos(const MainJobContext& ctx) {
+    const ArmSetup setup = loadSetup(ctx.muscle, "arm/default_male.yaml");
+    IsometricTrialSettings iso;
+    iso.elbowAngle = degToRad(90);
+    const FreeMovementSettings free;
+    // Two Systems, two threads.
+    auto freeTable = std::async(ctx.jobs > 1 ? std::launch::async : std::launch::deferred,
+                                [&] { return runFreeMovement(setup, free); });
+    const Table mvc = runIsometricTrial(setup, iso).series;
+    const Table movement = freeTable.get();
+    mvc.writeCsv(ctx.outDir + "/trial_mvc_90deg.csv");
+    movement.writeCsv(ctx.outDir + "/trial_free_movement.csv");
+
+    TrialVideoSettings v;
+    v.videoPath = ctx.outDir + "/video_mvc_90deg.mp4";
+    v.stillTime = iso.restDuration + iso.holdDuration - 0.5;
+    v.stillPath = ctx.outDir + "/still_mvc_90deg.png";
+    v.tableName = "trial_mvc_90deg.csv";
+    TrialVideoResult r = renderTrialVideo(setup, mvc, v, [](int d, int n) { printProgress("MVC video", d, n); });
+    std::printf("  wrote %s (%d frames) and %s\n", r.videoPath.c_str(), r.frames, r.stillPath.c_str());
+
+    v.videoPath = ctx.outDir + "/video_free_movement.mp4";
+    v.stillTime.reset();
+    v.stillPath.clear();
+    v.tableName = "trial_free_movement.csv";
+    r = renderTrialVideo(setup, movement, v, [](int d, int n) { printProgress("free-movement video", d, n); });
+    std::printf("  wrote %s (%d frames)\n", r.videoPath.c_str(), r.frames);
+}
+
+const CommandRegistrar registerRender(60, addRenderCommand);
+const MainJobStepRegistrar registerVideos(40, "Arm: videos of an MVC at 90 deg and a free movement", runTrialVideos);
+
+#else
+
+void addRenderCommand(CLI::App& app) {
+    CLI::App* c = app.add_subcommand("render", "video of a recorded trial (not in this build)");
+    c->allow_extras();
+    c->callback([] {
+        throw InputError("armsim render: this armsim was built without the renderer: configure with "
+                         "-DARMSIM_RENDER=ON");
+    });
+}
+
+const CommandRegistrar registerRender(60, addRenderCommand);
+
+#endif
+
+}  // namespace
+
+}  // namespace armsim::cli

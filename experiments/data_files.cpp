@@ -1,0 +1,151 @@
+#include "experiments/data_files.h"
+
+#include "muscles/param_file.h"
+
+#include <charconv>
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <stdexcept>
+
+namespace armsim {
+
+namespace {
+
+void appendNumber(std::string& out, double v, int digits) {
+    if (std::isnan(v)) {
+        out += "NaN";
+        return;
+    }
+    char buf[40];
+    const auto r = std::to_chars(buf, buf + sizeof buf, v, std::chars_format::general, digits);
+    out.append(buf, r.ptr);
+}
+
+void appendRows(std::string& out, const Table& t, char separator, int digits) {
+    for (int i = 0; i < t.getNumRows(); ++i) {
+        const std::vector<double>& r = t.getRow(i);
+        for (std::size_t c = 0; c < r.size(); ++c) {
+            if (c) out += separator;
+            appendNumber(out, r[c], digits);
+        }
+        out += '\n';
+    }
+}
+
+void checkDigits(int digits) {
+    if (digits < 1 || digits > 17) throw std::invalid_argument("digits must be in [1, 17]");
+}
+
+}  // namespace
+
+std::string formatCsv(const Table& t, int digits) {
+    checkDigits(digits);
+    std::string out;
+    out.reserve(std::size_t(t.getNumRows() + 1) * std::size_t(t.getNumColumns()) * (digits + 7));
+    for (int c = 0; c < t.getNumColumns(); ++c) out += (c ? "," : "") + t.getColumnNames()[c];
+    out += '\n';
+    appendRows(out, t, ',', digits);
+    return out;
+}
+
+std::string formatStorage(const Table& t, const std::string& name, bool inDegrees, int digits) {
+    checkDigits(digits);
+    if (t.getNumColumns() == 0) throw std::invalid_argument("storage '" + name + "': table has no columns");
+    std::string out;
+    out.reserve(std::size_t(t.getNumRows() + 8) * std::size_t(t.getNumColumns()) * (digits + 7));
+    out += name + "\nversion=1\nnRows=" + std::to_string(t.getNumRows()) +
+           "\nnColumns=" + std::to_string(t.getNumColumns()) + "\ninDegrees=" + (inDegrees ? "yes" : "no") +
+           "\nendheader\ntime";
+    for (int c = 1; c < t.getNumColumns(); ++c) out += "\t" + t.getColumnNames()[c];
+    out += '\n';
+    appendRows(out, t, '\t', digits);
+    return out;
+}
+
+Table readStorage(const std::string& path, StorageHeader* header) {
+    std::ifstream in(path);
+    if (!in) throw InputError(path + ": cannot open file (does it exist and is it readable?)");
+    StorageHeader h;
+    std::string line;
+    int lineNo = 0;
+    long nRows = -1, nColumns = -1;
+    bool ended = false;
+    auto at = [&] { return path + ":" + std::to_string(lineNo); };
+    auto integer = [&](const std::string& key, const std::string& value) {
+        char* end = nullptr;
+        const long v = std::strtol(value.c_str(), &end, 10);
+        if (value.empty() || *end || v < 0)
+            throw InputError(at() + ": header '" + key + "=" + value + "': expected a whole number >= 0");
+        return v;
+    };
+    while (std::getline(in, line)) {
+        ++lineNo;
+        if (!line.empty() && line.back() == '\r') line.pop_back();
+        if (lineNo == 1) {
+            h.name = line;
+            continue;
+        }
+        if (line == "endheader") {
+            ended = true;
+            break;
+        }
+        const auto eq = line.find('=');
+        if (eq == std::string::npos) continue;  // free-text header lines are allowed
+        const std::string key = line.substr(0, eq), value = line.substr(eq + 1);
+        if (key == "version") h.version = int(integer(key, value));
+        else if (key == "nRows") nRows = integer(key, value);
+        else if (key == "nColumns") nColumns = integer(key, value);
+        else if (key == "inDegrees") {
+            if (value != "yes" && value != "no")
+                throw InputError(at() + ": header 'inDegrees=" + value + "': expected yes or no");
+            h.inDegrees = value == "yes";
+        }
+    }
+    if (!ended) throw InputError(path + ": no 'endheader' line: not an OpenSim storage file");
+    if (nRows < 0 || nColumns < 0)
+        throw InputError(path + ": header lacks nRows= or nColumns= (required before endheader)");
+    if (!std::getline(in, line)) throw InputError(path + ": no column labels after endheader");
+    ++lineNo;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    std::vector<std::string> names;
+    for (std::size_t b = 0;;) {
+        const std::size_t e = line.find('\t', b);
+        names.push_back(line.substr(b, e == std::string::npos ? std::string::npos : e - b));
+        if (e == std::string::npos) break;
+        b = e + 1;
+    }
+    if (names.front() != "time")
+        throw InputError(at() + ": first column label is '" + names.front() + "': expected 'time'");
+    if (long(names.size()) != nColumns)
+        throw InputError(at() + ": " + std::to_string(names.size()) + " column labels, header says nColumns=" +
+                         std::to_string(nColumns));
+    Table t(names);
+    while (std::getline(in, line)) {
+        ++lineNo;
+        if (!line.empty() && line.back() == '\r') line.pop_back();
+        if (line.empty()) continue;
+        std::vector<double> row;
+        const char* p = line.c_str();
+        for (std::size_t c = 0; c < names.size(); ++c) {
+            char* end = nullptr;
+            const double v = std::strtod(p, &end);
+            if (end == p || (*end && *end != '\t'))
+                throw InputError(at() + ": column '" + names[c] + "': expected a number");
+            row.push_back(v);
+            p = *end ? end + 1 : end;
+            if (c + 1 < names.size() && end == p)
+                throw InputError(at() + ": " + std::to_string(c + 1) + " values, expected " +
+                                 std::to_string(names.size()));
+        }
+        if (*p) throw InputError(at() + ": more values than the " + std::to_string(names.size()) + " columns");
+        t.appendRow(std::move(row));
+    }
+    if (t.getNumRows() != nRows)
+        throw InputError(path + ": " + std::to_string(t.getNumRows()) + " data rows, header says nRows=" +
+                         std::to_string(nRows));
+    if (header) *header = h;
+    return t;
+}
+
+}  // namespace armsim

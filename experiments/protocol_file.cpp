@@ -1,0 +1,274 @@
+#include "experiments/protocol.h"
+
+#include "model/geometry.h"
+#include "muscles/muscle_file.h"
+#include "muscles/param_file.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+namespace fs = std::filesystem;
+
+namespace armsim {
+
+namespace {
+
+std::string fmt(const char* format, double v) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, format, v);
+    return buf;
+}
+
+std::string readText(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw InputError(path + ": cannot open file (does it exist and is it readable?)");
+    std::stringstream s;
+    s << in.rdbuf();
+    return s.str();
+}
+
+// ---- Reading --------------------------------------------------------------------------------------
+
+std::vector<double> readRange(const ParamNode& parent, const std::string& key, const Bound& bound) {
+    const ParamNode r = parent.child(key);
+    const double from = r.getNumber("from", bound), to = r.getNumber("to", bound);
+    const double step = r.getNumber("step", Bound::positive(bound.unit));
+    r.finish();
+    if (to < from)
+        throw InputError(r.where("to") + ": field '" + r.path("to") + "' is below 'from': expected from <= to");
+    std::vector<double> v;
+    for (int k = 0;; ++k) {
+        const double x = from + k * step;
+        if (x > to + 1e-9 * std::max(1.0, std::abs(to))) break;
+        v.push_back(std::min(x, to));
+        if (v.size() > 10000)
+            throw InputError(r.where("step") + ": field '" + r.path("step") + "' gives more than 10000 values");
+    }
+    return v;
+}
+
+std::vector<double> requireNonEmpty(const ParamNode& n, const std::string& key, std::vector<double> v,
+                                    const char* what) {
+    if (v.empty())
+        throw InputError(n.where(key) + ": field '" + n.path(key) + "' is empty: expected at least one " + what);
+    return v;
+}
+
+/// Maps EmgAcquisitionSettings' field names to the protocol's keys.
+std::string acquisitionKey(const std::string& field) {
+    static const std::map<std::string, std::string> keys = {
+        {"gain", "gain"},
+        {"outputRate", "output_rate"},
+        {"bandHigh", "band_high"},
+        {"bandLow", "band_low"},
+        {"bandOrder", "band_order"},
+        {"mainsFrequency", "mains_frequency"},
+        {"notchQuality", "notch_quality"},
+        {"antiAliasCutoff", "anti_alias_cutoff"},
+        {"antiAliasOrder", "anti_alias_order"},
+        {"mainsAmplitude", "mains_amplitude"},
+        {"electrodeNoiseRms", "electrode_noise_rms"}};
+    const auto it = keys.find(field);
+    return it == keys.end() ? field : it->second;
+}
+
+void readEmg(const ParamNode& n, Protocol& p) {
+    const Bound any = Bound::any();
+    SurfaceEmgSettings& e = p.emg;
+    EmgAcquisitionSettings& a = e.acquisition;
+    p.emgEnabled = n.getBool("enabled", true);
+    e.internalRate = n.getNumber("internal_rate", Bound::positive("Hz"), e.internalRate);
+    e.isiCv = n.getNumber("isi_cv", any, e.isiCv);
+    e.trainsPerUnit = n.getInt("trains_per_unit", 1, 1000, e.trainsPerUnit);
+    e.muapAmplitude = n.getNumber("muap_amplitude", any, e.muapAmplitude);
+    e.muapWidthSlow = n.getNumber("muap_width_slow", any, e.muapWidthSlow);
+    e.muapWidthFast = n.getNumber("muap_width_fast", any, e.muapWidthFast);
+    p.emgRmsWindow = n.getNumber("rms_window", Bound::positive("s"), p.emgRmsWindow);
+    a.gain = n.getNumber("gain", any, a.gain);
+    a.bandLow = n.getNumber("band_low", any, a.bandLow);
+    a.bandHigh = n.getNumber("band_high", any, a.bandHigh);
+    a.bandOrder = n.getInt("band_order", 1, 10, a.bandOrder);
+    a.notch = n.getBool("notch", a.notch);
+    a.notchQuality = n.getNumber("notch_quality", any, a.notchQuality);
+    a.mainsFrequency = n.getNumber("mains_frequency", any, a.mainsFrequency);
+    a.mainsAmplitude = n.getNumber("mains_amplitude", any, a.mainsAmplitude);
+    a.electrodeNoiseRms = n.getNumber("electrode_noise_rms", any, a.electrodeNoiseRms);
+    a.antiAliasCutoff = n.getNumber("anti_alias_cutoff", any, a.antiAliasCutoff);
+    a.antiAliasOrder = n.getInt("anti_alias_order", 1, 20, a.antiAliasOrder);
+    a.zeroPhase = n.getBool("zero_phase", a.zeroPhase);
+    a.outputRate = p.trial.sampleRate;  // the EMG is sampled with the other channels
+    n.finish();
+    try {
+        e.validate();
+    } catch (const FieldError& err) {
+        if (err.getField() == "outputRate")
+            throw InputError(n.where() + ": the EMG output rate is trial.sample_rate = " + fmt("%g", a.outputRate) +
+                             " Hz: " + err.getDetail());
+        n.throwLocated(FieldError(n.path(acquisitionKey(err.getField())), err.getDetail()));
+    }
+}
+
+IsometricTrialSettings readTrialTemplate(const ParamNode& n, const ArmParameters& arm) {
+    IsometricTrialSettings s;
+    s.restDuration = n.getNumber("rest", Bound::positive("s"), s.restDuration);
+    s.riseTime = n.getNumber("rise", Bound::nonNegative("s"), s.riseTime);
+    s.holdDuration = n.getNumber("hold", Bound::positive("s"), s.holdDuration);
+    s.sampleRate = n.getNumber("sample_rate", Bound::positive("Hz"), s.sampleRate);
+    s.averagingWindow = n.getNumber("averaging_window", Bound::positive("s"), std::min(s.averagingWindow, s.holdDuration));
+    s.integration.accuracy = n.getNumber("accuracy", Bound::open(0, 1), s.integration.accuracy);
+    n.finish();
+    s.elbowAngle = degToRad(0.5 * (arm.minElbowAngleDeg + arm.maxElbowAngleDeg));
+    n.rethrowWithLocation([&] { s.validate(arm); });
+    return s;
+}
+
+}  // namespace
+
+std::string getProtocolKindName(ProtocolKind kind) {
+    switch (kind) {
+        case ProtocolKind::Mvc: return "mvc";
+        case ProtocolKind::Submaximal: return "submaximal";
+        case ProtocolKind::ForceLength: return "force_length";
+        case ProtocolKind::Composition: return "composition";
+    }
+    return "?";
+}
+
+Protocol readProtocol(const std::string& path) {
+    Protocol p;
+    p.sourcePath = path;
+    p.sourceText = readText(path);
+    const ParamNode root = ParamNode::loadString(p.sourceText, path);
+    p.name = root.getString("name");
+    if (p.name.empty() || p.name.find_first_of("/\\ \t") != std::string::npos)
+        throw InputError(root.where("name") + ": field 'name' = '" + p.name +
+                         "': expected a non-empty name without spaces or slashes");
+    p.description = root.getString("description", "");
+    root.getString("kind");  // required
+    const std::string kind = root.getChoice("kind", {"mvc", "submaximal", "force_length", "composition"}, "mvc");
+    p.kind = kind == "mvc" ? ProtocolKind::Mvc
+           : kind == "submaximal" ? ProtocolKind::Submaximal
+           : kind == "force_length" ? ProtocolKind::ForceLength
+                                    : ProtocolKind::Composition;
+    const bool armTrials = p.kind != ProtocolKind::Composition;
+
+    if (root.has("subject")) {
+        const ParamNode s = root.child("subject");
+        p.armFile = s.getString("arm", p.armFile);
+        p.muscleFile = s.getString("muscle", p.muscleFile);
+        s.finish();
+    }
+    auto resolve = [&](const std::string& key, const std::string& file) {
+        const std::string relative = root.getDirectory().empty() ? file : root.getDirectory() + "/" + file;
+        if (fs::exists(relative)) return relative;
+        try {
+            return findAsset(file);
+        } catch (const InputError& e) {
+            throw InputError(root.where("subject") + ": field 'subject." + key + "': " + e.what());
+        }
+    };
+    p.armFile = resolve("arm", p.armFile);
+    p.muscleFile = resolve("muscle", p.muscleFile);
+    const ArmSetup subject = loadProtocolSubject(p);
+    const ArmParameters& arm = subject.arm;
+    const double pMax = subject.calcBicepsParameters().maxPathLength;
+
+    if (armTrials) {
+        const double seed = root.getNumber("seed", Bound::closed(0, 9007199254740992.0));
+        if (seed != std::floor(seed))
+            throw InputError(root.where("seed") + ": field 'seed' = " + fmt("%g", seed) + ": expected a whole number");
+        p.seed = std::uint64_t(seed);
+        p.randomOrder = root.getChoice("order", {"random", "listed"}, "random") == "random";
+        p.repetitions = root.getInt("repetitions", 1, 1000, 1);
+        p.interTrialRest = root.getNumber("inter_trial_rest", Bound::nonNegative("s"), 0.0);
+        p.trial = root.has("trial") ? readTrialTemplate(root.child("trial"), arm) : p.trial;
+    }
+
+    const ParamNode c = root.child("conditions");
+    // The moment arm vanishes at full extension, so efforts there have no measurable force.
+    const Bound angle{arm.minElbowAngleDeg, arm.maxElbowAngleDeg, false, true, "deg, the subject's elbow range"};
+    auto toRadians = [](std::vector<double> v) {
+        for (double& a : v) a = degToRad(a);
+        return v;
+    };
+    switch (p.kind) {
+        case ProtocolKind::Mvc:
+            p.elbowAngles = toRadians(requireNonEmpty(c, "elbow_angles_deg", c.getNumbers("elbow_angles_deg", angle), "angle"));
+            p.levels = {1.0};
+            break;
+        case ProtocolKind::Submaximal: {
+            p.elbowAngles = toRadians(requireNonEmpty(c, "elbow_angles_deg", c.getNumbers("elbow_angles_deg", angle), "angle"));
+            std::vector<double> pct = requireNonEmpty(
+                c, "levels_pct_mvc", c.getNumbers("levels_pct_mvc", {0, 100, true, false, "% MVC"}), "level");
+            if (std::find(pct.begin(), pct.end(), 100.0) == pct.end())
+                throw InputError(c.where("levels_pct_mvc") + ": field 'conditions.levels_pct_mvc' lacks 100: the 100 % "
+                                 "MVC trials are the reference of the other levels and of the EMG normalisation");
+            for (double l : pct) p.levels.push_back(l / 100.0);
+            break;
+        }
+        case ProtocolKind::ForceLength: {
+            if (c.has("elbow_angle_range_deg")) p.elbowAngles = toRadians(readRange(c, "elbow_angle_range_deg", angle));
+            p.maxPathLength = c.getNumber("max_path_length", Bound::positive("m"), 0.0);
+            const double limit = p.maxPathLength > 0 ? p.maxPathLength : pMax;
+            if (c.has("path_range"))
+                p.pathLengths = readRange(c, "path_range", {0, limit, true, false,
+                                                           p.maxPathLength > 0 ? "m, up to max_path_length"
+                                                                               : "m, up to the muscle's P_max"});
+            p.levels = {1.0};
+            if (p.elbowAngles.empty() && p.pathLengths.empty())
+                throw InputError(c.where() + ": field 'conditions' has no trials: expected elbow_angle_range_deg "
+                                 "and/or path_range");
+            break;
+        }
+        case ProtocolKind::Composition: {
+            const ParamNode su = c.child("slow_units"), fu = c.child("fast_units");
+            p.slowUnitsFrom = su.getInt("from", 0, 100);
+            p.slowUnitsTo = su.getInt("to", p.slowUnitsFrom, 100);
+            p.fastUnitsFrom = fu.getInt("from", 0, 100);
+            p.fastUnitsTo = fu.getInt("to", p.fastUnitsFrom, 100);
+            su.finish();
+            fu.finish();
+            p.compositionActivation = c.getNumber("activation", Bound::closed(0, 1), p.compositionActivation);
+            p.compositionPath = c.getNumber("path_length", {0, pMax, true, false, "m, up to the muscle's P_max"},
+                                            p.compositionPath);
+            break;
+        }
+    }
+    c.finish();
+
+    if (armTrials && root.has("sensors")) {
+        const ParamNode s = root.child("sensors");
+        if (s.has("transducer")) {
+            const ParamNode t = s.child("transducer");
+            p.transducerNoiseRms = t.getNumber("noise_rms", Bound::nonNegative("N"), 0.0);
+            t.finish();
+        }
+        p.emg.acquisition.outputRate = p.trial.sampleRate;
+        if (s.has("emg")) readEmg(s.child("emg"), p);
+        s.finish();
+    }
+    p.emg.acquisition.outputRate = p.trial.sampleRate;
+    if (armTrials && p.emgEnabled) {
+        try {
+            p.emg.validate();
+        } catch (const FieldError& e) {
+            throw InputError(root.where("trial") + ": trial.sample_rate does not suit the EMG defaults: " + e.what());
+        }
+    }
+    root.finish();
+    return p;
+}
+
+ArmSetup loadProtocolSubject(const Protocol& protocol) {
+    ArmSetup s;
+    s.arm = loadArmParameters(findAsset(protocol.armFile));
+    s.biceps = loadMuscleParameters(findAsset(protocol.muscleFile));
+    return s;
+}
+
+}  // namespace armsim

@@ -1,0 +1,129 @@
+// armsim render and armsim trial --video end to end (no X display): exit codes, the written video
+// and still, and named errors that leave no file behind.
+#include "muscles/table.h"
+#include "tests/render/render_test_util.h"
+
+#include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/videoio.hpp>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <string>
+
+namespace {
+
+using armsim::test::ScratchDir;
+
+constexpr double kFpsTolerance = 1e-6;   // container frame rate vs requested (1/s)
+constexpr double kRest = 0.2, kHold = 0.3;  // recorded isometric trial (s)
+
+struct CommandResult {
+    int exitCode;
+    std::string output;  // stdout and stderr
+};
+
+CommandResult runArmsim(const std::string& args) {
+    const std::string cmd = "env -u DISPLAY " + std::string(ARMSIM_EXE) + " " + args + " 2>&1";
+    std::unique_ptr<FILE, int (*)(FILE*)> pipe(popen(cmd.c_str(), "r"), pclose);
+    std::string out;
+    std::array<char, 4096> buf;
+    while (std::fgets(buf.data(), int(buf.size()), pipe.get())) out += buf.data();
+    const int status = pclose(pipe.release());
+    return {WEXITSTATUS(status), out};
+}
+
+struct VideoInfo {
+    int frames = 0;
+    double fps = 0;
+    cv::Size size;
+};
+
+VideoInfo probe(const std::string& path) {
+    cv::VideoCapture cap(path, cv::CAP_FFMPEG);
+    VideoInfo v;
+    if (!cap.isOpened()) return v;
+    v.fps = cap.get(cv::CAP_PROP_FPS);
+    v.size = cv::Size(int(cap.get(cv::CAP_PROP_FRAME_WIDTH)), int(cap.get(cv::CAP_PROP_FRAME_HEIGHT)));
+    for (cv::Mat f; cap.read(f);) ++v.frames;
+    return v;
+}
+
+int expectedFrames(double duration, double fps) { return int(std::floor(duration * fps + 1e-9)) + 1; }
+
+// Records a short isometric trial into dir/t.csv (and its default video into dir/t.mp4).
+CommandResult recordTrial(const ScratchDir& dir) {
+    return runArmsim("trial --angle 90 --rest " + std::to_string(kRest) + " --hold " + std::to_string(kHold) +
+                     " --rate 100 --out " + dir.file("t.csv") + " --video " + dir.file("t.mp4"));
+}
+
+}  // namespace
+
+TEST(RenderCli, TrialVideoAndRenderOfTheRecordedTable) {
+    ScratchDir dir;
+    const CommandResult trial = recordTrial(dir);
+    ASSERT_EQ(trial.exitCode, 0) << trial.output;
+    const VideoInfo tv = probe(dir.file("t.mp4"));
+    EXPECT_EQ(tv.frames, expectedFrames(kRest + kHold, 30));   // defaults: 30 fps, 1280x720
+    EXPECT_EQ(tv.size, cv::Size(1280, 720));
+
+    const CommandResult r = runArmsim("render " + dir.file("t.csv") + " --out " + dir.file("r.mp4") +
+                                      " --fps 20 --width 320 --height 240 --still-at 0.4 --still " + dir.file("s.png"));
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    const VideoInfo rv = probe(dir.file("r.mp4"));
+    EXPECT_EQ(rv.frames, expectedFrames(kRest + kHold, 20));
+    EXPECT_NEAR(rv.fps, 20, kFpsTolerance);
+    EXPECT_EQ(rv.size, cv::Size(320, 240));
+    const cv::Mat still = cv::imread(dir.file("s.png"));
+    EXPECT_EQ(still.size(), cv::Size(320, 240));
+}
+
+TEST(RenderCli, MissingStateColumnIsANamedErrorAndWritesNothing) {
+    ScratchDir dir;
+    ASSERT_EQ(recordTrial(dir).exitCode, 0);
+    const armsim::Table t = armsim::Table::readCsv(dir.file("t.csv"));
+    std::vector<std::string> names;
+    for (const std::string& n : t.getColumnNames())
+        if (n != "state_feff_3") names.push_back(n);
+    armsim::Table cut(names);
+    for (int i = 0; i < t.getNumRows(); ++i) {
+        std::vector<double> row;
+        for (const std::string& n : names) row.push_back(t.get(i, n));
+        cut.appendRow(row);
+    }
+    cut.writeCsv(dir.file("cut.csv"));
+    const CommandResult r = runArmsim("render " + dir.file("cut.csv") + " --out " + dir.file("cut.mp4") +
+                                      " --still-at 0.1 --still " + dir.file("cut.png"));
+    EXPECT_EQ(r.exitCode, 2) << r.output;
+    EXPECT_NE(r.output.find("'state_feff_3'"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("cut.csv"), std::string::npos) << r.output;
+    std::vector<std::string> files = dir.list();
+    std::sort(files.begin(), files.end());
+    EXPECT_EQ(files, (std::vector<std::string>{"cut.csv", "t.csv", "t.mp4"}));
+}
+
+TEST(RenderCli, BadOptionsAreNamedErrors) {
+    ScratchDir dir;
+    ASSERT_EQ(recordTrial(dir).exitCode, 0);
+    const std::string table = dir.file("t.csv");
+    struct Case {
+        std::string args, expect;
+    };
+    const Case cases[] = {
+        {"--out " + dir.file("a.mp4") + " --codec vp9", "codec"},
+        {"--out " + dir.file("a.mp4") + " --width 0", "width"},
+        {"--out " + dir.file("a.mp4") + " --width 321", "even"},
+        {"--out " + dir.path() + "/missing/a.mp4", "missing"},
+        {"--still-at 9 --still " + dir.file("a.png"), "still_at"},
+        {"", "nothing to write"},
+    };
+    for (const Case& c : cases) {
+        const CommandResult r = runArmsim("render " + table + " " + c.args);
+        EXPECT_EQ(r.exitCode, 2) << c.args << ": " << r.output;
+        EXPECT_NE(r.output.find(c.expect), std::string::npos) << c.args << ": " << r.output;
+    }
+    EXPECT_EQ(dir.list().size(), 2u);   // t.csv and t.mp4 only
+}
