@@ -17,8 +17,8 @@ namespace armsim {
 /// a failed trial. Invalid parameters throw InputError/FieldError, a model that cannot run at all
 /// throws SimulationError; the identifier reports both as a failed evaluation, with the message.
 ///
-/// Two models: SteadyForceModel (the steady isometric solve, this file) and a "faithful" model that
-/// runs the full protocol in the Simbody arm (added in experiments/model by the lead).
+/// Two models: SteadyForceModel (the steady isometric solve, this file) and FaithfulForceModel
+/// (faithful_model.h), which runs the MVC protocol in the Simbody arm through the transducer chain.
 class ForceModel {
 public:
     virtual ~ForceModel() = default;
@@ -27,6 +27,13 @@ public:
                                            const std::vector<Observation>& observations) const = 0;
     /// Short name for reports ("steady", "faithful").
     virtual std::string getName() const = 0;
+    /// Central-difference step for lm's Jacobian, in the unknowns' scaled units (x / scale), suited to
+    /// the model's numerical noise: a step h turns a relative force noise e into a derivative error of
+    /// about e / h. Default 1e-6 for a model solved to round-off.
+    virtual double getDifferenceStep() const { return 1e-6; }
+    /// lm stops when a step changes the scaled unknowns by less than this (Ceres parameter_tolerance);
+    /// below the model's noise a smaller value only buys rejected steps. Default 1e-12.
+    virtual double getParameterTolerance() const { return 1e-12; }
 };
 
 /// The steady isometric force: VirtualMuscle::calcSteadyState(P, U).force (spec section 6), i.e. the

@@ -38,6 +38,9 @@ void validateOptions(const IdentificationOptions& o) {
     if (!std::isnan(o.relativeForceSd)) checkField("options.relative_force_sd", o.relativeForceSd, Bound::positive());
     checkField("options.confidence_level", o.confidenceLevel, Bound::open(0, 1));
     checkField("options.starts", o.starts, Bound::closed(1, 1e6));
+    if (!std::isnan(o.differenceStep)) checkField("options.difference_step", o.differenceStep, Bound::open(0, 1));
+    if (!std::isnan(o.parameterTolerance))
+        checkField("options.parameter_tolerance", o.parameterTolerance, Bound::open(0, 1));
 }
 
 }  // namespace
@@ -214,10 +217,15 @@ IdentificationReport identify(const IdentificationProblem& problem, const ForceM
     const int distinct = data.countDistinctPoints();
     std::string names;
     for (const std::string& s : map.getNames()) names += (names.empty() ? "" : ", ") + s;
-    if (options.method != Method::IlcStandard && distinct < p)
-        throw InputError(data.source + ": " + std::to_string(distinct) + " distinct (path, activation) point(s) for " +
+    if (options.method != Method::IlcStandard && distinct < p) {
+        std::string lines;
+        for (int k = 0; k < n && k < 5; ++k) lines += (k ? ", " : "") + data.where(k);
+        if (n > 5) lines += ", ...";
+        throw InputError(data.source + ": " + std::to_string(distinct) + " distinct (path, activation) point(s) (" +
+                         lines + ") for " +
                          std::to_string(p) + " unknowns (" + names +
                          "): expected at least as many distinct points as unknowns");
+    }
     switch (options.method) {
         case Method::FalsePosition:
             if (p != 1 || n != 1)
@@ -311,6 +319,55 @@ IdentificationReport identify(const IdentificationProblem& problem, const ForceM
     if (report.history.empty()) report.history = ctx.takeHistory();
     report.wallTime = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     return report;
+}
+
+IdentificationReport identifyWarmStarted(const IdentificationProblem& problem, const ForceModel& warmModel,
+                                         const ForceModel& model, const IdentificationOptions& options) {
+    IdentificationOptions warmOptions = options;
+    warmOptions.method = Method::LevenbergMarquardt;
+    warmOptions.differenceStep = warmOptions.parameterTolerance = std::numeric_limits<double>::quiet_NaN();
+    const IdentificationReport warm = identify(problem, warmModel, warmOptions);
+    IdentificationProblem second = problem;
+    std::string how;
+    if (warm.isConverged()) {
+        for (std::size_t j = 0; j < second.unknowns.size(); ++j) second.unknowns[j].start = warm.parameters[j].value;
+        how = "started from the " + warmModel.getName() + "-model lm estimate (" + std::to_string(warm.iterations) +
+              " iterations, " + std::to_string(warm.forwardEvaluations) + " evaluations, " + fmt(warm.wallTime) +
+              " s)";
+    } else {
+        how = "the " + warmModel.getName() + "-model warm start did not converge (" +
+              getStopReasonName(warm.stopReason) + "), started from the given starts";
+    }
+    IdentificationReport report = identify(second, model, options);
+    for (std::size_t j = 0; j < report.parameters.size(); ++j) report.parameters[j].start = problem.unknowns[j].start;
+    report.message += "; " + how;
+    report.wallTime += warm.wallTime;
+    return report;
+}
+
+void addModelCheck(IdentificationReport& report, const ForceModel& model, const std::string& note) {
+    ModelCheck c;
+    c.model = model.getName();
+    c.note = note;
+    const std::size_t n = report.observations.size();
+    c.forces.assign(n, std::numeric_limits<double>::quiet_NaN());
+    c.residuals = c.forces;
+    try {
+        const std::vector<double> y = model.calcForces(report.muscle, report.observations);
+        if (y.size() != n) throw SimulationError("returned " + std::to_string(y.size()) + " forces for " +
+                                                 std::to_string(n) + " observations");
+        double ssr = 0;
+        for (std::size_t k = 0; k < n; ++k) {
+            c.forces[k] = y[k];
+            c.residuals[k] = y[k] - report.observations[k].force;
+            ssr += c.residuals[k] * c.residuals[k];
+        }
+        c.rmsResidual = std::sqrt(ssr / double(n));
+        if (!std::isfinite(c.rmsResidual)) c.failure = "no solution at some observation (NaN force)";
+    } catch (const std::exception& e) {
+        c.failure = e.what();
+    }
+    report.checks.push_back(std::move(c));
 }
 
 }  // namespace armsim

@@ -51,8 +51,11 @@
 // 0.1 N).
 //
 // "lm"  Levenberg-Marquardt (Ceres) on the scaled unknowns with bounds (SetParameterLowerBound /
-//     UpperBound). Derivatives: "central" (armsim's cost function returns the Jacobian from central
-//     differences of the forward model, one-sided at a bound) or "ceres-numeric" (Ceres's
+//     UpperBound; steps are projected onto the bounds, without Ceres's projected line search, which
+//     costs a Jacobian per trial step). Difference step and parameter tolerance come from the
+//     ForceModel (steady: 1e-6, 1e-12; faithful: 1e-3, 1e-5, matched to its integration noise).
+//     Derivatives: "central" (armsim's cost function returns the Jacobian from central differences
+//     of the forward model, one-sided at a bound) or "ceres-numeric" (Ceres's
 //     DynamicNumericDiffCostFunction, central). Noise model "absolute" fits r_k [N]; "relative" fits
 //     r_k / y_d,k (force errors proportional to the force, e.g. "2 % noise"). Uncertainty from
 //     ceres::Covariance (J^T J)^{-1} of the weighted residuals, times s^2 = SSR / (n - p) with
@@ -118,6 +121,8 @@ struct IdentificationOptions {
     double probeStep = 0.01;         ///< secant ILC: initial one-at-a-time trials change x_j by this * scale_j
     int stallIterations = 50;        ///< ILC "no-progress" after this many iterations without a lower cost
     Derivatives derivatives = Derivatives::Central;   ///< lm
+    double differenceStep = 0.0 / 0.0;      ///< lm: central-difference step [scaled]; NaN: ForceModel::getDifferenceStep()
+    double parameterTolerance = 0.0 / 0.0;  ///< lm: Ceres parameter_tolerance; NaN: ForceModel::getParameterTolerance()
     NoiseModel noise = NoiseModel::Absolute;  ///< lm: residual weighting
     double forceSd = 0.0 / 0.0;      ///< lm, absolute noise: known force sd [N]; NaN: estimate from residuals (n > p)
     double relativeForceSd = 0.0 / 0.0;  ///< lm, relative noise: known sd / force [1]; NaN: estimate (n > p)
@@ -158,6 +163,17 @@ struct IterationRecord {
     double cost = 0;                   ///< 0.5 sum r^2 [N^2]
 };
 
+/// A forward model's forces at a run's estimate: the re-check of an estimate with a second model
+/// (e.g. the faithful model at the full protocol after iterations with a cheaper one).
+struct ModelCheck {
+    std::string model;               ///< ForceModel::getName()
+    std::string note;                ///< the model and its settings in words (e.g. FaithfulForceModel::describe()); empty: the name
+    std::vector<double> forces;      ///< model forces at the estimate [N] (NaN where it failed)
+    std::vector<double> residuals;   ///< model - measured [N]
+    double rmsResidual = 0.0 / 0.0;  ///< [N]
+    std::string failure;             ///< why the model failed (empty: it ran)
+};
+
 /// Everything a run produced.
 struct IdentificationReport {
     std::string method;                   ///< method name
@@ -185,6 +201,7 @@ struct IdentificationReport {
     std::vector<std::vector<double>> correlation;  ///< p x p [1]
     std::vector<double> startCosts;       ///< lm multi-start: final cost of every start [N^2]
     std::vector<IterationRecord> history; ///< of the run (the best start for lm)
+    std::vector<ModelCheck> checks;       ///< re-checks of the estimate with other models (addModelCheck)
 
     bool isConverged() const { return stopReason == StopReason::Converged; }
 };
@@ -202,6 +219,44 @@ struct IdentificationProblem {
 /// Solver trouble never throws: it is reported in stopReason and message.
 IdentificationReport identify(const IdentificationProblem& problem, const ForceModel& model,
                               const IdentificationOptions& options = {});
+
+/// Identifies with `model` starting from the estimate of a cheap `warmModel` (lm on the same
+/// problem, the unknowns' starts as given): an expensive model then only walks the last few
+/// iterations. The warm estimate is used only when the warm run converged; otherwise the given
+/// starts are kept (the message says which). The report is the second run's: its counts are the
+/// expensive model's, its wallTime covers both runs and its message names the warm run's cost.
+IdentificationReport identifyWarmStarted(const IdentificationProblem& problem, const ForceModel& warmModel,
+                                         const ForceModel& model, const IdentificationOptions& options = {});
+
+/// Settings of identifyCorrected.
+struct CorrectionOptions {
+    int maxCorrections = 10;    ///< expensive-model evaluations at most
+    /// Stop when no unknown moves by more than this * its scale between corrections; NaN: the
+    /// expensive model's getParameterTolerance() (below it the corrections only chase its noise).
+    double tolerance = 0.0 / 0.0;
+};
+
+/// Output correction (defect correction, a form of space mapping): identifies with the cheap model
+/// shifted by the expensive model's offset at the current estimate, c_j = fine(x_j) - cheap(x_j),
+/// then re-evaluates the expensive model at the new estimate, until the estimate stops moving. Each
+/// correction costs one expensive evaluation, whatever the method: five-angle identification with
+/// the faithful model in ~3-4 faithful evaluations for every method. The fixed point x* minimises
+/// ||cheap(x) + c* - y_d||; where the data can be reproduced (noise-free, or n = p) that is exactly
+/// the expensive model's solution, otherwise it differs from the expensive model's own least-squares
+/// point by a term in the difference of the two models' Jacobians (small when the offset varies
+/// slowly with x, as the tare and transient offsets do).
+/// Report: method as given, forceModel "<fine> (corrected <cheap>)", residuals and modelForces of the
+/// expensive model, iterations = the inner runs' iterations, forwardEvaluations = expensive
+/// evaluations, history = one record per correction (expensive residuals), uncertainty from the last
+/// inner run (the cheap model's Jacobian). Stop reason: the last inner run's, or max-iterations when
+/// the corrections did not settle.
+IdentificationReport identifyCorrected(const IdentificationProblem& problem, const ForceModel& cheap,
+                                       const ForceModel& fine, const IdentificationOptions& options = {},
+                                       const CorrectionOptions& correction = {});
+
+/// Evaluates `model` at report.muscle for report.observations and appends the forces and residuals
+/// to report.checks; a model failure is recorded in ModelCheck::failure, never thrown.
+void addModelCheck(IdentificationReport& report, const ForceModel& model, const std::string& note = "");
 
 /// Unknowns with default settings from names ("mass", "optimal_tendon_length", ...).
 std::vector<Unknown> makeUnknowns(const std::vector<std::string>& names);

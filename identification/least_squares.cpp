@@ -14,7 +14,15 @@ namespace armsim::detail {
 
 namespace {
 
-constexpr double kFiniteDifferenceStep = 1e-6;   // in scaled units (z ~ 1)
+/// Central-difference step in scaled units (z ~ 1): the option, else the model's suggestion.
+double getDifferenceStep(const SolverContext& ctx) {
+    return std::isnan(ctx.options.differenceStep) ? ctx.model.getDifferenceStep() : ctx.options.differenceStep;
+}
+
+double getParameterTolerance(const SolverContext& ctx) {
+    return std::isnan(ctx.options.parameterTolerance) ? ctx.model.getParameterTolerance()
+                                                      : ctx.options.parameterTolerance;
+}
 
 /// Residual weights of the noise model: 1, or 1 / measured force.
 std::vector<double> calcWeights(const SolverContext& ctx) {
@@ -40,7 +48,7 @@ std::string fmt(double v) {
 /// r(z) = model(x = z * scale) - measured, with the Jacobian from central differences.
 class ForceCostFunction : public ceres::CostFunction {
 public:
-    explicit ForceCostFunction(SolverContext& ctx) : ctx_(ctx), w_(calcWeights(ctx)) {
+    explicit ForceCostFunction(SolverContext& ctx) : ctx_(ctx), w_(calcWeights(ctx)), step_(getDifferenceStep(ctx)) {
         set_num_residuals(ctx.getNumObservations());
         mutable_parameter_block_sizes()->push_back(ctx.getNumUnknowns());
     }
@@ -55,7 +63,7 @@ public:
         const std::vector<double> hi = ctx_.map.toScaled(ctx_.map.getUpper());
         std::vector<double> rPlus, rMinus;
         for (int j = 0; j < p; ++j) {
-            const double h = kFiniteDifferenceStep * std::max(1.0, std::abs(z[j]));
+            const double h = step_ * std::max(1.0, std::abs(z[j]));
             std::vector<double> zp = z, zm = z;
             zp[j] = std::min(z[j] + h, hi[j]);
             zm[j] = std::max(z[j] - h, lo[j]);
@@ -72,6 +80,7 @@ public:
 private:
     SolverContext& ctx_;
     std::vector<double> w_;
+    double step_;
 };
 
 /// The same residuals for Ceres's own numeric differentiation.
@@ -122,7 +131,10 @@ Run runFrom(SolverContext& ctx, const std::vector<double>& xStart) {
     if (ctx.options.derivatives == Derivatives::Central) {
         cost = new ForceCostFunction(ctx);
     } else {
-        auto* numeric = new ceres::DynamicNumericDiffCostFunction<ForceResidual, ceres::CENTRAL>(new ForceResidual{&ctx, calcWeights(ctx)});
+        ceres::NumericDiffOptions nd;
+        nd.relative_step_size = getDifferenceStep(ctx);
+        auto* numeric = new ceres::DynamicNumericDiffCostFunction<ForceResidual, ceres::CENTRAL>(
+            new ForceResidual{&ctx, calcWeights(ctx)}, ceres::TAKE_OWNERSHIP, nd);
         numeric->AddParameterBlock(ctx.getNumUnknowns());
         numeric->SetNumResiduals(ctx.getNumObservations());
         cost = numeric;
@@ -142,7 +154,11 @@ Run runFrom(SolverContext& ctx, const std::vector<double>& xStart) {
     so.max_num_iterations = ctx.options.maxIterations;
     so.function_tolerance = 1e-14;
     so.gradient_tolerance = 1e-14;
-    so.parameter_tolerance = 1e-12;
+    so.parameter_tolerance = getParameterTolerance(ctx);
+    // No projected line search after each step (Ceres's default for bounded problems): it evaluates the
+    // Jacobian at every trial step size, 2p extra model runs each, and the bounds are still enforced by
+    // projecting the step. Measured on five angles: steady lm 35 -> 20 evaluations, faithful 35 -> 20.
+    so.max_num_line_search_step_size_iterations = 0;
     so.num_threads = 1;
     so.logging_type = ceres::SILENT;
     so.minimizer_progress_to_stdout = false;

@@ -77,6 +77,15 @@ nlohmann::json toJson(const IdentificationReport& r) {
     u["correlation"] = cor;
     j["uncertainty"] = u;
     j["start_costs_N2"] = numbers(r.startCosts);
+    nlohmann::json checks = nlohmann::json::array();
+    for (const ModelCheck& c : r.checks)
+        checks.push_back({{"model", c.model},
+                          {"note", c.note},
+                          {"forces_N", numbers(c.forces)},
+                          {"residuals_N", numbers(c.residuals)},
+                          {"rms_residual_N", number(c.rmsResidual)},
+                          {"failure", c.failure}});
+    j["model_checks"] = checks;
     j["history_length"] = r.history.size();
     return j;
 }
@@ -165,6 +174,20 @@ std::string formatReport(const IdentificationReport& r) {
     std::snprintf(buf, sizeof buf, "rms residual %.4g N, %d iterations, %d forward evaluations, %.3g s\n",
                   r.rmsResidual, r.iterations, r.forwardEvaluations, r.wallTime);
     s << buf;
+    for (const ModelCheck& c : r.checks) {
+        s << "re-check with the " << (c.note.empty() ? c.model + " model" : c.note) << ": ";
+        if (!c.failure.empty()) {
+            s << "failed: " << c.failure << "\n";
+            continue;
+        }
+        std::snprintf(buf, sizeof buf, "rms residual %.4g N; residuals", c.rmsResidual);
+        s << buf;
+        for (double v : c.residuals) {
+            std::snprintf(buf, sizeof buf, " %+.3f", v);
+            s << buf;
+        }
+        s << " N\n";
+    }
     return s.str();
 }
 

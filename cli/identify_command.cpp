@@ -1,0 +1,435 @@
+// armsim identify: muscle mass and optimal tendon length (or other parameters) from measured MVC forces,
+// with the steady or the faithful forward model; armsim validate: the identifiers against ground truth
+// on synthetic MVC data; and the main-job step that identifies the thesis's and our own MVC data.
+#include "cli/commands.h"
+#include "identification/faithful_model.h"
+#include "identification/identifier.h"
+#include "identification/report_io.h"
+#include "identification/thesis_cases.h"
+#include "identification/validation.h"
+#include "model/biceps_arm.h"
+#include "model/geometry.h"
+#include "muscles/muscle_file.h"
+#include "muscles/param_file.h"
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <sstream>
+
+namespace armsim::cli {
+
+namespace {
+
+constexpr double kThesisMeasuredMass = 0.3377;          // kg, thesis Table 7.3
+constexpr double kThesisMeasuredTendonLength = 0.244;   // m, thesis Table 7.3
+
+double parseNumber(const std::string& option, const std::string& text) {
+    std::size_t used = 0;
+    double v = 0;
+    try {
+        v = std::stod(text, &used);
+    } catch (const std::exception&) {
+        used = 0;
+    }
+    if (used != text.size() || text.empty() || !std::isfinite(v))
+        throw InputError(option + " '" + text + "': expected a finite number");
+    return v;
+}
+
+std::vector<std::string> splitList(const std::string& text) {
+    std::vector<std::string> items;
+    std::stringstream s(text);
+    for (std::string item; std::getline(s, item, ',');)
+        if (!item.empty()) items.push_back(item);
+    return items;
+}
+
+/// Parameter name with the short aliases of the command line (tendon_length, fascicle_length).
+ParameterId parseParameter(const std::string& option, const std::string& name) {
+    const std::string full = name == "tendon_length" ? "optimal_tendon_length"
+                             : name == "fascicle_length" ? "optimal_fascicle_length"
+                                                         : name;
+    try {
+        return parseParameterName(full);
+    } catch (const InputError& e) {
+        throw InputError(option + ": " + e.what() + " (or the aliases tendon_length, fascicle_length)");
+    }
+}
+
+/// "name=value" -> (name, value).
+std::pair<std::string, std::string> splitAssignment(const std::string& option, const std::string& text) {
+    const auto eq = text.find('=');
+    if (eq == std::string::npos || eq == 0)
+        throw InputError(option + " '" + text + "': expected name=value");
+    return {text.substr(0, eq), text.substr(eq + 1)};
+}
+
+struct ModelOptions {
+    std::string model = "steady";
+    std::string estimate = "moment-arm";
+    double hold = 3.0, rate = 200.0;
+    bool noWarmStart = false;
+    int jobs = 2;
+
+    void add(CLI::App& c, bool withModel) {
+        if (withModel)
+            c.add_option("--model", model, "forward model: steady | faithful (Simbody arm in the loop) | corrected "
+                                           "(steady iterations corrected by the faithful model)")
+                ->capture_default_str()
+                ->check(CLI::IsMember({"steady", "faithful", "corrected"}));
+        c.add_option("--estimate", estimate, "faithful: force the experimenter reports: moment-arm | fixed-ratio | true")
+            ->capture_default_str()
+            ->check(CLI::IsMember({"moment-arm", "fixed-ratio", "true"}));
+        c.add_option("--hold", hold, "faithful: effort duration in iterations [s] (mean of the last third)")
+            ->capture_default_str();
+        c.add_option("--rate", rate, "faithful: transducer sample rate in iterations [Hz]")->capture_default_str();
+        c.add_option("--jobs", jobs, "faithful: trials run in parallel")->capture_default_str()->check(CLI::Range(1, 64));
+    }
+    FaithfulModelOptions makeFast() const {
+        FaithfulModelOptions o;
+        o.estimate = parseForceEstimateName(estimate);
+        o.protocol.holdDuration = hold;
+        o.protocol.averagingWindow = std::min(o.protocol.averagingWindow, hold / 3);
+        o.protocol.sampleRate = rate;
+        o.jobs = jobs;
+        return o;
+    }
+    FaithfulModelOptions makeReference() const {
+        FaithfulModelOptions o = makeFast();
+        o.protocol = FaithfulProtocol::makeReference();
+        return o;
+    }
+};
+
+struct IdentifyOptions {
+    MuscleOptions muscle;
+    std::string armFile = "arm/default_male.yaml";
+    std::string data;
+    std::string method = "lm";
+    std::string freeList = "mass,optimal_tendon_length";
+    std::vector<std::string> bounds, starts;
+    ModelOptions model;
+    double forceSd = NAN;
+    std::string noise = "absolute";
+    int multistart = 1;
+    unsigned seed = 1;
+    int maxIterations = 200;
+    double tolerance = 0.1;
+    int subject = -1;
+    bool thesisCases = false;
+    std::string out = "out/identify";
+};
+
+ArmSetup loadSetup(const MuscleOptions& muscle, const std::string& armFile) {
+    ArmSetup s;
+    s.arm = loadArmParameters(findAsset(armFile));
+    s.biceps = muscle.loadParameters();
+    return s;
+}
+
+/// Reads a force file; angle columns are converted with the arm's own geometry.
+ObservationSet readData(const std::string& file, const ArmParameters& arm, int subject) {
+    ObservationOptions oo;
+    const double A = arm.originDistance, B = arm.insertionDistance;
+    oo.pathFromAngle = [A, B](double theta) { return calcBicepsPathLength(A, B, theta); };
+    oo.subject = subject;
+    return readObservations(file, oo);
+}
+
+/// Identifies with the chosen model, then re-checks the estimate with the steady model and with the
+/// faithful model at the reference protocol (1000 Hz).
+IdentificationReport runIdentification(const IdentificationProblem& pr, const IdentificationOptions& o,
+                                       const ArmParameters& arm, const ModelOptions& m, bool verbose = true) {
+    const SteadyForceModel steady;
+    const FaithfulForceModel fast(arm, m.makeFast()), reference(arm, m.makeReference());
+    IdentificationReport r;
+    if (m.model == "steady") {
+        r = identify(pr, steady, o);
+    } else {
+        fast.calcElbowAngles(pr.data);  // InputError naming file and line for a path outside the elbow range
+        if (m.model == "faithful")
+            r = m.noWarmStart ? identify(pr, fast, o) : identifyWarmStarted(pr, steady, fast, o);
+        else
+            r = identifyCorrected(pr, steady, fast, o);
+        if (verbose) std::printf("in the iterations: %s\n", fast.describe().c_str());
+    }
+    addModelCheck(r, steady, "steady model (isometric solve)");
+    addModelCheck(r, reference, reference.describe());
+    return r;
+}
+
+void printThesisCases(const MuscleParameters& base, const ForceModel& model, const std::string& outDir) {
+    const std::vector<ThesisCase> cases = reproduceThesisCases(base, model);
+    std::printf("%s", formatThesisComparison(cases).c_str());
+    std::ostringstream csv;
+    csv << "case,quantity,unit,ours,thesis\n";
+    for (const ThesisComparisonRow& r : collectRows(cases)) {
+        char b[128];
+        std::snprintf(b, sizeof b, ",%.10g,", r.ours);
+        csv << r.caseName << "," << r.quantity << "," << r.unit << b;
+        if (std::isfinite(r.thesis)) csv << r.thesis;
+        csv << "\n";
+    }
+    std::filesystem::create_directories(outDir);
+    const std::string path = outDir + "/thesis_cases_" + model.getName() + ".csv";
+    writeFileAtomically(path, csv.str());
+    std::printf("wrote %s\n", path.c_str());
+}
+
+void runIdentify(const IdentifyOptions& o) {
+    const ArmSetup setup = loadSetup(o.muscle, o.armFile);
+    const MuscleParameters base = setup.calcBicepsParameters();
+    if (o.thesisCases) {
+        if (o.model.model == "corrected")
+            throw InputError("--thesis-cases: --model corrected is not a single forward model; expected steady or faithful");
+        if (o.model.model == "steady") {
+            printThesisCases(base, SteadyForceModel(), o.out);
+        } else {
+            const FaithfulForceModel fast(setup.arm, o.model.makeFast());
+            std::printf("thesis cases with the %s\n", fast.describe().c_str());
+            printThesisCases(base, fast, o.out);
+        }
+        return;
+    }
+    if (o.data.empty()) throw InputError("identify: no data file given: expected DATA.csv or --thesis-cases");
+
+    IdentificationProblem pr;
+    pr.base = base;
+    pr.data = readData(findAsset(o.data), setup.arm, o.subject);
+    pr.unknowns.clear();
+    for (const std::string& name : splitList(o.freeList)) pr.unknowns.push_back(makeUnknown(parseParameter("--free", name)));
+    if (pr.unknowns.empty()) throw InputError("--free '" + o.freeList + "': expected at least one parameter");
+    auto findUnknown = [&](const std::string& option, const std::string& name) -> Unknown& {
+        const ParameterId id = parseParameter(option, name);
+        for (Unknown& u : pr.unknowns)
+            if (u.id == id) return u;
+        throw InputError(option + " " + name + ": not a free parameter (--free " + o.freeList + ")");
+    };
+    for (const std::string& b : o.bounds) {
+        const auto [name, range] = splitAssignment("--bounds", b);
+        const auto colon = range.find(':');
+        if (colon == std::string::npos) throw InputError("--bounds '" + b + "': expected name=lo:hi");
+        Unknown& u = findUnknown("--bounds", name);
+        u.lower = parseNumber("--bounds " + name + " lower", range.substr(0, colon));
+        u.upper = parseNumber("--bounds " + name + " upper", range.substr(colon + 1));
+    }
+    for (const std::string& s : o.starts) {
+        const auto [name, value] = splitAssignment("--start", s);
+        findUnknown("--start", name).start = parseNumber("--start " + name, value);
+    }
+
+    IdentificationOptions io;
+    io.method = parseMethodName(o.method);
+    io.forceSd = o.forceSd;
+    io.noise = parseNoiseModelName(o.noise);
+    if (io.noise == NoiseModel::Relative && !std::isnan(o.forceSd)) io.relativeForceSd = o.forceSd, io.forceSd = NAN;
+    io.starts = o.multistart;
+    io.seed = o.seed;
+    io.maxIterations = o.maxIterations;
+    io.forceTolerance = o.tolerance;
+
+    const IdentificationReport r = runIdentification(pr, io, setup.arm, o.model);
+    std::printf("%s", formatReport(r).c_str());
+    std::filesystem::create_directories(o.out);
+    for (const std::string& p : writeReportFiles(r, o.out)) std::printf("wrote %s\n", p.c_str());
+}
+
+void addIdentifyCommand(CLI::App& app) {
+    auto o = std::make_shared<IdentifyOptions>();
+    CLI::App* c = app.add_subcommand("identify", "identify muscle parameters (default: mass and optimal tendon length) "
+                                                 "from measured isometric forces");
+    c->add_option("data", o->data, "force CSV: path_m | path_cm | angle_deg, force_N [, trial, subject, activation]");
+    c->add_option("--method", o->method, "lm | false-position | ilc-standard | ilc-constant | ilc-secant | "
+                                         "ilc-bounded-secant | ilc-sign-search")
+        ->capture_default_str()
+        ->check(CLI::IsMember(getMethodNames()));
+    c->add_option("--free", o->freeList, "comma-separated unknowns (mass, tendon_length, fascicle_length, "
+                                         "slow_fraction, max_path_length)")
+        ->capture_default_str();
+    c->add_option("--bounds", o->bounds, "name=lo:hi in SI units, repeatable");
+    c->add_option("--start", o->starts, "name=value in SI units, repeatable");
+    o->model.add(*c, true);
+    c->add_flag("--no-warm-start", o->model.noWarmStart, "faithful: start from --start, not from the steady estimate");
+    c->add_option("--force-sd", o->forceSd, "lm: known force sd [N] (relative noise: fraction of the force)");
+    c->add_option("--noise", o->noise, "lm noise model: absolute | relative")
+        ->capture_default_str()
+        ->check(CLI::IsMember({"absolute", "relative"}));
+    c->add_option("--multistart", o->multistart, "lm: starts (the first at --start, others seeded uniform in the bounds)")
+        ->capture_default_str()
+        ->check(CLI::Range(1, 10000));
+    c->add_option("--seed", o->seed, "lm multi-start seed")->capture_default_str();
+    c->add_option("--max-iterations", o->maxIterations, "solver iterations")->capture_default_str();
+    c->add_option("--tolerance", o->tolerance, "force tolerance [N] (forces reproduced)")->capture_default_str();
+    c->add_option("--subject", o->subject, "keep only this subject's rows (-1: all)")->capture_default_str();
+    c->add_flag("--thesis-cases", o->thesisCases, "rerun the thesis's cases (4.5.1, Tables 7.1-7.3) beside its numbers");
+    c->add_option("--arm", o->armFile, "arm parameter file (path, or name under assets/)")->capture_default_str();
+    o->muscle.add(*c);
+    c->add_option("--out", o->out, "output directory (report JSON, history CSV, convergence PNG)")->capture_default_str();
+    c->callback([o] { runIdentify(*o); });
+}
+
+// ---- validate -----------------------------------------------------------------------------------
+
+struct ValidateOptions {
+    MuscleOptions muscle;
+    std::string armFile = "arm/default_male.yaml";
+    int seeds = 1;
+    unsigned seed = 1;
+    std::string noise = "0,1,2,5";
+    std::string methods;
+    std::string model = "corrected";
+    std::string estimate = "moment-arm";
+    int jobs = 2;
+    std::string out = "out/validate";
+};
+
+void runValidate(const ValidateOptions& o) {
+    const ArmSetup setup = loadSetup(o.muscle, o.armFile);
+    ValidationSettings s;
+    s.seeds = o.seeds;
+    s.seed = o.seed;
+    s.noiseLevels.clear();
+    for (const std::string& v : splitList(o.noise)) s.noiseLevels.push_back(parseNumber("--noise", v) / 100.0);
+    for (const std::string& m : splitList(o.methods)) s.methods.push_back(parseMethodName(m));
+    s.model = parseValidationModelName(o.model);
+    s.estimate = parseForceEstimateName(o.estimate);
+    s.jobs = o.jobs;
+    s.validate(setup.arm);
+    std::printf("validation: data from the faithful model (thesis protocol, 1000 Hz, %s estimate) at %zu angles, "
+                "identified with the %s model, start 330 g / 22 cm\n",
+                o.estimate.c_str(), s.anglesDeg.size(), o.model.c_str());
+    std::fflush(stdout);
+    const std::vector<ValidationRow> rows = runValidation(setup.arm, setup.calcBicepsParameters(), s,
+                                                          [](int d, int n) { printProgress("identifications", d, n); });
+    std::printf("%s", formatValidationTable(rows).c_str());
+    std::filesystem::create_directories(o.out);
+    const std::string path = o.out + "/validation.csv";
+    writeFileAtomically(path, formatValidationCsv(rows));
+    std::printf("wrote %s\n", path.c_str());
+}
+
+void addValidateCommand(CLI::App& app) {
+    auto o = std::make_shared<ValidateOptions>();
+    CLI::App* c = app.add_subcommand("validate", "identifiers vs ground truth on synthetic MVC data (faithful model, "
+                                                 "transducer noise)");
+    c->add_option("--seeds", o->seeds, "random true muscles besides the thesis's")->capture_default_str();
+    c->add_option("--seed", o->seed, "generator seed (truths and noise)")->capture_default_str();
+    c->add_option("--noise", o->noise, "comma-separated transducer noise levels [% of the force]")->capture_default_str();
+    c->add_option("--methods", o->methods, "comma-separated methods (default: lm and the two-output learning family)");
+    c->add_option("--model", o->model, "identifying model: corrected | faithful | steady")
+        ->capture_default_str()
+        ->check(CLI::IsMember({"steady", "faithful", "corrected"}));
+    c->add_option("--estimate", o->estimate, "force the experimenter reports: moment-arm | fixed-ratio | true")
+        ->capture_default_str()
+        ->check(CLI::IsMember({"moment-arm", "fixed-ratio", "true"}));
+    c->add_option("--jobs", o->jobs, "trials run in parallel")->capture_default_str()->check(CLI::Range(1, 64));
+    c->add_option("--arm", o->armFile, "arm parameter file")->capture_default_str();
+    o->muscle.add(*c);
+    c->add_option("--out", o->out, "output directory (validation.csv)")->capture_default_str();
+    c->callback([o] { runValidate(*o); });
+}
+
+// ---- main job -----------------------------------------------------------------------------------
+
+void printEstimateLine(const std::string& label, const IdentificationReport& r, double mass, double tendon,
+                       const std::string& reference) {
+    const ModelCheck* faithful = nullptr;
+    for (const ModelCheck& c : r.checks)
+        if (c.model == "faithful") faithful = &c;
+    std::printf("  %-34s %8.2f g %7.3f cm   (%s %.2f g, %.3f cm)  %-14s %3d it %4d ev %6.2f s  rms %.3g N "
+                "(faithful re-check %.3g N)\n",
+                label.c_str(), 1000 * r.parameters[0].value, 100 * r.parameters[1].value, reference.c_str(),
+                1000 * mass, 100 * tendon, getStopReasonName(r.stopReason).c_str(), r.iterations,
+                r.forwardEvaluations, r.wallTime, r.rmsResidual, faithful ? faithful->rmsResidual : NAN);
+}
+
+void runIdentificationStep(const MainJobContext& ctx) {
+    const ArmSetup setup = loadSetup(ctx.muscle, "arm/default_male.yaml");
+    const MuscleParameters base = setup.calcBicepsParameters();
+    ModelOptions faithful;
+    faithful.model = "faithful";
+    faithful.jobs = ctx.jobs;
+    ModelOptions steadyOnly = faithful;
+    steadyOnly.model = "steady";
+    const std::string dir = ctx.outDir + "/identification";
+    std::filesystem::create_directories(dir);
+    auto problemFor = [&](const ObservationSet& data) {
+        IdentificationProblem pr;
+        pr.base = base;
+        pr.data = data;
+        pr.unknowns[0].start = 0.330;  // thesis start (Tables 7.2, 7.3)
+        pr.unknowns[1].start = 0.22;
+        return pr;
+    };
+
+    // 1. The thesis's measured forces (600 N at 41 cm, 458 N at 37.5 cm).
+    std::printf("faithful model in the iterations: %s; re-checks at 1000 Hz\n",
+                FaithfulForceModel(setup.arm, faithful.makeFast()).describe().c_str());
+    std::printf("thesis measured data (Table 7.3: 600 N at 41 cm, 458 N at 37.5 cm), lm from 330 g / 22 cm:\n");
+    const IdentificationProblem measured = problemFor(readData(findAsset("measured/thesis_measured.csv"), setup.arm, -1));
+    IdentificationOptions lm;
+    struct Run {
+        const char* label;
+        const char* stem;
+        ModelOptions model;
+    };
+    ModelOptions fixedRatio = faithful;
+    fixedRatio.estimate = "fixed-ratio";
+    for (const Run& run : {Run{"steady model", "thesis_measured_steady", steadyOnly},
+                           Run{"faithful model (moment-arm est.)", "thesis_measured_faithful", faithful},
+                           Run{"faithful model (fixed-ratio est.)", "thesis_measured_faithful_fixed_ratio", fixedRatio}}) {
+        const IdentificationReport r = runIdentification(measured, lm, setup.arm, run.model, false);
+        printEstimateLine(run.label, r, kThesisMeasuredMass, kThesisMeasuredTendonLength, "thesis");
+        writeReportFiles(r, dir, run.stem);
+    }
+
+    // 2. Our own MVC data: five angles, the faithful model at the thesis protocol, the default subject.
+    FaithfulModelOptions ro = faithful.makeReference();
+    const FaithfulForceModel reference(setup.arm, ro);
+    ObservationSet angles;
+    for (double deg : {45.0, 60.0, 90.0, 120.0, 150.0}) {
+        Observation ob;
+        ob.angle = degToRad(deg);
+        ob.pathLength = calcBicepsPathLength(setup.arm.originDistance, setup.arm.insertionDistance, ob.angle);
+        angles.points.push_back(ob);
+    }
+    const std::vector<double> y = reference.calcForces(base, angles.points);
+    std::ostringstream csv;
+    csv << "# MVC forces of armsim's default subject (" << base.name << ", M = " << base.mass
+        << " kg, L0T = " << base.optimalTendonLength << " m): " << reference.describe() << "\nangle_deg,force_N\n";
+    for (std::size_t k = 0; k < y.size(); ++k) {
+        char b[64];
+        std::snprintf(b, sizeof b, "%.1f,%.6f\n", radToDeg(angles.points[k].angle), y[k]);
+        csv << b;
+    }
+    const std::string dataPath = dir + "/mvc_five_angles.csv";
+    writeFileAtomically(dataPath, csv.str());
+    std::printf("own MVC data (%s; truth %.2f g, %.3f cm), from 330 g / 22 cm:\n", dataPath.c_str(), 1000 * base.mass,
+                100 * base.optimalTendonLength);
+    const IdentificationProblem own = problemFor(readData(dataPath, setup.arm, -1));
+    for (Method m : {Method::LevenbergMarquardt, Method::IlcSignSearch}) {
+        IdentificationOptions o;
+        o.method = m;
+        for (const Run& run : {Run{"steady model", "steady", steadyOnly}, Run{"faithful model", "faithful", faithful}}) {
+            const IdentificationReport r = runIdentification(own, o, setup.arm, run.model, false);
+            printEstimateLine(getMethodName(m) + ", " + run.label, r, base.mass, base.optimalTendonLength, "truth");
+            writeReportFiles(r, dir, "mvc_" + getMethodName(m) + "_" + run.stem);
+        }
+    }
+
+    // 3. The thesis's cases with the steady model.
+    std::printf("thesis cases (steady model) beside the thesis's numbers:\n");
+    printThesisCases(base, SteadyForceModel(), dir);
+    std::printf("  wrote reports (JSON, history CSV, convergence PNG) to %s/\n", dir.c_str());
+}
+
+const CommandRegistrar registerIdentify(40, addIdentifyCommand);
+const CommandRegistrar registerValidate(41, addValidateCommand);
+const MainJobStepRegistrar registerIdentificationStep(50, "Identification: mass and tendon length (thesis data, own MVC data)",
+                                                      runIdentificationStep);
+
+}  // namespace
+
+}  // namespace armsim::cli

@@ -1,0 +1,152 @@
+// armsim identify / validate end to end (the built binary through popen): reports written whole,
+// bad data rejected with file and line, a tiny validation table.
+#include "muscles/table.h"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <string>
+#include <unistd.h>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr int kInputErrorExit = 2;             // main(): InputError
+constexpr std::uintmax_t kMinPngBytes = 1000;  // a real plot, not an empty file
+constexpr double kThesisTable73Tol = 0.01;     // relative: steady estimate vs thesis Table 7.3 (337.7 g, 24.4 cm)
+
+struct CommandResult {
+    int exitCode;
+    std::string output;  // stdout and stderr
+};
+
+CommandResult runArmsim(const std::string& args) {
+    const std::string cmd = std::string(ARMSIM_EXE) + " " + args + " 2>&1";
+    std::unique_ptr<FILE, int (*)(FILE*)> pipe(popen(cmd.c_str(), "r"), pclose);
+    std::string out;
+    std::array<char, 4096> buf;
+    while (std::fgets(buf.data(), int(buf.size()), pipe.get())) out += buf.data();
+    const int status = pclose(pipe.release());
+    return {WEXITSTATUS(status), out};
+}
+
+fs::path freshDir(const std::string& name) {
+    const fs::path d = fs::temp_directory_path() / ("armsim_ident_cli_" + name + "_" + std::to_string(::getpid()));
+    fs::remove_all(d);
+    fs::create_directories(d);
+    return d;
+}
+
+std::string measuredFile() { return std::string(ARMSIM_ASSET_DIR) + "/measured/thesis_measured.csv"; }
+
+void expectReportFiles(const fs::path& d) {
+    ASSERT_TRUE(fs::exists(d / "identification.json"));
+    std::ifstream in(d / "identification.json");
+    const nlohmann::json j = nlohmann::json::parse(in);
+    EXPECT_EQ(j["parameters"].size(), 2u);
+    EXPECT_EQ(j["model_checks"].size(), 2u);  // steady and faithful re-checks
+    const armsim::Table h = armsim::Table::readCsv((d / "identification_history.csv").string());
+    EXPECT_GT(h.getNumRows(), 1);
+    EXPECT_TRUE(h.hasColumn("mass_kg"));
+    EXPECT_GT(fs::file_size(d / "identification_convergence.png"), kMinPngBytes);
+}
+
+/// Writes `body` after a header to a fresh file; returns its path.
+std::string writeData(const fs::path& dir, const std::string& name, const std::string& body) {
+    const fs::path p = dir / name;
+    std::ofstream(p) << "path_cm,force_N\n" << body;
+    return p.string();
+}
+
+}  // namespace
+
+TEST(CliIdentify, ShippedMeasuredFileGivesTheThesisEstimateAndWritesTheReport) {
+    const fs::path d = freshDir("measured");
+    const CommandResult r = runArmsim("identify " + measuredFile() + " --out " + d.string());
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    EXPECT_NE(r.output.find("converged"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("re-check with the faithful model"), std::string::npos) << r.output;
+    expectReportFiles(d);
+    std::ifstream in(d / "identification.json");
+    const nlohmann::json j = nlohmann::json::parse(in);
+    EXPECT_LT(std::abs(j["parameters"][0]["value"].get<double>() / 0.3377 - 1), kThesisTable73Tol);
+    EXPECT_LT(std::abs(j["parameters"][1]["value"].get<double>() / 0.244 - 1), kThesisTable73Tol);
+}
+
+TEST(CliIdentify, FaithfulModelRunsOnTheMeasuredFile) {
+    const fs::path d = freshDir("faithful");
+    const CommandResult r = runArmsim("identify " + measuredFile() + " --model faithful --method ilc-sign-search --out " +
+                                      d.string());
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    EXPECT_NE(r.output.find("faithful model (moment-arm estimate"), std::string::npos) << r.output;
+    expectReportFiles(d);
+}
+
+TEST(CliIdentify, BadDataExitsNonZeroNamingFileAndLine) {
+    const fs::path d = freshDir("bad");
+    struct Case {
+        std::string name, body, expected;
+    };
+    const Case cases[] = {
+        {"nan.csv", "41,600\n37.5,nan\n", "nan.csv:3"},
+        {"negative.csv", "41,-600\n37.5,458\n", "negative.csv:2"},
+        {"one_point.csv", "41,600\n", "one_point.csv:2"},
+        {"duplicate.csv", "41,600\n37.5,458\n41,600\n", "duplicate.csv:4"},
+    };
+    for (const Case& c : cases) {
+        const std::string file = writeData(d, c.name, c.body);
+        const CommandResult r = runArmsim("identify " + file + " --out " + (d / "out").string());
+        EXPECT_EQ(r.exitCode, kInputErrorExit) << c.name << ": " << r.output;
+        EXPECT_NE(r.output.find(c.expected), std::string::npos) << c.name << ": " << r.output;
+    }
+    EXPECT_FALSE(fs::exists(d / "out" / "identification.json"));  // nothing written for bad data
+
+    // A path the arm cannot take is an error for the faithful model, with file and line.
+    const std::string far = writeData(d, "far.csv", "41,600\n30,300\n");
+    const CommandResult r = runArmsim("identify " + far + " --model faithful --out " + (d / "out").string());
+    EXPECT_EQ(r.exitCode, kInputErrorExit) << r.output;
+    EXPECT_NE(r.output.find("far.csv:3"), std::string::npos) << r.output;
+}
+
+TEST(CliIdentify, BadOptionsNameTheOption) {
+    CommandResult r = runArmsim("identify " + measuredFile() + " --bounds mass=0.5");
+    EXPECT_EQ(r.exitCode, kInputErrorExit) << r.output;
+    EXPECT_NE(r.output.find("--bounds"), std::string::npos) << r.output;
+    r = runArmsim("identify " + measuredFile() + " --start tendon=0.2");
+    EXPECT_EQ(r.exitCode, kInputErrorExit) << r.output;
+    EXPECT_NE(r.output.find("unknown parameter 'tendon'"), std::string::npos) << r.output;
+}
+
+TEST(CliIdentify, ThesisCasesPrintOursBesideTheThesis) {
+    const fs::path d = freshDir("thesis");
+    const CommandResult r = runArmsim("identify --thesis-cases --out " + d.string());
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    for (const char* c : {"Table 7.1 ilc-standard", "Table 7.2 ilc-sign-search", "Table 7.3 lm"})
+        EXPECT_NE(r.output.find(c), std::string::npos) << c << "\n" << r.output;
+    EXPECT_TRUE(fs::exists(d / "thesis_cases_steady.csv"));
+}
+
+TEST(CliValidate, TinyConfigurationPrintsItsTableAndWritesTheCsv) {
+    const fs::path d = freshDir("validate");
+    const CommandResult r = runArmsim("validate --seeds 0 --noise 0,2 --methods lm --out " + d.string());
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    EXPECT_NE(r.output.find("thesis"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("dM (%)"), std::string::npos) << r.output;
+    std::ifstream in(d / "validation.csv");
+    std::string header, line;
+    std::getline(in, header);
+    int rows = 0;
+    while (std::getline(in, line)) ++rows;
+    EXPECT_EQ(rows, 2);
+    EXPECT_NE(header.find("mass_error_pct"), std::string::npos);
+    const CommandResult bad = runArmsim("validate --noise 80 --out " + d.string());
+    EXPECT_EQ(bad.exitCode, kInputErrorExit) << bad.output;
+    EXPECT_NE(bad.output.find("noise"), std::string::npos) << bad.output;
+}
