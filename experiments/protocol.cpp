@@ -1,5 +1,7 @@
 #include "experiments/protocol.h"
 
+#include "model/parallel.h"
+
 #include "experiments/data_files.h"
 #include "experiments/plot.h"
 #include "model/geometry.h"
@@ -114,60 +116,6 @@ double calcActivationForActiveForce(const VirtualMuscle& muscle, double pathLeng
 }
 
 namespace {
-
-// ---- Parallel execution ---------------------------------------------------------------------------
-
-/// Runs task(0..n-1) on `jobs` threads; onDone() runs in the caller's thread after each task. The first
-/// exception (from a task or from onDone) stops the remaining tasks and is rethrown after all threads
-/// have joined.
-void runParallel(int n, int jobs, const std::function<void(int)>& task, const std::function<void()>& onDone) {
-    if (n <= 0) return;
-    std::atomic<int> next{0};
-    std::atomic<bool> stop{false};
-    std::mutex mutex;
-    std::condition_variable finished;
-    int done = 0;
-    std::exception_ptr error;
-    auto worker = [&] {
-        for (int i = next++; i < n; i = next++) {
-            if (!stop) {
-                try {
-                    task(i);
-                } catch (...) {
-                    std::lock_guard<std::mutex> lock(mutex);
-                    if (!error) error = std::current_exception();
-                    stop = true;
-                }
-            }
-            std::lock_guard<std::mutex> lock(mutex);
-            ++done;
-            finished.notify_all();
-        }
-    };
-    std::vector<std::thread> threads;
-    const int numThreads = std::max(1, std::min(jobs, n));
-    for (int k = 0; k < numThreads; ++k) threads.emplace_back(worker);
-    for (int reported = 0; reported < n;) {
-        int now;
-        {
-            std::unique_lock<std::mutex> lock(mutex);
-            finished.wait(lock, [&] { return done != reported; });
-            now = done;
-        }
-        for (; reported < now; ++reported) {
-            if (stop || !onDone) continue;
-            try {
-                onDone();
-            } catch (...) {
-                std::lock_guard<std::mutex> lock(mutex);
-                if (!error) error = std::current_exception();
-                stop = true;
-            }
-        }
-    }
-    for (auto& t : threads) t.join();
-    if (error) std::rethrow_exception(error);
-}
 
 // ---- The run directory ----------------------------------------------------------------------------
 
@@ -673,7 +621,7 @@ ProtocolResult runProtocol(const Protocol& protocol, const ArmSetup& subject, co
     nlohmann::ordered_json results;
 
     int done = 0, total = 0;
-    auto tick = [&] {
+    auto tick = [&](int, int) {
         ++done;
         if (options.progress) options.progress(done, total);
     };
@@ -707,7 +655,7 @@ ProtocolResult runProtocol(const Protocol& protocol, const ArmSetup& subject, co
                 matrix += "," + (std::isnan(F) ? std::string("NaN") : fmt("%.10g", F));
             }
             matrix += "\n";
-            tick();
+            tick(0, 0);
         }
         if (dir.isEnabled()) {
             dir.write("composition.csv", formatCsv(result.composition, kCsvDigits));

@@ -1,14 +1,10 @@
 #include "model/trial.h"
 
 #include "model/geometry.h"
+#include "model/parallel.h"
 #include "muscles/param_file.h"
 
-#include <atomic>
 #include <cmath>
-#include <condition_variable>
-#include <exception>
-#include <mutex>
-#include <thread>
 
 using namespace SimTK;
 
@@ -140,46 +136,9 @@ std::vector<IsometricTrialResult> runIsometricTrials(const ArmSetup& setup,
                                                      const std::vector<IsometricTrialSettings>& settings, int jobs,
                                                      const std::function<void(int, int)>& progress) {
     for (const auto& s : settings) s.validate(setup.arm);  // fail before any work starts
-    const int n = int(settings.size());
-    std::vector<IsometricTrialResult> results(n);
-    std::atomic<int> next{0};
-    int done = 0;  // claimed trials finished, failed or skipped; reaches n in every case
-    std::exception_ptr error;
-    std::mutex mutex;
-    std::condition_variable finished;
-    auto worker = [&] {
-        for (int i = next++; i < n; i = next++) {
-            bool skip;
-            {
-                std::lock_guard<std::mutex> lock(mutex);
-                skip = bool(error);
-            }
-            if (!skip) {
-                try {
-                    results[i] = runIsometricTrial(setup, settings[i]);
-                } catch (...) {
-                    std::lock_guard<std::mutex> lock(mutex);
-                    if (!error) error = std::current_exception();
-                }
-            }
-            std::lock_guard<std::mutex> lock(mutex);
-            ++done;
-            finished.notify_all();
-        }
-    };
-    std::vector<std::thread> threads;
-    const int numThreads = std::max(1, std::min(jobs, n));
-    for (int k = 0; k < numThreads; ++k) threads.emplace_back(worker);
-    for (int reported = 0; reported < n;) {
-        {
-            std::unique_lock<std::mutex> lock(mutex);
-            finished.wait(lock, [&] { return done != reported; });
-            reported = done;
-        }
-        if (progress) progress(reported, n);
-    }
-    for (auto& t : threads) t.join();
-    if (error) std::rethrow_exception(error);
+    std::vector<IsometricTrialResult> results(settings.size());
+    runParallel(int(settings.size()), jobs, [&](int i) { results[i] = runIsometricTrial(setup, settings[i]); },
+                progress);
     return results;
 }
 

@@ -1,6 +1,8 @@
 // The armsim command end to end: exit codes, messages, and files written whole or not at all.
 #include "muscles/table.h"
 
+#include "tests/support/run_armsim.h"
+
 #include <gtest/gtest.h>
 
 #include <array>
@@ -14,20 +16,8 @@ namespace fs = std::filesystem;
 
 namespace {
 
-struct CommandResult {
-    int exitCode;
-    std::string output;  // stdout and stderr
-};
-
-CommandResult runArmsim(const std::string& args) {
-    const std::string cmd = std::string(ARMSIM_EXE) + " " + args + " 2>&1";
-    std::unique_ptr<FILE, int (*)(FILE*)> pipe(popen(cmd.c_str(), "r"), pclose);
-    std::string out;
-    std::array<char, 4096> buf;
-    while (std::fgets(buf.data(), int(buf.size()), pipe.get())) out += buf.data();
-    const int status = pclose(pipe.release());
-    return {WEXITSTATUS(status), out};
-}
+using armsim::testing::CommandResult;
+using armsim::testing::runArmsim;
 
 fs::path freshDir(const std::string& name) {
     const fs::path d = fs::temp_directory_path() / ("armsim_cli_" + name + "_" + std::to_string(::getpid()));

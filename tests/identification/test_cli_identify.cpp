@@ -2,6 +2,8 @@
 // bad data rejected with file and line, a tiny validation table.
 #include "muscles/table.h"
 
+#include "tests/support/run_armsim.h"
+
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -22,20 +24,8 @@ constexpr int kInputErrorExit = 2;             // main(): InputError
 constexpr std::uintmax_t kMinPngBytes = 1000;  // a real plot, not an empty file
 constexpr double kThesisTable73Tol = 0.01;     // relative: steady estimate vs thesis Table 7.3 (337.7 g, 24.4 cm)
 
-struct CommandResult {
-    int exitCode;
-    std::string output;  // stdout and stderr
-};
-
-CommandResult runArmsim(const std::string& args) {
-    const std::string cmd = std::string(ARMSIM_EXE) + " " + args + " 2>&1";
-    std::unique_ptr<FILE, int (*)(FILE*)> pipe(popen(cmd.c_str(), "r"), pclose);
-    std::string out;
-    std::array<char, 4096> buf;
-    while (std::fgets(buf.data(), int(buf.size()), pipe.get())) out += buf.data();
-    const int status = pclose(pipe.release());
-    return {WEXITSTATUS(status), out};
-}
+using armsim::testing::CommandResult;
+using armsim::testing::runArmsim;
 
 fs::path freshDir(const std::string& name) {
     const fs::path d = fs::temp_directory_path() / ("armsim_ident_cli_" + name + "_" + std::to_string(::getpid()));

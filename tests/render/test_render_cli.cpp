@@ -3,6 +3,8 @@
 #include "muscles/table.h"
 #include "tests/render/render_test_util.h"
 
+#include "tests/support/run_armsim.h"
+
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
@@ -21,20 +23,8 @@ using armsim::test::ScratchDir;
 constexpr double kFpsTolerance = 1e-6;   // container frame rate vs requested (1/s)
 constexpr double kRest = 0.2, kHold = 0.3;  // recorded isometric trial (s)
 
-struct CommandResult {
-    int exitCode;
-    std::string output;  // stdout and stderr
-};
-
-CommandResult runArmsim(const std::string& args) {
-    const std::string cmd = "env -u DISPLAY " + std::string(ARMSIM_EXE) + " " + args + " 2>&1";
-    std::unique_ptr<FILE, int (*)(FILE*)> pipe(popen(cmd.c_str(), "r"), pclose);
-    std::string out;
-    std::array<char, 4096> buf;
-    while (std::fgets(buf.data(), int(buf.size()), pipe.get())) out += buf.data();
-    const int status = pclose(pipe.release());
-    return {WEXITSTATUS(status), out};
-}
+using armsim::testing::CommandResult;
+using armsim::testing::runArmsim;
 
 struct VideoInfo {
     int frames = 0;
