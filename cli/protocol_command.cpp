@@ -3,9 +3,16 @@
 #include "cli/commands.h"
 #include "experiments/protocol.h"
 #include "muscles/muscle_file.h"
+#include "model/parallel.h"
 #include "muscles/param_file.h"
+#include "muscles/table.h"
+
+#ifdef ARMSIM_WITH_RENDER
+#include "render/trial_video.h"
+#endif
 
 #include <cmath>
+#include <filesystem>
 #include <cstdio>
 #include <memory>
 
@@ -17,7 +24,39 @@ struct ProtocolOptions {
     std::string file;
     std::string out;
     int jobs = 2;
+    bool video = false;      ///< render every trial's video into <out>/videos/
+    double videoFps = 30;
+    int videoWidth = 1280, videoHeight = 720;
 };
+
+/// Renders the video of every trial of a finished run (replaying trials/<id>.csv) into videos/.
+void renderProtocolVideos(const ProtocolOptions& o, const ArmSetup& subject, const ProtocolResult& r,
+                          const std::string& out) {
+#ifdef ARMSIM_WITH_RENDER
+    const int n = int(r.trialIds.size());
+    if (n == 0) {
+        std::printf("  --video: this protocol has no arm trials to render\n");
+        return;
+    }
+    std::filesystem::create_directories(out + "/videos");
+    runParallel(
+        n, o.jobs,
+        [&](int i) {
+            const std::string csv = out + "/trials/" + r.trialIds[i] + ".csv";
+            TrialVideoSettings v;
+            v.videoPath = out + "/videos/" + r.trialIds[i] + ".mp4";
+            v.tableName = csv;
+            v.fps = o.videoFps;
+            v.render.width = o.videoWidth;
+            v.render.height = o.videoHeight;
+            renderTrialVideo(subject, Table::readCsv(csv), v);
+        },
+        [](int d, int total) { printProgress("trial videos", d, total); });
+    std::printf("  wrote %d videos to %s/videos/\n", n, out.c_str());
+#else
+    throw InputError("--video: this armsim was built without the renderer (-DARMSIM_RENDER=OFF)");
+#endif
+}
 
 void printFit(const char* label, const QuadraticFit& q, const char* xUnit, double xScale, const char* reference) {
     std::printf("  %-34s peak %7.1f N at %6.1f %s (R^2 %.4f)%s\n", label, q.peakY, xScale * q.peakX, xUnit,
@@ -74,6 +113,9 @@ void printResult(const Protocol& p, const ProtocolResult& r, const std::string& 
 std::string defaultOut(const Protocol& p) { return "out/" + p.name; }
 
 void runProtocolCommand(const ProtocolOptions& o) {
+#ifndef ARMSIM_WITH_RENDER
+    if (o.video) throw InputError("--video: this armsim was built without the renderer (-DARMSIM_RENDER=OFF)");
+#endif
     const Protocol protocol = readProtocol(findAsset(o.file));
     const ArmSetup subject = loadProtocolSubject(protocol);
     const std::string out = o.out.empty() ? defaultOut(protocol) : o.out;
@@ -83,6 +125,7 @@ void runProtocolCommand(const ProtocolOptions& o) {
     const ProtocolResult r =
         runProtocol(protocol, subject, {out, o.jobs, [&](int d, int n) { printProgress(protocol.name, d, n); }});
     printResult(protocol, r, out);
+    if (o.video) renderProtocolVideos(o, subject, r, out);
 }
 
 void addProtocolCommand(CLI::App& app) {
@@ -91,6 +134,10 @@ void addProtocolCommand(CLI::App& app) {
     c->add_option("file", o->file, "protocol file (path, or name under assets/)")->required();
     c->add_option("--out", o->out, "run directory (default out/<protocol name>); an earlier run there is replaced");
     c->add_option("--jobs", o->jobs, "worker threads (results do not depend on it)")->capture_default_str()->check(CLI::Range(1, 64));
+    c->add_flag("--video", o->video, "also render every trial's video (H.264) into <out>/videos/");
+    c->add_option("--video-fps", o->videoFps, "video frame rate [1/s]")->capture_default_str();
+    c->add_option("--video-width", o->videoWidth, "video width [px]")->capture_default_str();
+    c->add_option("--video-height", o->videoHeight, "video height [px]")->capture_default_str();
     c->callback([o] { runProtocolCommand(*o); });
 }
 

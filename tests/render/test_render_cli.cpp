@@ -13,6 +13,7 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <fstream>
 #include <memory>
 #include <string>
 
@@ -116,4 +117,24 @@ TEST(RenderCli, BadOptionsAreNamedErrors) {
         EXPECT_NE(r.output.find(c.expect), std::string::npos) << c.args << ": " << r.output;
     }
     EXPECT_EQ(dir.list().size(), 2u);   // t.csv and t.mp4 only
+}
+
+TEST(RenderCli, ProtocolVideoRendersEveryTrial) {
+    ScratchDir dir;
+    const double rest = 0.2, hold = 0.4;
+    {
+        std::ofstream f(dir.file("p.yaml"));
+        f << "name: two_angles\nkind: mvc\ndescription: short\nseed: 7\norder: listed\nrepetitions: 1\n"
+          << "trial:\n  rest: " << rest << "\n  hold: " << hold << "\n  averaging_window: 0.2\n"
+          << "conditions:\n  elbow_angles_deg: [90, 120]\nsensors:\n  emg:\n    enabled: false\n";
+    }
+    const CommandResult r = runArmsim("protocol " + dir.file("p.yaml") + " --out " + dir.file("run") +
+                                      " --video --video-fps 20 --video-width 320 --video-height 180");
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    for (const char* id : {"a090", "a120"}) {
+        const VideoInfo v = probe(dir.file("run/videos/" + std::string(id) + ".mp4"));
+        EXPECT_EQ(v.frames, expectedFrames(rest + hold, 20)) << id;
+        EXPECT_EQ(v.size, cv::Size(320, 180)) << id;
+        EXPECT_NEAR(v.fps, 20.0, kFpsTolerance) << id;
+    }
 }
