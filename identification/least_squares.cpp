@@ -194,8 +194,8 @@ void addUncertainty(SolverContext& ctx, Run& run, const std::vector<double>& r, 
                                  " noise model; Student-t quantile";
     } else {
         report.uncertaintyNote = "no intervals: as many observations as unknowns (n = p = " + std::to_string(n) +
-                                 ") leave no residual to estimate the noise; give a force sd (forceSd or "
-                                 "relativeForceSd) to get them";
+                                 ") leave no residual to estimate the noise; give the measurement's force sd "
+                                 "(armsim identify --force-sd; IdentificationOptions::forceSd) to get them";
         return;
     }
     ceres::Covariance::Options co;
