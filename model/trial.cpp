@@ -96,12 +96,40 @@ IsometricTrialResult runIsometricTrial(const ArmSetup& setup, const IsometricTri
          "force_moment_arm_N", "force_fixed_ratio_N", "error_moment_arm_pct", "error_fixed_ratio_pct"},
         model.getMuscle()));
     const double h = sum.momentArm;
+    const VirtualMuscle& muscle = model.getMuscle();
+    const double L0 = muscle.getParameters().optimalFascicleLength;
+
+    // Holding torque measured (findMotionForces) at every step end; see realizeEverySample.
+    struct StepTorque { double t, F, torque; };
+    StepTorque prev{}, cur{};
+    bool haveStep = false;
+    auto onStep = [&](const State& s) {
+        prev = cur;
+        cur = {s.getTime(), biceps.getForce(s), arm.calcHoldingTorque(s)};
+        if (!haveStep) prev = cur;
+        haveStep = true;
+    };
+    auto torqueAt = [&](double t, double F) {
+        const double dF = cur.F - prev.F;
+        if (std::abs(dF) > 1e-9 * (1.0 + std::abs(cur.F))) return prev.torque + (F - prev.F) / dF * (cur.torque - prev.torque);
+        const double dt = cur.t - prev.t;
+        return dt > 0 ? prev.torque + (t - prev.t) / dt * (cur.torque - prev.torque) : cur.torque;
+    };
+
     sum.stats = simulateSampled(
         system, state, settings.getDuration(), settings.sampleRate, profile.getBreakpoints(), settings.integration,
         [&](const State& s) {
-            system.realize(s, Stage::Acceleration);
-            const double F = biceps.getForce(s);
-            const double torque = arm.calcHoldingTorque(s);
+            const double t = s.getTime();
+            const std::vector<double> y = biceps.getMuscleStates(s);
+            double F, torque;
+            if (settings.realizeEverySample) {
+                system.realize(s, Stage::Acceleration);
+                F = biceps.getForce(s);
+                torque = arm.calcHoldingTorque(s);
+            } else {  // the path is fixed: the pure model gives Fse from the interpolated states
+                F = muscle.calcForce(sum.pathLength, y.data());
+                torque = torqueAt(t, F);
+            }
             const double muscleTorque = sum.tareTorque - torque;  // tared, + = flexion
             double strap = muscleTorque / ap.strapDistance;          // perpendicular strap at d1
             const bool saturated = std::abs(strap) > ap.transducerRange;
@@ -110,14 +138,14 @@ IsometricTrialResult runIsometricTrial(const ArmSetup& setup, const IsometricTri
             const double byMomentArm = calcBicepsForceFromTorque(strap * ap.strapDistance, h);
             const double byFixedRatio = calcBicepsForceFixedRatio(strap, settings.elbowAngle, kPi / 2);
             auto pct = [F](double estimate) { return F > 0 ? 100 * (estimate - F) / F : NAN; };
-            std::vector<double> row{s.getTime(), biceps.getActivation(s), radToDeg(settings.elbowAngle), 0.0, F,
-                                    biceps.getFascicleLength(s), biceps.getFascicleVelocity(s), torque,
-                                    muscleTorque, strap, saturated ? 1.0 : 0.0, byMomentArm, byFixedRatio,
-                                    pct(byMomentArm), pct(byFixedRatio)};
-            appendMuscleStates(row, biceps, s);
+            std::vector<double> row{t, profile.getValue(t), radToDeg(settings.elbowAngle), 0.0, F,
+                                    y[VirtualMuscle::kL] * L0, y[VirtualMuscle::kV] * L0, torque, muscleTorque,
+                                    strap, saturated ? 1.0 : 0.0, byMomentArm, byFixedRatio, pct(byMomentArm),
+                                    pct(byFixedRatio)};
+            row.insert(row.end(), y.begin(), y.end());
             result.series.appendRow(std::move(row));
         },
-        [&](const State& s) { biceps.checkMuscleStates(s); });
+        [&](const State& s) { biceps.checkMuscleStates(s); }, onStep);
 
     const Table& t = result.series;
     const std::vector<double> time = t.getColumn("time_s");

@@ -180,3 +180,26 @@ TEST(FreeMovement, FullActivationIsStoppedByTheFlexionStop) {
     EXPECT_LT(minAngle, 45.0);  // it reaches the stop...
     EXPECT_GT(minAngle, subject().arm.minElbowAngleDeg - kPenetrationTolDeg);  // ...and the stop holds
 }
+
+// The default reads the lock's torque at every integrator step and interpolates samples in muscle
+// force; the reference realizes every sample. For a locked elbow the two must agree to round-off.
+TEST(IsometricTrial, StepTorqueInterpolationEqualsPerSampleFindMotionForces) {
+    constexpr double kRelTol = 1e-9;  // of the largest holding torque
+    for (double deg : {60.0, 150.0}) {
+        IsometricTrialSettings fast = mvcAt(deg);
+        fast.riseTime = 0.05;
+        IsometricTrialSettings reference = fast;
+        reference.realizeEverySample = true;
+        const Table a = runIsometricTrial(subject(), fast).series;
+        const Table b = runIsometricTrial(subject(), reference).series;
+        ASSERT_EQ(a.getNumRows(), b.getNumRows());
+        const auto ta = a.getColumn("holding_torque_Nm"), tb = b.getColumn("holding_torque_Nm");
+        const auto fa = a.getColumn("muscle_force_N"), fb = b.getColumn("muscle_force_N");
+        double scale = 0;
+        for (double v : tb) scale = std::max(scale, std::abs(v));
+        for (std::size_t i = 0; i < ta.size(); ++i) {
+            ASSERT_NEAR(ta[i], tb[i], kRelTol * scale) << deg << " deg, row " << i;
+            ASSERT_NEAR(fa[i], fb[i], 1e-9 * (1 + std::abs(fb[i]))) << deg << " deg, row " << i;
+        }
+    }
+}
