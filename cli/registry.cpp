@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <memory>
+#include <unistd.h>
 #include <vector>
 
 namespace armsim::cli {
@@ -40,6 +41,10 @@ MainJobStepRegistrar::MainJobStepRegistrar(int order, std::string name,
 }
 
 void printProgress(const std::string& label, int done, int total) {
+    if (!isatty(fileno(stderr))) {  // a log file gets one line, not a stream of carriage returns
+        if (done >= total) std::fprintf(stderr, "%s: %d/%d done\n", label.c_str(), done, total);
+        return;
+    }
     constexpr int kWidth = 30;
     const int filled = total > 0 ? done * kWidth / total : kWidth;
     std::fprintf(stderr, "\r%-28s [%s%s] %d/%d", label.c_str(), std::string(filled, '#').c_str(),
