@@ -4,6 +4,7 @@
 #include "render/renderer.h"
 
 #include <opencv2/core.hpp>
+#include <opencv2/videoio.hpp>
 
 #include <cmath>
 #include <cstdlib>
@@ -55,6 +56,26 @@ inline bool dominates(const cv::Vec3b& bgr, int c, int margin) {
     for (int k = 0; k < 3; ++k)
         if (k != c && int(bgr[c]) - int(bgr[k]) < margin) return false;
     return true;
+}
+
+/// A video file decoded back with OpenCV (FFmpeg backend).
+struct Decoded {
+    double fps = 0, reportedCount = 0;
+    cv::Size size;
+    std::vector<cv::Mat> frames;
+};
+
+/// Every frame of the video at path; empty if it cannot be opened.
+inline Decoded decode(const std::string& path) {
+    cv::VideoCapture cap(path, cv::CAP_FFMPEG);
+    Decoded d;
+    if (!cap.isOpened()) return d;
+    d.fps = cap.get(cv::CAP_PROP_FPS);
+    d.reportedCount = cap.get(cv::CAP_PROP_FRAME_COUNT);
+    d.size = cv::Size(int(cap.get(cv::CAP_PROP_FRAME_WIDTH)), int(cap.get(cv::CAP_PROP_FRAME_HEIGHT)));
+    cv::Mat f;
+    while (cap.read(f)) d.frames.push_back(f.clone());
+    return d;
 }
 
 }  // namespace armsim::test

@@ -30,23 +30,8 @@ cv::Mat testFrame(int i, cv::Size size) {
     return f;
 }
 
-struct Decoded {
-    double fps = 0, reportedCount = 0;
-    cv::Size size;
-    std::vector<cv::Mat> frames;
-};
-
-Decoded decode(const std::string& path) {
-    cv::VideoCapture cap(path, cv::CAP_FFMPEG);
-    Decoded d;
-    if (!cap.isOpened()) return d;
-    d.fps = cap.get(cv::CAP_PROP_FPS);
-    d.reportedCount = cap.get(cv::CAP_PROP_FRAME_COUNT);
-    d.size = cv::Size(int(cap.get(cv::CAP_PROP_FRAME_WIDTH)), int(cap.get(cv::CAP_PROP_FRAME_HEIGHT)));
-    cv::Mat f;
-    while (cap.read(f)) d.frames.push_back(f.clone());
-    return d;
-}
+using test::Decoded;
+using test::decode;
 
 void expectRoundTrip(const std::string& codec, const std::string& name) {
     ScratchDir dir;
