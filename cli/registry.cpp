@@ -41,6 +41,7 @@ MainJobStepRegistrar::MainJobStepRegistrar(int order, std::string name,
 }
 
 void printProgress(const std::string& label, int done, int total) {
+    std::fflush(stdout);  // keep results and progress in order when both go to one log
     if (!isatty(fileno(stderr))) {  // a log file gets one line, not a stream of carriage returns
         if (done >= total) std::fprintf(stderr, "%s: %d/%d done\n", label.c_str(), done, total);
         return;

@@ -87,6 +87,7 @@ void runTrialCommand(const TrialOptions& o) {
     if (type == "isometric") {
         const IsometricTrialResult r = runIsometricTrial(setup, iso);
         r.series.writeCsv(o.out);
+        std::printf("wrote %s\n", o.out.c_str());
         if (!o.video.empty()) renderVideo(o, setup, r.series, 0);
         const IsometricSummary& s = r.summary;
         std::printf("isometric trial at %.1f deg: path %.2f cm, moment arm %.2f cm\n", radToDeg(s.elbowAngle),
@@ -109,6 +110,7 @@ void runTrialCommand(const TrialOptions& o) {
         IntegrationStats stats;
         const Table t = runFreeMovement(setup, free, &stats);
         t.writeCsv(o.out);
+        std::printf("wrote %s\n", o.out.c_str());
         if (!o.video.empty()) renderVideo(o, setup, t, free.handLoad);
         std::printf("free movement: elbow %.1f -> %.1f deg in %.2f s (%d integrator steps)\n",
                     t.get(0, "elbow_angle_deg"), t.get(t.getNumRows() - 1, "elbow_angle_deg"), free.duration,
@@ -117,7 +119,6 @@ void runTrialCommand(const TrialOptions& o) {
         spec.yLabel = "elbow angle (deg)";
         spec.series.push_back({"elbow angle", t.getColumn("time_s"), t.getColumn("elbow_angle_deg")});
     }
-    std::printf("wrote %s\n", o.out.c_str());
     if (!o.plot.empty()) {
         writePlotPng(o.plot, spec);
         std::printf("wrote %s\n", o.plot.c_str());
