@@ -10,57 +10,14 @@
 
 namespace armsim {
 
-namespace {
-
-void appendNumber(std::string& out, double v, int digits) {
-    if (std::isnan(v)) {
-        out += "NaN";
-        return;
-    }
-    char buf[40];
-    const auto r = std::to_chars(buf, buf + sizeof buf, v, std::chars_format::general, digits);
-    out.append(buf, r.ptr);
-}
-
-void appendRows(std::string& out, const Table& t, char separator, int digits) {
-    for (int i = 0; i < t.getNumRows(); ++i) {
-        const std::vector<double>& r = t.getRow(i);
-        for (std::size_t c = 0; c < r.size(); ++c) {
-            if (c) out += separator;
-            appendNumber(out, r[c], digits);
-        }
-        out += '\n';
-    }
-}
-
-void checkDigits(int digits) {
-    if (digits < 1 || digits > 17) throw std::invalid_argument("digits must be in [1, 17]");
-}
-
-}  // namespace
-
-std::string formatCsv(const Table& t, int digits) {
-    checkDigits(digits);
-    std::string out;
-    out.reserve(std::size_t(t.getNumRows() + 1) * std::size_t(t.getNumColumns()) * (digits + 7));
-    for (int c = 0; c < t.getNumColumns(); ++c) out += (c ? "," : "") + t.getColumnNames()[c];
-    out += '\n';
-    appendRows(out, t, ',', digits);
-    return out;
-}
-
 std::string formatStorage(const Table& t, const std::string& name, bool inDegrees, int digits) {
-    checkDigits(digits);
     if (t.getNumColumns() == 0) throw std::invalid_argument("storage '" + name + "': table has no columns");
-    std::string out;
-    out.reserve(std::size_t(t.getNumRows() + 8) * std::size_t(t.getNumColumns()) * (digits + 7));
-    out += name + "\nversion=1\nnRows=" + std::to_string(t.getNumRows()) +
+    std::string out = name + "\nversion=1\nnRows=" + std::to_string(t.getNumRows()) +
            "\nnColumns=" + std::to_string(t.getNumColumns()) + "\ninDegrees=" + (inDegrees ? "yes" : "no") +
            "\nendheader\ntime";
     for (int c = 1; c < t.getNumColumns(); ++c) out += "\t" + t.getColumnNames()[c];
     out += '\n';
-    appendRows(out, t, '\t', digits);
-    return out;
+    return out + t.formatRows('\t', digits);
 }
 
 Table readStorage(const std::string& path, StorageHeader* header) {

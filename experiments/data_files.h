@@ -1,5 +1,5 @@
-// Result files of experiments: CSV and OpenSim storage (.sto) text of a Table, fast enough for
-// protocols that write tens of thousands of rows, and a reader for .sto files. Framework-free.
+// OpenSim storage (.sto) text of a Table and a reader for .sto files (CSV is Table::toCsv).
+// Framework-free.
 #pragma once
 
 #include "muscles/table.h"
@@ -7,11 +7,6 @@
 #include <string>
 
 namespace armsim {
-
-/// CSV text of t, laid out like Table::toCsv (header of column names, then one comma-separated row per
-/// sample) with `digits` significant digits per number (std::to_chars; 17 digits round-trip exactly;
-/// NaN is written "NaN"). Table::readCsv reads it back.
-std::string formatCsv(const Table& t, int digits = 10);
 
 /// OpenSim 4 storage text of t (the format of OpenSim's STOFileAdapter / Storage version 1):
 ///   <name>

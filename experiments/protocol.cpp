@@ -1,25 +1,20 @@
 #include "experiments/protocol.h"
 
-#include "model/parallel.h"
-
 #include "experiments/data_files.h"
 #include "experiments/plot.h"
 #include "model/geometry.h"
+#include "model/parallel.h"
 #include "muscles/param_file.h"
 
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
-#include <condition_variable>
 #include <cstdio>
-#include <exception>
 #include <filesystem>
 #include <fstream>
 #include <mutex>
 #include <set>
-#include <thread>
 #include <unistd.h>
 
 #ifndef ARMSIM_VERSION
@@ -295,7 +290,7 @@ ArmTrialOutcome runArmTrial(const ArmTrialPlan& plan, const Protocol& protocol, 
         o.emgRms = emgRms;
     }
     if (dir.isEnabled()) {
-        dir.write("trials/" + plan.id + ".csv", formatCsv(out, kCsvDigits));
+        dir.write("trials/" + plan.id + ".csv", out.toCsv(kCsvDigits));
         dir.write("trials/" + plan.id + ".sto",
                   formatStorage(selectColumns(out, columnsWithoutStates(out)), plan.id, true, kCsvDigits));
     }
@@ -325,7 +320,7 @@ MuscleTrialOutcome runMuscleTrial(double pathLength, const std::string& id, cons
     o.steadyForce = full.converged ? full.force : NAN;
     o.passiveForce = passive.converged ? passive.force : NAN;
     if (dir.isEnabled()) {
-        dir.write("trials/" + id + ".csv", formatCsv(t, kCsvDigits));
+        dir.write("trials/" + id + ".csv", t.toCsv(kCsvDigits));
         dir.write("trials/" + id + ".sto", formatStorage(t, id, false, kCsvDigits));
     }
     return o;
@@ -658,7 +653,7 @@ ProtocolResult runProtocol(const Protocol& protocol, const ArmSetup& subject, co
             tick(0, 0);
         }
         if (dir.isEnabled()) {
-            dir.write("composition.csv", formatCsv(result.composition, kCsvDigits));
+            dir.write("composition.csv", result.composition.toCsv(kCsvDigits));
             dir.write("composition_matrix.csv", matrix);
             writeHeatMapPng(dir.addFile("composition_heatmap.png"), heat);
         }
@@ -788,11 +783,11 @@ ProtocolResult runProtocol(const Protocol& protocol, const ArmSetup& subject, co
         // Files.
         if (dir.isEnabled()) {
             if (!plans.empty()) {
-                dir.write("trials.csv", formatCsv(result.trials, kCsvDigits));
-                dir.write("summary.csv", formatCsv(result.summary, kCsvDigits));
+                dir.write("trials.csv", result.trials.toCsv(kCsvDigits));
+                dir.write("summary.csv", result.summary.toCsv(kCsvDigits));
                 if (protocol.emgEnabled) plotExampleEmg(dir, plans[0].id, outcomes[0]);
             }
-            if (numMuscle > 0) dir.write("muscle_sweep.csv", formatCsv(result.muscleSweep, kCsvDigits));
+            if (numMuscle > 0) dir.write("muscle_sweep.csv", result.muscleSweep.toCsv(kCsvDigits));
             if (!result.quadraticFits.empty() || result.emgToActivation)
                 dir.write("fits.csv", fitsCsv(result.quadraticFits, result.emgToActivation));
             if (protocol.kind == ProtocolKind::Mvc) plotMvc(dir, result.trials, result.summary, result.quadraticFits);

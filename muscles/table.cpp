@@ -2,6 +2,8 @@
 
 #include "muscles/param_file.h"
 
+#include <charconv>
+#include <cmath>
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
@@ -38,16 +40,43 @@ std::vector<double> Table::getColumn(const std::string& name) const {
     return out;
 }
 
-std::string Table::toCsv(int digits) const {
-    std::ostringstream s;
-    s.precision(digits);
-    for (int i = 0; i < getNumColumns(); ++i) s << (i ? "," : "") << names_[i];
-    s << '\n';
-    for (const auto& r : rows_) {
-        for (std::size_t i = 0; i < r.size(); ++i) s << (i ? "," : "") << r[i];
-        s << '\n';
+namespace {
+
+void checkDigits(int digits) {
+    if (digits < 1 || digits > 17) throw std::invalid_argument("CSV digits must be in [1, 17]");
+}
+
+void appendNumber(std::string& out, double v, int digits) {
+    if (std::isnan(v)) {
+        out += "NaN";
+        return;
     }
-    return s.str();
+    char buf[40];
+    const auto r = std::to_chars(buf, buf + sizeof buf, v, std::chars_format::general, digits);
+    out.append(buf, r.ptr);
+}
+
+}  // namespace
+
+std::string Table::formatRows(char separator, int digits) const {
+    checkDigits(digits);
+    std::string out;
+    out.reserve(rows_.size() * names_.size() * std::size_t(digits + 7));
+    for (const auto& r : rows_) {
+        for (std::size_t c = 0; c < r.size(); ++c) {
+            if (c) out += separator;
+            appendNumber(out, r[c], digits);
+        }
+        out += '\n';
+    }
+    return out;
+}
+
+std::string Table::toCsv(int digits) const {
+    std::string out;
+    for (int i = 0; i < getNumColumns(); ++i) out += (i ? "," : "") + names_[i];
+    out += '\n';
+    return out + formatRows(',', digits);
 }
 
 void Table::writeCsv(const std::string& path, int digits) const { writeFileAtomically(path, toCsv(digits)); }

@@ -24,8 +24,11 @@ public:
     const std::vector<double>& getRow(int i) const { return rows_[i]; }
     double get(int row, const std::string& column) const { return rows_[row][findColumn(column)]; }
     std::vector<double> getColumn(const std::string& name) const;
-    /// CSV text: a header line of column names, then rows with up to `digits` significant digits.
+    /// CSV text: a header line of column names, then rows with `digits` significant digits (1..17;
+    /// 17 round-trips every double). Numbers are locale-free; NaN is written "NaN".
     std::string toCsv(int digits = 10) const;
+    /// The data rows only, cells joined by `separator`, formatted as in toCsv (for other file formats).
+    std::string formatRows(char separator, int digits) const;
     /// Writes toCsv() to path atomically (temporary + rename).
     void writeCsv(const std::string& path, int digits = 10) const;
     /// Reads a CSV file with a header line and numeric cells (empty lines and lines starting with

@@ -74,7 +74,7 @@ TEST(Csv, FormattedCsvReadsBackIncludingNaN) {
     Table t = sampleTable();
     t.appendRow({1, NAN, 2, 3});
     const fs::path p = tempFile("t.csv");
-    writeText(p, formatCsv(t, 17));
+    writeText(p, t.toCsv(17));
     const Table r = Table::readCsv(p.string());
     ASSERT_EQ(r.getNumRows(), t.getNumRows());
     EXPECT_EQ(r.getColumnNames(), t.getColumnNames());

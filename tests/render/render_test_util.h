@@ -58,6 +58,18 @@ inline bool dominates(const cv::Vec3b& bgr, int c, int margin) {
     return true;
 }
 
+/// Pixels that differ from the background bg, inside and outside the rectangle `inside`.
+struct DrawnPixels {
+    int inside = 0, outside = 0;
+};
+inline DrawnPixels countDrawn(const cv::Mat& frame, const cv::Vec3b& bg, const cv::Rect& inside) {
+    DrawnPixels n;
+    for (int y = 0; y < frame.rows; ++y)
+        for (int x = 0; x < frame.cols; ++x)
+            if (frame.at<cv::Vec3b>(y, x) != bg) (inside.contains({x, y}) ? n.inside : n.outside)++;
+    return n;
+}
+
 /// A video file decoded back with OpenCV (FFmpeg backend).
 struct Decoded {
     double fps = 0, reportedCount = 0;

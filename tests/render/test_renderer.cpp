@@ -211,15 +211,9 @@ TEST(OffscreenRenderer, NothingOutsideTheSceneBoxIsDrawn) {
     ASSERT_LT(inside.area(), 0.8 * s.width * s.height);   // a real outside region remains
     for (double q : {-0.9, 0.0, 0.9}) {
         const cv::Mat frame = renderer.renderFrame(scene.getSystem(), scene.makeState(q, 1));
-        int drawnInside = 0, drawnOutside = 0;
-        for (int y = 0; y < frame.rows; ++y)
-            for (int x = 0; x < frame.cols; ++x) {
-                const bool isBg = frame.at<cv::Vec3b>(y, x) == bg;
-                if (inside.contains({x, y})) drawnInside += !isBg;
-                else drawnOutside += !isBg;
-            }
-        EXPECT_EQ(drawnOutside, 0) << "q = " << q;
-        EXPECT_GT(drawnInside, 500) << "q = " << q;
+        const test::DrawnPixels drawn = test::countDrawn(frame, bg, inside);
+        EXPECT_EQ(drawn.outside, 0) << "q = " << q;
+        EXPECT_GT(drawn.inside, 500) << "q = " << q;
     }
 }
 

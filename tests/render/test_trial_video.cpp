@@ -229,15 +229,9 @@ TEST_F(TrialVideo, NothingIsDrawnOutsideTheSceneBox) {
         const cv::Vec3b bg = test::toBgr8(kBackground);
         for (int row : {0, table->getNumRows() / 3, 2 * table->getNumRows() / 3, table->getNumRows() - 1}) {
             const cv::Mat frame = r.renderRow(row);
-            int drawnInside = 0, drawnOutside = 0;
-            for (int y = 0; y < frame.rows; ++y)
-                for (int x = 0; x < frame.cols; ++x) {
-                    const bool isBg = frame.at<cv::Vec3b>(y, x) == bg;
-                    if (inside.contains({x, y})) drawnInside += !isBg;
-                    else drawnOutside += !isBg;
-                }
-            EXPECT_EQ(drawnOutside, 0) << "row " << row;
-            EXPECT_GT(drawnInside, 2000) << "row " << row;
+            const test::DrawnPixels drawn = test::countDrawn(frame, bg, inside);
+            EXPECT_EQ(drawn.outside, 0) << "row " << row;
+            EXPECT_GT(drawn.inside, 2000) << "row " << row;
         }
     }
 }
