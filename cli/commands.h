@@ -4,25 +4,32 @@
 // turns into a message and an exit code.
 #pragma once
 
+#include "model/model_file.h"
 #include "muscles/virtual_muscle.h"
 
 #include <CLI/CLI.hpp>
 
 #include <functional>
+#include <optional>
 #include <string>
 
 namespace armsim::cli {
 
-/// Muscle options shared by several commands.
+/// Model and muscle options shared by every command that simulates. The muscle overrides apply to
+/// the model's primary muscle (the thesis's biceps); an option not given leaves the model's value.
 struct MuscleOptions {
-    std::string file = "muscles/biceps_long_head.yaml";  ///< muscle file (path or asset name)
-    int slowUnits = -1;                                   ///< override Ns (-1: from the file)
-    int fastUnits = -1;                                   ///< override Nf (-1: from the file)
-    double mass = 0;                                      ///< override M [kg] (0: from the file)
-    double tendonLength = 0;                              ///< override L0T [m] (0: from the file)
-    double maxPathLength = 0;                             ///< override P_max [m] (0: from the file)
+    std::string model = "thesis";          ///< model name under assets/models/ or a model file
+    std::string file;                      ///< muscle file replacing the primary muscle's parameters
+    std::string armFile;                   ///< arm file replacing the model's arm
+    std::optional<int> slowUnits;          ///< override Ns
+    std::optional<int> fastUnits;          ///< override Nf
+    std::optional<double> mass;            ///< override M [kg]
+    std::optional<double> tendonLength;    ///< override L0T [m]
+    std::optional<double> maxPathLength;   ///< override P_max [m]
     void add(CLI::App& app);
-    /// Loads the file and applies the overrides, validated.
+    /// The model with the overrides applied, validated (errors name the option and value).
+    ArmSetup loadSetup() const;
+    /// The primary muscle's parameters from loadSetup().
     MuscleParameters loadParameters() const;
     /// loadParameters() built into a VirtualMuscle.
     VirtualMuscle build() const;

@@ -7,7 +7,7 @@
 #include "identification/report_io.h"
 #include "identification/thesis_cases.h"
 #include "identification/validation.h"
-#include "model/biceps_arm.h"
+#include "model/muscle_arm.h"
 #include "model/geometry.h"
 #include "muscles/muscle_file.h"
 #include "muscles/param_file.h"
@@ -75,7 +75,7 @@ struct ModelOptions {
 
     void add(CLI::App& c, bool withModel) {
         if (withModel)
-            c.add_option("--model", model, "forward model: steady | faithful (Simbody arm in the loop) | corrected "
+            c.add_option("--forward", model, "forward model: steady | faithful (Simbody arm in the loop) | corrected "
                                            "(steady iterations corrected by the faithful model)")
                 ->capture_default_str()
                 ->check(CLI::IsMember({"steady", "faithful", "corrected"}));
@@ -105,7 +105,6 @@ struct ModelOptions {
 
 struct IdentifyOptions {
     MuscleOptions muscle;
-    std::string armFile = "arm/default_male.yaml";
     std::string data;
     std::string method = "lm";
     std::string freeList = "mass,optimal_tendon_length";
@@ -121,13 +120,6 @@ struct IdentifyOptions {
     bool thesisCases = false;
     std::string out = "out/identify";
 };
-
-ArmSetup loadSetup(const MuscleOptions& muscle, const std::string& armFile) {
-    ArmSetup s;
-    s.arm = loadArmParameters(findAsset(armFile));
-    s.biceps = muscle.loadParameters();
-    return s;
-}
 
 /// Reads a force file; angle columns are converted with the arm's own geometry.
 ObservationSet readData(const std::string& file, const ArmParameters& arm, int subject) {
@@ -179,11 +171,11 @@ void printThesisCases(const MuscleParameters& base, const ForceModel& model, con
 }
 
 void runIdentify(const IdentifyOptions& o) {
-    const ArmSetup setup = loadSetup(o.muscle, o.armFile);
+    const ArmSetup setup = o.muscle.loadSetup();
     const MuscleParameters base = setup.calcBicepsParameters();
     if (o.thesisCases) {
         if (o.model.model == "corrected")
-            throw InputError("--thesis-cases: --model corrected is not a single forward model; expected steady or faithful");
+            throw InputError("--thesis-cases: --forward corrected is not a single forward model; expected steady or faithful");
         if (o.model.model == "steady") {
             printThesisCases(base, SteadyForceModel(), o.out);
         } else {
@@ -264,7 +256,6 @@ void addIdentifyCommand(CLI::App& app) {
     c->add_option("--tolerance", o->tolerance, "force tolerance [N] (forces reproduced)")->capture_default_str();
     c->add_option("--subject", o->subject, "keep only this subject's rows (-1: all)")->capture_default_str();
     c->add_flag("--thesis-cases", o->thesisCases, "rerun the thesis's cases (4.5.1, Tables 7.1-7.3) beside its numbers");
-    c->add_option("--arm", o->armFile, "arm parameter file (path, or name under assets/)")->capture_default_str();
     o->muscle.add(*c);
     c->add_option("--out", o->out, "output directory (report JSON, history CSV, convergence PNG)")->capture_default_str();
     c->callback([o] { runIdentify(*o); });
@@ -274,7 +265,6 @@ void addIdentifyCommand(CLI::App& app) {
 
 struct ValidateOptions {
     MuscleOptions muscle;
-    std::string armFile = "arm/default_male.yaml";
     int seeds = 1;
     unsigned seed = 1;
     std::string noise = "0,1,2,5";
@@ -286,7 +276,7 @@ struct ValidateOptions {
 };
 
 void runValidate(const ValidateOptions& o) {
-    const ArmSetup setup = loadSetup(o.muscle, o.armFile);
+    const ArmSetup setup = o.muscle.loadSetup();
     ValidationSettings s;
     s.seeds = o.seeds;
     s.seed = o.seed;
@@ -318,14 +308,13 @@ void addValidateCommand(CLI::App& app) {
     c->add_option("--seed", o->seed, "generator seed (truths and noise)")->capture_default_str();
     c->add_option("--noise", o->noise, "comma-separated transducer noise levels [% of the force]")->capture_default_str();
     c->add_option("--methods", o->methods, "comma-separated methods (default: lm and the two-output learning family)");
-    c->add_option("--model", o->model, "identifying model: corrected | faithful | steady")
+    c->add_option("--forward", o->model, "identifying forward model: corrected | faithful | steady")
         ->capture_default_str()
         ->check(CLI::IsMember({"steady", "faithful", "corrected"}));
     c->add_option("--estimate", o->estimate, "force the experimenter reports: moment-arm | fixed-ratio | true")
         ->capture_default_str()
         ->check(CLI::IsMember({"moment-arm", "fixed-ratio", "true"}));
     c->add_option("--jobs", o->jobs, "trials run in parallel")->capture_default_str()->check(CLI::Range(1, 64));
-    c->add_option("--arm", o->armFile, "arm parameter file")->capture_default_str();
     o->muscle.add(*c);
     c->add_option("--out", o->out, "output directory (validation.csv)")->capture_default_str();
     c->callback([o] { runValidate(*o); });
@@ -346,7 +335,7 @@ void printEstimateLine(const std::string& label, const IdentificationReport& r, 
 }
 
 void runIdentificationStep(const MainJobContext& ctx) {
-    const ArmSetup setup = loadSetup(ctx.muscle, "arm/default_male.yaml");
+    const ArmSetup setup = ctx.muscle.loadSetup();
     const MuscleParameters base = setup.calcBicepsParameters();
     ModelOptions faithful;
     faithful.model = "faithful";

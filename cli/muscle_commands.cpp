@@ -1,6 +1,8 @@
 // armsim muscle steady | sweep | trial: the muscle alone, both path ends fixed.
 #include "cli/commands.h"
 #include "experiments/plot.h"
+#include "model/arm_parameters.h"
+#include "model/muscle_arm.h"
 #include "muscles/muscle_file.h"
 #include "muscles/param_file.h"
 #include "muscles/simbody_isometric.h"
@@ -13,28 +15,57 @@
 namespace armsim::cli {
 
 void MuscleOptions::add(CLI::App& app) {
-    app.add_option("--muscle", file, "muscle parameter file (path, or name under assets/)")->capture_default_str();
-    app.add_option("--slow-units", slowUnits, "number of slow motor units (default: from the file)");
-    app.add_option("--fast-units", fastUnits, "number of fast motor units (default: from the file)");
-    app.add_option("--mass", mass, "muscle mass M [kg] (default: from the file)");
-    app.add_option("--tendon-length", tendonLength, "optimal tendon length L0T [m] (default: from the file)");
-    app.add_option("--max-path", maxPathLength, "path length at the anatomical limit P_max [m]");
+    app.add_option("--model", model, "model: a name under assets/models/ (thesis, elbow) or a model file")
+        ->capture_default_str();
+    app.add_option("--muscle", file, "muscle file replacing the primary muscle's parameters (path, or name under assets/)");
+    app.add_option("--arm", armFile, "arm file replacing the model's arm (path, or name under assets/)");
+    app.add_option("--slow-units", slowUnits, "number of slow motor units (default: from the model)");
+    app.add_option("--fast-units", fastUnits, "number of fast motor units (default: from the model)");
+    app.add_option("--mass", mass, "muscle mass M [kg] (default: from the model)");
+    app.add_option("--tendon-length", tendonLength, "optimal tendon length L0T [m] (default: from the model)");
+    app.add_option("--max-path", maxPathLength, "path length at the anatomical limit P_max [m] (default: the "
+                                                "longest path over the elbow range)");
 }
 
-MuscleParameters MuscleOptions::loadParameters() const {
-    MuscleParameters p = loadMuscleParameters(findAsset(file));
-    if (slowUnits >= 0) p.numSlowUnits = slowUnits;
-    if (fastUnits >= 0) p.numFastUnits = fastUnits;
-    if (mass != 0) p.mass = mass;
-    if (tendonLength != 0) p.optimalTendonLength = tendonLength;
-    if (maxPathLength != 0) p.maxPathLength = maxPathLength;
+ArmSetup MuscleOptions::loadSetup() const {
+    ArmSetup s = loadModel(model);
+    if (!armFile.empty()) {
+        const ArmParameters a = loadArmParameters(findAsset(armFile));
+        s.arm = a;
+    }
+    MuscleParameters& p = s.biceps();
+    if (!file.empty()) {
+        const std::string name = p.name;
+        p = loadMuscleParameters(findAsset(file));
+        p.name = name;
+    }
+    auto check = [](const char* option, double v, const Bound& b) {
+        try {
+            checkField(option, v, b);
+        } catch (const FieldError& e) {
+            throw InputError(std::string("option ") + e.what());
+        }
+    };
+    if (slowUnits) check("--slow-units", *slowUnits, Bound::closed(0, 1000)), p.numSlowUnits = *slowUnits;
+    if (fastUnits) check("--fast-units", *fastUnits, Bound::closed(0, 1000)), p.numFastUnits = *fastUnits;
+    if (mass) check("--mass", *mass, Bound{0, 100, true, false, "kg"}), p.mass = *mass;
+    if (tendonLength) check("--tendon-length", *tendonLength, Bound{0, 2, true, false, "m"}), p.optimalTendonLength = *tendonLength;
+    if (maxPathLength) {
+        check("--max-path", *maxPathLength, Bound{0, 3, true, false, "m"});
+        p.maxPathLength = *maxPathLength;
+        s.muscles[s.primary].maxPathFromRange = false;
+    }
+    if (!armFile.empty()) resolveMaxPathLengths(s);
     try {
-        p.validate();
-        return p;
+        s.validate();
+        return s;
     } catch (const FieldError& e) {
-        throw InputError(std::string("muscle '") + p.name + "' (" + file + " with command-line overrides): " + e.what());
+        throw InputError(std::string("muscle '") + p.name + "' (model " + model +
+                         (file.empty() ? "" : ", muscle file " + file) + ", with command-line overrides): " + e.what());
     }
 }
+
+MuscleParameters MuscleOptions::loadParameters() const { return loadSetup().calcBicepsParameters(); }
 
 VirtualMuscle MuscleOptions::build() const { return VirtualMuscle(loadParameters()); }
 

@@ -145,7 +145,7 @@ void addProtocolCommand(CLI::App& app) {
 void runMvcProtocol(const MainJobContext& ctx) {
     const Protocol protocol = readProtocol(findAsset("protocols/mvc_force_angle.yaml"));
     ArmSetup subject = loadProtocolSubject(protocol);
-    subject.biceps = ctx.muscle.loadParameters();
+    subject.biceps() = ctx.muscle.loadParameters();
     const std::string out = ctx.outDir + "/protocol_mvc";
     const ProtocolResult r =
         runProtocol(protocol, subject, {out, ctx.jobs, [](int d, int n) { printProgress("MVC protocol trials", d, n); }});

@@ -22,7 +22,6 @@ namespace {
 
 struct RenderOptions {
     MuscleOptions muscle;
-    std::string armFile = "arm/default_male.yaml";
     std::string table, out, still, renderSettingsFile;
     double stillAt = 0, fps = 30, speed = 1, load = 0, arrowScale = 0;
     int width = 1280, height = 720, supersample = 2;
@@ -32,13 +31,6 @@ struct RenderOptions {
     CLI::Option* widthOption = nullptr;
     CLI::Option* heightOption = nullptr;
 };
-
-ArmSetup loadSetup(const MuscleOptions& muscle, const std::string& armFile) {
-    ArmSetup s;
-    s.arm = loadArmParameters(findAsset(armFile));
-    s.biceps = muscle.loadParameters();
-    return s;
-}
 
 void runRenderCommand(const RenderOptions& o) {
     TrialVideoSettings v;
@@ -71,7 +63,7 @@ void runRenderCommand(const RenderOptions& o) {
         throw InputError("armsim render: nothing to write: expected --out VIDEO and/or --still-at T --still FILE.png");
     v.validate();  // before the table is read
 
-    const ArmSetup setup = loadSetup(o.muscle, o.armFile);
+    const ArmSetup setup = o.muscle.loadSetup();
     const Table table = Table::readCsv(o.table);
     const TrialVideoResult r =
         renderTrialVideo(setup, table, v, [](int d, int n) { printProgress("rendering", d, n); });
@@ -110,14 +102,13 @@ void addRenderCommand(CLI::App& app) {
     c->add_option("--load", o->load, "mass held in the hand [kg], drawn as a ball (as given to armsim trial)");
     c->add_flag("--no-floor", o->noFloor, "no floor (with 10 cm ticks)");
     c->add_flag("--no-overlay", o->noOverlay, "no text panel and plots");
-    c->add_option("--arm", o->armFile, "arm parameter file of the trial's subject")->capture_default_str();
     o->muscle.add(*c);
     c->callback([o] { runRenderCommand(*o); });
 }
 
 /// Main job: one MVC video (isometric at 90 deg), one free-movement video, and a still of the MVC.
 void runTrialVideos(const MainJobContext& ctx) {
-    const ArmSetup setup = loadSetup(ctx.muscle, "arm/default_male.yaml");
+    const ArmSetup setup = ctx.muscle.loadSetup();
     IsometricTrialSettings iso;
     iso.elbowAngle = degToRad(90);
     const FreeMovementSettings free;

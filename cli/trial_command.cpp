@@ -18,7 +18,6 @@ namespace {
 
 struct TrialOptions {
     MuscleOptions muscle;
-    std::string armFile = "arm/default_male.yaml";
     std::string settingsFile;
     std::string type = "isometric";
     double angleDeg = 90, activation = 1.0, rest = 0.5, rise = 0.0, hold = 3.0;
@@ -26,13 +25,6 @@ struct TrialOptions {
     double rate = 1000, accuracy = 1e-4;
     std::string out = "out/trial.csv", plot, video;
 };
-
-ArmSetup loadSetup(const MuscleOptions& muscle, const std::string& armFile) {
-    ArmSetup s;
-    s.arm = loadArmParameters(findAsset(armFile));
-    s.biceps = muscle.loadParameters();
-    return s;
-}
 
 // --video: renders the written table (a replay of the trial).
 void renderVideo(const TrialOptions& o, const ArmSetup& setup, const Table& table, double handLoad) {
@@ -50,7 +42,7 @@ void runTrialCommand(const TrialOptions& o) {
 #ifndef ARMSIM_WITH_RENDER
     if (!o.video.empty()) throw InputError("--video: this armsim was built without the renderer (-DARMSIM_RENDER=OFF)");
 #endif
-    const ArmSetup setup = loadSetup(o.muscle, o.armFile);
+    const ArmSetup setup = o.muscle.loadSetup();
     std::string type = o.type;
     IsometricTrialSettings iso;
     FreeMovementSettings free;
@@ -129,7 +121,6 @@ void addTrialCommand(CLI::App& app) {
     auto o = std::make_shared<TrialOptions>();
     CLI::App* c = app.add_subcommand("trial", "one trial of the arm: isometric (elbow locked) or free movement");
     o->muscle.add(*c);
-    c->add_option("--arm", o->armFile, "arm parameter file (path, or name under assets/)")->capture_default_str();
     c->add_option("--settings", o->settingsFile,
                   "YAML trial settings (type: isometric|free, and the keys of that trial type) instead of options");
     c->add_option("--type", o->type, "isometric | free")->capture_default_str()->check(CLI::IsMember({"isometric", "free"}));
@@ -153,7 +144,7 @@ void addTrialCommand(CLI::App& app) {
 
 /// Main job: MVC at the thesis's five angles, in parallel.
 void runMvcAngles(const MainJobContext& ctx) {
-    ArmSetup setup = loadSetup(ctx.muscle, "arm/default_male.yaml");
+    ArmSetup setup = ctx.muscle.loadSetup();
     const double angles[] = {45, 60, 90, 120, 150};
     std::vector<IsometricTrialSettings> settings;
     for (double a : angles) {

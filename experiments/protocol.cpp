@@ -221,7 +221,15 @@ ArmTrialOutcome runArmTrial(const ArmTrialPlan& plan, const Protocol& protocol, 
                             const VirtualMuscle& muscle, RunDirectory& dir, bool keepSeries) {
     IsometricTrialSettings s = protocol.trial;
     s.elbowAngle = plan.angle;
-    s.activation = plan.activation;
+    // The subject's effort: agonists at the planned drive times the voluntary activation, antagonists
+    // co-contracting; both vary from trial to trial (seeded) and fade with fatigue over repetitions.
+    const SubjectEffort& e = subject.effort;
+    std::mt19937_64 effortRng(splitMix(plan.seed ^ 0xE1F0E1F0ULL));
+    std::normal_distribution<double> unit(0.0, 1.0);
+    const double variation = 1 + e.trialCv * unit(effortRng), antagonistVariation = 1 + e.trialCv * unit(effortRng);
+    const double fatigue = std::pow(1 - e.fatigue, plan.repetition - 1);
+    s.activation = std::clamp(plan.activation * e.voluntaryActivation * variation * fatigue, 0.0, 1.0);
+    s.antagonistActivation = std::clamp(e.coContraction * antagonistVariation * fatigue, 0.0, 1.0);
     const IsometricTrialResult r = runIsometricTrial(subject, s);
     const Table& t = r.series;
     const int rows = t.getNumRows();
@@ -589,8 +597,12 @@ nlohmann::ordered_json subjectJson(const Protocol& p, const ArmSetup& subject, c
     const MuscleParameters& mp = m.getParameters();
     const ArmParameters& a = subject.arm;
     nlohmann::ordered_json j;
-    j["arm_file"] = fs::path(p.armFile).filename().string();
-    j["muscle_file"] = fs::path(p.muscleFile).filename().string();
+    j["model"] = subject.name;
+    j["arm_file"] = p.armFile.empty() ? std::string("(model)") : fs::path(p.armFile).filename().string();
+    j["muscle_file"] = p.muscleFile.empty() ? std::string("(model)") : fs::path(p.muscleFile).filename().string();
+    j["effort"] = {{"voluntary_activation", subject.effort.voluntaryActivation},
+                   {"co_contraction", subject.effort.coContraction}, {"trial_cv", subject.effort.trialCv},
+                   {"fatigue", subject.effort.fatigue}};
     j["arm"] = {{"body_mass_kg", a.bodyMass}, {"body_height_m", a.bodyHeight},
                 {"origin_distance_m", a.originDistance}, {"insertion_distance_m", a.insertionDistance},
                 {"strap_distance_m", a.strapDistance}, {"transducer_range_N", a.transducerRange},

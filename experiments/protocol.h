@@ -51,8 +51,12 @@ struct Protocol {
     /// costs no simulated time.
     double interTrialRest = 0;
 
-    std::string armFile = "arm/default_male.yaml";            ///< subject: arm file (path or asset)
-    std::string muscleFile = "muscles/biceps_long_head.yaml"; ///< subject: muscle file (path or asset)
+    std::string model = "thesis";      ///< subject: model name or file (model/model_file.h)
+    std::string armFile;               ///< subject: arm file replacing the model's ("" = the model's)
+    std::string muscleFile;            ///< subject: muscle file replacing the primary's ("" = the model's)
+    /// Overrides of the model's subject effort (voluntary activation, co-contraction, trial CV,
+    /// fatigue per repetition); unset = the model file's values.
+    std::optional<double> voluntaryActivation, coContraction, trialCv, fatigue;
 
     /// Template of every arm trial (rest with tare, rise, hold, sample rate, averaging window,
     /// integrator accuracy); elbow angle and activation are set per trial.

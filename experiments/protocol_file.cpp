@@ -159,8 +159,14 @@ Protocol readProtocol(const std::string& path) {
 
     if (root.has("subject")) {
         const ParamNode s = root.child("subject");
+        p.model = s.getString("model", p.model);
         p.armFile = s.getString("arm", p.armFile);
         p.muscleFile = s.getString("muscle", p.muscleFile);
+        const Bound any = Bound::any();
+        if (s.has("voluntary_activation")) p.voluntaryActivation = s.getNumber("voluntary_activation", any);
+        if (s.has("co_contraction")) p.coContraction = s.getNumber("co_contraction", any);
+        if (s.has("trial_cv")) p.trialCv = s.getNumber("trial_cv", any);
+        if (s.has("fatigue")) p.fatigue = s.getNumber("fatigue", any);
         s.finish();
     }
     auto resolve = [&](const std::string& key, const std::string& file) {
@@ -172,9 +178,16 @@ Protocol readProtocol(const std::string& path) {
             throw InputError(root.where("subject") + ": field 'subject." + key + "': " + e.what());
         }
     };
-    p.armFile = resolve("arm", p.armFile);
-    p.muscleFile = resolve("muscle", p.muscleFile);
-    const ArmSetup subject = loadProtocolSubject(p);
+    if (!p.armFile.empty()) p.armFile = resolve("arm", p.armFile);
+    if (!p.muscleFile.empty()) p.muscleFile = resolve("muscle", p.muscleFile);
+    if (p.model.find('/') != std::string::npos || p.model.find(".yaml") != std::string::npos)
+        p.model = resolve("model", p.model);
+    ArmSetup subject;
+    try {
+        subject = loadProtocolSubject(p);
+    } catch (const InputError& e) {
+        throw InputError(root.where("subject") + ": subject: " + e.what());
+    }
     const ArmParameters& arm = subject.arm;
     const double pMax = subject.calcBicepsParameters().maxPathLength;
 
@@ -265,9 +278,20 @@ Protocol readProtocol(const std::string& path) {
 }
 
 ArmSetup loadProtocolSubject(const Protocol& protocol) {
-    ArmSetup s;
-    s.arm = loadArmParameters(findAsset(protocol.armFile));
-    s.biceps = loadMuscleParameters(findAsset(protocol.muscleFile));
+    ArmSetup s = loadModel(protocol.model);
+    if (!protocol.armFile.empty()) s.arm = loadArmParameters(findAsset(protocol.armFile));
+    if (!protocol.muscleFile.empty()) {
+        const std::string name = s.biceps().name;
+        s.biceps() = loadMuscleParameters(findAsset(protocol.muscleFile));
+        s.biceps().name = name;
+        s.muscles[s.primary].maxPathFromRange = true;
+    }
+    if (protocol.voluntaryActivation) s.effort.voluntaryActivation = *protocol.voluntaryActivation;
+    if (protocol.coContraction) s.effort.coContraction = *protocol.coContraction;
+    if (protocol.trialCv) s.effort.trialCv = *protocol.trialCv;
+    if (protocol.fatigue) s.effort.fatigue = *protocol.fatigue;
+    resolveMaxPathLengths(s);
+    s.validate();
     return s;
 }
 

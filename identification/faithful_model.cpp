@@ -71,6 +71,9 @@ double calcElbowAngleFromPath(double A, double B, double path) {
 FaithfulForceModel::FaithfulForceModel(ArmParameters arm, FaithfulModelOptions options)
     : arm_(std::move(arm)), options_(std::move(options)) {
     arm_.validate();
+    setup_ = ArmSetup::loadDefault();
+    setup_.arm = arm_;
+    setup_.muscles[setup_.primary].maxPathFromRange = false;
     options_.protocol.validate();
     checkField("jobs", options_.jobs, Bound::closed(1, 256));
 }
@@ -112,10 +115,8 @@ std::vector<double> FaithfulForceModel::calcForces(const MuscleParameters& param
     set.points = observations;
     const std::vector<double> angles = calcElbowAngles(set);
 
-    ArmSetup setup;
-    setup.arm = arm_;
-    setup.biceps = params;
-    setup.musclePmaxFromArm = false;
+    ArmSetup setup = setup_;
+    setup.biceps() = params;
     const FaithfulProtocol& p = options_.protocol;
     std::vector<IsometricTrialSettings> trials;
     for (std::size_t k = 0; k < observations.size(); ++k) {

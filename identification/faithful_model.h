@@ -21,6 +21,7 @@
 #include "identification/force_model.h"
 #include "identification/observations.h"
 #include "model/arm_parameters.h"
+#include "model/model_file.h"
 
 #include <atomic>
 #include <string>
@@ -100,6 +101,7 @@ public:
 
 private:
     ArmParameters arm_;
+    ArmSetup setup_;  ///< the thesis model on arm_; its biceps is replaced per evaluation
     FaithfulModelOptions options_;
     mutable std::atomic<long> trials_{0};
     mutable std::atomic<long> saturated_{0};

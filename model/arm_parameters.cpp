@@ -59,9 +59,16 @@ ArmParameters ArmParameters::scaled(double newBodyMass, double newBodyHeight) co
 
 ArmParameters loadArmParameters(const std::string& path) {
     const ParamNode root = ParamNode::loadFile(path);
-    const Bound any = Bound::any();
-    ArmParameters p;
     root.getString("source", "");
+    ArmParameters p;
+    readArmParameters(root, p, true);
+    root.finish();
+    root.rethrowWithLocation([&] { p.validate(); });
+    return p;
+}
+
+bool readArmParameters(const ParamNode& root, ArmParameters& p, bool requireBiceps) {
+    const Bound any = Bound::any();
 
     const ParamNode body = root.child("body");
     p.bodyMass = body.getNumber("mass", any);
@@ -84,10 +91,13 @@ ArmParameters loadArmParameters(const std::string& path) {
     p.handComFraction = fore.getNumber("hand_com_fraction", any);
     fore.finish();
 
-    const ParamNode biceps = root.child("biceps");
-    p.originDistance = biceps.getNumber("origin_distance", any);
-    p.insertionDistance = biceps.getNumber("insertion_distance", any);
-    biceps.finish();
+    const bool hasBiceps = requireBiceps || root.has("biceps");
+    if (hasBiceps) {
+        const ParamNode biceps = root.child("biceps");
+        p.originDistance = biceps.getNumber("origin_distance", any);
+        p.insertionDistance = biceps.getNumber("insertion_distance", any);
+        biceps.finish();
+    }
 
     const ParamNode transducer = root.child("transducer");
     p.strapDistance = transducer.getNumber("strap_distance", any);
@@ -103,9 +113,7 @@ ArmParameters loadArmParameters(const std::string& path) {
 
     p.gravity = root.getNumber("gravity", any);
     p.handLoad = root.getNumber("hand_load", any);
-    root.finish();
-    root.rethrowWithLocation([&] { p.validate(); });
-    return p;
+    return hasBiceps;
 }
 
 }  // namespace armsim

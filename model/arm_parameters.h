@@ -80,4 +80,10 @@ struct ArmParameters {
 /// keys are errors, and every error names the file, line, field, value and expected bound.
 ArmParameters loadArmParameters(const std::string& path);
 
+class ParamNode;
+/// Reads the arm sections of root (an arm file, or a model file's `arm` mapping) into p without
+/// validating or finishing root. The `biceps` section is required when requireBiceps; returns whether
+/// it was there.
+bool readArmParameters(const ParamNode& root, ArmParameters& p, bool requireBiceps);
+
 }  // namespace armsim

@@ -16,14 +16,22 @@ void checkElbowAngle(const std::string& field, double theta, const ArmParameters
     checkField(field, radToDeg(theta), Bound::closed(arm.minElbowAngleDeg, arm.maxElbowAngleDeg, "deg"));
 }
 
-std::vector<std::string> withStateColumns(std::vector<std::string> names, const VirtualMuscle& m) {
-    for (const std::string& n : m.getStateNames()) names.push_back(kStateColumnPrefix + n);
+// Per-muscle force and activation columns (models with several muscles), then the state columns.
+std::vector<std::string> withMuscleColumns(std::vector<std::string> names, const MuscleArm& model) {
+    if (model.getNumMuscles() > 1) {
+        for (int i = 0; i < model.getNumMuscles(); ++i) names.push_back("force_" + model.getMuscleName(i) + "_N");
+        for (int i = 0; i < model.getNumMuscles(); ++i) names.push_back("activation_" + model.getMuscleName(i));
+    }
+    for (const std::string& n : model.getStateColumnNames()) names.push_back(n);
     return names;
 }
 
-void appendMuscleStates(std::vector<double>& row, const VirtualMuscleForce& biceps, const State& s) {
-    const std::vector<double> y = biceps.getMuscleStates(s);
-    row.insert(row.end(), y.begin(), y.end());
+void appendMuscleForces(std::vector<double>& row, const MuscleArm& model, const std::vector<double>& forces,
+                        double t) {
+    if (model.getNumMuscles() == 1) return;
+    row.insert(row.end(), forces.begin(), forces.end());
+    for (int i = 0; i < model.getNumMuscles(); ++i)
+        row.push_back(model.getMuscleForce(i).getActivationProfile().getValue(t));
 }
 
 double mean(const std::vector<double>& v, std::size_t from) {
@@ -34,20 +42,33 @@ double mean(const std::vector<double>& v, std::size_t from) {
 
 }  // namespace
 
-void setStateFromTrialRow(const BicepsArm& model, const Table& table, int row, State& state) {
+void setStateFromTrialRow(const MuscleArm& model, const Table& table, int row, State& state) {
     const ArmModel& arm = model.getArm();
     state.setTime(table.get(row, "time_s"));
     arm.setElbowAngle(state, degToRad(table.get(row, "elbow_angle_deg")));
     arm.setElbowAngularVelocity(state, degToRad(table.get(row, "elbow_velocity_degps")));
     std::vector<double> y;
-    for (const std::string& n : model.getMuscle().getStateNames()) {
-        const std::string column = kStateColumnPrefix + n;
+    for (const std::string& column : model.getStateColumnNames()) {
         if (!table.hasColumn(column))
-            throw InputError("trial table has no column '" + column +
-                             "': it was not written by armsim trial, or for another muscle composition");
+            throw InputError("trial table has no column '" + column + "': it was not written by armsim trial for "
+                             "model '" + model.getSetup().name + "', or for another muscle composition");
         y.push_back(table.get(row, column));
     }
-    model.getBiceps().setMuscleStates(state, y);
+    model.setMuscleStates(state, y);
+}
+
+std::vector<ActivationProfile> readActivationProfiles(const ArmSetup& setup, const Table& table,
+                                                      const std::string& tableName) {
+    const std::vector<double> time = table.getColumn("time_s");
+    std::vector<ActivationProfile> profiles;
+    for (const MuscleSpec& m : setup.muscles) {
+        const std::string column = setup.getNumMuscles() == 1 ? "activation" : "activation_" + m.params.name;
+        if (!table.hasColumn(column))
+            throw InputError(tableName + " has no column '" + column + "' (model '" + setup.name +
+                             "'): was it written for another model?");
+        profiles.emplace_back(time, table.getColumn(column), tableName + " " + column);
+    }
+    return profiles;
 }
 
 // ---- Isometric ----------------------------------------------------------------------------------
@@ -55,6 +76,7 @@ void setStateFromTrialRow(const BicepsArm& model, const Table& table, int row, S
 void IsometricTrialSettings::validate(const ArmParameters& arm) const {
     checkElbowAngle("elbow_angle_deg", elbowAngle, arm);
     checkField("activation", activation, Bound::closed(0, 1));
+    checkField("antagonist_activation", antagonistActivation, Bound::closed(0, 1));
     checkField("rest", restDuration, Bound::positive("s"));
     checkField("rise", riseTime, Bound::nonNegative("s"));
     checkField("hold", holdDuration, Bound::positive("s"));
@@ -63,73 +85,88 @@ void IsometricTrialSettings::validate(const ArmParameters& arm) const {
     integration.validate();
 }
 
-ActivationProfile IsometricTrialSettings::calcActivationProfile() const {
-    if (riseTime > 0) return ActivationProfile::ramp(restDuration, restDuration + riseTime, 0.0, activation);
-    return ActivationProfile::step(restDuration, 0.0, activation);
+namespace {
+
+ActivationProfile riseTo(const IsometricTrialSettings& s, double U) {
+    if (s.riseTime > 0) return ActivationProfile::ramp(s.restDuration, s.restDuration + s.riseTime, 0.0, U);
+    return ActivationProfile::step(s.restDuration, 0.0, U);
+}
+
+}  // namespace
+
+ActivationProfile IsometricTrialSettings::calcActivationProfile() const { return riseTo(*this, activation); }
+
+std::vector<ActivationProfile> IsometricTrialSettings::calcActivationProfiles(const ArmSetup& setup) const {
+    std::vector<ActivationProfile> profiles;
+    for (const MuscleSpec& m : setup.muscles)
+        profiles.push_back(riseTo(*this, m.group == effort ? activation : antagonistActivation));
+    return profiles;
 }
 
 IsometricTrialResult runIsometricTrial(const ArmSetup& setup, const IsometricTrialSettings& settings) {
     settings.validate(setup.arm);
     const ActivationProfile profile = settings.calcActivationProfile();
-    const BicepsArm model(setup, profile);
+    const MuscleArm model(setup, settings.calcActivationProfiles(setup));
     const ArmModel& arm = model.getArm();
-    const VirtualMuscleForce& biceps = model.getBiceps();
     const MultibodySystem& system = model.getSystem();
     const ArmParameters& ap = setup.arm;
+    const int n = model.getNumMuscles(), primary = setup.primary;
 
     State state = model.getDefaultState();
     arm.lockElbow(state, settings.elbowAngle);
-    biceps.setSteadyMuscleStates(state);  // passive equilibrium at U(0) = 0
+    model.setSteadyMuscleStates(state);  // passive equilibrium at U(0) = 0
     system.realize(state, Stage::Acceleration);
 
     IsometricTrialResult result;
     IsometricSummary& sum = result.summary;
     sum.elbowAngle = settings.elbowAngle;
-    sum.pathLength = arm.calcPathLength(state);
-    sum.momentArm = arm.calcMomentArm(state);
+    std::vector<double> restForces(n);
+    for (int i = 0; i < n; ++i) {
+        sum.pathLengths.push_back(model.calcPathLength(state, i));
+        sum.momentArms.push_back(model.calcMomentArm(state, i));
+        restForces[i] = model.getMuscleForce(i).getForce(state);
+    }
+    sum.pathLength = sum.pathLengths[primary];
+    sum.momentArm = sum.momentArms[primary];
     sum.tareTorque = arm.calcHoldingTorque(state);
-    sum.restForce = biceps.getForce(state);
+    sum.restForce = restForces[primary];
+    // Locked: gravity and the stop are constant, so the lock's torque is G - sum_i h_i F_i exactly.
+    double G = sum.tareTorque;
+    for (int i = 0; i < n; ++i) G += sum.momentArms[i] * restForces[i];
 
-    result.series = Table(withStateColumns(
+    result.series = Table(withMuscleColumns(
         {"time_s", "activation", "elbow_angle_deg", "elbow_velocity_degps", "muscle_force_N", "fascicle_length_m",
          "fascicle_velocity_mps", "holding_torque_Nm", "muscle_torque_Nm", "strap_force_N", "saturated",
          "force_moment_arm_N", "force_fixed_ratio_N", "error_moment_arm_pct", "error_fixed_ratio_pct"},
-        model.getMuscle()));
+        model));
     const double h = sum.momentArm;
-    const VirtualMuscle& muscle = model.getMuscle();
-    const double L0 = muscle.getParameters().optimalFascicleLength;
-
-    // Holding torque measured (findMotionForces) at every step end; see realizeEverySample.
-    struct StepTorque { double t, F, torque; };
-    StepTorque prev{}, cur{};
-    bool haveStep = false;
-    auto onStep = [&](const State& s) {
-        prev = cur;
-        cur = {s.getTime(), biceps.getForce(s), arm.calcHoldingTorque(s)};
-        if (!haveStep) prev = cur;
-        haveStep = true;
-    };
-    auto torqueAt = [&](double t, double F) {
-        const double dF = cur.F - prev.F;
-        if (std::abs(dF) > 1e-9 * (1.0 + std::abs(cur.F))) return prev.torque + (F - prev.F) / dF * (cur.torque - prev.torque);
-        const double dt = cur.t - prev.t;
-        return dt > 0 ? prev.torque + (t - prev.t) / dt * (cur.torque - prev.torque) : cur.torque;
-    };
+    const double L0 = model.getMuscle(primary).getParameters().optimalFascicleLength;
+    std::vector<const VirtualMuscle*> muscles;
+    for (int i = 0; i < n; ++i) muscles.push_back(&model.getMuscle(i));
+    std::vector<double> forces(n);
+    std::vector<int> firstState(n);
+    for (int i = 0, at = 0; i < n; at += muscles[i]->getNumStates(), ++i) firstState[i] = at;
 
     sum.stats = simulateSampled(
         system, state, settings.getDuration(), settings.sampleRate, profile.getBreakpoints(), settings.integration,
         [&](const State& s) {
             const double t = s.getTime();
-            const std::vector<double> y = biceps.getMuscleStates(s);
-            double F, torque;
+            std::vector<double> row;
+            model.appendMuscleStates(s, row);  // the states, in column order
+            const std::vector<double> y = std::move(row);
+            double torque;
             if (settings.realizeEverySample) {
                 system.realize(s, Stage::Acceleration);
-                F = biceps.getForce(s);
+                for (int i = 0; i < n; ++i) forces[i] = model.getMuscleForce(i).getForce(s);
                 torque = arm.calcHoldingTorque(s);
-            } else {  // the path is fixed: the pure model gives Fse from the interpolated states
-                F = muscle.calcForce(sum.pathLength, y.data());
-                torque = torqueAt(t, F);
+            } else {  // the paths are fixed: the pure model gives Fse from the interpolated states
+                torque = G;
+                for (int i = 0; i < n; ++i) {
+                    forces[i] = muscles[i]->calcForce(sum.pathLengths[i], y.data() + firstState[i]);
+                    torque -= sum.momentArms[i] * forces[i];
+                }
             }
+            const double F = forces[primary];
             const double muscleTorque = sum.tareTorque - torque;  // tared, + = flexion
             double strap = muscleTorque / ap.strapDistance;          // perpendicular strap at d1
             const bool saturated = std::abs(strap) > ap.transducerRange;
@@ -138,14 +175,16 @@ IsometricTrialResult runIsometricTrial(const ArmSetup& setup, const IsometricTri
             const double byMomentArm = calcBicepsForceFromTorque(strap * ap.strapDistance, h);
             const double byFixedRatio = calcBicepsForceFixedRatio(strap, settings.elbowAngle, kPi / 2);
             auto pct = [F](double estimate) { return F > 0 ? 100 * (estimate - F) / F : NAN; };
-            std::vector<double> row{t, profile.getValue(t), radToDeg(settings.elbowAngle), 0.0, F,
-                                    y[VirtualMuscle::kL] * L0, y[VirtualMuscle::kV] * L0, torque, muscleTorque,
-                                    strap, saturated ? 1.0 : 0.0, byMomentArm, byFixedRatio, pct(byMomentArm),
-                                    pct(byFixedRatio)};
+            const double* yp = y.data() + firstState[primary];
+            row = {t, profile.getValue(t), radToDeg(settings.elbowAngle), 0.0, F,
+                   yp[VirtualMuscle::kL] * L0, yp[VirtualMuscle::kV] * L0, torque, muscleTorque,
+                   strap, saturated ? 1.0 : 0.0, byMomentArm, byFixedRatio, pct(byMomentArm),
+                   pct(byFixedRatio)};
+            appendMuscleForces(row, model, forces, t);
             row.insert(row.end(), y.begin(), y.end());
             result.series.appendRow(std::move(row));
         },
-        [&](const State& s) { biceps.checkMuscleStates(s); }, onStep);
+        [&](const State& s) { model.checkMuscleStates(s); });
 
     const Table& t = result.series;
     const std::vector<double> time = t.getColumn("time_s");
@@ -157,6 +196,9 @@ IsometricTrialResult runIsometricTrial(const ArmSetup& setup, const IsometricTri
     sum.meanStrapForce = mean(t.getColumn("strap_force_N"), first);
     sum.meanForceMomentArm = mean(t.getColumn("force_moment_arm_N"), first);
     sum.meanForceFixedRatio = mean(t.getColumn("force_fixed_ratio_N"), first);
+    sum.meanMuscleTorque = mean(t.getColumn("muscle_torque_Nm"), first);
+    for (int i = 0; i < n; ++i)
+        sum.meanForces.push_back(n == 1 ? sum.meanForce : mean(t.getColumn("force_" + model.getMuscleName(i) + "_N"), first));
     return result;
 }
 
@@ -185,35 +227,42 @@ Table runFreeMovement(const ArmSetup& setup, const FreeMovementSettings& setting
     settings.validate(setup.arm);
     ArmSetup loaded = setup;
     loaded.arm.handLoad = settings.handLoad;
-    const BicepsArm model(loaded, settings.activation);
+    std::vector<ActivationProfile> profiles;
+    for (const MuscleSpec& m : setup.muscles)
+        profiles.push_back(m.group == MuscleGroup::Flexor ? settings.activation : ActivationProfile::constant(0.0));
+    const MuscleArm model(loaded, profiles);
     const ArmModel& arm = model.getArm();
-    const VirtualMuscleForce& biceps = model.getBiceps();
     const MultibodySystem& system = model.getSystem();
+    const int primary = setup.primary, n = model.getNumMuscles();
+    const VirtualMuscleForce& biceps = model.getBiceps();
 
     State state = model.getDefaultState();
     arm.setElbowAngle(state, settings.initialAngle);
     arm.setElbowAngularVelocity(state, settings.initialVelocity);
-    if (settings.startSteady) biceps.setSteadyMuscleStates(state);
-    else biceps.setInitialMuscleStates(state);
+    if (settings.startSteady) model.setSteadyMuscleStates(state);
+    else model.setInitialMuscleStates(state);
 
-    Table t(withStateColumns({"time_s", "activation", "elbow_angle_deg", "elbow_velocity_degps", "path_length_m",
-                              "moment_arm_m", "muscle_force_N", "fascicle_length_m", "fascicle_velocity_mps",
-                              "active_fraction"},
-                             model.getMuscle()));
+    Table t(withMuscleColumns({"time_s", "activation", "elbow_angle_deg", "elbow_velocity_degps", "path_length_m",
+                               "moment_arm_m", "muscle_force_N", "fascicle_length_m", "fascicle_velocity_mps",
+                               "active_fraction"},
+                              model));
+    const double L0 = model.getMuscle(primary).getParameters().optimalFascicleLength;
+    std::vector<double> forces(n);
     const IntegrationStats st = simulateSampled(
         system, state, settings.duration, settings.sampleRate, settings.activation.getBreakpoints(),
         settings.integration,
         [&](const State& s) {
             system.realize(s, Stage::Position);
             const MuscleOutputs o = biceps.calcOutputs(s);
-            const double L0 = model.getMuscle().getParameters().optimalFascicleLength;
+            for (int i = 0; i < n; ++i) forces[i] = model.getMuscleForce(i).getForce(s);
             std::vector<double> row{s.getTime(), biceps.getActivation(s), radToDeg(arm.getElbowAngle(s)),
-                                    radToDeg(arm.getElbowAngularVelocity(s)), arm.calcPathLength(s),
-                                    arm.calcMomentArm(s), o.Fse, o.L * L0, o.V * L0, o.activeFraction};
-            appendMuscleStates(row, biceps, s);
+                                    radToDeg(arm.getElbowAngularVelocity(s)), model.calcPathLength(s, primary),
+                                    model.calcMomentArm(s, primary), o.Fse, o.L * L0, o.V * L0, o.activeFraction};
+            appendMuscleForces(row, model, forces, s.getTime());
+            model.appendMuscleStates(s, row);
             t.appendRow(std::move(row));
         },
-        [&](const State& s) { biceps.checkMuscleStates(s); });
+        [&](const State& s) { model.checkMuscleStates(s); });
     if (stats) *stats = st;
     return t;
 }
@@ -225,6 +274,9 @@ IsometricTrialSettings readIsometricTrialSettings(const ParamNode& n, const ArmP
     const Bound any = Bound::any();
     s.elbowAngle = degToRad(n.getNumber("elbow_angle_deg", any, radToDeg(s.elbowAngle)));
     s.activation = n.getNumber("activation", any, s.activation);
+    s.effort = n.getChoice("effort", {"flexion", "extension"}, "flexion") == "flexion" ? MuscleGroup::Flexor
+                                                                                     : MuscleGroup::Extensor;
+    s.antagonistActivation = n.getNumber("antagonist_activation", any, s.antagonistActivation);
     s.restDuration = n.getNumber("rest", any, s.restDuration);
     s.riseTime = n.getNumber("rise", any, s.riseTime);
     s.holdDuration = n.getNumber("hold", any, s.holdDuration);

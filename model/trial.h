@@ -4,7 +4,7 @@
 // Simbody System, so trials run in parallel threads and give the same numbers as a sequential run.
 #pragma once
 
-#include "model/biceps_arm.h"
+#include "model/muscle_arm.h"
 #include "muscles/simbody_isometric.h"
 #include "muscles/table.h"
 
@@ -16,19 +16,29 @@ namespace armsim {
 
 class ParamNode;
 
-/// Trial tables end with one column per muscle state, named this prefix + the state's name
-/// ("state_L", "state_feff_3"), so a recorded trial can be replayed exactly (rendering, analysis).
+/// Trial tables end with one column per muscle state (MuscleArm::getStateColumnNames: "state_L",
+/// "state_feff_3" for a one-muscle model, "state_BIClong_L" otherwise), so a recorded trial can be
+/// replayed exactly (rendering, analysis). Models with several muscles also get per-muscle columns
+/// force_<muscle>_N and activation_<muscle>.
 inline const std::string kStateColumnPrefix = "state_";
 
 /// Sets time, elbow angle and velocity, and every muscle state of `state` from one row of a trial
 /// table (isometric or free movement). Throws InputError if a state column is missing.
-void setStateFromTrialRow(const BicepsArm& model, const Table& table, int row, SimTK::State& state);
+void setStateFromTrialRow(const MuscleArm& model, const Table& table, int row, SimTK::State& state);
 
-/// An isometric trial: elbow locked at theta; rest (muscle off, transducer tared), activation rises
-/// to the target (step or ramp), held; sampled at sampleRate.
+/// The activation of every muscle of a model over a trial, as recorded in a trial table: the
+/// activation_<muscle> columns, or the `activation` column for every muscle of a one-muscle model.
+std::vector<ActivationProfile> readActivationProfiles(const ArmSetup& setup, const Table& table,
+                                                      const std::string& tableName);
+
+/// An isometric trial: elbow locked at theta; rest (muscles off, transducer tared), activation rises
+/// to the target (step or ramp), held; sampled at sampleRate. The agonists (muscles of the effort's
+/// group) rise to `activation`, the antagonists to `antagonistActivation` (co-contraction).
 struct IsometricTrialSettings {
     double elbowAngle = 90 * 3.14159265358979323846 / 180;  ///< theta, included angle [rad]
-    double activation = 1.0;       ///< target U during the hold [1]
+    double activation = 1.0;       ///< target U of the agonists during the hold [1]
+    MuscleGroup effort = MuscleGroup::Flexor;  ///< which group pulls: a flexion or an extension effort
+    double antagonistActivation = 0.0;  ///< target U of the other group during the hold [1]
     double restDuration = 0.5;     ///< muscle inactive; the transducer is tared at its start [s]
     double riseTime = 0.0;         ///< ramp from 0 to the target; 0 = step [s]
     double holdDuration = 3.0;     ///< time at the target [s] (thesis: 3 s efforts)
@@ -45,20 +55,26 @@ struct IsometricTrialSettings {
     /// Throws InputError naming the field unless every value is in range (angle inside the arm's
     /// elbow range, durations positive, activation in [0, 1], window inside the hold).
     void validate(const ArmParameters& arm) const;
-    /// Onset, rise and hold as an activation profile.
+    /// Onset, rise and hold of the agonists as an activation profile.
     ActivationProfile calcActivationProfile() const;
+    /// One profile per muscle of setup: agonists to `activation`, antagonists to antagonistActivation.
+    std::vector<ActivationProfile> calcActivationProfiles(const ArmSetup& setup) const;
     double getDuration() const { return restDuration + riseTime + holdDuration; }
 };
 
 /// Summary of an isometric trial, averaged over the last averagingWindow of the hold.
 struct IsometricSummary {
     double elbowAngle = 0;          ///< theta [rad]
-    double pathLength = 0;          ///< P [m]
-    double momentArm = 0;           ///< h [m]
+    double pathLength = 0;          ///< P of the primary muscle [m]
+    double momentArm = 0;           ///< h of the primary muscle [m]
     double tareTorque = 0;          ///< holding torque at rest, subtracted by the tare [N m]
-    double restForce = 0;           ///< passive muscle force at rest (hidden by the tare) [N]
-    double finalForce = 0;          ///< true muscle force Fse at the last sample [N]
-    double meanForce = 0;           ///< true muscle force, window mean [N]
+    double restForce = 0;           ///< passive force of the primary muscle at rest (hidden by the tare) [N]
+    double finalForce = 0;          ///< true force Fse of the primary muscle at the last sample [N]
+    double meanForce = 0;           ///< true force of the primary muscle, window mean [N]
+    double meanMuscleTorque = 0;    ///< tared elbow torque (what the transducer sees), window mean [N m]
+    std::vector<double> pathLengths;     ///< per muscle [m]
+    std::vector<double> momentArms;      ///< per muscle [m], + = flexor
+    std::vector<double> meanForces;      ///< per muscle, window mean [N]
     double meanStrapForce = 0;      ///< transducer reading, window mean [N]
     double meanForceMomentArm = 0;  ///< estimate from tared torque / h, window mean [N]
     double meanForceFixedRatio = 0; ///< thesis fixed-ratio estimate, window mean [N]
@@ -67,12 +83,13 @@ struct IsometricSummary {
 };
 
 struct IsometricTrialResult {
-    /// Columns: time_s, activation, elbow_angle_deg, elbow_velocity_degps (0: locked),
-    /// muscle_force_N, fascicle_length_m, fascicle_velocity_mps,
+    /// Columns: time_s, activation (of the agonists), elbow_angle_deg, elbow_velocity_degps (0: locked),
+    /// muscle_force_N, fascicle_length_m, fascicle_velocity_mps (of the primary muscle),
     /// holding_torque_Nm (raw lock torque, + = flexion), muscle_torque_Nm (tared, + = flexion),
     /// strap_force_N (transducer reading, clipped to its range), saturated (0/1),
     /// force_moment_arm_N, force_fixed_ratio_N, error_moment_arm_pct, error_fixed_ratio_pct
-    /// (errors of the estimates against the true muscle force), then the muscle states.
+    /// (errors of the estimates against the true force of the primary muscle), with several muscles
+    /// force_<muscle>_N and activation_<muscle> per muscle, then the muscle states.
     Table series;
     IsometricSummary summary;
 };
@@ -86,7 +103,8 @@ std::vector<IsometricTrialResult> runIsometricTrials(const ArmSetup& setup,
                                                      int jobs,
                                                      const std::function<void(int, int)>& progress = {});
 
-/// Free movement: the elbow unlocked, an optional load in the hand, an activation profile.
+/// Free movement: the elbow unlocked, an optional load in the hand, an activation profile for the
+/// flexors (the other muscles rest).
 struct FreeMovementSettings {
     double initialAngle = 150 * 3.14159265358979323846 / 180;  ///< theta at t = 0 [rad]
     double initialVelocity = 0.0;      ///< dtheta/dt at t = 0 [rad/s]
@@ -103,7 +121,8 @@ struct FreeMovementSettings {
 
 /// Columns: time_s, activation, elbow_angle_deg, elbow_velocity_degps (+ = extending),
 /// path_length_m, moment_arm_m, muscle_force_N, fascicle_length_m, fascicle_velocity_mps,
-/// active_fraction, then the muscle states.
+/// active_fraction (of the primary muscle), per-muscle force and activation columns for several
+/// muscles, then the muscle states.
 Table runFreeMovement(const ArmSetup& setup, const FreeMovementSettings& settings, IntegrationStats* stats = nullptr);
 
 /// Reads trial settings from a YAML mapping (keys: elbow_angle_deg, activation, rest, rise, hold,

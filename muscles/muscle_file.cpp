@@ -88,40 +88,74 @@ void loadFibreTypes(const std::string& path, FibreType& slow, FibreType& fast, M
     root.finish();
 }
 
+void readMuscleFields(const ParamNode& root, MuscleParameters& p, bool required) {
+    const Bound any = Bound::any();
+    auto number = [&](const std::string& key, double& field) {
+        if (required || root.has(key)) field = root.getNumber(key, any);
+    };
+    if (root.has("max_isometric_force")) {
+        if (root.has("mass"))
+            throw InputError(root.where("max_isometric_force") +
+                             ": give either 'mass' or 'max_isometric_force', not both");
+    } else {
+        number("mass", p.mass);
+    }
+    number("optimal_fascicle_length", p.optimalFascicleLength);
+    if (root.has("tendon_slack_length")) {
+        if (root.has("optimal_tendon_length"))
+            throw InputError(root.where("tendon_slack_length") +
+                             ": give either 'optimal_tendon_length' or 'tendon_slack_length', not both");
+    } else {
+        number("optimal_tendon_length", p.optimalTendonLength);
+    }
+    if (root.has("max_path_length") || required) number("max_path_length", p.maxPathLength);
+    root.getNumber("pennation_angle", Bound{0, 1.5707963267948966, false, true, "rad, informative only"}, 0.0);
+
+    if (required || root.has("fibre_fractions")) {
+        const ParamNode fr = root.child("fibre_fractions");
+        p.slowFraction = fr.getNumber("slow", Bound::closed(0, 1));
+        const double fastFraction = fr.getNumber("fast", Bound::closed(0, 1));
+        constexpr double kFractionSumTol = 1e-9;
+        if (std::abs(p.slowFraction + fastFraction - 1.0) > kFractionSumTol)
+            throw InputError(fr.where("fast") + ": fibre_fractions slow + fast = " +
+                             std::to_string(p.slowFraction + fastFraction) + ": expected 1 (they share the PCSA)");
+        fr.finish();
+    }
+    if (required || root.has("motor_units")) {
+        const ParamNode mu = root.child("motor_units");
+        p.numSlowUnits = mu.getInt("slow", 0, 1000);
+        p.numFastUnits = mu.getInt("fast", 0, 1000);
+        p.apportioning = mu.getChoice("apportioning", {"thesis", "equal"}, "thesis") == "equal"
+                             ? Apportioning::Equal : Apportioning::Thesis;
+        mu.finish();
+    }
+    if (required || root.has("fibre_types")) {
+        std::string typesFile = root.getString("fibre_types");
+        const std::string relative =
+            root.getDirectory().empty() ? typesFile : root.getDirectory() + "/" + typesFile;
+        if (std::filesystem::exists(relative)) typesFile = relative;
+        else if (!std::filesystem::exists(typesFile))
+            throw InputError(root.where("fibre_types") + ": field '" + root.path("fibre_types") + "' = '" +
+                             typesFile + "': no such file (relative paths are taken from the file's directory)");
+        loadFibreTypes(typesFile, p.slow, p.fast, p.coefficients);
+    }
+    // Conversions need the coefficients (sigma, rho, LrT), so they come last.
+    if (root.has("max_isometric_force")) {
+        const double F0 = root.getNumber("max_isometric_force", Bound::positive("N"));
+        p.mass = F0 * p.optimalFascicleLength * p.coefficients.density / p.coefficients.sigma;
+    }
+    if (root.has("tendon_slack_length")) {
+        const double slack = root.getNumber("tendon_slack_length", Bound::positive("m"));
+        p.optimalTendonLength = slack / p.coefficients.LrT;
+    }
+}
+
 MuscleParameters loadMuscleParameters(const std::string& path) {
     const ParamNode root = ParamNode::loadFile(path);
     MuscleParameters p;
-    const Bound any = Bound::any();
     p.name = root.getString("name");
     root.getString("source", "");
-    p.mass = root.getNumber("mass", any);
-    p.optimalFascicleLength = root.getNumber("optimal_fascicle_length", any);
-    p.optimalTendonLength = root.getNumber("optimal_tendon_length", any);
-    p.maxPathLength = root.getNumber("max_path_length", any);
-
-    const ParamNode fr = root.child("fibre_fractions");
-    p.slowFraction = fr.getNumber("slow", Bound::closed(0, 1));
-    const double fastFraction = fr.getNumber("fast", Bound::closed(0, 1));
-    constexpr double kFractionSumTol = 1e-9;
-    if (std::abs(p.slowFraction + fastFraction - 1.0) > kFractionSumTol)
-        throw InputError(fr.where("fast") + ": fibre_fractions slow + fast = " +
-                         std::to_string(p.slowFraction + fastFraction) + ": expected 1 (they share the PCSA)");
-    fr.finish();
-
-    const ParamNode mu = root.child("motor_units");
-    p.numSlowUnits = mu.getInt("slow", 0, 1000);
-    p.numFastUnits = mu.getInt("fast", 0, 1000);
-    p.apportioning = mu.getChoice("apportioning", {"thesis", "equal"}, "thesis") == "equal"
-                         ? Apportioning::Equal : Apportioning::Thesis;
-    mu.finish();
-
-    std::string typesFile = root.getString("fibre_types");
-    const std::string relative = root.getDirectory().empty() ? typesFile : root.getDirectory() + "/" + typesFile;
-    if (std::filesystem::exists(relative)) typesFile = relative;
-    else if (!std::filesystem::exists(typesFile))
-        throw InputError(root.where("fibre_types") + ": field 'fibre_types' = '" + typesFile +
-                         "': no such file (relative paths are taken from the muscle file's directory)");
-    loadFibreTypes(typesFile, p.slow, p.fast, p.coefficients);
+    readMuscleFields(root, p, true);
     root.finish();
     root.rethrowWithLocation([&] { p.validate(); });
     return p;

@@ -20,4 +20,11 @@ void loadFibreTypes(const std::string& path, FibreType& slow, FibreType& fast, M
 /// file, line, field, value and bound.
 MuscleParameters loadMuscleParameters(const std::string& path);
 
+class ParamNode;
+/// Reads the fields of a muscle file present in root into p (all of them when required): mass or
+/// max_isometric_force [N] (mass = F0 L0 rho / sigma), optimal_fascicle_length, optimal_tendon_length
+/// or tendon_slack_length [m] (L0T = slack / LrT, see model/model_file.h), max_path_length,
+/// pennation_angle (informative), fibre_fractions, motor_units, fibre_types. Does not validate.
+void readMuscleFields(const ParamNode& root, MuscleParameters& p, bool required);
+
 }  // namespace armsim

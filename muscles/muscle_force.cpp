@@ -11,26 +11,24 @@ namespace armsim {
 
 class VirtualMuscleForce::Impl : public Force::Custom::Implementation {
 public:
-    Impl(SubsystemIndex forces, std::shared_ptr<const VirtualMuscle> muscle, const MobilizedBody& origin,
-         const Vec3& originStation, const MobilizedBody& insertion, const Vec3& insertionStation,
+    Impl(SubsystemIndex forces, std::shared_ptr<const VirtualMuscle> muscle, MusclePath path,
          ActivationProfile activation)
-        : forces_(forces), muscle_(std::move(muscle)), origin_(origin), insertion_(insertion),
-          originStation_(originStation), insertionStation_(insertionStation),
-          activation_(std::move(activation)) {}
+        : forces_(forces), muscle_(std::move(muscle)), path_(std::move(path)), activation_(std::move(activation)) {}
 
     const VirtualMuscle& muscle() const { return *muscle_; }
+    const MusclePath& path() const { return path_; }
     const ActivationProfile& activation() const { return activation_; }
+    const std::string& name() const { return muscle_->getParameters().name; }
 
     void realizeTopology(State& s) const override {
         const Vector zInit(muscle_->getNumStates(), 0.0);
         firstZ_ = s.allocateZ(forces_, zInit);
     }
 
-    Vec3 originInGround(const State& s) const { return origin_.findStationLocationInGround(s, originStation_); }
-    Vec3 insertionInGround(const State& s) const {
-        return insertion_.findStationLocationInGround(s, insertionStation_);
+    double pathLength(const State& s) const { return path_.calcLength(s); }
+    PathGeometry geometry(const State& s, bool withPolyline = false) const {
+        return path_.calcGeometry(s, name(), withPolyline);
     }
-    double pathLength(const State& s) const { return (insertionInGround(s) - originInGround(s)).norm(); }
     const double* z(const State& s) const { return &s.getZ(forces_)[firstZ_]; }
 
     void realizeDynamics(const State& s) const override {
@@ -39,12 +37,8 @@ public:
     }
 
     void calcForce(const State& s, Vector_<SpatialVec>& bodyForces, Vector_<Vec3>&, Vector&) const override {
-        const Vec3 pA = originInGround(s), pB = insertionInGround(s);
-        const Vec3 d = pB - pA;
-        const double P = d.norm();
-        const Vec3 f = (muscle_->calcForce(P, z(s)) / P) * d;  // pulls the origin towards the insertion
-        origin_.applyForceToBodyPoint(s, originStation_, f, bodyForces);
-        insertion_.applyForceToBodyPoint(s, insertionStation_, -f, bodyForces);
+        const PathGeometry g = geometry(s);
+        MusclePath::applyTension(g, muscle_->calcForce(g.length, z(s)), bodyForces);
     }
 
     Real calcPotentialEnergy(const State&) const override { return 0; }
@@ -52,16 +46,15 @@ public:
     void calcDecorativeGeometryAndAppend(const State& s, Stage stage,
                                          Array_<DecorativeGeometry>& geometry) const override {
         if (stage != Stage::Position) return;
-        const MuscleOutputs out = muscle_->calcOutputs(pathLength(s), activation_.getValue(s.getTime()), z(s));
-        geometry.push_back(DecorativeLine(originInGround(s), insertionInGround(s))
-                               .setColor(calcActivationColor(out.activeFraction))
-                               .setLineThickness(3.0 + 5.0 * out.activeFraction));
+        const PathGeometry g = this->geometry(s, true);
+        const MuscleOutputs out = muscle_->calcOutputs(g.length, activation_.getValue(s.getTime()), z(s));
+        appendPathDecorations(path_, g, calcActivationColor(out.activeFraction), 3.0 + 5.0 * out.activeFraction,
+                              geometry);
     }
 
     SubsystemIndex forces_;
     std::shared_ptr<const VirtualMuscle> muscle_;
-    MobilizedBody origin_, insertion_;
-    Vec3 originStation_, insertionStation_;
+    MusclePath path_;
     ActivationProfile activation_;
     mutable ZIndex firstZ_;  // topology-stage cache
 };
@@ -70,20 +63,27 @@ VirtualMuscleForce::VirtualMuscleForce(GeneralForceSubsystem& forces, std::share
                                        const MobilizedBody& originBody, const Vec3& originStation,
                                        const MobilizedBody& insertionBody, const Vec3& insertionStation,
                                        ActivationProfile activation)
-    : Force::Custom(forces, new Impl(forces.getMySubsystemIndex(), std::move(muscle), originBody, originStation,
-                                     insertionBody, insertionStation, std::move(activation))) {}
+    : VirtualMuscleForce(forces, std::move(muscle),
+                         MusclePath(originBody, originStation, insertionBody, insertionStation),
+                         std::move(activation)) {}
+
+VirtualMuscleForce::VirtualMuscleForce(GeneralForceSubsystem& forces, std::shared_ptr<const VirtualMuscle> muscle,
+                                       MusclePath path, ActivationProfile activation)
+    : Force::Custom(forces, new Impl(forces.getMySubsystemIndex(), std::move(muscle), std::move(path),
+                                     std::move(activation))) {}
 
 const VirtualMuscleForce::Impl& VirtualMuscleForce::getImpl() const {
     return dynamic_cast<const Impl&>(getImplementation());
 }
 
 const VirtualMuscle& VirtualMuscleForce::getMuscle() const { return getImpl().muscle(); }
+const MusclePath& VirtualMuscleForce::getPath() const { return getImpl().path(); }
 const ActivationProfile& VirtualMuscleForce::getActivationProfile() const { return getImpl().activation(); }
 
 double VirtualMuscleForce::getPathLength(const State& s) const { return getImpl().pathLength(s); }
 
-UnitVec3 VirtualMuscleForce::getPathDirection(const State& s) const {
-    return UnitVec3(getImpl().insertionInGround(s) - getImpl().originInGround(s));
+PathGeometry VirtualMuscleForce::calcPathGeometry(const State& s, bool withPolyline) const {
+    return getImpl().geometry(s, withPolyline);
 }
 
 double VirtualMuscleForce::getActivation(const State& s) const {

@@ -1,8 +1,10 @@
 // The Simbody adapter of the Virtual Muscle: a Force::Custom that owns the muscle states as Simbody
-// continuous (z) states and applies Fse along a straight path between a station on each of two bodies.
+// continuous (z) states and applies Fse along its path (muscles/muscle_path.h): a straight line between
+// two stations, or a path through via points and over wrapping surfaces.
 #pragma once
 
 #include "muscles/activation.h"
+#include "muscles/muscle_path.h"
 #include "muscles/simbody.h"
 #include "muscles/virtual_muscle.h"
 
@@ -11,12 +13,13 @@
 
 namespace armsim {
 
-/// A Virtual Muscle acting along the straight line from an origin station to an insertion station.
+/// A Virtual Muscle acting along a MusclePath.
 ///
 /// The muscle's states (VirtualMuscle::getNumStates(), all of order 1) are allocated as z states in
-/// realizeTopology and their derivatives written in realizeDynamics; the force Fse pulls the two
-/// stations together. Activation U(t) comes from an ActivationProfile evaluated at the state's time.
-/// Path length P is taken from the station positions (m) and must stay inside (0, P_max].
+/// realizeTopology and their derivatives written in realizeDynamics; the tension Fse acts along the
+/// path (pulling origin and insertion together, pressing on via points and wrapping surfaces).
+/// Activation U(t) comes from an ActivationProfile evaluated at the state's time. Path length P [m]
+/// must stay inside (0, P_max].
 ///
 /// Like every Simbody handle this class has no data members; the implementation holds the model.
 class VirtualMuscleForce : public SimTK::Force::Custom {
@@ -26,14 +29,17 @@ public:
                        const SimTK::MobilizedBody& originBody, const SimTK::Vec3& originStation,
                        const SimTK::MobilizedBody& insertionBody, const SimTK::Vec3& insertionStation,
                        ActivationProfile activation);
+    VirtualMuscleForce(SimTK::GeneralForceSubsystem& forces, std::shared_ptr<const VirtualMuscle> muscle,
+                       MusclePath path, ActivationProfile activation);
 
     const VirtualMuscle& getMuscle() const;
+    const MusclePath& getPath() const;
     const ActivationProfile& getActivationProfile() const;
 
-    /// Path length P between the stations [m] (Stage::Position).
+    /// Path length P [m] (Stage::Position).
     double getPathLength(const SimTK::State& s) const;
-    /// Unit vector from origin to insertion in Ground (Stage::Position).
-    SimTK::UnitVec3 getPathDirection(const SimTK::State& s) const;
+    /// The path at the state's configuration: length, unit-tension loads, polyline (Stage::Position).
+    PathGeometry calcPathGeometry(const SimTK::State& s, bool withPolyline = false) const;
     /// Activation U at the state's time [1].
     double getActivation(const SimTK::State& s) const;
     /// Muscle (series-elastic) force Fse [N] (Stage::Position).

@@ -125,6 +125,29 @@ ParamNode ParamNode::child(const std::string& key) const {
     return ParamNode(impl);
 }
 
+std::vector<ParamNode> ParamNode::children(const std::string& key) const {
+    YAML::Node n = requireKey(key);
+    if (!n.IsSequence()) throw InputError(where(key) + ": field '" + path(key) + "' must be a list");
+    std::vector<ParamNode> out;
+    for (std::size_t i = 0; i < n.size(); ++i) {
+        const std::string item = path(key) + "[" + std::to_string(i) + "]";
+        if (!n[i].IsMap())
+            throw InputError(impl_->source + ":" + std::to_string(n[i].Mark().line + 1) + ": field '" + item +
+                             "' must be a mapping");
+        auto impl = std::make_shared<Impl>();
+        impl->source = impl_->source;
+        impl->prefix = item;
+        impl->node = n[i];
+        out.push_back(ParamNode(impl));
+    }
+    return out;
+}
+
+bool ParamNode::isMapping(const std::string& key) const {
+    const YAML::Node n = node()[key];
+    return n && n.IsMap();
+}
+
 static double toNumber(const YAML::Node& n, const std::string& where, const std::string& field) {
     if (!n.IsScalar()) throw InputError(where + ": field '" + field + "' must be a number");
     try {

@@ -78,6 +78,10 @@ public:
     bool has(const std::string& key) const;
     /// The sub-mapping under key (required).
     ParamNode child(const std::string& key) const;
+    /// The mappings of the list under key (required), each named "key[i]" in messages.
+    std::vector<ParamNode> children(const std::string& key) const;
+    /// true when key holds a mapping (false when missing or of another kind).
+    bool isMapping(const std::string& key) const;
     double getNumber(const std::string& key, const Bound& bound) const;
     double getNumber(const std::string& key, const Bound& bound, double defaultValue) const;
     int getInt(const std::string& key, int lo, int hi) const;

@@ -156,7 +156,7 @@ struct TrialRenderer::Impl {
     Table table;
     TrialVideoSettings settings;
     RenderSettings renderSettings;
-    std::unique_ptr<BicepsArm> model;
+    std::unique_ptr<MuscleArm> model;
     SimTK::State state;
     std::unique_ptr<OffscreenRenderer> renderer;
     bool isometric = false;
@@ -185,7 +185,7 @@ struct TrialRenderer::Impl {
             throw InputError("force arrow 'strap': " + name + " has no column 'strap_force_N' (not an isometric "
                              "trial): expected the muscle arrow or none");
 
-        model = std::make_unique<BicepsArm>(setup, ActivationProfile(time, activation, name + " activation"));
+        model = std::make_unique<MuscleArm>(setup, ActivationProfile(time, activation, name + " activation"));
         state = model->getDefaultState();
         try {
             setRow(0);  // checks the state columns
@@ -477,7 +477,7 @@ int TrialRenderer::findRow(double t) const {
 const SimTK::State& TrialRenderer::setRow(int row) { return impl_->setRow(row); }
 cv::Mat TrialRenderer::renderRow(int row) { return impl_->renderRow(row); }
 std::pair<Vec3, Vec3> TrialRenderer::calcSceneBox() const { return impl_->calcSceneBox(); }
-const BicepsArm& TrialRenderer::getModel() const { return *impl_->model; }
+const MuscleArm& TrialRenderer::getModel() const { return *impl_->model; }
 const RenderSettings& TrialRenderer::getRenderSettings() const { return impl_->renderSettings; }
 
 TrialVideoResult renderTrialVideo(const ArmSetup& setup, const Table& table, const TrialVideoSettings& settings,

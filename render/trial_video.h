@@ -1,5 +1,5 @@
 // Videos and stills of arm trials. A recorded trial table (armsim trial / model/trial.h, ending with
-// "state_*" columns) is replayed exactly: a BicepsArm of the same subject is built with the table's
+// "state_*" columns) is replayed exactly: a MuscleArm of the same subject is built with the table's
 // activation trace, and each frame's State is set from one table row with setStateFromTrialRow.
 //
 // The scene is the arm's own Simbody decorations (upper arm, forearm and hand as shaded solids, the
@@ -12,7 +12,7 @@
 // to the right, +Y up; the overlay shows time, elbow angle, activation, forces and live force plots.
 #pragma once
 
-#include "model/biceps_arm.h"
+#include "model/muscle_arm.h"
 #include "muscles/table.h"
 #include "render/overlay.h"
 #include "render/renderer.h"
@@ -83,7 +83,7 @@ struct TrialVideoSettings {
 /// aspect (width / height).
 Camera calcSagittalCamera(const ArmParameters& arm, double aspect);
 
-/// Renders frames of one recorded trial of one subject. Owns a BicepsArm (one Simbody System) and an
+/// Renders frames of one recorded trial of one subject. Owns a MuscleArm (one Simbody System) and an
 /// OSMesa renderer: use from one thread.
 class TrialRenderer {
 public:
@@ -114,7 +114,7 @@ public:
 
     /// A Ground box (min, max corners, m) that contains everything the scene draws at any row.
     std::pair<SimTK::Vec3, SimTK::Vec3> calcSceneBox() const;
-    const BicepsArm& getModel() const;
+    const MuscleArm& getModel() const;
     /// The render settings in use (the camera resolved).
     const RenderSettings& getRenderSettings() const;
 

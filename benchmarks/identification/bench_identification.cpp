@@ -5,7 +5,7 @@
 // thesis_iterations = 52 (thesis Table 7.2, one forward run per iteration) for comparison.
 #include "identification/faithful_model.h"
 #include "identification/identifier.h"
-#include "model/biceps_arm.h"
+#include "model/muscle_arm.h"
 #include "model/geometry.h"
 #include "muscles/muscle_file.h"
 

@@ -72,7 +72,7 @@ TEST(CliIdentify, ShippedMeasuredFileGivesTheThesisEstimateAndWritesTheReport) {
 
 TEST(CliIdentify, FaithfulModelRunsOnTheMeasuredFile) {
     const fs::path d = freshDir("faithful");
-    const CommandResult r = runArmsim("identify " + measuredFile() + " --model faithful --method ilc-sign-search --out " +
+    const CommandResult r = runArmsim("identify " + measuredFile() + " --forward faithful --method ilc-sign-search --out " +
                                       d.string());
     ASSERT_EQ(r.exitCode, 0) << r.output;
     EXPECT_NE(r.output.find("faithful model (moment-arm estimate"), std::string::npos) << r.output;
@@ -100,7 +100,7 @@ TEST(CliIdentify, BadDataExitsNonZeroNamingFileAndLine) {
 
     // A path the arm cannot take is an error for the faithful model, with file and line.
     const std::string far = writeData(d, "far.csv", "41,600\n30,300\n");
-    const CommandResult r = runArmsim("identify " + far + " --model faithful --out " + (d / "out").string());
+    const CommandResult r = runArmsim("identify " + far + " --forward faithful --out " + (d / "out").string());
     EXPECT_EQ(r.exitCode, kInputErrorExit) << r.output;
     EXPECT_NE(r.output.find("far.csv:3"), std::string::npos) << r.output;
 }

@@ -5,7 +5,7 @@
 #include "identification/faithful_model.h"
 #include "identification/identifier.h"
 #include "identification/validation.h"
-#include "model/biceps_arm.h"
+#include "model/muscle_arm.h"
 #include "model/geometry.h"
 #include "muscles/param_file.h"
 #include "test_support.h"

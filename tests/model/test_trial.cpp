@@ -26,7 +26,7 @@ IsometricTrialSettings mvcAt(double deg) {
 
 }  // namespace
 
-TEST(BicepsArm, MusclePmaxIsThePathAtTheExtensionLimit) {
+TEST(MuscleArm, MusclePmaxIsThePathAtTheExtensionLimit) {
     const MuscleParameters p = subject().calcBicepsParameters();
     EXPECT_NEAR(p.maxPathLength, subject().arm.originDistance + subject().arm.insertionDistance, 1e-15);
 }

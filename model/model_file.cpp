@@ -1,0 +1,248 @@
+#include "model/model_file.h"
+
+#include "model/muscle_arm.h"
+#include "muscles/muscle_file.h"
+#include "muscles/param_file.h"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <regex>
+
+namespace armsim {
+
+const char* getMuscleGroupName(MuscleGroup g) { return g == MuscleGroup::Flexor ? "flexor" : "extensor"; }
+const char* getArmBodyName(ArmBody b) { return b == ArmBody::UpperArm ? "upper_arm" : "forearm"; }
+
+void SubjectEffort::validate() const {
+    checkField("subject.voluntary_activation", voluntaryActivation, Bound{0, 1, true, false});
+    checkField("subject.co_contraction", coContraction, Bound::closed(0, 1));
+    checkField("subject.trial_cv", trialCv, Bound::closed(0, 0.5));
+    checkField("subject.fatigue", fatigue, Bound{0, 1, false, true, "fraction of effort lost per repetition"});
+}
+
+int ArmSetup::findMuscle(const std::string& muscleName) const {
+    std::string names;
+    for (int i = 0; i < getNumMuscles(); ++i) {
+        if (muscles[i].params.name == muscleName) return i;
+        names += (i ? ", " : "") + muscles[i].params.name;
+    }
+    throw InputError("model '" + name + "' has no muscle '" + muscleName + "' (muscles: " + names + ")");
+}
+
+MuscleParameters ArmSetup::calcMuscleParameters(int i) const {
+    MuscleParameters p = muscles.at(i).params;
+    p.validate();
+    return p;
+}
+
+void ArmSetup::validate() const {
+    arm.validate();
+    effort.validate();
+    if (muscles.empty()) throw InputError("model '" + name + "': no muscles");
+    if (primary < 0 || primary >= getNumMuscles())
+        throw InputError("model '" + name + "': primary muscle index " + std::to_string(primary) + " out of range");
+    for (int i = 0; i < getNumMuscles(); ++i) {
+        for (int j = 0; j < i; ++j)
+            if (muscles[i].params.name == muscles[j].params.name)
+                throw InputError("model '" + name + "': two muscles are called '" + muscles[i].params.name + "'");
+        muscles[i].params.validate();
+    }
+}
+
+ArmSetup ArmSetup::loadDefault() { return loadModel("thesis"); }
+
+namespace {
+
+std::array<double, 3> readVec3(const ParamNode& n, const std::string& key, const Bound& bound) {
+    const std::vector<double> v = n.getNumbers(key, bound);
+    if (v.size() != 3)
+        throw InputError(n.where(key) + ": field '" + n.path(key) + "' has " + std::to_string(v.size()) +
+                         " numbers: expected 3 (x, y, z in the body frame, m)");
+    return {v[0], v[1], v[2]};
+}
+
+ArmBody readBody(const ParamNode& n) {
+    return n.getChoice("body", {"upper_arm", "forearm"}, "") == "upper_arm" ? ArmBody::UpperArm : ArmBody::Forearm;
+}
+
+PathElementSpec readPoint(const ParamNode& n, const std::string& label) {
+    PathElementSpec e;
+    e.body = readBody(n);
+    e.location = readVec3(n, "location", Bound::closed(-2, 2, "m"));
+    e.label = label;
+    n.finish();
+    return e;
+}
+
+PathElementSpec readViaElement(const ParamNode& n, int index) {
+    const bool cylinder = n.has("cylinder"), sphere = n.has("sphere");
+    if (!cylinder && !sphere) return readPoint(n, "via " + std::to_string(index + 1));
+    if (cylinder && sphere || n.has("location"))
+        throw InputError(n.where() + ": via element '" + n.path("") +
+                         "' must be one of: a point (location), a cylinder or a sphere");
+    PathElementSpec e;
+    e.body = readBody(n);
+    const ParamNode s = n.child(cylinder ? "cylinder" : "sphere");
+    e.kind = cylinder ? PathElementSpec::Kind::Cylinder : PathElementSpec::Kind::Sphere;
+    e.location = readVec3(s, "centre", Bound::closed(-2, 2, "m"));
+    e.radius = s.getNumber("radius", Bound{0, 0.5, true, false, "m"});
+    if (cylinder) {
+        e.axis = readVec3(s, "axis", Bound::closed(-1e3, 1e3));
+        if (std::hypot(e.axis[0], e.axis[1], e.axis[2]) < 1e-9)
+            throw InputError(s.where("axis") + ": field '" + s.path("axis") + "' is the zero vector: expected a direction");
+    }
+    s.finish();
+    if (n.has("side")) e.side = readVec3(n, "side", Bound::closed(-1e3, 1e3));
+    e.label = std::string(cylinder ? "cylinder " : "sphere ") + std::to_string(index + 1);
+    n.finish();
+    return e;
+}
+
+MuscleSpec readMuscle(const ParamNode& n) {
+    MuscleSpec m;
+    const std::string name = n.getString("name");
+    if (!std::regex_match(name, std::regex("[A-Za-z][A-Za-z0-9_]*")))
+        throw InputError(n.where("name") + ": field '" + n.path("name") + "' = '" + name +
+                         "': expected a name of letters, digits and _ (it names CSV columns)");
+    m.source = n.getString("source", "");
+    m.group = n.getChoice("group", {"flexor", "extensor"}, "flexor") == "flexor" ? MuscleGroup::Flexor
+                                                                                : MuscleGroup::Extensor;
+    const bool fromFile = n.has("parameters");
+    if (fromFile) {
+        std::string file = n.getString("parameters");
+        const std::string relative = n.getDirectory().empty() ? file : n.getDirectory() + "/" + file;
+        if (std::filesystem::exists(relative)) file = relative;
+        else if (!std::filesystem::exists(file))
+            throw InputError(n.where("parameters") + ": field '" + n.path("parameters") + "' = '" + file +
+                             "': no such muscle file (relative paths are taken from the model file's directory)");
+        m.params = loadMuscleParameters(file);
+    } else {
+        auto require = [&](const char* key, const char* alternative) {
+            if (n.has(key) || (alternative && n.has(alternative))) return;
+            throw InputError(n.where() + ": muscle '" + name + "' needs '" + n.path(key) + "'" +
+                             (alternative ? std::string(" or '") + n.path(alternative) + "'" : std::string()) +
+                             " (or a 'parameters' muscle file)");
+        };
+        require("mass", "max_isometric_force");
+        require("optimal_fascicle_length", nullptr);
+        require("optimal_tendon_length", "tendon_slack_length");
+        require("fibre_fractions", nullptr);
+        require("fibre_types", nullptr);
+    }
+    readMuscleFields(n, m.params, false);
+    m.maxPathFromRange = !n.has("max_path_length");
+    m.params.name = name;
+
+    const ParamNode path = n.child("path");
+    m.path.push_back(readPoint(path.child("origin"), "origin"));
+    if (path.has("via")) {
+        const std::vector<ParamNode> via = path.children("via");
+        for (int i = 0; i < int(via.size()); ++i) m.path.push_back(readViaElement(via[i], i));
+    }
+    m.path.push_back(readPoint(path.child("insertion"), "insertion"));
+    path.finish();
+    for (std::size_t k = 1; k + 1 < m.path.size(); ++k)
+        if (m.path[k].kind != PathElementSpec::Kind::Point && m.path[k + 1].kind != PathElementSpec::Kind::Point)
+            throw InputError(path.where("via") + ": muscle '" + name + "': wrapping surfaces '" + m.path[k].label +
+                             "' and '" + m.path[k + 1].label +
+                             "' follow each other: put a via point between them (one surface between two points)");
+    n.finish();
+    if (!m.maxPathFromRange) n.rethrowWithLocation([&] { m.params.validate(); });
+    return m;
+}
+
+// The thesis's A and B for a model without a `biceps` section: the primary muscle's origin and
+// insertion distances from the elbow centre.
+void deriveThesisGeometry(ArmSetup& s) {
+    const std::vector<PathElementSpec>& path = s.muscles[s.primary].path;
+    const auto& o = path.front().location;
+    const auto& i = path.back().location;
+    s.arm.originDistance = std::hypot(o[0], o[1], o[2]);
+    s.arm.insertionDistance = std::hypot(i[0], i[1], i[2]);
+}
+
+}  // namespace
+
+std::vector<std::string> listModels() {
+    std::vector<std::string> names;
+    const std::filesystem::path dir = std::filesystem::path(getAssetDirectory()) / "models";
+    std::error_code ec;
+    for (const auto& e : std::filesystem::directory_iterator(dir, ec))
+        if (e.path().extension() == ".yaml") names.push_back(e.path().stem().string());
+    std::sort(names.begin(), names.end());
+    return names;
+}
+
+ArmSetup loadModel(const std::string& nameOrFile) {
+    std::string file = nameOrFile;
+    const bool looksLikeName = nameOrFile.find('/') == std::string::npos &&
+                               nameOrFile.find(".yaml") == std::string::npos;
+    if (looksLikeName) {
+        const std::string asset = getAssetDirectory() + "/models/" + nameOrFile + ".yaml";
+        if (!std::filesystem::exists(asset)) {
+            std::string known;
+            for (const std::string& m : listModels()) known += (known.empty() ? "" : ", ") + m;
+            throw InputError("--model '" + nameOrFile + "': no such model (shipped models: " + known +
+                             "; or give a model file path)");
+        }
+        file = asset;
+    } else if (!std::filesystem::exists(file)) {
+        throw InputError(file + ": no such model file");
+    }
+
+    const ParamNode root = ParamNode::loadFile(file);
+    ArmSetup s;
+    s.file = file;
+    s.name = root.getString("name");
+    s.description = root.getString("description", "");
+    root.getString("source", "");
+
+    bool hasBiceps = false;
+    if (root.isMapping("arm")) {
+        const ParamNode arm = root.child("arm");
+        arm.getString("source", "");
+        hasBiceps = readArmParameters(arm, s.arm, false);
+        arm.finish();
+    } else {
+        std::string armFile = root.getString("arm");
+        const std::string relative = root.getDirectory().empty() ? armFile : root.getDirectory() + "/" + armFile;
+        if (std::filesystem::exists(relative)) armFile = relative;
+        s.arm = loadArmParameters(findAsset(armFile));
+        hasBiceps = true;
+    }
+
+    if (root.has("subject")) {
+        const ParamNode subj = root.child("subject");
+        const Bound any = Bound::any();
+        s.effort.voluntaryActivation = subj.getNumber("voluntary_activation", any, s.effort.voluntaryActivation);
+        s.effort.coContraction = subj.getNumber("co_contraction", any, s.effort.coContraction);
+        s.effort.trialCv = subj.getNumber("trial_cv", any, s.effort.trialCv);
+        s.effort.fatigue = subj.getNumber("fatigue", any, s.effort.fatigue);
+        subj.finish();
+        subj.rethrowWithLocation([&] { s.effort.validate(); });
+    }
+
+    for (const ParamNode& m : root.children("muscles")) s.muscles.push_back(readMuscle(m));
+    if (s.muscles.empty()) throw InputError(root.where("muscles") + ": field 'muscles' is empty: expected at least one muscle");
+    if (root.has("primary")) {
+        const std::string primary = root.getString("primary");
+        try {
+            s.primary = s.findMuscle(primary);
+        } catch (const InputError& e) {
+            throw InputError(root.where("primary") + ": field 'primary' = '" + primary + "': " + e.what());
+        }
+    }
+    root.finish();
+    if (!hasBiceps) deriveThesisGeometry(s);
+    root.rethrowWithLocation([&] { s.arm.validate(); });
+    resolveMaxPathLengths(s);
+    try {
+        s.validate();
+    } catch (const InputError& e) {
+        throw InputError(file + ": " + e.what());
+    }
+    return s;
+}
+
+}  // namespace armsim

@@ -1,0 +1,115 @@
+// Model files (assets/models/*.yaml): an arm and its muscles, each a Virtual Muscle on its own path.
+// Framework-free data; model/muscle_arm.h builds the Simbody system from it.
+//
+// A model file has
+//   name, source, description            text
+//   arm:                                 the arm file's sections inline (body, upper_arm,
+//                                        forearm_hand, transducer, elbow, gravity, hand_load; see
+//                                        model/arm_parameters.h), or the name of an arm file.
+//                                        Its optional `biceps` section (A, B of the thesis's straight
+//                                        line) defaults to the primary muscle's origin and insertion
+//                                        distances from the elbow centre.
+//   subject:                             voluntary_activation, co_contraction, trial_cv, fatigue
+//                                        (defaults of the virtual subject's effort, see SubjectEffort)
+//   primary: NAME                        the muscle the thesis calls "the biceps": the transducer
+//                                        estimate and the identification address it (default: first)
+//   muscles: [...]                       each: name, group (flexor|extensor), Virtual Muscle
+//                                        parameters (a `parameters:` muscle file and/or the fields of a
+//                                        muscle file; `max_isometric_force` [N] may stand for `mass` and
+//                                        `tendon_slack_length` [m] for `optimal_tendon_length`), and a
+//                                        path: origin, via (points, cylinders, spheres), insertion.
+//
+// Conversions from OpenSim (Holzbaur et al. 2005) parameters, stated once here:
+//   mass = F0 L0 rho / sigma              (spec 1: F0 = sigma M / (rho L0))
+//   L0T  = tendon_slack_length / LrT      the VM series-elastic force is F0 cT (LT - LrT) on its linear
+//                                         part, so LrT L0T is the length where the tendon's linear force
+//                                         extrapolates to zero: the slack length of a Hill tendon. The
+//                                         VM tendon then strains 1/LrT - 1 = 3.7 % at F0 (Thelen 2003's
+//                                         OpenSim tendon: 3.3 %).
+#pragma once
+
+#include "model/arm_parameters.h"
+#include "muscles/virtual_muscle.h"
+
+#include <array>
+#include <string>
+#include <vector>
+
+namespace armsim {
+
+/// Which effort recruits a muscle: an elbow flexion or an extension MVC.
+enum class MuscleGroup { Flexor, Extensor };
+const char* getMuscleGroupName(MuscleGroup g);
+
+/// The two bodies a path element can sit on.
+enum class ArmBody { UpperArm, Forearm };
+const char* getArmBodyName(ArmBody b);
+
+/// One element of a muscle path in a model file (body frame, metres; frames in model/arm.h).
+struct PathElementSpec {
+    enum class Kind { Point, Cylinder, Sphere };
+    Kind kind = Kind::Point;
+    ArmBody body = ArmBody::UpperArm;
+    std::array<double, 3> location{};   ///< point, or surface centre [m]
+    std::array<double, 3> axis{0, 0, 1};  ///< cylinder axis [1]
+    double radius = 0;                  ///< [m]
+    std::array<double, 3> side{};       ///< the path passes on this side; zero = the shorter way
+    std::string label;                  ///< "origin", "via 1", "cylinder 2", "insertion"
+};
+
+/// One muscle of a model.
+struct MuscleSpec {
+    MuscleParameters params;              ///< Virtual Muscle parameters; params.name = the model's name
+    MuscleGroup group = MuscleGroup::Flexor;
+    std::vector<PathElementSpec> path;    ///< origin, via elements, insertion
+    /// true: P_max is the longest path over the elbow's range (resolved by resolveMaxPathLengths);
+    /// false: params.maxPathLength as given.
+    bool maxPathFromRange = true;
+    std::string source;                   ///< where the numbers come from
+};
+
+/// The virtual subject's effort in a trial (spec: a realistic MVC).
+struct SubjectEffort {
+    double voluntaryActivation = 1.0;  ///< U of the agonists at a maximal effort [1]
+    double coContraction = 0.0;        ///< U of the antagonists during an effort [1]
+    double trialCv = 0.0;              ///< trial-to-trial coefficient of variation of the effort [1]
+    double fatigue = 0.0;              ///< fractional loss of effort per repetition [1]
+    void validate() const;
+};
+
+/// Everything that defines a simulated arm and its muscles (immutable model).
+struct ArmSetup {
+    std::string name = "thesis";          ///< model name
+    std::string file;                     ///< the model file it came from ("" when built in code)
+    std::string description;
+    ArmParameters arm;                    ///< segments, elbow range, transducer (and the thesis's A, B)
+    SubjectEffort effort;                 ///< defaults of the subject's effort
+    std::vector<MuscleSpec> muscles;
+    int primary = 0;                      ///< index of the thesis's "biceps"
+
+    int getNumMuscles() const { return int(muscles.size()); }
+    /// Index of the muscle called name; throws InputError listing the names.
+    int findMuscle(const std::string& name) const;
+    /// The primary muscle's parameters (the thesis's biceps).
+    const MuscleParameters& biceps() const { return muscles.at(primary).params; }
+    MuscleParameters& biceps() { return muscles.at(primary).params; }
+    /// Validated parameters of muscle i (P_max as resolved).
+    MuscleParameters calcMuscleParameters(int i) const;
+    /// The primary muscle's, as calcMuscleParameters(primary).
+    MuscleParameters calcBicepsParameters() const { return calcMuscleParameters(primary); }
+    /// Throws InputError for an inconsistent model (no muscles, duplicate names, bad primary).
+    void validate() const;
+
+    /// The thesis model (assets/models/thesis.yaml).
+    static ArmSetup loadDefault();
+};
+
+/// Loads a model: a name under assets/models/ ("thesis", "elbow") or a file path. Every error names
+/// the file, line, key and value. P_max of muscles with `max_path_length: range` is resolved
+/// (model/muscle_arm.h: resolveMaxPathLengths).
+ArmSetup loadModel(const std::string& nameOrFile);
+
+/// Names of the shipped models (files in assets/models/).
+std::vector<std::string> listModels();
+
+}  // namespace armsim

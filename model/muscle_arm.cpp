@@ -1,0 +1,176 @@
+#include "model/muscle_arm.h"
+
+#include "model/geometry.h"
+#include "muscles/param_file.h"
+
+#include <cmath>
+
+using namespace SimTK;
+
+namespace armsim {
+
+namespace {
+
+Vec3 toVec3(const std::array<double, 3>& a) { return Vec3(a[0], a[1], a[2]); }
+
+}  // namespace
+
+MusclePath buildMusclePath(const ArmModel& arm, const MuscleSpec& muscle) {
+    std::vector<PathElement> elements;
+    for (const PathElementSpec& s : muscle.path) {
+        PathElement e;
+        e.kind = s.kind == PathElementSpec::Kind::Point      ? PathElement::Kind::Point
+                 : s.kind == PathElementSpec::Kind::Cylinder ? PathElement::Kind::Cylinder
+                                                             : PathElement::Kind::Sphere;
+        e.body = s.body == ArmBody::UpperArm ? MobilizedBody(arm.getUpperArm()) : MobilizedBody(arm.getForearm());
+        e.location = toVec3(s.location);
+        e.axis = UnitVec3(toVec3(s.axis));
+        e.radius = s.radius;
+        e.side = toVec3(s.side);
+        e.label = s.label;
+        elements.push_back(e);
+    }
+    try {
+        return MusclePath(std::move(elements));
+    } catch (const InputError& e) {
+        throw InputError("muscle '" + muscle.params.name + "': " + e.what());
+    }
+}
+
+double calcPathMomentArm(const SimbodyMatterSubsystem& matter, const MobilizedBody& joint, const State& s,
+                         const PathGeometry& g) {
+    Vector_<SpatialVec> bodyForces(matter.getNumBodies(), SpatialVec(Vec3(0), Vec3(0)));
+    MusclePath::applyTension(g, 1.0, bodyForces);
+    Vector f;
+    matter.multiplyBySystemJacobianTranspose(s, bodyForces, f);
+    return f[joint.getFirstUIndex(s)];
+}
+
+// ---- MuscleArm ----------------------------------------------------------------------------------
+
+MuscleArm::MuscleArm(const ArmSetup& setup, std::vector<ActivationProfile> activations)
+    : setup_(setup), arm_(std::make_unique<ArmModel>(setup.arm)) {
+    if (int(activations.size()) != setup_.getNumMuscles())
+        throw std::logic_error("MuscleArm: " + std::to_string(activations.size()) + " activation profiles for " +
+                               std::to_string(setup_.getNumMuscles()) + " muscles");
+    for (int i = 0; i < setup_.getNumMuscles(); ++i) {
+        auto muscle = std::make_shared<VirtualMuscle>(setup_.calcMuscleParameters(i));
+        forces_.emplace_back(arm_->updForces(), std::move(muscle), buildMusclePath(*arm_, setup_.muscles[i]),
+                             std::move(activations[i]));
+    }
+    arm_->finalize();
+}
+
+MuscleArm::MuscleArm(const ArmSetup& setup, const ActivationProfile& activation)
+    : MuscleArm(setup, std::vector<ActivationProfile>(setup.muscles.size(), activation)) {}
+
+double MuscleArm::calcPathLength(const State& s, int i) const { return forces_.at(i).getPathLength(s); }
+
+double MuscleArm::calcMomentArm(const State& s, int i) const {
+    return calcPathMomentArm(arm_->getMatter(), arm_->getForearm(), s, forces_.at(i).calcPathGeometry(s));
+}
+
+double MuscleArm::calcMuscleTorque(const State& s) const {
+    double torque = 0;
+    for (int i = 0; i < getNumMuscles(); ++i) torque += forces_[i].getForce(s) * calcMomentArm(s, i);
+    return torque;
+}
+
+void MuscleArm::setSteadyMuscleStates(State& s) const {
+    for (const VirtualMuscleForce& f : forces_) {
+        try {
+            f.setSteadyMuscleStates(s);
+        } catch (const SimulationError& e) {
+            throw SimulationError("muscle '" + f.getMuscle().getParameters().name + "': " + e.what());
+        }
+    }
+}
+
+void MuscleArm::setInitialMuscleStates(State& s) const {
+    for (const VirtualMuscleForce& f : forces_) f.setInitialMuscleStates(s);
+}
+
+void MuscleArm::checkMuscleStates(const State& s) const {
+    for (const VirtualMuscleForce& f : forces_) f.checkMuscleStates(s);
+}
+
+std::vector<std::string> MuscleArm::getStateColumnNames() const {
+    std::vector<std::string> names;
+    for (int i = 0; i < getNumMuscles(); ++i)
+        for (const std::string& n : getMuscle(i).getStateNames())
+            names.push_back(getNumMuscles() == 1 ? "state_" + n : "state_" + getMuscleName(i) + "_" + n);
+    return names;
+}
+
+void MuscleArm::appendMuscleStates(const State& s, std::vector<double>& row) const {
+    for (const VirtualMuscleForce& f : forces_) {
+        const std::vector<double> y = f.getMuscleStates(s);
+        row.insert(row.end(), y.begin(), y.end());
+    }
+}
+
+void MuscleArm::setMuscleStates(State& s, const std::vector<double>& y) const {
+    std::size_t at = 0;
+    for (const VirtualMuscleForce& f : forces_) {
+        const std::size_t n = std::size_t(f.getMuscle().getNumStates());
+        if (at + n > y.size()) throw std::logic_error("MuscleArm::setMuscleStates: too few values");
+        f.setMuscleStates(s, std::vector<double>(y.begin() + at, y.begin() + at + n));
+        at += n;
+    }
+}
+
+// ---- ArmGeometry --------------------------------------------------------------------------------
+
+ArmGeometry::ArmGeometry(const ArmSetup& setup) : arm_(setup.arm) {
+    for (const MuscleSpec& m : setup.muscles) {
+        paths_.push_back(buildMusclePath(arm_, m));
+        names_.push_back(m.params.name);
+    }
+    state_ = arm_.finalize();
+}
+
+void ArmGeometry::setElbowAngle(double theta) {
+    arm_.setElbowAngle(state_, theta);
+    arm_.getSystem().realize(state_, Stage::Position);
+}
+
+double ArmGeometry::calcPathLength(int i) const { return paths_.at(i).calcGeometry(state_, names_.at(i)).length; }
+
+double ArmGeometry::calcMomentArm(int i) const {
+    return calcPathMomentArm(arm_.getMatter(), arm_.getForearm(), state_, paths_.at(i).calcGeometry(state_, names_.at(i)));
+}
+
+void resolveMaxPathLengths(ArmSetup& setup) {
+    bool any = false;
+    for (const MuscleSpec& m : setup.muscles) any = any || m.maxPathFromRange;
+    if (!any) return;
+    ArmGeometry geometry(setup);
+    const double lo = degToRad(setup.arm.minElbowAngleDeg), hi = degToRad(setup.arm.maxElbowAngleDeg);
+    const int n = std::max(2, int(std::ceil(radToDeg(hi - lo))) + 1);
+    auto lengthAt = [&](int i, double theta) {
+        geometry.setElbowAngle(theta);
+        return geometry.calcPathLength(i);
+    };
+    for (int i = 0; i < setup.getNumMuscles(); ++i) {
+        if (!setup.muscles[i].maxPathFromRange) continue;
+        int best = 0;
+        double bestLength = -1;
+        for (int k = 0; k < n; ++k) {
+            const double len = lengthAt(i, k + 1 == n ? hi : lo + k * (hi - lo) / (n - 1));
+            if (len > bestLength) bestLength = len, best = k;
+        }
+        // Golden-section refinement around the best sample (the maximum may be inside the range).
+        double a = lo + std::max(0, best - 1) * (hi - lo) / (n - 1);
+        double b = best + 1 >= n ? hi : lo + (best + 1) * (hi - lo) / (n - 1);
+        const double g = (std::sqrt(5.0) - 1) / 2;
+        double c = b - g * (b - a), d = a + g * (b - a);
+        double fc = lengthAt(i, c), fd = lengthAt(i, d);
+        while (b - a > 1e-10) {
+            if (fc > fd) { b = d; d = c; fd = fc; c = b - g * (b - a); fc = lengthAt(i, c); }
+            else { a = c; c = d; fc = fd; d = a + g * (b - a); fd = lengthAt(i, d); }
+        }
+        setup.muscles[i].params.maxPathLength = std::max({bestLength, fc, fd});
+    }
+}
+
+}  // namespace armsim

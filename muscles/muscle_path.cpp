@@ -1,0 +1,253 @@
+#include "muscles/muscle_path.h"
+
+#include "muscles/param_file.h"
+
+#include <cmath>
+#include <sstream>
+
+using namespace SimTK;
+
+namespace armsim {
+
+namespace {
+
+constexpr double kTwoPi = 6.283185307179586476925;
+// A wrap whose arc would exceed this is the path clearing the surface the long way round: inactive.
+constexpr double kMaxWrapAngle = 0.75 * kTwoPi;
+constexpr int kArcSamplesPerRadian = 8;
+
+double cross2(const Vec2& a, const Vec2& b) { return a[0] * b[1] - a[1] * b[0]; }
+
+// Tangent points, arc and polyline of one surface between the fixed points a and b (Ground).
+struct SurfaceWrap {
+    bool active = false;
+    Vec3 ta{0}, tb{0};
+    double length = 0;  // |ta - a| + arc + |b - tb|
+    std::vector<Vec3> arc;
+};
+
+[[noreturn]] void throwInside(const std::string& muscle, const PathElement& e, double distance) {
+    std::ostringstream msg;
+    msg << "muscle '" << muscle << "': a path point lies inside the wrapping surface '" << e.label
+        << "' (distance " << distance << " m from its axis or centre, radius " << e.radius
+        << " m): move the point or shrink the surface";
+    throw SimulationError(msg.str());
+}
+
+// The 2D wrap lifted to 3D: e1, e2 span the wrap plane, e3 is the cylinder axis (zero for a sphere).
+SurfaceWrap liftWrap(const CircleWrap& w, const Vec3& c, const UnitVec3& e1, const UnitVec3& e2, const Vec3& e3,
+                     double zp, double zq, double R, bool withArc) {
+    SurfaceWrap out;
+    out.active = true;
+    const double planar = w.lengthP + R * w.angle + w.lengthQ;
+    const double dz = zq - zp;
+    const double zTp = zp + dz * w.lengthP / planar;
+    const double zTq = zp + dz * (w.lengthP + R * w.angle) / planar;
+    out.ta = c + w.tp[0] * e1 + w.tp[1] * e2 + zTp * e3;
+    out.tb = c + w.tq[0] * e1 + w.tq[1] * e2 + zTq * e3;
+    out.length = std::sqrt(planar * planar + dz * dz);
+    if (withArc) {
+        const double th0 = std::atan2(w.tp[1], w.tp[0]);
+        const int n = std::max(2, int(std::ceil(w.angle * kArcSamplesPerRadian)));
+        for (int k = 1; k < n; ++k) {
+            const double f = double(k) / n;
+            const double th = th0 + w.direction * w.angle * f;
+            out.arc.push_back(c + R * std::cos(th) * e1 + R * std::sin(th) * e2 + (zTp + f * (zTq - zTp)) * e3);
+        }
+    }
+    return out;
+}
+
+SurfaceWrap wrapSurface(const PathElement& e, const State& s, const Vec3& a, const Vec3& b,
+                        const std::string& muscle, bool withArc) {
+    const Transform& X_GB = e.body.getBodyTransform(s);
+    const Vec3 c = X_GB * e.location;
+    const Vec3 side = X_GB.R() * e.side;
+    const Vec3 p = a - c, q = b - c;
+    if (e.kind == PathElement::Kind::Cylinder) {
+        const UnitVec3 e3 = X_GB.R() * e.axis;
+        const UnitVec3 e1 = e3.perp();
+        const UnitVec3 e2(e3 % e1, true);
+        const Vec2 p2(dot(p, e1), dot(p, e2)), q2(dot(q, e1), dot(q, e2)), s2(dot(side, e1), dot(side, e2));
+        if (p2.norm() <= e.radius) throwInside(muscle, e, p2.norm());
+        if (q2.norm() <= e.radius) throwInside(muscle, e, q2.norm());
+        const CircleWrap w = calcCircleWrap(p2, q2, e.radius, s2, s2.norm() > 0);
+        if (!w.active) return {};
+        return liftWrap(w, c, e1, e2, Vec3(e3), dot(p, e3), dot(q, e3), e.radius, withArc);
+    }
+    // Sphere: the great circle in the plane of the centre, a and b.
+    if (p.norm() <= e.radius) throwInside(muscle, e, p.norm());
+    if (q.norm() <= e.radius) throwInside(muscle, e, q.norm());
+    Vec3 n = p % q;
+    if (n.norm() <= 1e-12 * p.norm() * q.norm()) n = p % side;
+    if (n.norm() <= 1e-12 * p.norm() * (side.norm() + 1e-300)) n = UnitVec3(p).perp().asVec3();
+    const UnitVec3 e1(p), e3(n);
+    const UnitVec3 e2(e3 % e1, true);
+    const Vec2 p2(p.norm(), 0), q2(dot(q, e1), dot(q, e2)), s2(dot(side, e1), dot(side, e2));
+    const CircleWrap w = calcCircleWrap(p2, q2, e.radius, s2, s2.norm() > 0);
+    if (!w.active) return {};
+    return liftWrap(w, c, e1, e2, Vec3(0), 0, 0, e.radius, withArc);
+}
+
+}  // namespace
+
+CircleWrap calcCircleWrap(const Vec2& p, const Vec2& q, double R, const Vec2& side, bool hasSide) {
+    CircleWrap w;
+    const Vec2 d = q - p;
+    const double dd = d.normSqr();
+    if (dd == 0) return w;
+    int sigma;
+    if (hasSide) {
+        // Passing on the +s side puts the centre on the path's right when s is on its left: clockwise.
+        sigma = cross2(d, side) > 0 ? -1 : +1;
+        Vec2 n(-d[1], d[0]);
+        n /= std::sqrt(dd);
+        if (dot(n, side) < 0) n = -n;
+        if (dot(p, n) >= R) return w;  // the straight line clears the surface on the allowed side
+    } else {
+        const double t = -dot(p, d) / dd;
+        if (t <= 0 || t >= 1) return w;
+        const Vec2 foot = p + t * d;
+        if (foot.norm() >= R) return w;
+        sigma = cross2(d, foot) > 0 ? -1 : +1;
+    }
+    const double rp = p.norm(), rq = q.norm();
+    const double alpha = std::acos(R / rp), beta = std::acos(R / rq);
+    const double thP = std::atan2(p[1], p[0]) + sigma * alpha;
+    const double thQ = std::atan2(q[1], q[0]) - sigma * beta;
+    double angle = std::fmod(sigma * (thQ - thP), kTwoPi);
+    if (angle < 0) angle += kTwoPi;
+    if (angle > kMaxWrapAngle) return w;
+    w.active = true;
+    w.direction = sigma;
+    w.angle = angle;
+    w.tp = Vec2(R * std::cos(thP), R * std::sin(thP));
+    w.tq = Vec2(R * std::cos(thQ), R * std::sin(thQ));
+    w.lengthP = std::sqrt(std::max(0.0, rp * rp - R * R));
+    w.lengthQ = std::sqrt(std::max(0.0, rq * rq - R * R));
+    return w;
+}
+
+MusclePath::MusclePath(const MobilizedBody& originBody, const Vec3& origin, const MobilizedBody& insertionBody,
+                       const Vec3& insertion) {
+    PathElement o, i;
+    o.body = originBody;
+    o.location = origin;
+    o.label = "origin";
+    i.body = insertionBody;
+    i.location = insertion;
+    i.label = "insertion";
+    elements_ = {o, i};
+}
+
+MusclePath::MusclePath(std::vector<PathElement> elements) : elements_(std::move(elements)) {
+    const int n = int(elements_.size());
+    if (n < 2) throw InputError("muscle path: needs an origin and an insertion, got " + std::to_string(n) + " elements");
+    if (elements_.front().isSurface() || elements_.back().isSurface())
+        throw InputError("muscle path: the origin and the insertion must be points, not wrapping surfaces");
+    for (int k = 0; k < n; ++k) {
+        const PathElement& e = elements_[k];
+        if (!e.isSurface()) continue;
+        if (elements_[k + 1].isSurface())
+            throw InputError("muscle path: wrapping surfaces '" + e.label + "' and '" + elements_[k + 1].label +
+                             "' follow each other; put a via point between them (one surface between two points)");
+        checkField(e.label + ".radius", e.radius, Bound::positive("m"));
+    }
+}
+
+PathGeometry MusclePath::calcGeometry(const State& s, const std::string& muscleName, bool withPolyline) const {
+    PathGeometry g;
+    const int n = int(elements_.size());
+    g.wrapping.assign(n, false);
+    auto pointInGround = [&](int k) {
+        return elements_[k].body.getBodyTransform(s) * elements_[k].location;
+    };
+    auto addLoad = [&](int k, const Vec3& point, const Vec3& force) {
+        const MobilizedBody& body = elements_[k].body;
+        g.loads.push_back({k, body.getMobilizedBodyIndex(), point, point - body.getBodyTransform(s).p(), force});
+    };
+    int i = 0;
+    Vec3 a = pointInGround(0);
+    if (withPolyline) g.polyline.push_back(a);
+    while (i < n - 1) {
+        const int k = elements_[i + 1].isSurface() ? i + 1 : -1;  // the surface between two points
+        const int j = k >= 0 ? i + 2 : i + 1;
+        const Vec3 b = pointInGround(j);
+        SurfaceWrap w;
+        if (k >= 0) {
+            w = wrapSurface(elements_[k], s, a, b, muscleName, withPolyline);
+            if (w.active) {
+                g.wrapping[k] = true;
+                addLoad(k, w.ta, Vec3(UnitVec3(a - w.ta).asVec3()));
+                addLoad(k, w.tb, Vec3(UnitVec3(b - w.tb).asVec3()));
+            }
+        }
+        if (w.active) {
+            g.length += w.length;
+            addLoad(i, a, Vec3(UnitVec3(w.ta - a).asVec3()));
+            addLoad(j, b, Vec3(UnitVec3(w.tb - b).asVec3()));
+            if (withPolyline) {
+                g.polyline.push_back(w.ta);
+                g.polyline.insert(g.polyline.end(), w.arc.begin(), w.arc.end());
+                g.polyline.push_back(w.tb);
+            }
+        } else {
+            const Vec3 d = b - a;
+            const double len = d.norm();
+            g.length += len;
+            const Vec3 u = len > 0 ? Vec3(d / len) : Vec3(0);
+            addLoad(i, a, u);
+            addLoad(j, b, -u);
+        }
+        if (withPolyline) g.polyline.push_back(b);
+        i = j;
+        a = b;
+    }
+    return g;
+}
+
+double MusclePath::calcLength(const State& s) const {
+    if (isStraight())
+        return (elements_[1].body.getBodyTransform(s) * elements_[1].location -
+                elements_[0].body.getBodyTransform(s) * elements_[0].location).norm();
+    return calcGeometry(s).length;
+}
+
+void MusclePath::applyTension(const PathGeometry& g, double tension, Vector_<SpatialVec>& bodyForces) {
+    for (const PathLoad& l : g.loads) {
+        const Vec3 f = tension * l.force;
+        bodyForces[l.body] += SpatialVec(l.arm % f, f);
+    }
+}
+
+void appendPathDecorations(const MusclePath& path, const PathGeometry& g, const Vec3& color, double lineThickness,
+                           Array_<DecorativeGeometry>& geometry) {
+    constexpr double kViaRadius = 0.004;       // m, drawing only
+    constexpr double kCylinderHalfLength = 0.02;  // m, drawing only
+    for (std::size_t k = 1; k < g.polyline.size(); ++k)
+        geometry.push_back(DecorativeLine(g.polyline[k - 1], g.polyline[k]).setColor(color).setLineThickness(lineThickness));
+    const std::vector<PathElement>& elements = path.getElements();
+    for (std::size_t k = 0; k < elements.size(); ++k) {
+        const PathElement& e = elements[k];
+        const int body = int(e.body.getMobilizedBodyIndex());
+        if (e.kind == PathElement::Kind::Point) {
+            if (k == 0 || k + 1 == elements.size()) continue;  // origin and insertion: the line ends there
+            geometry.push_back(DecorativeSphere(kViaRadius).setBodyId(body).setTransform(Transform(e.location))
+                                   .setColor(Vec3(0.9, 0.9, 0.2)));
+            continue;
+        }
+        const double opacity = g.wrapping.size() > k && g.wrapping[k] ? 0.55 : 0.25;
+        const Vec3 surfaceColor(0.55, 0.6, 0.75);
+        if (e.kind == PathElement::Kind::Cylinder) {
+            // DecorativeCylinder runs along its Y axis: rotate Y onto the cylinder's axis.
+            const Rotation R_BC(e.axis, YAxis);
+            geometry.push_back(DecorativeCylinder(e.radius, kCylinderHalfLength).setBodyId(body)
+                                   .setTransform(Transform(R_BC, e.location)).setColor(surfaceColor).setOpacity(opacity));
+        } else {
+            geometry.push_back(DecorativeSphere(e.radius).setBodyId(body).setTransform(Transform(e.location))
+                                   .setColor(surfaceColor).setOpacity(opacity));
+        }
+    }
+}
+
+}  // namespace armsim
