@@ -208,6 +208,10 @@ ArmSetup loadModel(const std::string& nameOrFile) {
         std::string armFile = root.getString("arm");
         const std::string relative = root.getDirectory().empty() ? armFile : root.getDirectory() + "/" + armFile;
         if (std::filesystem::exists(relative)) armFile = relative;
+        else if (!std::filesystem::exists(armFile) &&
+                 !std::filesystem::exists(getAssetDirectory() + "/" + armFile))
+            throw InputError(root.where("arm") + ": field 'arm' = '" + armFile +
+                             "': no such arm file (relative to the model file or to " + getAssetDirectory() + ")");
         s.arm = loadArmParameters(findAsset(armFile));
         hasBiceps = true;
     }

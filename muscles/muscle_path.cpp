@@ -2,6 +2,7 @@
 
 #include "muscles/param_file.h"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -96,20 +97,34 @@ CircleWrap calcCircleWrap(const Vec2& p, const Vec2& q, double R, const Vec2& si
     const Vec2 d = q - p;
     const double dd = d.normSqr();
     if (dd == 0) return w;
+    // Closest point of the segment to the centre.
+    const double t = std::clamp(-dot(p, d) / dd, 0.0, 1.0);
+    const Vec2 c = p + t * d;
     int sigma;
     if (hasSide) {
+        // The path may not pass through the circle nor through the strip behind it (the side opposite
+        // s, as wide as the circle): clip the segment to the band |x . u| < R (u normal to s) and
+        // look for a point of the clipped part inside the circle or behind the centre.
+        const Vec2 s = side / side.norm(), u(-s[1], s[0]);
+        const double a = dot(p, u), b = dot(d, u);
+        double u0 = 0, u1 = 1;
+        if (std::abs(b) < 1e-300) {
+            if (std::abs(a) >= R) return w;
+        } else {
+            const double e0 = (-R - a) / b, e1 = (R - a) / b;
+            u0 = std::max(0.0, std::min(e0, e1));
+            u1 = std::min(1.0, std::max(e0, e1));
+            if (u0 >= u1) return w;
+        }
+        const bool behind = std::min(dot(p + u0 * d, s), dot(p + u1 * d, s)) < 0;
+        const double tc = std::clamp(-dot(p, d) / dd, u0, u1);
+        const bool cuts = (p + tc * d).norm() < R;
+        if (!behind && !cuts) return w;
         // Passing on the +s side puts the centre on the path's right when s is on its left: clockwise.
-        sigma = cross2(d, side) > 0 ? -1 : +1;
-        Vec2 n(-d[1], d[0]);
-        n /= std::sqrt(dd);
-        if (dot(n, side) < 0) n = -n;
-        if (dot(p, n) >= R) return w;  // the straight line clears the surface on the allowed side
+        sigma = cross2(d, s) > 0 ? -1 : +1;
     } else {
-        const double t = -dot(p, d) / dd;
-        if (t <= 0 || t >= 1) return w;
-        const Vec2 foot = p + t * d;
-        if (foot.norm() >= R) return w;
-        sigma = cross2(d, foot) > 0 ? -1 : +1;
+        if (c.norm() >= R || t <= 0 || t >= 1) return w;
+        sigma = cross2(d, c) > 0 ? -1 : +1;  // round the side the segment passes: the shorter way
     }
     const double rp = p.norm(), rq = q.norm();
     const double alpha = std::acos(R / rp), beta = std::acos(R / rq);

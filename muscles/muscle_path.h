@@ -17,9 +17,11 @@
 // equals -dP/dq, which tests check against finite differences.
 //
 // Contact rule of a surface with a `side` s (OpenSim's quadrant): the path passes the surface on the
-// +s side; it touches (wraps) when the straight segment would come closer than the radius on that
-// side or pass on the other side; the wrap length then grows continuously from zero. Without a side
-// the path wraps only when the straight segment cuts the surface, the shorter way round.
+// +s side; it wraps when the straight segment cuts the surface or crosses the strip behind it (the
+// -s side, as wide as the surface); the wrap length grows continuously from zero as the segment comes
+// to touch the surface on the +s side (OpenSim's quadrant rule, with the same jump where a segment
+// enters the strip from its flank). Without a side the path wraps only when the
+// straight segment cuts the surface, the shorter way round.
 #pragma once
 
 #include "muscles/simbody.h"
