@@ -70,12 +70,6 @@ double MuscleArm::calcMomentArm(const State& s, int i) const {
     return calcPathMomentArm(arm_->getMatter(), arm_->getForearm(), s, forces_.at(i).calcPathGeometry(s));
 }
 
-double MuscleArm::calcMuscleTorque(const State& s) const {
-    double torque = 0;
-    for (int i = 0; i < getNumMuscles(); ++i) torque += forces_[i].getForce(s) * calcMomentArm(s, i);
-    return torque;
-}
-
 void MuscleArm::setSteadyMuscleStates(State& s) const {
     for (const VirtualMuscleForce& f : forces_) {
         try {

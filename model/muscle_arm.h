@@ -46,8 +46,6 @@ public:
     /// Moment arm of muscle i about the elbow [m], + = flexes: the elbow torque of a unit tension along
     /// its path, through Simbody's system Jacobian (virtual work). Equals -dP/dq. Stage::Position.
     double calcMomentArm(const SimTK::State& s, int i) const;
-    /// Elbow torque of every muscle's present force [N m], + = flexion (Stage::Position).
-    double calcMuscleTorque(const SimTK::State& s) const;
 
     /// Every muscle at its steady isometric state for the present path and activation; throws
     /// SimulationError naming the muscle when one has no equilibrium.

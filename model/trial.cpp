@@ -151,9 +151,8 @@ IsometricTrialResult runIsometricTrial(const ArmSetup& setup, const IsometricTri
         system, state, settings.getDuration(), settings.sampleRate, profile.getBreakpoints(), settings.integration,
         [&](const State& s) {
             const double t = s.getTime();
-            std::vector<double> row;
-            model.appendMuscleStates(s, row);  // the states, in column order
-            const std::vector<double> y = std::move(row);
+            std::vector<double> y;
+            model.appendMuscleStates(s, y);  // the states, in column order
             double torque;
             if (settings.realizeEverySample) {
                 system.realize(s, Stage::Acceleration);
@@ -176,7 +175,7 @@ IsometricTrialResult runIsometricTrial(const ArmSetup& setup, const IsometricTri
             const double byFixedRatio = calcBicepsForceFixedRatio(strap, settings.elbowAngle, kPi / 2);
             auto pct = [F](double estimate) { return F > 0 ? 100 * (estimate - F) / F : NAN; };
             const double* yp = y.data() + firstState[primary];
-            row = {t, profile.getValue(t), radToDeg(settings.elbowAngle), 0.0, F,
+            std::vector<double> row{t, profile.getValue(t), radToDeg(settings.elbowAngle), 0.0, F,
                    yp[VirtualMuscle::kL] * L0, yp[VirtualMuscle::kV] * L0, torque, muscleTorque,
                    strap, saturated ? 1.0 : 0.0, byMomentArm, byFixedRatio, pct(byMomentArm),
                    pct(byFixedRatio)};

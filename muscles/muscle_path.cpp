@@ -97,9 +97,7 @@ CircleWrap calcCircleWrap(const Vec2& p, const Vec2& q, double R, const Vec2& si
     const Vec2 d = q - p;
     const double dd = d.normSqr();
     if (dd == 0) return w;
-    // Closest point of the segment to the centre.
-    const double t = std::clamp(-dot(p, d) / dd, 0.0, 1.0);
-    const Vec2 c = p + t * d;
+    const double tClosest = -dot(p, d) / dd;  // parameter of the line's point closest to the centre
     int sigma;
     if (hasSide) {
         // The path may not pass through the circle nor through the strip behind it (the side opposite
@@ -117,13 +115,15 @@ CircleWrap calcCircleWrap(const Vec2& p, const Vec2& q, double R, const Vec2& si
             if (u0 >= u1) return w;
         }
         const bool behind = std::min(dot(p + u0 * d, s), dot(p + u1 * d, s)) < 0;
-        const double tc = std::clamp(-dot(p, d) / dd, u0, u1);
+        const double tc = std::clamp(tClosest, u0, u1);
         const bool cuts = (p + tc * d).norm() < R;
         if (!behind && !cuts) return w;
         // Passing on the +s side puts the centre on the path's right when s is on its left: clockwise.
         sigma = cross2(d, s) > 0 ? -1 : +1;
     } else {
-        if (c.norm() >= R || t <= 0 || t >= 1) return w;
+        if (tClosest <= 0 || tClosest >= 1) return w;
+        const Vec2 c = p + tClosest * d;
+        if (c.norm() >= R) return w;
         sigma = cross2(d, c) > 0 ? -1 : +1;  // round the side the segment passes: the shorter way
     }
     const double rp = p.norm(), rq = q.norm();
