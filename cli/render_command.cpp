@@ -91,9 +91,9 @@ void addRenderCommand(CLI::App& app) {
                   "without a camera key the sagittal camera is used");
     o->stillAtOption = c->add_option("--still-at", o->stillAt, "trial time of a PNG still [s]");
     c->add_option("--still", o->still, "PNG file of the still");
-    c->add_option("--color-by", o->colorBy, "biceps colour follows: activation | force")
+    c->add_option("--color-by", o->colorBy, "muscle colour follows: activation | force")
         ->capture_default_str()->check(CLI::IsMember({"activation", "force"}));
-    c->add_flag("--fixed-thickness", o->fixedThickness, "biceps line thickness does not follow the colour");
+    c->add_flag("--fixed-thickness", o->fixedThickness, "muscle line thickness does not follow the colour");
     c->add_option("--arrow", o->arrow, "force arrow: auto (strap if isometric, else muscle) | strap | muscle | none")
         ->capture_default_str()->check(CLI::IsMember({"auto", "strap", "muscle", "none"}));
     c->add_option("--arrow-scale", o->arrowScale,

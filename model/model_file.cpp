@@ -133,6 +133,18 @@ MuscleSpec readMuscle(const ParamNode& n) {
     readMuscleFields(n, m.params, false);
     m.maxPathFromRange = !n.has("max_path_length");
     m.params.name = name;
+    m.sourceParams = m.params;
+    if (n.has("calibration")) {
+        const ParamNode c = n.child("calibration");
+        const Bound scale = Bound::closed(0.2, 5);
+        MuscleCalibration cal;
+        cal.forceScale = c.getNumber("force_scale", scale, 1.0);
+        cal.fascicleLengthScale = c.getNumber("fascicle_length_scale", scale, 1.0);
+        cal.tendonLengthScale = c.getNumber("tendon_length_scale", scale, 1.0);
+        c.getString("source", "");
+        c.finish();
+        m.setCalibration(cal);
+    }
 
     const ParamNode path = n.child("path");
     m.path.push_back(readPoint(path.child("origin"), "origin"));
@@ -163,6 +175,24 @@ void deriveThesisGeometry(ArmSetup& s) {
 }
 
 }  // namespace
+
+void MuscleCalibration::validate() const {
+    const Bound scale = Bound::closed(0.2, 5);
+    checkField("calibration.force_scale", forceScale, scale);
+    checkField("calibration.fascicle_length_scale", fascicleLengthScale, scale);
+    checkField("calibration.tendon_length_scale", tendonLengthScale, scale);
+}
+
+void MuscleSpec::setCalibration(const MuscleCalibration& c) {
+    c.validate();
+    calibration = c;
+    const double maxPath = params.maxPathLength;
+    params = sourceParams;
+    params.maxPathLength = maxPath;
+    params.optimalFascicleLength *= c.fascicleLengthScale;
+    params.mass *= c.forceScale * c.fascicleLengthScale;
+    params.optimalTendonLength *= c.tendonLengthScale;
+}
 
 std::vector<std::string> listModels() {
     std::vector<std::string> names;

@@ -57,15 +57,30 @@ struct PathElementSpec {
     std::string label;                  ///< "origin", "via 1", "cylinder 2", "insertion"
 };
 
+/// Scales fitted to a subject's measured strength (a model file's per-muscle `calibration:`), applied to
+/// the source parameters: F0' = k F0, L0' = f L0, L0T' = t L0T (mass = F0' L0' rho / sigma).
+struct MuscleCalibration {
+    double forceScale = 1;            ///< k, on the maximal isometric force F0 [1]
+    double fascicleLengthScale = 1;   ///< f, on the optimal fascicle length L0 [1]
+    double tendonLengthScale = 1;     ///< t, on the optimal tendon length L0T [1]
+    bool isIdentity() const { return forceScale == 1 && fascicleLengthScale == 1 && tendonLengthScale == 1; }
+    /// Throws FieldError naming the field unless every scale is in [0.2, 5].
+    void validate() const;
+};
+
 /// One muscle of a model.
 struct MuscleSpec {
-    MuscleParameters params;              ///< Virtual Muscle parameters; params.name = the model's name
+    MuscleParameters params;              ///< Virtual Muscle parameters in use (calibration applied)
+    MuscleParameters sourceParams;        ///< as the sources give them (before calibration)
+    MuscleCalibration calibration;        ///< identity unless the file has `calibration:`
     MuscleGroup group = MuscleGroup::Flexor;
     std::vector<PathElementSpec> path;    ///< origin, via elements, insertion
     /// true: P_max is the longest path over the elbow's range (resolved by resolveMaxPathLengths);
     /// false: params.maxPathLength as given.
     bool maxPathFromRange = true;
     std::string source;                   ///< where the numbers come from
+    /// Sets calibration and recomputes params from sourceParams (P_max kept).
+    void setCalibration(const MuscleCalibration& c);
 };
 
 /// The virtual subject's effort in a trial (spec: a realistic MVC).

@@ -12,13 +12,11 @@
 
 namespace armsim {
 
-namespace {
 std::string formatNumber(double v) {
     char buf[32];
     const auto r = std::to_chars(buf, buf + sizeof buf, v);  // shortest round-trip form
     return std::string(buf, r.ptr);
 }
-}  // namespace
 
 FieldError::FieldError(std::string field, const std::string& message)
     : InputError("field '" + field + "' " + message), field_(std::move(field)), detail_(message) {}

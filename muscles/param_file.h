@@ -17,6 +17,9 @@ namespace YAML { class Node; }
 
 namespace armsim {
 
+/// Shortest round-trip decimal form of v, locale-free (for error messages).
+std::string formatNumber(double v);
+
 /// A user error (bad file, bad value, bad option). The CLI prints what() and exits non-zero.
 class InputError : public std::invalid_argument {
 public:

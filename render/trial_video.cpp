@@ -162,6 +162,8 @@ struct TrialRenderer::Impl {
     bool isometric = false;
     ForceArrowKind arrow = ForceArrowKind::None;
     std::vector<double> time, angleDeg, velocityDeg, activation, force, strap, saturated;
+    std::vector<std::vector<double>> muscleForce;  // per muscle (empty: the table lacks its column)
+    std::vector<double> muscleForceScale;          // per muscle: force at full red (N)
     double forceScale = 1;
     double arrowScale = 1;  // (m/N)
     std::vector<DecorativeGeometry> floor;
@@ -185,7 +187,7 @@ struct TrialRenderer::Impl {
             throw InputError("force arrow 'strap': " + name + " has no column 'strap_force_N' (not an isometric "
                              "trial): expected the muscle arrow or none");
 
-        model = std::make_unique<MuscleArm>(setup, ActivationProfile(time, activation, name + " activation"));
+        model = std::make_unique<MuscleArm>(setup, readActivationProfiles(setup, table, name));
         state = model->getDefaultState();
         try {
             setRow(0);  // checks the state columns
@@ -201,6 +203,14 @@ struct TrialRenderer::Impl {
 
         const double peak = *std::max_element(force.begin(), force.end());
         forceScale = settings.scene.forceScale > 0 ? settings.scene.forceScale : (peak > 0 ? peak : 1.0);
+        for (int i = 0; i < setup.getNumMuscles(); ++i) {
+            const std::string column = setup.getNumMuscles() == 1 ? "muscle_force_N" : "force_" + model->getMuscleName(i) + "_N";
+            muscleForce.push_back(table.hasColumn(column) ? table.getColumn(column) : std::vector<double>());
+            double musclePeak = 0;
+            for (double f : muscleForce.back()) musclePeak = std::max(musclePeak, f);
+            // A fixed --force-scale is for the primary muscle; the others keep their own peak.
+            muscleForceScale.push_back(i == setup.primary ? forceScale : (musclePeak > 0 ? musclePeak : 1.0));
+        }
         arrowScale = settings.scene.arrowScale;
         if (!(arrowScale > 0)) {
             double arrowPeak = 0;
@@ -327,43 +337,32 @@ struct TrialRenderer::Impl {
     }
 
     // The arm's own decorations: body decorations (the matter subsystem's Topology-stage output,
-    // which leaves out Simbody's default frames) and every other subsystem's geometry. The muscle
-    // line goes on top, restyled as the settings ask.
+    // which leaves out Simbody's default frames) and every other subsystem's geometry; every muscle's
+    // path on top, coloured as the settings ask.
     void collectDecorations(int row, SimTK::Array_<DecorativeGeometry>& base,
                             SimTK::Array_<DecorativeGeometry>& top) const {
         const SimTK::MultibodySystem& system = model->getSystem();
         const SimTK::SubsystemIndex matter = system.getMatterSubsystem().getMySubsystemIndex();
-        SimTK::Array_<DecorativeGeometry> other;
+        // The muscles' own decorations are left out: they are drawn below with the scene's colouring.
+        const SimTK::SubsystemIndex forces = model->getMuscleForce(0).getForceSubsystem().getMySubsystemIndex();
         for (SimTK::SubsystemIndex i(0); i < system.getNumSubsystems(); ++i) {
             const SimTK::Subsystem::Guts& guts = system.getSubsystem(i).getSubsystemGuts();
-            if (i == matter) {
-                guts.calcDecorativeGeometryAndAppend(state, SimTK::Stage::Topology, base);
-                continue;
-            }
-            for (SimTK::Stage stage = SimTK::Stage::Topology; stage <= state.getSystemStage(); ++stage)
-                guts.calcDecorativeGeometryAndAppend(state, stage, other);
+            if (i == matter) guts.calcDecorativeGeometryAndAppend(state, SimTK::Stage::Topology, base);
+            else if (i != forces)
+                for (SimTK::Stage stage = SimTK::Stage::Topology; stage <= state.getSystemStage(); ++stage)
+                    guts.calcDecorativeGeometryAndAppend(state, stage, base);
         }
-        const ArmModel& arm = model->getArm();
-        const Vec3 origin = arm.getUpperArm().findStationLocationInGround(state, arm.getOriginStation());
-        const Vec3 insertion = arm.getForearm().findStationLocationInGround(state, arm.getInsertionStation());
-        constexpr double kSameTolerance = 1e-9;  // (m)
-        for (DecorativeGeometry& g : other) {
-            const bool isMuscle = SimTK::DecorativeLine::isInstanceOf(g) &&
-                                  (SimTK::DecorativeLine::downcast(g).getPoint1() - origin).norm() < kSameTolerance &&
-                                  (SimTK::DecorativeLine::downcast(g).getPoint2() - insertion).norm() < kSameTolerance;
-            if (!isMuscle) {
-                base.push_back(g);
-                continue;
-            }
-            const TrialSceneSettings& sc = settings.scene;
-            double value = -1;
-            if (sc.muscleColoring == MuscleColoring::Force) {
-                value = std::clamp(force[row] / forceScale, 0.0, 1.0);
-                g.setColor(VirtualMuscleForce::calcActivationColor(value));
-                if (sc.thicknessFollows) g.setLineThickness(kMuscleThicknessAtZero + kMuscleThicknessGain * value);
-            }
-            if (!sc.thicknessFollows) g.setLineThickness(sc.muscleThickness);
-            top.push_back(g);
+        // Every muscle on its wrapped path (via points and wrap surfaces drawn with it), on top.
+        const TrialSceneSettings& sc = settings.scene;
+        for (int m = 0; m < model->getNumMuscles(); ++m) {
+            const VirtualMuscleForce& f = model->getMuscleForce(m);
+            double value = f.calcOutputs(state).activeFraction;
+            if (sc.muscleColoring == MuscleColoring::Force && !muscleForce[m].empty())
+                value = std::clamp(muscleForce[m][row] / muscleForceScale[m], 0.0, 1.0);
+            const double thickness = sc.thicknessFollows ? kMuscleThicknessAtZero + kMuscleThicknessGain * value
+                                                         : sc.muscleThickness;
+            appendPathDecorations(f.getPath(), f.calcPathGeometry(state, true),
+                                  VirtualMuscleForce::calcActivationColor(value), thickness, top);
         }
     }
 

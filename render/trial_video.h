@@ -24,11 +24,11 @@
 
 namespace armsim {
 
-/// What the biceps line's colour (blue at 0, red at 1, VirtualMuscleForce::calcActivationColor)
+/// What each muscle path's colour (blue at 0, red at 1, VirtualMuscleForce::calcActivationColor)
 /// and, optionally, thickness follow.
 enum class MuscleColoring {
     Activation,  ///< the muscle's own decoration: PCSA-weighted active fraction of its motor units
-    Force,       ///< muscle force Fse / TrialSceneSettings::forceScale
+    Force,       ///< muscle force Fse / TrialSceneSettings::forceScale (the primary muscle; others: / own peak)
 };
 
 /// Which force the arrow shows.

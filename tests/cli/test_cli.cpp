@@ -136,3 +136,33 @@ TEST(Cli, TrialWritesTheSeriesAndRejectsBadSettings) {
     EXPECT_NE(r.output.find("duraton"), std::string::npos) << r.output;
     EXPECT_FALSE(fs::exists(d / "bad.csv"));
 }
+
+// armsim model show: the files it promises, the summary it prints, and CSV numbers that agree with
+// each other (net torque = sum of muscle torques; moment arm table at 90 deg = the MVC table's arm).
+TEST(Cli, ModelShowWritesTablesAndPlots) {
+    constexpr double kSumTol = 1e-6;  // N m, CSV digits
+    const fs::path d = freshDir("model_show");
+    const CommandResult r = runArmsim("model show --model elbow --step 10 --out " + d.string());
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    EXPECT_NE(r.output.find("flexion MVC: peak"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("share of the flexors' torque at 90 deg"), std::string::npos) << r.output;
+    for (const char* f : {"muscles.csv", "moment_arms.csv", "moment_arms.png", "mvc_flexion.csv", "mvc_flexion.png",
+                          "mvc_extension.csv", "mvc_extension.png"})
+        EXPECT_TRUE(fs::exists(d / f)) << f;
+    const armsim::Table t = armsim::Table::readCsv((d / "mvc_flexion.csv").string());
+    ASSERT_EQ(t.getNumRows(), 15);  // 0..140 deg every 10
+    for (int i = 0; i < t.getNumRows(); ++i) {
+        double sum = 0;
+        for (const char* m : {"BIClong", "BICshort", "BRA", "BRD", "TRIlong", "TRIlat", "TRImed"})
+            sum += t.get(i, std::string("torque_") + m + "_Nm");
+        EXPECT_NEAR(t.get(i, "torque_total_Nm"), sum, kSumTol) << i;
+        EXPECT_GE(t.get(i, "primary_share"), 0.0);
+        EXPECT_LE(t.get(i, "primary_share"), 1.0);
+    }
+    const armsim::Table arms = armsim::Table::readCsv((d / "moment_arms.csv").string());
+    EXPECT_NEAR(t.get(9, "torque_BRA_Nm"), arms.get(9, "moment_arm_BRA_m") * t.get(9, "force_BRA_N"), 1e-6);
+
+    const CommandResult bad = runArmsim("model show --model elbow --step 0 --out " + d.string());
+    EXPECT_NE(bad.exitCode, 0);
+    EXPECT_NE(bad.output.find("angle step = 0"), std::string::npos) << bad.output;
+}

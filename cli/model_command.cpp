@@ -1,0 +1,92 @@
+// armsim model: list the shipped models, show one (muscle table, moment arms, steady MVC torque-angle
+// curves as CSV + PNG), calibrate a model's muscle strength to the elbow target curves.
+#include "cli/commands.h"
+#include "experiments/model_report.h"
+#include "identification/strength_calibration.h"
+#include "muscles/param_file.h"
+
+#include <cstdio>
+#include <memory>
+
+namespace armsim::cli {
+
+namespace {
+
+void printSummary(const char* effort, const MvcCurveSummary& s) {
+    std::printf("%s MVC: peak %.1f N m at %.1f deg flexion; %.1f N m at 90 deg\n", effort, s.peakTorque,
+                s.peakFlexionDeg, s.torqueAt90);
+}
+
+void addModelCommands(CLI::App& app) {
+    CLI::App* model = app.add_subcommand("model", "model files: list, show, calibrate");
+    model->require_subcommand(1);
+
+    model->add_subcommand("list", "names of the shipped models (assets/models/)")->callback([] {
+        for (const std::string& n : listModels()) {
+            const ArmSetup s = loadModel(n);
+            std::printf("%-10s %d muscle(s)  %s\n", n.c_str(), s.getNumMuscles(), s.description.c_str());
+        }
+    });
+
+    {
+        auto name = std::make_shared<std::string>("elbow");
+        auto out = std::make_shared<std::string>("out/model");
+        auto step = std::make_shared<double>(5.0);
+        auto reference = std::make_shared<std::string>();
+        CLI::App* c = model->add_subcommand(
+            "show", "muscle table, moment arms and steady MVC torque-angle curves (CSV + PNG)");
+        c->add_option("--model", *name, "model name or file")->capture_default_str();
+        c->add_option("--out", *out, "output directory")->capture_default_str();
+        c->add_option("--step", *step, "angle step [deg]")->capture_default_str();
+        c->add_option("--reference", *reference,
+                      "published reference data (default assets/measured/elbow_reference.yaml)");
+        c->callback([=] {
+            const ArmSetup setup = loadModel(*name);
+            const ElbowReference ref = reference->empty() ? loadDefaultElbowReference() : loadElbowReference(*reference);
+            const ModelReportFiles r = writeModelReport(setup, *out, *step, ref);
+            const Table t = calcMuscleTable(setup);
+            std::printf("model %s: %s\n%-9s %-8s %8s %7s %7s %7s %6s  calibration k f t\n", setup.name.c_str(),
+                        setup.description.c_str(), "muscle", "group", "F0 (N)", "L0 (m)", "L0T (m)", "M (kg)", "slow");
+            for (int i = 0; i < t.getNumRows(); ++i) {
+                const auto& row = t.getRow(i);
+                std::printf("%-9s %-8s %8.1f %7.4f %7.4f %7.4f %6.3f  %.3f %.3f %.3f\n",
+                            setup.muscles[i].params.name.c_str(), getMuscleGroupName(setup.muscles[i].group), row[0],
+                            row[1], row[2], row[3], row[5], row[7], row[8], row[9]);
+            }
+            printSummary("flexion", r.flexion);
+            printSummary("extension", r.extension);
+            std::printf("primary muscle (%s) share of the flexors' torque at 90 deg: %.1f %%\n",
+                        setup.muscles[setup.primary].params.name.c_str(), 100 * r.primaryShareAt90);
+            for (const std::string& f : r.files) std::printf("wrote %s\n", f.c_str());
+        });
+    }
+
+    {
+        auto name = std::make_shared<std::string>("elbow");
+        CLI::App* c = model->add_subcommand(
+            "calibrate", "fit muscle strength scales to the elbow's target MVC curves; prints calibration lines");
+        c->add_option("--model", *name, "model name or file (its present calibration is the start)")->capture_default_str();
+        c->callback([=] {
+            ArmSetup setup = loadModel(*name);
+            for (const MvcTorqueTarget& target : {getElbowFlexionTarget(), getElbowExtensionTarget()}) {
+                std::printf("fitting the %s muscles to: %s\n", getMuscleGroupName(target.effort), target.source.c_str());
+                std::fflush(stdout);
+                StrengthCalibrationResult r = calibrateStrength(setup, target);
+                std::printf("  %s\n  torque error: rms %.2f N m, max %.2f N m\n", r.report.c_str(), r.rmsTorqueError,
+                            r.maxTorqueError);
+                setup = applyCalibration(setup, r.muscles);
+            }
+            std::printf("calibration lines for the model file:\n");
+            for (const MuscleSpec& m : setup.muscles)
+                std::printf("  %-9s calibration: {force_scale: %.4f, fascicle_length_scale: %.4f, tendon_length_scale: %.4f}\n",
+                            m.params.name.c_str(), m.calibration.forceScale, m.calibration.fascicleLengthScale,
+                            m.calibration.tendonLengthScale);
+        });
+    }
+}
+
+const CommandRegistrar registerModel(15, addModelCommands);
+
+}  // namespace
+
+}  // namespace armsim::cli

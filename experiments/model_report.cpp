@@ -1,0 +1,269 @@
+#include "experiments/model_report.h"
+
+#include "experiments/plot.h"
+#include "model/geometry.h"
+#include "model/muscle_arm.h"
+#include "muscles/muscle_file.h"
+#include "muscles/param_file.h"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+
+namespace armsim {
+
+namespace {
+
+std::vector<MvcTorqueReference> readMvcReferences(const ParamNode& root, const std::string& key) {
+    std::vector<MvcTorqueReference> out;
+    if (!root.has(key)) return out;
+    for (const ParamNode& n : root.children(key)) {
+        MvcTorqueReference r;
+        r.flexionDeg = n.getNumber("flexion_deg", Bound::closed(0, 180));
+        r.torque = n.getNumber("torque", Bound::any("N m"));
+        r.sd = n.getNumber("sd", Bound{0, 1e300, false, false, "N m"}, 0.0);
+        r.source = n.getString("source");
+        n.finish();
+        out.push_back(r);
+    }
+    return out;
+}
+
+std::vector<double> calcAngles(const ArmSetup& setup, double stepDeg) {
+    if (!(stepDeg > 0 && stepDeg <= 90))
+        throw InputError("angle step = " + formatNumber(stepDeg) + " deg: expected in (0, 90]");
+    const double lo = 180.0 - setup.arm.maxElbowAngleDeg, hi = 180.0 - setup.arm.minElbowAngleDeg;
+    std::vector<double> q;
+    for (int k = 0; lo + k * stepDeg < hi - 1e-9; ++k) q.push_back(lo + k * stepDeg);
+    q.push_back(hi);
+    return q;
+}
+
+double interpolate(const std::vector<double>& x, const std::vector<double>& y, double at) {
+    for (std::size_t k = 1; k < x.size(); ++k)
+        if (at <= x[k]) {
+            const double w = (at - x[k - 1]) / (x[k] - x[k - 1]);
+            return y[k - 1] + w * (y[k] - y[k - 1]);
+        }
+    return y.back();
+}
+
+}  // namespace
+
+ElbowReference loadElbowReference(const std::string& path) {
+    const ParamNode root = ParamNode::loadFile(path);
+    ElbowReference ref;
+    if (root.has("moment_arms"))
+        for (const ParamNode& n : root.children("moment_arms")) {
+            MomentArmReference r;
+            r.muscle = n.getString("muscle");
+            r.flexionDeg = n.getNumber("flexion_deg", Bound::closed(0, 180));
+            r.min = n.getNumber("min", Bound::closed(-0.2, 0.2));
+            r.max = n.getNumber("max", Bound::closed(-0.2, 0.2));
+            r.source = n.getString("source");
+            if (r.min > r.max)
+                throw InputError(n.where("max") + ": moment arm max = " + formatNumber(r.max) +
+                                 " m is below min = " + formatNumber(r.min) + " m");
+            n.finish();
+            ref.momentArms.push_back(r);
+        }
+    if (root.has("peak_moment_arms")) root.children("peak_moment_arms");  // informative, not plotted
+    ref.mvcFlexion = readMvcReferences(root, "mvc_flexion");
+    ref.mvcExtension = readMvcReferences(root, "mvc_extension");
+    root.getString("source", "");
+    return ref;
+}
+
+ElbowReference loadDefaultElbowReference() {
+    return loadElbowReference(getAssetDirectory() + "/measured/elbow_reference.yaml");
+}
+
+bool referenceCoversMuscle(const std::string& referenceMuscle, const std::string& modelMuscle) {
+    return modelMuscle.compare(0, referenceMuscle.size(), referenceMuscle) == 0;
+}
+
+Table calcMuscleTable(const ArmSetup& setup) {
+    Table t({"F0_N", "L0_m", "L0T_m", "mass_kg", "max_path_m", "slow_fraction", "flexor", "force_scale",
+             "fascicle_length_scale", "tendon_length_scale"});
+    for (int i = 0; i < setup.getNumMuscles(); ++i) {
+        const MuscleParameters p = setup.calcMuscleParameters(i);
+        const VirtualMuscle m(p);
+        const MuscleCalibration& c = setup.muscles[i].calibration;
+        t.appendRow({m.getF0(), p.optimalFascicleLength, p.optimalTendonLength, p.mass, p.maxPathLength,
+                     p.slowFraction, setup.muscles[i].group == MuscleGroup::Flexor ? 1.0 : 0.0, c.forceScale,
+                     c.fascicleLengthScale, c.tendonLengthScale});
+    }
+    return t;
+}
+
+Table calcMomentArmTable(const ArmSetup& setup, double stepDeg) {
+    std::vector<std::string> cols = {"flexion_deg", "elbow_angle_deg"};
+    for (const MuscleSpec& m : setup.muscles) cols.push_back("path_" + m.params.name + "_m");
+    for (const MuscleSpec& m : setup.muscles) cols.push_back("moment_arm_" + m.params.name + "_m");
+    Table t(cols);
+    ArmGeometry g(setup);
+    for (double q : calcAngles(setup, stepDeg)) {
+        g.setElbowAngle(elbowAngleFromFlexion(degToRad(q)));
+        std::vector<double> row = {q, 180.0 - q};
+        for (int i = 0; i < g.getNumMuscles(); ++i) row.push_back(g.calcPathLength(i));
+        for (int i = 0; i < g.getNumMuscles(); ++i) row.push_back(g.calcMomentArm(i));
+        t.appendRow(row);
+    }
+    return t;
+}
+
+Table formatMvcCurve(const ArmSetup& setup, const SteadyMvcCurve& curve) {
+    std::vector<std::string> cols = {"flexion_deg", "elbow_angle_deg", "torque_total_Nm"};
+    for (const std::string& m : curve.muscles) cols.push_back("torque_" + m + "_Nm");
+    for (const std::string& m : curve.muscles) cols.push_back("force_" + m + "_N");
+    for (const std::string& m : curve.muscles) cols.push_back("fibre_length_" + m);
+    const bool flexion = curve.effort == MuscleGroup::Flexor;
+    if (flexion) cols.push_back("primary_share");
+    Table t(cols);
+    for (std::size_t a = 0; a < curve.flexionDeg.size(); ++a) {
+        std::vector<double> row = {curve.flexionDeg[a], 180.0 - curve.flexionDeg[a], curve.totalTorque[a]};
+        for (const SteadyMusclePoint& p : curve.points[a]) row.push_back(p.torque);
+        for (const SteadyMusclePoint& p : curve.points[a]) row.push_back(p.force);
+        for (const SteadyMusclePoint& p : curve.points[a]) row.push_back(p.fibreLength);
+        if (flexion) row.push_back(curve.calcFlexorShare(int(a), setup.primary));
+        t.appendRow(row);
+    }
+    return t;
+}
+
+MvcCurveSummary summarizeMvcCurve(const SteadyMvcCurve& curve) {
+    MvcCurveSummary s;
+    std::vector<double> mag;
+    for (double t : curve.totalTorque) mag.push_back(std::abs(t));
+    const std::size_t k = std::max_element(mag.begin(), mag.end()) - mag.begin();
+    s.peakTorque = mag[k];
+    s.peakFlexionDeg = curve.flexionDeg[k];
+    if (k > 0 && k + 1 < mag.size()) {  // vertex of the parabola through three samples
+        const double x0 = curve.flexionDeg[k - 1], x1 = curve.flexionDeg[k], x2 = curve.flexionDeg[k + 1];
+        const double y0 = mag[k - 1], y1 = mag[k], y2 = mag[k + 1];
+        const double d = (x0 - x1) * (x0 - x2) * (x1 - x2);
+        const double a = (x2 * (y1 - y0) + x1 * (y0 - y2) + x0 * (y2 - y1)) / d;
+        const double b = (x2 * x2 * (y0 - y1) + x1 * x1 * (y2 - y0) + x0 * x0 * (y1 - y2)) / d;
+        if (a < 0) {
+            s.peakFlexionDeg = -b / (2 * a);
+            s.peakTorque = y1 + a * (s.peakFlexionDeg - x1) * (s.peakFlexionDeg - x1) + (b + 2 * a * x1) * (s.peakFlexionDeg - x1);
+        }
+    }
+    s.torqueAt90 = interpolate(curve.flexionDeg, mag, 90.0);
+    return s;
+}
+
+ModelReportFiles writeModelReport(const ArmSetup& setup, const std::string& outDir, double stepDeg,
+                                  const ElbowReference& reference) {
+    namespace fs = std::filesystem;
+    fs::create_directories(outDir);
+    ModelReportFiles out;
+    auto path = [&](const std::string& f) { return (fs::path(outDir) / f).string(); };
+
+    const Table muscles = calcMuscleTable(setup);
+    std::string text = "muscle";
+    for (const std::string& c : muscles.getColumnNames()) text += "," + c;
+    text += "\n";
+    for (int i = 0; i < muscles.getNumRows(); ++i) {
+        text += setup.muscles[i].params.name;
+        for (double v : muscles.getRow(i)) text += "," + formatNumber(v);
+        text += "\n";
+    }
+    writeFileAtomically(path("muscles.csv"), text);
+    out.files.push_back(path("muscles.csv"));
+
+    const Table arms = calcMomentArmTable(setup, stepDeg);
+    arms.writeCsv(path("moment_arms.csv"));
+    out.files.push_back(path("moment_arms.csv"));
+    PlotSpec armPlot;
+    armPlot.title = "Moment arms, model " + setup.name + " (virtual work); markers: published ranges";
+    armPlot.xLabel = "flexion angle (deg, 0 = extended)";
+    armPlot.yLabel = "moment arm (cm, + = flexion)";
+    armPlot.legend = PlotSpec::Legend::TopLeft;
+    const std::vector<double> q = arms.getColumn("flexion_deg");
+    for (int i = 0; i < setup.getNumMuscles(); ++i) {
+        PlotSeries s;
+        s.label = setup.muscles[i].params.name;
+        s.x = q;
+        for (double h : arms.getColumn("moment_arm_" + s.label + "_m")) s.y.push_back(100 * h);
+        s.color = i % 8;
+        armPlot.series.push_back(s);
+    }
+    PlotSeries refs;
+    refs.label = "published min/max";
+    refs.markers = true;
+    refs.color = 7;
+    for (const MomentArmReference& r : reference.momentArms) {
+        bool covered = false;
+        for (const MuscleSpec& m : setup.muscles) covered = covered || referenceCoversMuscle(r.muscle, m.params.name);
+        if (!covered) continue;
+        for (double v : {r.min, r.max}) {
+            refs.x.push_back(r.flexionDeg);
+            refs.y.push_back(100 * v);
+        }
+    }
+    if (!refs.x.empty()) armPlot.series.push_back(refs);
+    double lo = 0, hi = 0;
+    for (const PlotSeries& ps : armPlot.series)
+        for (double v : ps.y) lo = std::min(lo, v), hi = std::max(hi, v);
+    armPlot.yMin = lo - 0.05 * (hi - lo);
+    armPlot.yMax = hi + 1.0 * (hi - lo);  // room for the legend above the curves
+    writePlotPng(path("moment_arms.png"), armPlot);
+    out.files.push_back(path("moment_arms.png"));
+
+    const std::vector<double> angles = calcAngles(setup, stepDeg);
+    for (MuscleGroup g : {MuscleGroup::Flexor, MuscleGroup::Extensor}) {
+        const bool flexion = g == MuscleGroup::Flexor;
+        const std::string name = flexion ? "flexion" : "extension";
+        const double sign = flexion ? 1.0 : -1.0;  // plot the effort's torque as positive
+        const SteadyMvcCurve curve = calcSteadyMvcCurve(setup, g, setup.effort, angles);
+        const Table t = formatMvcCurve(setup, curve);
+        t.writeCsv(path("mvc_" + name + ".csv"));
+        out.files.push_back(path("mvc_" + name + ".csv"));
+        (flexion ? out.flexion : out.extension) = summarizeMvcCurve(curve);
+        if (flexion)
+            out.primaryShareAt90 = interpolate(t.getColumn("flexion_deg"), t.getColumn("primary_share"), 90.0);
+
+        PlotSpec plot;
+        plot.title = "Steady " + name + " MVC, model " + setup.name + " (agonists U " +
+                     formatNumber(setup.effort.voluntaryActivation) + ", antagonists " +
+                     formatNumber(setup.effort.coContraction) + ")";
+        plot.xLabel = "flexion angle (deg, 0 = extended)";
+        plot.yLabel = name + " torque (N m)";
+        PlotSeries total;
+        total.label = "net (all muscles)";
+        total.x = curve.flexionDeg;
+        for (double v : curve.totalTorque) total.y.push_back(sign * v);
+        plot.series.push_back(total);
+        int color = 1;
+        for (int i = 0; i < setup.getNumMuscles(); ++i) {
+            if (setup.muscles[i].group != g) continue;
+            PlotSeries m;
+            m.label = curve.muscles[i];
+            m.x = curve.flexionDeg;
+            for (double v : t.getColumn("torque_" + curve.muscles[i] + "_Nm")) m.y.push_back(sign * v);
+            m.color = color++ % 7;
+            plot.series.push_back(m);
+        }
+        PlotSeries pub;
+        pub.label = "published mean, +/- SD";
+        pub.markers = true;
+        pub.color = 7;
+        for (const MvcTorqueReference& r : flexion ? reference.mvcFlexion : reference.mvcExtension)
+            for (double v : {r.torque - r.sd, r.torque, r.torque + r.sd}) {
+                pub.x.push_back(r.flexionDeg);
+                pub.y.push_back(sign * v);
+            }
+        if (!pub.x.empty()) plot.series.push_back(pub);
+        double top = 0;
+        for (const PlotSeries& ps : plot.series)
+            for (double v : ps.y) top = std::max(top, v);
+        plot.yMin = 0;
+        plot.yMax = 1.7 * top;  // room for the legend above the curves
+        writePlotPng(path("mvc_" + name + ".png"), plot);
+        out.files.push_back(path("mvc_" + name + ".png"));
+    }
+    return out;
+}
+
+}  // namespace armsim

@@ -1,0 +1,42 @@
+// The MVC torque-angle curve of a model from the steady isometric state of every muscle (no time
+// integration): what `armsim model show` plots and what the elbow calibration fits.
+#pragma once
+
+#include "model/model_file.h"
+
+#include <string>
+#include <vector>
+
+namespace armsim {
+
+/// One muscle at one elbow angle during a steady maximal effort.
+struct SteadyMusclePoint {
+    double pathLength = 0;   ///< P [m]
+    double momentArm = 0;    ///< h, + = flexes [m] (virtual work)
+    double activation = 0;   ///< U [1]
+    double fibreLength = 0;  ///< L / L0 at the steady state [1]
+    double force = 0;        ///< tendon force Fse [N]
+    double torque = 0;       ///< h Fse, + = flexion [N m]
+};
+
+/// The steady MVC torque-angle curve of a model: rows = angles, columns = muscles.
+struct SteadyMvcCurve {
+    MuscleGroup effort = MuscleGroup::Flexor;
+    std::vector<std::string> muscles;
+    std::vector<double> flexionDeg;                       ///< 0 = full extension
+    std::vector<std::vector<SteadyMusclePoint>> points;   ///< [angle][muscle]
+    std::vector<double> totalTorque;                      ///< sum of muscle torques, + = flexion [N m]
+    /// Share of the flexion torque of the flexors that muscle m gives at angle a [1].
+    double calcFlexorShare(int a, int m) const;
+};
+
+/// Every muscle of `setup` at its steady isometric state at each flexion angle [deg], the agonists of
+/// `effort` at subject.voluntaryActivation and the others at subject.coContraction (both in [0, 1]; 0 and 0
+/// give the passive torque). Net torque is the
+/// muscles' alone (gravity tared, as the transducer protocol does). Throws InputError for an angle
+/// outside the elbow's range and SimulationError (naming muscle and angle) when a muscle has no
+/// equilibrium.
+SteadyMvcCurve calcSteadyMvcCurve(const ArmSetup& setup, MuscleGroup effort, const SubjectEffort& subject,
+                                  const std::vector<double>& flexionDeg);
+
+}  // namespace armsim
