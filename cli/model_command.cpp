@@ -44,7 +44,7 @@ void addModelCommands(CLI::App& app) {
             const ArmSetup setup = loadModel(*name);
             const ElbowReference ref = reference->empty() ? loadDefaultElbowReference() : loadElbowReference(*reference);
             const ModelReportFiles r = writeModelReport(setup, *out, *step, ref);
-            const Table t = calcMuscleTable(setup);
+            const Table& t = r.muscles;
             std::printf("model %s: %s\n%-9s %-8s %8s %7s %7s %7s %6s  calibration k f t\n", setup.name.c_str(),
                         setup.description.c_str(), "muscle", "group", "F0 (N)", "L0 (m)", "L0T (m)", "M (kg)", "slow");
             for (int i = 0; i < t.getNumRows(); ++i) {

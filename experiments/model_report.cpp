@@ -32,7 +32,7 @@ std::vector<MvcTorqueReference> readMvcReferences(const ParamNode& root, const s
 std::vector<double> calcAngles(const ArmSetup& setup, double stepDeg) {
     if (!(stepDeg > 0 && stepDeg <= 90))
         throw InputError("angle step = " + formatNumber(stepDeg) + " deg: expected in (0, 90]");
-    const double lo = 180.0 - setup.arm.maxElbowAngleDeg, hi = 180.0 - setup.arm.minElbowAngleDeg;
+    const double lo = setup.arm.getMinFlexionDeg(), hi = setup.arm.getMaxFlexionDeg();
     std::vector<double> q;
     for (int k = 0; lo + k * stepDeg < hi - 1e-9; ++k) q.push_back(lo + k * stepDeg);
     q.push_back(hi);
@@ -67,10 +67,8 @@ ElbowReference loadElbowReference(const std::string& path) {
             n.finish();
             ref.momentArms.push_back(r);
         }
-    if (root.has("peak_moment_arms")) root.children("peak_moment_arms");  // informative, not plotted
     ref.mvcFlexion = readMvcReferences(root, "mvc_flexion");
     ref.mvcExtension = readMvcReferences(root, "mvc_extension");
-    root.getString("source", "");
     return ref;
 }
 
@@ -104,9 +102,11 @@ Table calcMomentArmTable(const ArmSetup& setup, double stepDeg) {
     ArmGeometry g(setup);
     for (double q : calcAngles(setup, stepDeg)) {
         g.setElbowAngle(elbowAngleFromFlexion(degToRad(q)));
+        std::vector<PathGeometry> paths;
+        for (int i = 0; i < g.getNumMuscles(); ++i) paths.push_back(g.calcPathGeometry(i));
         std::vector<double> row = {q, 180.0 - q};
-        for (int i = 0; i < g.getNumMuscles(); ++i) row.push_back(g.calcPathLength(i));
-        for (int i = 0; i < g.getNumMuscles(); ++i) row.push_back(g.calcMomentArm(i));
+        for (const PathGeometry& p : paths) row.push_back(p.length);
+        for (const PathGeometry& p : paths) row.push_back(g.calcMomentArm(p));
         t.appendRow(row);
     }
     return t;
@@ -146,7 +146,7 @@ MvcCurveSummary summarizeMvcCurve(const SteadyMvcCurve& curve) {
         const double b = (x2 * x2 * (y0 - y1) + x1 * x1 * (y2 - y0) + x0 * x0 * (y1 - y2)) / d;
         if (a < 0) {
             s.peakFlexionDeg = -b / (2 * a);
-            s.peakTorque = y1 + a * (s.peakFlexionDeg - x1) * (s.peakFlexionDeg - x1) + (b + 2 * a * x1) * (s.peakFlexionDeg - x1);
+            s.peakTorque = y1 - a * (s.peakFlexionDeg - x1) * (s.peakFlexionDeg - x1);  // y' = 0 at the vertex
         }
     }
     s.torqueAt90 = interpolate(curve.flexionDeg, mag, 90.0);
@@ -160,7 +160,8 @@ ModelReportFiles writeModelReport(const ArmSetup& setup, const std::string& outD
     ModelReportFiles out;
     auto path = [&](const std::string& f) { return (fs::path(outDir) / f).string(); };
 
-    const Table muscles = calcMuscleTable(setup);
+    out.muscles = calcMuscleTable(setup);
+    const Table& muscles = out.muscles;
     std::string text = "muscle";
     for (const std::string& c : muscles.getColumnNames()) text += "," + c;
     text += "\n";

@@ -63,6 +63,7 @@ MvcCurveSummary summarizeMvcCurve(const SteadyMvcCurve& curve);
 /// What writeModelReport wrote.
 struct ModelReportFiles {
     std::vector<std::string> files;
+    Table muscles;                 ///< calcMuscleTable(setup), as written to muscles.csv
     MvcCurveSummary flexion, extension;
     double primaryShareAt90 = 0;   ///< primary muscle's share of the flexors' torque at 90 deg
 };

@@ -49,18 +49,24 @@ struct CalibrationProblem {
     bool operator()(double const* const* x, double* r) const {
         try {
             const ArmSetup s = applyCalibration(*setup, calcCalibration(x[0]));
-            const SteadyMvcCurve c = calcSteadyMvcCurve(s, target->effort, s.effort, target->flexionDeg);
-            for (MuscleGroup g : {MuscleGroup::Flexor, MuscleGroup::Extensor})
-                calcSteadyMvcCurve(s, g, s.effort, options->feasibilityDeg);
-            const SteadyMvcCurve mid = calcSteadyMvcCurve(s, target->effort, s.effort, {options->midRangeDeg});
+            // One curve of the target's effort: the target angles, the mid-range angle, the feasibility
+            // angles; the other effort only needs to be feasible.
+            const std::size_t numTarget = target->flexionDeg.size();
+            std::vector<double> angles = target->flexionDeg;
+            angles.push_back(options->midRangeDeg);
+            angles.insert(angles.end(), options->feasibilityDeg.begin(), options->feasibilityDeg.end());
+            const SteadyMvcCurve c = calcSteadyMvcCurve(s, target->effort, s.effort, angles);
+            const MuscleGroup other = target->effort == MuscleGroup::Flexor ? MuscleGroup::Extensor : MuscleGroup::Flexor;
+            calcSteadyMvcCurve(s, other, s.effort, options->feasibilityDeg);
+            const std::vector<SteadyMusclePoint>& mid = c.points[numTarget];
             int k = 0;
-            for (std::size_t a = 0; a < c.totalTorque.size(); ++a)
+            for (std::size_t a = 0; a < numTarget; ++a)
                 r[k++] = (c.totalTorque[a] - target->torque[a]) / options->torqueScale;
             const int n = int(members.size());
             for (int j = 0; j < n; ++j) r[k++] = options->regularization * std::log(x[0][j]);
             r[k++] = options->regularization * std::log(x[0][n]);
             for (int j = 0; j < n; ++j) {
-                const double excess = std::abs(mid.points[0][members[j]].fibreLength - 1.0) - options->midRangeTolerance;
+                const double excess = std::abs(mid[members[j]].fibreLength - 1.0) - options->midRangeTolerance;
                 r[k++] = options->midRangeWeight * std::max(0.0, excess);
             }
             return true;
@@ -85,15 +91,6 @@ MvcTorqueTarget getElbowExtensionTarget() {
     return t;
 }
 
-ArmSetup applyCalibration(const ArmSetup& setup, const std::vector<MuscleCalibration>& calibration) {
-    if (calibration.size() != setup.muscles.size())
-        throw std::logic_error("applyCalibration: " + std::to_string(calibration.size()) + " calibrations for " +
-                               std::to_string(setup.muscles.size()) + " muscles");
-    ArmSetup s = setup;
-    for (std::size_t i = 0; i < s.muscles.size(); ++i) s.muscles[i].setCalibration(calibration[i]);
-    return s;
-}
-
 StrengthCalibrationResult calibrateStrength(const ArmSetup& setup, const MvcTorqueTarget& target,
                                             const StrengthCalibrationOptions& options) {
     if (target.flexionDeg.empty() || target.flexionDeg.size() != target.torque.size())
@@ -102,7 +99,7 @@ StrengthCalibrationResult calibrateStrength(const ArmSetup& setup, const MvcTorq
                          std::to_string(target.torque.size()) + " torques)");
     StrengthCalibrationOptions opts = options;
     if (opts.feasibilityDeg.empty())
-        opts.feasibilityDeg = {180.0 - setup.arm.maxElbowAngleDeg, 180.0 - setup.arm.minElbowAngleDeg};
+        opts.feasibilityDeg = {setup.arm.getMinFlexionDeg(), setup.arm.getMaxFlexionDeg()};
     CalibrationProblem problem{&setup, &target, &opts, {}};
     for (int i = 0; i < setup.getNumMuscles(); ++i)
         if (setup.muscles[i].group == target.effort) problem.members.push_back(i);

@@ -67,7 +67,4 @@ struct StrengthCalibrationResult {
 StrengthCalibrationResult calibrateStrength(const ArmSetup& setup, const MvcTorqueTarget& target,
                                             const StrengthCalibrationOptions& options = {});
 
-/// The model with calibration applied (P_max re-resolved where it comes from the range).
-ArmSetup applyCalibration(const ArmSetup& setup, const std::vector<MuscleCalibration>& calibration);
-
 }  // namespace armsim

@@ -57,6 +57,9 @@ struct ArmParameters {
     double gravity = 9.80665;  ///< [m/s^2] magnitude of gravity, along -Y; standard gravity
     double handLoad = 0;       ///< [kg] point mass held in the hand, at the hand COM; 0 = none
 
+    /// The elbow's range as flexion angles (0 = straight) [deg].
+    double getMinFlexionDeg() const { return 180.0 - maxElbowAngleDeg; }
+    double getMaxFlexionDeg() const { return 180.0 - minElbowAngleDeg; }
     /// Mass of the forearm + hand body without handLoad [kg].
     double calcForearmHandMass() const { return forearmHandMassFraction * bodyMass; }
     /// Mass of the upper arm [kg].

@@ -78,7 +78,7 @@ PathElementSpec readPoint(const ParamNode& n, const std::string& label) {
 PathElementSpec readViaElement(const ParamNode& n, int index) {
     const bool cylinder = n.has("cylinder"), sphere = n.has("sphere");
     if (!cylinder && !sphere) return readPoint(n, "via " + std::to_string(index + 1));
-    if (cylinder && sphere || n.has("location"))
+    if ((cylinder && sphere) || n.has("location"))
         throw InputError(n.where() + ": via element '" + n.path("") +
                          "' must be one of: a point (location), a cylinder or a sphere");
     PathElementSpec e;
@@ -110,13 +110,7 @@ MuscleSpec readMuscle(const ParamNode& n) {
                                                                                 : MuscleGroup::Extensor;
     const bool fromFile = n.has("parameters");
     if (fromFile) {
-        std::string file = n.getString("parameters");
-        const std::string relative = n.getDirectory().empty() ? file : n.getDirectory() + "/" + file;
-        if (std::filesystem::exists(relative)) file = relative;
-        else if (!std::filesystem::exists(file))
-            throw InputError(n.where("parameters") + ": field '" + n.path("parameters") + "' = '" + file +
-                             "': no such muscle file (relative paths are taken from the model file's directory)");
-        m.params = loadMuscleParameters(file);
+        m.params = loadMuscleParameters(n.findFile("parameters", "muscle file"));
     } else {
         auto require = [&](const char* key, const char* alternative) {
             if (n.has(key) || (alternative && n.has(alternative))) return;
@@ -194,6 +188,15 @@ void MuscleSpec::setCalibration(const MuscleCalibration& c) {
     params.optimalTendonLength *= c.tendonLengthScale;
 }
 
+ArmSetup applyCalibration(const ArmSetup& setup, const std::vector<MuscleCalibration>& calibration) {
+    if (calibration.size() != setup.muscles.size())
+        throw std::logic_error("applyCalibration: " + std::to_string(calibration.size()) + " calibrations for " +
+                               std::to_string(setup.muscles.size()) + " muscles");
+    ArmSetup s = setup;
+    for (std::size_t i = 0; i < s.muscles.size(); ++i) s.muscles[i].setCalibration(calibration[i]);
+    return s;
+}
+
 std::vector<std::string> listModels() {
     std::vector<std::string> names;
     const std::filesystem::path dir = std::filesystem::path(getAssetDirectory()) / "models";
@@ -235,14 +238,7 @@ ArmSetup loadModel(const std::string& nameOrFile) {
         hasBiceps = readArmParameters(arm, s.arm, false);
         arm.finish();
     } else {
-        std::string armFile = root.getString("arm");
-        const std::string relative = root.getDirectory().empty() ? armFile : root.getDirectory() + "/" + armFile;
-        if (std::filesystem::exists(relative)) armFile = relative;
-        else if (!std::filesystem::exists(armFile) &&
-                 !std::filesystem::exists(getAssetDirectory() + "/" + armFile))
-            throw InputError(root.where("arm") + ": field 'arm' = '" + armFile +
-                             "': no such arm file (relative to the model file or to " + getAssetDirectory() + ")");
-        s.arm = loadArmParameters(findAsset(armFile));
+        s.arm = loadArmParameters(root.findFile("arm", "arm file", getAssetDirectory()));
         hasBiceps = true;
     }
 

@@ -119,6 +119,10 @@ struct ArmSetup {
     static ArmSetup loadDefault();
 };
 
+/// The model with calibration[i] applied to muscle i (MuscleSpec::setCalibration; P_max, a geometric
+/// limit, is kept). Throws std::logic_error unless there is one calibration per muscle.
+ArmSetup applyCalibration(const ArmSetup& setup, const std::vector<MuscleCalibration>& calibration);
+
 /// Loads a model: a name under assets/models/ ("thesis", "elbow") or a file path. Every error names
 /// the file, line, key and value. P_max of muscles with `max_path_length: range` is resolved
 /// (model/muscle_arm.h: resolveMaxPathLengths).

@@ -128,10 +128,10 @@ void ArmGeometry::setElbowAngle(double theta) {
     arm_.getSystem().realize(state_, Stage::Position);
 }
 
-double ArmGeometry::calcPathLength(int i) const { return paths_.at(i).calcGeometry(state_, names_.at(i)).length; }
+PathGeometry ArmGeometry::calcPathGeometry(int i) const { return paths_.at(i).calcGeometry(state_, names_.at(i)); }
 
-double ArmGeometry::calcMomentArm(int i) const {
-    return calcPathMomentArm(arm_.getMatter(), arm_.getForearm(), state_, paths_.at(i).calcGeometry(state_, names_.at(i)));
+double ArmGeometry::calcMomentArm(const PathGeometry& g) const {
+    return calcPathMomentArm(arm_.getMatter(), arm_.getForearm(), state_, g);
 }
 
 void resolveMaxPathLengths(ArmSetup& setup) {

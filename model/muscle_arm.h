@@ -77,10 +77,13 @@ public:
     int getNumMuscles() const { return int(paths_.size()); }
     /// Sets the elbow to theta (included angle, rad) and realizes positions.
     void setElbowAngle(double theta);
+    /// Path geometry of muscle i at the present angle (length, unit-tension loads).
+    PathGeometry calcPathGeometry(int i) const;
     /// Path length of muscle i at the present angle [m].
-    double calcPathLength(int i) const;
-    /// Moment arm by virtual work [m] (as MuscleArm::calcMomentArm).
-    double calcMomentArm(int i) const;
+    double calcPathLength(int i) const { return calcPathGeometry(i).length; }
+    /// Moment arm by virtual work [m] (as MuscleArm::calcMomentArm) of a path geometry at the present angle.
+    double calcMomentArm(const PathGeometry& g) const;
+    double calcMomentArm(int i) const { return calcMomentArm(calcPathGeometry(i)); }
     const ArmModel& getArm() const { return arm_; }
     const SimTK::State& getState() const { return state_; }
     const MusclePath& getPath(int i) const { return paths_.at(i); }

@@ -5,7 +5,6 @@
 #include "muscles/param_file.h"
 
 #include <cmath>
-#include <memory>
 
 namespace armsim {
 
@@ -29,7 +28,7 @@ SteadyMvcCurve calcSteadyMvcCurve(const ArmSetup& setup, MuscleGroup effort, con
         muscles.emplace_back(setup.calcMuscleParameters(i));
         curve.muscles.push_back(setup.muscles[i].params.name);
     }
-    const double lo = 180.0 - setup.arm.maxElbowAngleDeg, hi = 180.0 - setup.arm.minElbowAngleDeg;
+    const double lo = setup.arm.getMinFlexionDeg(), hi = setup.arm.getMaxFlexionDeg();
     for (double q : flexionDeg) {
         if (!(q >= lo - 1e-9 && q <= hi + 1e-9))
             throw InputError("flexion angle " + formatNumber(q) + " deg is outside the elbow's range [" +
@@ -39,8 +38,9 @@ SteadyMvcCurve calcSteadyMvcCurve(const ArmSetup& setup, MuscleGroup effort, con
         double total = 0;
         for (int i = 0; i < setup.getNumMuscles(); ++i) {
             SteadyMusclePoint p;
-            p.pathLength = geometry.calcPathLength(i);
-            p.momentArm = geometry.calcMomentArm(i);
+            const PathGeometry path = geometry.calcPathGeometry(i);
+            p.pathLength = path.length;
+            p.momentArm = geometry.calcMomentArm(path);
             p.activation = setup.muscles[i].group == effort ? subject.voluntaryActivation : subject.coContraction;
             const SteadyState st = muscles[i].calcSteadyState(p.pathLength, p.activation);
             if (!st.converged)

@@ -44,11 +44,11 @@ struct IsometricTrialSettings {
     double holdDuration = 3.0;     ///< time at the target [s] (thesis: 3 s efforts)
     double sampleRate = 1000.0;    ///< output rate [Hz] (thesis: 1000 Hz)
     double averagingWindow = 1.0;  ///< end of the hold averaged for the summary [s]
-    /// How the holding torque is read. false (default): findMotionForces at every integrator step;
-    /// a sample between two steps takes the torque interpolated linearly in the muscle force, which is
-    /// exact for a locked elbow (gravity and the stop are constant there, so the lock's torque is
-    /// affine in Fse). true: realize every sample and call findMotionForces on it (3x slower; the
-    /// reference the tests compare the default with).
+    /// How the holding torque is read. false (default): the torque at rest (findMotionForces) less
+    /// sum_i h_i (F_i - F_i,rest) with every muscle's force from its interpolated states, which is
+    /// exact for a locked elbow (gravity, the stop and the moment arms are constant there). true:
+    /// realize every sample and call findMotionForces on it (3x slower; the reference the tests
+    /// compare the default with).
     bool realizeEverySample = false;
     IntegrationSettings integration;
 

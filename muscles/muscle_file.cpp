@@ -93,21 +93,15 @@ void readMuscleFields(const ParamNode& root, MuscleParameters& p, bool required)
     auto number = [&](const std::string& key, double& field) {
         if (required || root.has(key)) field = root.getNumber(key, any);
     };
-    if (root.has("max_isometric_force")) {
-        if (root.has("mass"))
-            throw InputError(root.where("max_isometric_force") +
-                             ": give either 'mass' or 'max_isometric_force', not both");
-    } else {
-        number("mass", p.mass);
-    }
+    // A field or the OpenSim quantity it is converted from (below), not both.
+    auto numberOrConverted = [&](const std::string& key, const std::string& converted, double& field) {
+        if (!root.has(converted)) return number(key, field);
+        if (root.has(key))
+            throw InputError(root.where(converted) + ": give either '" + key + "' or '" + converted + "', not both");
+    };
+    numberOrConverted("mass", "max_isometric_force", p.mass);
     number("optimal_fascicle_length", p.optimalFascicleLength);
-    if (root.has("tendon_slack_length")) {
-        if (root.has("optimal_tendon_length"))
-            throw InputError(root.where("tendon_slack_length") +
-                             ": give either 'optimal_tendon_length' or 'tendon_slack_length', not both");
-    } else {
-        number("optimal_tendon_length", p.optimalTendonLength);
-    }
+    numberOrConverted("optimal_tendon_length", "tendon_slack_length", p.optimalTendonLength);
     if (root.has("max_path_length") || required) number("max_path_length", p.maxPathLength);
     root.getNumber("pennation_angle", Bound{0, 1.5707963267948966, false, true, "rad, informative only"}, 0.0);
 
@@ -130,13 +124,7 @@ void readMuscleFields(const ParamNode& root, MuscleParameters& p, bool required)
         mu.finish();
     }
     if (required || root.has("fibre_types")) {
-        std::string typesFile = root.getString("fibre_types");
-        const std::string relative =
-            root.getDirectory().empty() ? typesFile : root.getDirectory() + "/" + typesFile;
-        if (std::filesystem::exists(relative)) typesFile = relative;
-        else if (!std::filesystem::exists(typesFile))
-            throw InputError(root.where("fibre_types") + ": field '" + root.path("fibre_types") + "' = '" +
-                             typesFile + "': no such file (relative paths are taken from the file's directory)");
+        const std::string typesFile = root.findFile("fibre_types", "fibre-type file");
         loadFibreTypes(typesFile, p.slow, p.fast, p.coefficients);
     }
     // Conversions need the coefficients (sigma, rho, LrT), so they come last.

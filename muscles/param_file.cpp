@@ -89,6 +89,20 @@ std::string ParamNode::getDirectory() const {
     return std::filesystem::path(impl_->source).parent_path().string();
 }
 
+std::string ParamNode::findFile(const std::string& key, const std::string& what,
+                                const std::string& fallbackDirectory) const {
+    const std::string file = getString(key);
+    const std::string dir = getDirectory();
+    const std::string relative = dir.empty() ? file : dir + "/" + file;
+    if (std::filesystem::exists(relative)) return relative;
+    if (std::filesystem::exists(file)) return file;
+    if (!fallbackDirectory.empty() && std::filesystem::exists(fallbackDirectory + "/" + file))
+        return fallbackDirectory + "/" + file;
+    throw InputError(where(key) + ": field '" + path(key) + "' = '" + file + "': no such " + what +
+                     " (relative paths are taken from the file's directory" +
+                     (fallbackDirectory.empty() ? std::string() : " or " + fallbackDirectory) + ")");
+}
+
 std::string ParamNode::path(const std::string& key) const {
     if (impl_->prefix.empty()) return key;
     if (key.empty()) return impl_->prefix;

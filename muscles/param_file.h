@@ -108,6 +108,11 @@ public:
     const std::string& getSourceName() const;
     /// Directory of the source file, for resolving relative references.
     std::string getDirectory() const;
+    /// The file named by the string under key: relative to this file's directory, else as given (from
+    /// the working directory), else under fallbackDirectory when one is given. Throws InputError naming
+    /// file, line, key and value, calling the missing file `what` ("muscle file").
+    std::string findFile(const std::string& key, const std::string& what,
+                         const std::string& fallbackDirectory = "") const;
 
     /// Runs f (which may throw FieldError for field "x.y") and rethrows with the file and line of
     /// the key the field came from. fieldPrefix is prepended to FieldError fields before lookup.

@@ -39,8 +39,7 @@ void checkFinite(const State& s) {
 IntegrationStats simulateSampled(const MultibodySystem& system, State& state, double duration, double sampleRate,
                                  const std::vector<double>& breakpoints, const IntegrationSettings& settings,
                                  const std::function<void(const State&)>& sample,
-                                 const std::function<void(const State&)>& check,
-                                 const std::function<void(const State&)>& onStep) {
+                                 const std::function<void(const State&)>& check) {
     settings.validate();
     checkField("duration", duration, Bound::nonNegative("s"));
     checkField("sample_rate", sampleRate, Bound::positive("Hz"));
@@ -106,7 +105,6 @@ IntegrationStats simulateSampled(const MultibodySystem& system, State& state, do
     if (check) check(state);
     checkFinite(state);
     system.realize(state, Stage::Acceleration);
-    if (onStep) onStep(state);
     sample(state);
     long next = 1;
     for (double segmentEnd : cuts) {
@@ -114,7 +112,6 @@ IntegrationStats simulateSampled(const MultibodySystem& system, State& state, do
         ++stats.restarts;
         const State& a = integ.getState();
         system.realize(a, Stage::Acceleration);
-        if (onStep) onStep(a);
         ta = a.getTime();
         ya = a.getY();
         yda = a.getYDot();
@@ -142,7 +139,6 @@ IntegrationStats simulateSampled(const MultibodySystem& system, State& state, do
             if (check) check(b);  // element-specific checks first: they name the muscle and state
             checkFinite(b);
             system.realize(b, Stage::Acceleration);
-            if (onStep) onStep(b);
             yb = b.getY();
             ydb = b.getYDot();
             const bool atBreakpoint = b.getTime() >= segmentEnd - eps && segmentEnd < tEnd;

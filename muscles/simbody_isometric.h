@@ -34,16 +34,12 @@ struct IntegrationStats {
 ///   as a step in activation), so a step never smears across an error-controlled step;
 /// - check(state) runs after every internal step (step boundaries): it throws SimulationError to stop
 ///   a run that left the model's validity range; every q, u and z is checked for NaN here too.
-/// - onStep(state), if given, sees every step-end state (and each segment's start), realized to
-///   Stage::Acceleration, before the samples it closes: measurements too costly for every sample can
-///   be taken there and interpolated.
 /// Throws SimulationError naming the time when the integrator fails.
 IntegrationStats simulateSampled(const SimTK::MultibodySystem& system, SimTK::State& state, double duration,
                                  double sampleRate, const std::vector<double>& breakpoints,
                                  const IntegrationSettings& settings,
                                  const std::function<void(const SimTK::State&)>& sample,
-                                 const std::function<void(const SimTK::State&)>& check = {},
-                                 const std::function<void(const SimTK::State&)>& onStep = {});
+                                 const std::function<void(const SimTK::State&)>& check = {});
 
 /// A muscle-only isometric trial: the path held at a constant length.
 struct MuscleIsometricSettings {
