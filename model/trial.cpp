@@ -139,51 +139,85 @@ IsometricTrialResult runIsometricTrial(const ArmSetup& setup, const IsometricTri
          "fascicle_velocity_mps", "holding_torque_Nm", "muscle_torque_Nm", "strap_force_N", "saturated",
          "force_moment_arm_N", "force_fixed_ratio_N", "error_moment_arm_pct", "error_fixed_ratio_pct"},
         model));
+    result.series.reserveRows(int(std::lround(settings.getDuration() * settings.sampleRate)) + 1);
     const double h = sum.momentArm;
     const double L0 = model.getMuscle(primary).getParameters().optimalFascicleLength;
     std::vector<const VirtualMuscle*> muscles;
-    for (int i = 0; i < n; ++i) muscles.push_back(&model.getMuscle(i));
-    std::vector<double> forces(n);
+    std::vector<const ActivationProfile*> activations;
+    for (int i = 0; i < n; ++i) {
+        muscles.push_back(&model.getMuscle(i));
+        activations.push_back(&model.getMuscleForce(i).getActivationProfile());
+    }
+    // Where each muscle's states sit in y = [q u z].
+    const int nqu = state.getNQ() + state.getNU();
     std::vector<int> firstState(n);
-    for (int i = 0, at = 0; i < n; at += muscles[i]->getNumStates(), ++i) firstState[i] = at;
+    int numMuscleStates = 0;
+    for (int i = 0; i < n; ++i) {
+        firstState[i] = nqu + model.getMuscleForce(i).getFirstStateIndex(state);
+        numMuscleStates += muscles[i]->getNumStates();
+    }
+    if (numMuscleStates != state.getNZ())
+        throw std::logic_error("runIsometricTrial: the arm has z states that belong to no muscle");
+    std::vector<double> forces(n), row;
 
-    sum.stats = simulateSampled(
-        system, state, settings.getDuration(), settings.sampleRate, profile.getBreakpoints(), settings.integration,
-        [&](const State& s) {
-            const double t = s.getTime();
-            std::vector<double> y;
-            model.appendMuscleStates(s, y);  // the states, in column order
-            double torque;
-            if (settings.realizeEverySample) {
-                system.realize(s, Stage::Acceleration);
-                for (int i = 0; i < n; ++i) forces[i] = model.getMuscleForce(i).getForce(s);
-                torque = arm.calcHoldingTorque(s);
-            } else {  // the paths are fixed: the pure model gives Fse from the interpolated states
-                torque = G;
-                for (int i = 0; i < n; ++i) {
-                    forces[i] = muscles[i]->calcForce(sum.pathLengths[i], y.data() + firstState[i]);
-                    torque -= sum.momentArms[i] * forces[i];
-                }
+    // One sample from y = [q u z]; s is the realized-per-sample reference's State (else null).
+    auto sample = [&](double t, const double* y, const State* s) {
+        double torque;
+        if (s) {
+            system.realize(*s, Stage::Acceleration);
+            for (int i = 0; i < n; ++i) forces[i] = model.getMuscleForce(i).getForce(*s);
+            torque = arm.calcHoldingTorque(*s);
+        } else {  // the paths are fixed: the pure model gives Fse from the interpolated states
+            torque = G;
+            for (int i = 0; i < n; ++i) {
+                forces[i] = muscles[i]->calcForce(sum.pathLengths[i], y + firstState[i]);
+                torque -= sum.momentArms[i] * forces[i];
             }
-            const double F = forces[primary];
-            const double muscleTorque = sum.tareTorque - torque;  // tared, + = flexion
-            double strap = muscleTorque / ap.strapDistance;          // perpendicular strap at d1
-            const bool saturated = std::abs(strap) > ap.transducerRange;
-            if (saturated) strap = std::copysign(ap.transducerRange, strap);
-            sum.saturated = sum.saturated || saturated;
-            const double byMomentArm = calcBicepsForceFromTorque(strap * ap.strapDistance, h);
-            const double byFixedRatio = calcBicepsForceFixedRatio(strap, settings.elbowAngle, kPi / 2);
-            auto pct = [F](double estimate) { return F > 0 ? 100 * (estimate - F) / F : NAN; };
-            const double* yp = y.data() + firstState[primary];
-            std::vector<double> row{t, profile.getValue(t), radToDeg(settings.elbowAngle), 0.0, F,
-                   yp[VirtualMuscle::kL] * L0, yp[VirtualMuscle::kV] * L0, torque, muscleTorque,
-                   strap, saturated ? 1.0 : 0.0, byMomentArm, byFixedRatio, pct(byMomentArm),
-                   pct(byFixedRatio)};
-            appendMuscleForces(row, model, forces, t);
-            row.insert(row.end(), y.begin(), y.end());
-            result.series.appendRow(std::move(row));
-        },
-        [&](const State& s) { model.checkMuscleStates(s); });
+        }
+        const double F = forces[primary];
+        const double muscleTorque = sum.tareTorque - torque;  // tared, + = flexion
+        double strap = muscleTorque / ap.strapDistance;          // perpendicular strap at d1
+        const bool saturated = std::abs(strap) > ap.transducerRange;
+        if (saturated) strap = std::copysign(ap.transducerRange, strap);
+        sum.saturated = sum.saturated || saturated;
+        const double byMomentArm = calcBicepsForceFromTorque(strap * ap.strapDistance, h);
+        const double byFixedRatio = calcBicepsForceFixedRatio(strap, settings.elbowAngle, kPi / 2);
+        auto pct = [F](double estimate) { return F > 0 ? 100 * (estimate - F) / F : NAN; };
+        const double* yp = y + firstState[primary];
+        row.assign({t, profile.getValue(t), radToDeg(settings.elbowAngle), 0.0, F, yp[VirtualMuscle::kL] * L0,
+                    yp[VirtualMuscle::kV] * L0, torque, muscleTorque, strap, saturated ? 1.0 : 0.0, byMomentArm,
+                    byFixedRatio, pct(byMomentArm), pct(byFixedRatio)});
+        appendMuscleForces(row, model, forces, t);
+        for (int i = 0; i < n; ++i) row.insert(row.end(), y + firstState[i], y + firstState[i] + muscles[i]->getNumStates());
+        result.series.appendRow(row);
+    };
+
+    if (settings.solver == TrialSolver::LockedOde) {
+        // The locked arm's ODE on Simbody's own state vector: q' = u = 0 and u' = 0 (locked), each
+        // muscle's z' from its pure model at its fixed path length and its own activation.
+        std::vector<double> y(state.getNY());
+        for (int i = 0; i < state.getNY(); ++i) y[i] = state.getY()[i];
+        const std::vector<double>& P = sum.pathLengths;
+        const OdeRhs f = [&](double t, const double* yIn, double* ydot) {
+            std::fill(ydot, ydot + nqu, 0.0);
+            for (int i = 0; i < n; ++i)
+                muscles[i]->calcStateDerivative(P[i], activations[i]->getValue(t), yIn + firstState[i],
+                                                ydot + firstState[i]);
+        };
+        sum.stats = integrateSampled(
+            f, state.getTime(), y, settings.getDuration(), settings.sampleRate, profile.getBreakpoints(),
+            settings.integration, [&](double t, const double* yIn) { sample(t, yIn, nullptr); },
+            [&](double t, const double* yIn) {
+                for (int i = 0; i < n; ++i) muscles[i]->checkStates(t, yIn + firstState[i]);
+            });
+    } else {
+        const bool perSample = settings.solver == TrialSolver::SimbodyPerSample;
+        sum.stats = simulateSampled(
+            system, state, settings.getDuration(), settings.sampleRate, profile.getBreakpoints(),
+            settings.integration,
+            [&](const State& s) { sample(s.getTime(), &s.getY()[0], perSample ? &s : nullptr); },
+            [&](const State& s) { model.checkMuscleStates(s); });
+    }
 
     const Table& t = result.series;
     const std::vector<double> time = t.getColumn("time_s");

@@ -111,6 +111,10 @@ std::vector<double> VirtualMuscleForce::getMuscleStates(const State& s) const {
     return std::vector<double>(z, z + getMuscle().getNumStates());
 }
 
+int VirtualMuscleForce::getFirstStateIndex(const State& s) const {
+    return int(s.getZStart(getImpl().forces_)) + int(getImpl().firstZ_);
+}
+
 void VirtualMuscleForce::setMuscleStates(State& s, const std::vector<double>& y) const {
     SimTK_APIARGCHECK_ALWAYS(int(y.size()) == getMuscle().getNumStates(), "VirtualMuscleForce",
                              "setMuscleStates", "wrong number of muscle states");
@@ -133,23 +137,7 @@ void VirtualMuscleForce::setSteadyMuscleStates(State& s) const {
 }
 
 void VirtualMuscleForce::checkMuscleStates(const State& s) const {
-    const VirtualMuscle& m = getMuscle();
-    const double* z = getImpl().z(s);
-    for (int i = 0; i < m.getNumStates(); ++i)
-        if (!std::isfinite(z[i])) {
-            std::ostringstream msg;
-            msg << "t = " << s.getTime() << " s: muscle '" << m.getParameters().name << "' state "
-                << m.getStateNames()[i] << " is " << z[i] << " (not finite)";
-            throw SimulationError(msg.str());
-        }
-    const double L = z[VirtualMuscle::kL];
-    if (!(L > 0) || !(L < m.getNfLimit())) {
-        std::ostringstream msg;
-        msg << "t = " << s.getTime() << " s: muscle '" << m.getParameters().name << "' fascicle length L = " << L
-            << " L0 left the model's range (0, " << m.getNfLimit()
-            << ") L0; beyond it the activation-frequency exponent nf is not positive (spec 4)";
-        throw SimulationError(msg.str());
-    }
+    getMuscle().checkStates(s.getTime(), getImpl().z(s));
 }
 
 Vec3 VirtualMuscleForce::calcActivationColor(double a) {

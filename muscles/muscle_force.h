@@ -52,6 +52,8 @@ public:
 
     /// The muscle's slice of the state vector.
     std::vector<double> getMuscleStates(const SimTK::State& s) const;
+    /// Where the muscle's states start in s.getZ() (after realizeTopology).
+    int getFirstStateIndex(const SimTK::State& s) const;
     void setMuscleStates(SimTK::State& s, const std::vector<double>& y) const;
     /// Sets the spec-5 initial state for the current path length (Stage::Position realized here).
     void setInitialMuscleStates(SimTK::State& s) const;

@@ -12,11 +12,6 @@ using namespace SimTK;
 
 namespace armsim {
 
-void IntegrationSettings::validate() const {
-    checkField("accuracy", accuracy, Bound::open(0, 1));
-    checkField("max_step", maxStepSize, Bound::nonNegative("s"));
-}
-
 namespace {
 
 void checkFinite(const State& s) {
@@ -43,20 +38,11 @@ IntegrationStats simulateSampled(const MultibodySystem& system, State& state, do
     settings.validate();
     checkField("duration", duration, Bound::nonNegative("s"));
     checkField("sample_rate", sampleRate, Bound::positive("Hz"));
-    const double t0 = state.getTime(), tEnd = t0 + duration;
-    const long numSamples = std::lround(duration * sampleRate) + 1;
-    auto sampleTime = [&](long k) { return t0 + double(k) / sampleRate; };
-    const double eps = 1e-9 / sampleRate;
-
-    std::vector<double> cuts;
-    for (double b : breakpoints)
-        if (b > t0 + eps && b < tEnd - eps) cuts.push_back(b);
-    std::sort(cuts.begin(), cuts.end());
-    cuts.erase(std::unique(cuts.begin(), cuts.end()), cuts.end());
-    cuts.push_back(tEnd);
+    detail::SampledRun run(state.getTime(), duration, sampleRate, breakpoints, state.getNY());
 
     CPodesIntegrator integ(system, CPodes::BDF, CPodes::Newton);
     integ.setAccuracy(settings.accuracy);
+    integ.setMinimumStepSize(IntegrationSettings::kMinStepSize);
     if (settings.maxStepSize > 0) integ.setMaximumStepSize(settings.maxStepSize);
     integ.setReturnEveryInternalStep(true);
     integ.setProjectEveryStep(false);
@@ -65,40 +51,21 @@ IntegrationStats simulateSampled(const MultibodySystem& system, State& state, do
     // one scratch State: asking Simbody for interpolated reports copies a whole State per sample,
     // which costs more than the integration itself.
     State scratch = state;
-    Vector ya, yda, yb, ydb, y(state.getNY());
-    double ta = t0;
-    auto emitUpTo = [&](long& next, double tb, bool endSlopeValid) {
-        const double h = tb - ta;
-        while (next < numSamples && sampleTime(next) <= tb + eps) {
-            const double t = std::min(sampleTime(next), tb);
-            const double s = h > 0 ? (t - ta) / h : 1.0;
-            double c0, c1, c2, c3;  // weights of ya, h*yda, yb, h*ydb
-            if (endSlopeValid) {
-                c0 = (1 + 2 * s) * (1 - s) * (1 - s);
-                c1 = s * (1 - s) * (1 - s);
-                c2 = s * s * (3 - 2 * s);
-                c3 = s * s * (s - 1);
-            } else {  // quadratic through (ta, ya, yda) and (tb, yb): the end slope jumps at a breakpoint
-                c0 = 1 - s * s;
-                c1 = s * (1 - s);
-                c2 = s * s;
-                c3 = 0;
-            }
-            for (int i = 0; i < y.size(); ++i)
-                y[i] = c0 * ya[i] + c1 * h * yda[i] + c2 * yb[i] + c3 * h * ydb[i];
-            scratch.setTime(t);
-            // Write q and u only when they moved (a locked joint keeps them), so the scratch state
-            // keeps its position-level cache and a sample costs less to realize.
-            const int nq = scratch.getNQ(), nu = scratch.getNU(), nz = scratch.getNZ();
-            bool qMoved = false, uMoved = false;
-            for (int i = 0; i < nq; ++i) qMoved = qMoved || y[i] != scratch.getQ()[i];
-            for (int i = 0; i < nu; ++i) uMoved = uMoved || y[nq + i] != scratch.getU()[i];
-            if (qMoved) scratch.updQ() = y(0, nq);
-            if (uMoved) scratch.updU() = y(nq, nu);
-            scratch.updZ() = y(nq + nu, nz);
-            sample(scratch);
-            ++next;
+    const int nq = state.getNQ(), nu = state.getNU(), nz = state.getNZ();
+    const OdeVisitor emit = [&](double t, const double* y) {
+        scratch.setTime(t);
+        // Write q and u only when they moved (a locked joint keeps them), so the scratch state
+        // keeps its position-level cache and a sample costs less to realize.
+        bool qMoved = false, uMoved = false;
+        for (int i = 0; i < nq; ++i) qMoved = qMoved || y[i] != scratch.getQ()[i];
+        for (int i = 0; i < nu; ++i) uMoved = uMoved || y[nq + i] != scratch.getU()[i];
+        if (qMoved) scratch.updQ() = Vector(nq, y);
+        if (uMoved) scratch.updU() = Vector(nu, y + nq);
+        if (nz > 0) {
+            Vector& z = scratch.updZ();
+            for (int i = 0; i < nz; ++i) z[i] = y[nq + nu + i];
         }
+        sample(scratch);
     };
 
     IntegrationStats stats;
@@ -106,16 +73,17 @@ IntegrationStats simulateSampled(const MultibodySystem& system, State& state, do
     checkFinite(state);
     system.realize(state, Stage::Acceleration);
     sample(state);
-    long next = 1;
-    for (double segmentEnd : cuts) {
+    run.start();
+    Vector ya, yda;
+    for (double segmentEnd : run.getSegmentEnds()) {
         integ.initialize(state);
         ++stats.restarts;
         const State& a = integ.getState();
         system.realize(a, Stage::Acceleration);
-        ta = a.getTime();
         ya = a.getY();
         yda = a.getYDot();
-        while (integ.getTime() < segmentEnd - eps) {
+        run.restart(a.getTime(), &ya[0], &yda[0]);
+        while (integ.getTime() < segmentEnd - run.getEpsilon()) {
             Integrator::SuccessfulStepStatus status;
             try {
                 status = integ.stepTo(segmentEnd, segmentEnd);
@@ -139,13 +107,9 @@ IntegrationStats simulateSampled(const MultibodySystem& system, State& state, do
             if (check) check(b);  // element-specific checks first: they name the muscle and state
             checkFinite(b);
             system.realize(b, Stage::Acceleration);
-            yb = b.getY();
-            ydb = b.getYDot();
-            const bool atBreakpoint = b.getTime() >= segmentEnd - eps && segmentEnd < tEnd;
-            emitUpTo(next, b.getTime(), !atBreakpoint);
-            ta = b.getTime();
-            ya = yb;
-            yda = ydb;
+            ya = b.getY();
+            yda = b.getYDot();
+            run.advance(b.getTime(), &ya[0], &yda[0], run.isBreakpoint(b.getTime(), segmentEnd), emit);
         }
         state = integ.getState();
         stats.steps += integ.getNumStepsTaken();
@@ -165,30 +129,47 @@ void MuscleIsometricSettings::validate(const VirtualMuscle& muscle) const {
 Table runMuscleIsometric(const VirtualMuscle& muscle, const MuscleIsometricSettings& settings,
                          IntegrationStats* stats) {
     settings.validate(muscle);
-    MultibodySystem system;
-    SimbodyMatterSubsystem matter(system);
-    GeneralForceSubsystem forces(system);
-    const VirtualMuscleForce force(forces, std::make_shared<VirtualMuscle>(muscle), matter.Ground(), Vec3(0),
-                                   matter.Ground(), Vec3(settings.pathLength, 0, 0), settings.activation);
-    system.realizeTopology();
-    State state = system.getDefaultState();
-    if (settings.startSteady) force.setSteadyMuscleStates(state);
-    else force.setInitialMuscleStates(state);
-
+    const double P = settings.pathLength;
     const double L0 = muscle.getParameters().optimalFascicleLength;
     const double L0T = muscle.getParameters().optimalTendonLength;
     Table table({"time_s", "activation", "force_N", "fce_N", "fascicle_length_m", "fascicle_velocity_mps",
                  "tendon_length_m", "active_fraction"});
-    const IntegrationStats st = simulateSampled(
-        system, state, settings.duration, settings.sampleRate, settings.activation.getBreakpoints(),
-        settings.integration,
-        [&](const State& s) {
-            // Pure model at the known, fixed path: no Simbody realization per sample.
-            const double t = s.getTime(), U = settings.activation.getValue(t);
-            const MuscleOutputs o = muscle.calcOutputs(settings.pathLength, U, &s.getZ()[0]);
-            table.appendRow({t, U, o.Fse, o.Fce, o.L * L0, o.V * L0, o.LT * L0T, o.activeFraction});
-        },
-        [&](const State& s) { force.checkMuscleStates(s); });
+    table.reserveRows(int(std::lround(settings.duration * settings.sampleRate)) + 1);
+    const OdeVisitor sample = [&](double t, const double* z) {
+        const double U = settings.activation.getValue(t);
+        const MuscleOutputs o = muscle.calcOutputs(P, U, z);
+        table.appendRow({t, U, o.Fse, o.Fce, o.L * L0, o.V * L0, o.LT * L0T, o.activeFraction});
+    };
+    std::vector<double> z;
+    if (settings.startSteady) {
+        const SteadyState ss = muscle.calcSteadyState(P, settings.activation.getValue(0));
+        if (!ss.converged) throw SimulationError(ss.message);
+        z = ss.states;
+    } else {
+        z = muscle.calcInitialState(P);
+    }
+    IntegrationStats st;
+    if (!settings.integrateSimbodySystem) {
+        st = integrateSampled(
+            [&](double t, const double* y, double* ydot) {
+                muscle.calcStateDerivative(P, settings.activation.getValue(t), y, ydot);
+            },
+            0.0, z, settings.duration, settings.sampleRate, settings.activation.getBreakpoints(),
+            settings.integration, sample, [&](double t, const double* y) { muscle.checkStates(t, y); });
+    } else {
+        MultibodySystem system;
+        SimbodyMatterSubsystem matter(system);
+        GeneralForceSubsystem forces(system);
+        const VirtualMuscleForce force(forces, std::make_shared<VirtualMuscle>(muscle), matter.Ground(), Vec3(0),
+                                       matter.Ground(), Vec3(P, 0, 0), settings.activation);
+        system.realizeTopology();
+        State state = system.getDefaultState();
+        force.setMuscleStates(state, z);
+        st = simulateSampled(
+            system, state, settings.duration, settings.sampleRate, settings.activation.getBreakpoints(),
+            settings.integration, [&](const State& s) { sample(s.getTime(), &s.getZ()[0]); },
+            [&](const State& s) { force.checkMuscleStates(s); });
+    }
     if (stats) *stats = st;
     return table;
 }

@@ -4,6 +4,7 @@
 
 #include "muscles/activation.h"
 #include "muscles/simbody.h"
+#include "muscles/stiff_ode.h"
 #include "muscles/table.h"
 #include "muscles/virtual_muscle.h"
 
@@ -11,20 +12,6 @@
 #include <vector>
 
 namespace armsim {
-
-/// Settings of the stiff integrator (Simbody's CPodes, BDF with Newton iteration).
-struct IntegrationSettings {
-    double accuracy = 1e-4;     ///< relative accuracy of CPodes' error control [1]
-    double maxStepSize = 0.0;   ///< largest step [s]; 0 = no limit
-    void validate() const;
-};
-
-/// What an integration cost.
-struct IntegrationStats {
-    int steps = 0;              ///< internal steps taken
-    int restarts = 0;           ///< restarts at input discontinuities (breakpoints)
-    int realizations = 0;       ///< right-hand-side evaluations (Simbody realizeAcceleration calls)
-};
 
 /// Integrates system with CPodes from state.getTime() for `duration` seconds.
 /// - sample(state) is called at t0 + k / sampleRate for k = 0 .. round(duration * sampleRate), with
@@ -48,6 +35,10 @@ struct MuscleIsometricSettings {
     double duration = 3.0;                                     ///< simulated time [s]
     double sampleRate = 1000.0;                                ///< output samples per second [Hz]
     bool startSteady = false;  ///< true: start at the steady state for U(0); false: spec-5 initial state
+    /// false (default): integrate the muscle ODE directly (integrateSampled); true: integrate a Simbody
+    /// System holding the muscle between two Ground points (simulateSampled), the reference path the
+    /// tests compare the default with (same steps, same samples to 1e-6; about 10x slower).
+    bool integrateSimbodySystem = false;
     IntegrationSettings integration;
     /// Throws InputError naming the field for a bad value (path checked against the muscle's P_max).
     void validate(const VirtualMuscle& muscle) const;

@@ -25,18 +25,24 @@ bool Table::hasColumn(const std::string& name) const {
     return false;
 }
 
-void Table::appendRow(std::vector<double> row) {
+void Table::appendRow(const std::vector<double>& row) {
     if (row.size() != names_.size())
         throw std::invalid_argument("table row has " + std::to_string(row.size()) + " values, expected " +
                                     std::to_string(names_.size()));
-    rows_.push_back(std::move(row));
+    data_.insert(data_.end(), row.begin(), row.end());
+    ++numRows_;
+}
+
+std::vector<double> Table::getRow(int i) const {
+    const auto first = data_.begin() + std::ptrdiff_t(i) * std::ptrdiff_t(names_.size());
+    return std::vector<double>(first, first + std::ptrdiff_t(names_.size()));
 }
 
 std::vector<double> Table::getColumn(const std::string& name) const {
     const int c = findColumn(name);
     std::vector<double> out;
-    out.reserve(rows_.size());
-    for (const auto& r : rows_) out.push_back(r[c]);
+    out.reserve(std::size_t(numRows_));
+    for (int i = 0; i < numRows_; ++i) out.push_back(get(i, c));
     return out;
 }
 
@@ -61,11 +67,11 @@ void appendNumber(std::string& out, double v, int digits) {
 std::string Table::formatRows(char separator, int digits) const {
     checkDigits(digits);
     std::string out;
-    out.reserve(rows_.size() * names_.size() * std::size_t(digits + 7));
-    for (const auto& r : rows_) {
-        for (std::size_t c = 0; c < r.size(); ++c) {
+    out.reserve(data_.size() * std::size_t(digits + 7));
+    for (int i = 0; i < numRows_; ++i) {
+        for (int c = 0; c < getNumColumns(); ++c) {
             if (c) out += separator;
-            appendNumber(out, r[c], digits);
+            appendNumber(out, get(i, c), digits);
         }
         out += '\n';
     }
@@ -115,6 +121,7 @@ Table Table::readCsv(const std::string& path) {
             throw InputError(at + ": " + std::to_string(cells.size()) + " values, expected " +
                              std::to_string(t.names_.size()) + " (one per header column)");
         std::vector<double> row;
+        row.reserve(cells.size());
         for (std::size_t i = 0; i < cells.size(); ++i) {
             char* end = nullptr;
             const double v = std::strtod(cells[i].c_str(), &end);
@@ -122,7 +129,7 @@ Table Table::readCsv(const std::string& path) {
                 throw InputError(at + ": column '" + t.names_[i] + "' = '" + cells[i] + "': expected a number");
             row.push_back(v);
         }
-        t.rows_.push_back(std::move(row));
+        t.appendRow(row);
         t.lines_.push_back(lineNo);
     }
     if (header) throw InputError(path + ": empty file (expected a header line of column names)");

@@ -15,14 +15,17 @@ public:
 
     const std::vector<std::string>& getColumnNames() const { return names_; }
     int getNumColumns() const { return int(names_.size()); }
-    int getNumRows() const { return int(rows_.size()); }
+    int getNumRows() const { return numRows_; }
     /// Index of a column; throws std::invalid_argument naming the column if absent.
     int findColumn(const std::string& name) const;
     bool hasColumn(const std::string& name) const;
     /// Appends a row; throws std::invalid_argument if its size differs from the column count.
-    void appendRow(std::vector<double> row);
-    const std::vector<double>& getRow(int i) const { return rows_[i]; }
-    double get(int row, const std::string& column) const { return rows_[row][findColumn(column)]; }
+    void appendRow(const std::vector<double>& row);
+    /// Makes room for n rows in all (no reallocation while appending up to n).
+    void reserveRows(int n) { data_.reserve(std::size_t(n) * names_.size()); }
+    std::vector<double> getRow(int i) const;
+    double get(int row, int column) const { return data_[std::size_t(row) * names_.size() + column]; }
+    double get(int row, const std::string& column) const { return get(row, findColumn(column)); }
     std::vector<double> getColumn(const std::string& name) const;
     /// CSV text: a header line of column names, then rows with `digits` significant digits (1..17;
     /// 17 round-trips every double). Numbers are locale-free; NaN is written "NaN".
@@ -39,7 +42,8 @@ public:
 
 private:
     std::vector<std::string> names_;
-    std::vector<std::vector<double>> rows_;
+    std::vector<double> data_;  // row-major
+    int numRows_ = 0;
     std::vector<int> lines_;
 };
 

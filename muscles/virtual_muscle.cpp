@@ -313,6 +313,24 @@ void VirtualMuscle::calcStateDerivative(double P, double U, const double* y, dou
     }
 }
 
+void VirtualMuscle::checkStates(double t, const double* y) const {
+    for (int i = 0; i < numStates_; ++i)
+        if (!std::isfinite(y[i])) {
+            std::ostringstream msg;
+            msg << "t = " << t << " s: muscle '" << params_.name << "' state " << getStateNames()[i] << " is "
+                << y[i] << " (not finite)";
+            throw SimulationError(msg.str());
+        }
+    const double L = y[kL];
+    if (!(L > 0) || !(L < nfLimit_)) {
+        std::ostringstream msg;
+        msg << "t = " << t << " s: muscle '" << params_.name << "' fascicle length L = " << L
+            << " L0 left the model's range (0, " << nfLimit_
+            << ") L0; beyond it the activation-frequency exponent nf is not positive (spec 4)";
+        throw SimulationError(msg.str());
+    }
+}
+
 MuscleOutputs VirtualMuscle::calcOutputs(double P, double U, const double* y) const {
     MuscleOutputs out;
     std::vector<double> ydot(numStates_);

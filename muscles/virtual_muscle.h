@@ -220,6 +220,9 @@ public:
     /// dy/dt at path P, activation U. Optionally fills outputs.
     void calcStateDerivative(double pathLength, double U, const double* y, double* ydot,
                              MuscleOutputs* outputs = nullptr) const;
+    /// Throws SimulationError naming the time t, the muscle and the state unless every entry of y is
+    /// finite and 0 < L < getNfLimit() (the model's validity range; step boundaries).
+    void checkStates(double t, const double* y) const;
     /// Outputs at path P, activation U for state y.
     MuscleOutputs calcOutputs(double pathLength, double U, const double* y) const;
     /// Steady isometric state at path P and activation U: solves Fse(L) = Fce(L, V = 0).

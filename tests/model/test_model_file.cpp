@@ -162,7 +162,7 @@ TEST(ModelFile, ElbowIsometricTorqueMatchesTheLockReaction) {
     s.averagingWindow = 0.2;
     s.sampleRate = 200;
     const IsometricTrialResult fast = runIsometricTrial(elbow(), s);
-    s.realizeEverySample = true;
+    s.solver = TrialSolver::SimbodyPerSample;
     const IsometricTrialResult slow = runIsometricTrial(elbow(), s);
     const std::vector<double> a = fast.series.getColumn("holding_torque_Nm"), b = slow.series.getColumn("holding_torque_Nm");
     ASSERT_EQ(a.size(), b.size());
@@ -178,7 +178,7 @@ TEST(ModelFile, ElbowIsometricTorqueMatchesTheLockReaction) {
     EXPECT_NEAR(fast.series.get(fast.series.getNumRows() - 1, "activation_TRIlong"), 0.1, kExactTol);
 
     s.effort = MuscleGroup::Extensor;
-    s.realizeEverySample = false;
+    s.solver = TrialSolver::LockedOde;
     EXPECT_LT(runIsometricTrial(elbow(), s).summary.meanMuscleTorque, 0);  // an extension effort
 }
 

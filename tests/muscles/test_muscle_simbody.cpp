@@ -70,8 +70,11 @@ TEST(VirtualMuscleForce, AppliesFseAlongThePathAndOwnsItsStates) {
     EXPECT_NEAR((a - expected).norm(), 0.0, 1e-9 * ss.force);
     // The z slice holds exactly the muscle states and its derivative vanishes at the steady state.
     EXPECT_EQ(s.getNZ(), muscle.getMuscle().getNumStates());
-    for (int i = 0; i < s.getNZ(); ++i)
-        if (i != VirtualMuscle::kV) EXPECT_NEAR(s.getZDot()[i], 0.0, 1e-9) << i;
+    for (int i = 0; i < s.getNZ(); ++i) {
+        if (i != VirtualMuscle::kV) {
+            EXPECT_NEAR(s.getZDot()[i], 0.0, 1e-9) << i;
+        }
+    }
 }
 
 TEST(VirtualMuscleForce, StopsWithANamedErrorOnNonFiniteStatesOrFasciclesBeyondTheNfLimit) {
@@ -169,6 +172,33 @@ TEST(MuscleIsometric, StepActivationRisesMonotonicallyAndIsSampledAtTheRequested
     EXPECT_GT(F[150], 0.5 * F.back());   // 100 ms after the step
     // The fascicle shortens as force rises.
     EXPECT_LT(t.getColumn("fascicle_length_m").back(), t.getColumn("fascicle_length_m")[100]);
+}
+
+// Issue 14: the muscle ODE integrated directly (the default) and inside a Simbody System are one
+// computation (same solver settings, steps and interpolation): every column within 1e-6 relative.
+TEST(MuscleIsometric, DirectOdeMatchesTheSimbodySystem) {
+    constexpr double kRelTol = 1e-6;  // issue 14
+    const VirtualMuscle m(bicepsLongHead());
+    for (bool steady : {false, true}) {
+        MuscleIsometricSettings settings;
+        settings.pathLength = steady ? 0.33 : 0.40;
+        settings.activation = ActivationProfile::ramp(0.1, 0.3, 0.0, steady ? 0.4 : 1.0);
+        settings.startSteady = steady;
+        settings.duration = 1.0;
+        IntegrationStats direct, simbody;
+        const Table a = runMuscleIsometric(m, settings, &direct);
+        settings.integrateSimbodySystem = true;
+        const Table b = runMuscleIsometric(m, settings, &simbody);
+        ASSERT_EQ(a.getNumRows(), b.getNumRows());
+        EXPECT_EQ(direct.steps, simbody.steps);
+        for (const std::string& c : a.getColumnNames()) {
+            const auto x = a.getColumn(c), y = b.getColumn(c);
+            double scale = 0;
+            for (double v : y) scale = std::max(scale, std::abs(v));
+            for (std::size_t i = 0; i < x.size(); ++i)
+                ASSERT_NEAR(x[i], y[i], kRelTol * scale) << c << " row " << i << (steady ? " steady" : "");
+        }
+    }
 }
 
 TEST(MuscleIsometric, BadSettingsAreRejected) {

@@ -1,0 +1,95 @@
+// The direct stiff integrator (CPodes without a Simbody System): closed-form solutions, restarts at
+// breakpoints, sampling, and failures reported with the time and the model's message.
+#include "muscles/param_file.h"
+#include "muscles/stiff_ode.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+
+using namespace armsim;
+
+namespace {
+
+constexpr double kStiffRate = 1000;  // 1/s: y1 relaxes 2000x faster than y2
+constexpr double kSlowRate = 0.5;    // 1/s
+constexpr double kStepTime = 0.3;    // s: the input of y2 steps from 0 to 1
+
+// y1' = -k (y1 - sin t), y2' = -c y2 + H(t - t_s).
+void calcRhs(double t, const double* y, double* ydot) {
+    ydot[0] = -kStiffRate * (y[0] - std::sin(t));
+    ydot[1] = -kSlowRate * y[1] + (t >= kStepTime ? 1.0 : 0.0);
+}
+
+double exactY1(double t, double y0) {
+    const double k = kStiffRate, k2 = k * k;
+    const double particular = (k2 * std::sin(t) - k * std::cos(t)) / (k2 + 1);
+    return particular + (y0 + k / (k2 + 1)) * std::exp(-k * t);
+}
+
+double exactY2(double t, double y0) {
+    const double decay = y0 * std::exp(-kSlowRate * t);
+    return t < kStepTime ? decay : decay + (1 - std::exp(-kSlowRate * (t - kStepTime))) / kSlowRate;
+}
+
+}  // namespace
+
+TEST(StiffOde, StiffLinearSystemMatchesItsClosedFormThroughAStepInput) {
+    constexpr double kAbsTol = 2e-5;  // accuracy 1e-6 on states of order 1, global error
+    IntegrationSettings settings;
+    settings.accuracy = 1e-6;
+    std::vector<double> y{1.0, 0.5};
+    int samples = 0;
+    double worst = 0;
+    const IntegrationStats stats = integrateSampled(
+        calcRhs, 0.0, y, 2.0, 100.0, {kStepTime}, settings, [&](double t, const double* ys) {
+            EXPECT_NEAR(t, samples / 100.0, 1e-12);
+            worst = std::max({worst, std::abs(ys[0] - exactY1(t, 1.0)), std::abs(ys[1] - exactY2(t, 0.5))});
+            ++samples;
+        });
+    EXPECT_EQ(samples, 201);
+    EXPECT_LE(worst, kAbsTol);
+    EXPECT_NEAR(y[0], exactY1(2.0, 1.0), kAbsTol);
+    EXPECT_NEAR(y[1], exactY2(2.0, 0.5), kAbsTol);
+    EXPECT_EQ(stats.restarts, 1);  // at the step
+    // Stiff: an implicit method steps far beyond the explicit stability limit 2 / k = 2 ms.
+    EXPECT_LT(stats.steps, 1000 / 2);
+    EXPECT_GE(stats.realizations, stats.steps);
+}
+
+TEST(StiffOde, ARightHandSideThatThrowsIsReportedWithTheTimeAndTheModelsMessage) {
+    std::vector<double> y{1.0};
+    const OdeRhs f = [](double t, const double* yi, double* ydot) {
+        if (t > 0.25) throw SimulationError("muscle 'X' beyond its range");
+        ydot[0] = -yi[0];
+    };
+    try {
+        integrateSampled(f, 0.0, y, 1.0, 10.0, {}, IntegrationSettings{}, [](double, const double*) {});
+        ADD_FAILURE() << "no error";
+    } catch (const SimulationError& e) {
+        const std::string m = e.what();
+        EXPECT_NE(m.find("t = 0.2"), std::string::npos) << m;
+        EXPECT_NE(m.find("beyond its range"), std::string::npos) << m;
+    }
+}
+
+TEST(StiffOde, ACheckAtStepBoundariesStopsTheRunAndNonFiniteStatesAreNamed) {
+    std::vector<double> y{1.0};
+    const OdeRhs grow = [](double, const double* yi, double* ydot) { ydot[0] = yi[0]; };
+    auto check = [](double t, const double* yi) {
+        if (yi[0] > 2) throw SimulationError("t = " + formatNumber(t) + " s: y left (0, 2]");
+    };
+    try {
+        integrateSampled(grow, 0.0, y, 2.0, 10.0, {}, IntegrationSettings{}, [](double, const double*) {}, check);
+        ADD_FAILURE() << "no error";
+    } catch (const SimulationError& e) {
+        EXPECT_NE(std::string(e.what()).find("left (0, 2]"), std::string::npos) << e.what();
+    }
+    std::vector<double> bad{std::nan("")};
+    EXPECT_THROW(integrateSampled(grow, 0.0, bad, 1.0, 10.0, {}, IntegrationSettings{}, [](double, const double*) {}),
+                 SimulationError);
+    std::vector<double> ok{1.0};
+    EXPECT_THROW(integrateSampled(grow, 0.0, ok, -1.0, 10.0, {}, IntegrationSettings{}, [](double, const double*) {}),
+                 InputError);
+}
