@@ -17,6 +17,25 @@ void printSummary(const char* effort, const MvcCurveSummary& s) {
                 s.peakFlexionDeg, s.torqueAt90);
 }
 
+// Writes the model report to out and prints its muscle table and MVC summary.
+void showModel(const ArmSetup& setup, const std::string& out, double step, const ElbowReference& ref) {
+    const ModelReportFiles r = writeModelReport(setup, out, step, ref);
+    const Table& t = r.muscles;
+    std::printf("model %s: %s\n%-9s %-8s %8s %7s %7s %7s %6s  calibration k f t\n", setup.name.c_str(),
+                setup.description.c_str(), "muscle", "group", "F0 (N)", "L0 (m)", "L0T (m)", "M (kg)", "slow");
+    for (int i = 0; i < t.getNumRows(); ++i) {
+        const std::vector<double> row = t.getRow(i);
+        std::printf("%-9s %-8s %8.1f %7.4f %7.4f %7.4f %6.3f  %.3f %.3f %.3f\n", setup.muscles[i].params.name.c_str(),
+                    getMuscleGroupName(setup.muscles[i].group), row[0], row[1], row[2], row[3], row[5], row[7], row[8],
+                    row[9]);
+    }
+    printSummary("flexion", r.flexion);
+    printSummary("extension", r.extension);
+    std::printf("primary muscle (%s) share of the flexors' torque at 90 deg: %.1f %%\n",
+                setup.muscles[setup.primary].params.name.c_str(), 100 * r.primaryShareAt90);
+    for (const std::string& f : r.files) std::printf("wrote %s\n", f.c_str());
+}
+
 void addModelCommands(CLI::App& app) {
     CLI::App* model = app.add_subcommand("model", "model files: list, show, calibrate");
     model->require_subcommand(1);
@@ -41,23 +60,8 @@ void addModelCommands(CLI::App& app) {
         c->add_option("--reference", *reference,
                       "published reference data (default assets/measured/elbow_reference.yaml)");
         c->callback([=] {
-            const ArmSetup setup = loadModel(*name);
             const ElbowReference ref = reference->empty() ? loadDefaultElbowReference() : loadElbowReference(*reference);
-            const ModelReportFiles r = writeModelReport(setup, *out, *step, ref);
-            const Table& t = r.muscles;
-            std::printf("model %s: %s\n%-9s %-8s %8s %7s %7s %7s %6s  calibration k f t\n", setup.name.c_str(),
-                        setup.description.c_str(), "muscle", "group", "F0 (N)", "L0 (m)", "L0T (m)", "M (kg)", "slow");
-            for (int i = 0; i < t.getNumRows(); ++i) {
-                const auto& row = t.getRow(i);
-                std::printf("%-9s %-8s %8.1f %7.4f %7.4f %7.4f %6.3f  %.3f %.3f %.3f\n",
-                            setup.muscles[i].params.name.c_str(), getMuscleGroupName(setup.muscles[i].group), row[0],
-                            row[1], row[2], row[3], row[5], row[7], row[8], row[9]);
-            }
-            printSummary("flexion", r.flexion);
-            printSummary("extension", r.extension);
-            std::printf("primary muscle (%s) share of the flexors' torque at 90 deg: %.1f %%\n",
-                        setup.muscles[setup.primary].params.name.c_str(), 100 * r.primaryShareAt90);
-            for (const std::string& f : r.files) std::printf("wrote %s\n", f.c_str());
+            showModel(loadModel(*name), *out, *step, ref);
         });
     }
 
@@ -86,6 +90,9 @@ void addModelCommands(CLI::App& app) {
 }
 
 const CommandRegistrar registerModel(15, addModelCommands);
+const MainJobStepRegistrar registerElbowModel(
+    25, "Elbow model (the virtual subject): muscles, moment arms, steady MVC torque-angle curves",
+    [](const MainJobContext& ctx) { showModel(loadModel("elbow"), ctx.outDir + "/model_elbow", 5.0, loadDefaultElbowReference()); });
 
 }  // namespace
 

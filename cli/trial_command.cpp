@@ -9,6 +9,7 @@
 #include "render/trial_video.h"
 #endif
 
+#include <algorithm>
 #include <cstdio>
 #include <memory>
 
@@ -183,8 +184,86 @@ void runMvcAngles(const MainJobContext& ctx) {
     std::printf("  wrote %s/mvc_angles.csv, mvc_angles.png\n", ctx.outDir.c_str());
 }
 
+/// Main job: the same five-angle MVC on the seven-muscle elbow (the virtual subject: agonists at its
+/// voluntary activation, antagonists co-contracting), with the thesis's biceps-force estimate (tared
+/// torque over the biceps moment arm) beside every muscle's true force.
+void runElbowMvcAngles(const MainJobContext& ctx) {
+    const ArmSetup setup = loadModel("elbow");
+    const double angles[] = {45, 60, 90, 120, 150};  // thesis: included angle, 180 = extended
+    std::vector<IsometricTrialSettings> settings;
+    for (double a : angles) {
+        IsometricTrialSettings s;
+        s.elbowAngle = degToRad(a);
+        s.activation = setup.effort.voluntaryActivation;
+        s.antagonistActivation = setup.effort.coContraction;
+        settings.push_back(s);
+    }
+    const auto results = runIsometricTrials(setup, settings, ctx.jobs,
+                                            [](int d, int n) { printProgress("elbow MVC trials", d, n); });
+    const int n = setup.getNumMuscles(), primary = setup.primary;
+    const std::string biceps = setup.muscles[primary].params.name;
+    // The thesis's one biceps is both heads here (the muscles named BIC...).
+    std::vector<int> heads;
+    for (int i = 0; i < n; ++i)
+        if (setup.muscles[i].params.name.rfind("BIC", 0) == 0) heads.push_back(i);
+    std::vector<std::string> columns{"elbow_angle_deg", "flexion_deg", "tared_torque_Nm", "strap_force_N",
+                                     "primary_moment_arm_m", "primary_force_N", "biceps_both_heads_N",
+                                     "thesis_estimate_N", "estimate_error_vs_both_heads_pct"};
+    for (int i = 0; i < n; ++i) columns.push_back("force_" + setup.muscles[i].params.name + "_N");
+    for (int i = 0; i < n; ++i) columns.push_back("torque_" + setup.muscles[i].params.name + "_Nm");
+    Table t(columns);
+    PlotSpec spec;
+    spec.title = "Elbow model: MVC at the thesis's angles (VA " + formatNumber(setup.effort.voluntaryActivation) +
+                 ", co-contraction " + formatNumber(setup.effort.coContraction) + ")";
+    spec.xLabel = "elbow angle (deg, thesis convention: 180 = extended)";
+    spec.yLabel = "force (N)";
+    PlotSeries estimated{"thesis estimate: tared torque / " + biceps + " moment arm", {}, {}, false, 1};
+    std::vector<PlotSeries> forces;
+    for (int i = 0; i < n; ++i)
+        if (setup.muscles[i].group == MuscleGroup::Flexor)
+            forces.push_back({"true force " + setup.muscles[i].params.name, {}, {}, false, int(forces.size() + 2) % 8});
+    PlotSeries bothHeads{"true force, biceps (both heads)", {}, {}, false, 7};
+    std::printf("  angle (deg)  flexion (deg)  torque (N m)  %s (N)  biceps, both heads (N)  thesis estimate (N)  "
+                "error\n", biceps.c_str());
+    for (std::size_t k = 0; k < results.size(); ++k) {
+        const IsometricSummary& s = results[k].summary;
+        const double F = s.meanForce, estimate = s.meanForceMomentArm;
+        double both = 0;
+        for (int i : heads) both += s.meanForces[i];
+        bothHeads.x.push_back(angles[k]);
+        bothHeads.y.push_back(both);
+        std::vector<double> row{angles[k], 180 - angles[k], s.meanMuscleTorque, s.meanStrapForce, s.momentArm, F,
+                                both, estimate, 100 * (estimate - both) / both};
+        for (int i = 0; i < n; ++i) row.push_back(s.meanForces[i]);
+        for (int i = 0; i < n; ++i) row.push_back(s.momentArms[i] * s.meanForces[i]);
+        t.appendRow(row);
+        std::printf("  %11.0f  %13.0f  %12.1f  %*.1f  %22.1f  %19.1f  %+5.0f %%\n", angles[k], 180 - angles[k],
+                    s.meanMuscleTorque, int(biceps.size()) + 4, F, both, estimate, 100 * (estimate - both) / both);
+        estimated.x.push_back(angles[k]);
+        estimated.y.push_back(estimate);
+        for (int i = 0, j = 0; i < n; ++i)
+            if (setup.muscles[i].group == MuscleGroup::Flexor) {
+                forces[j].x.push_back(angles[k]);
+                forces[j++].y.push_back(s.meanForces[i]);
+            }
+    }
+    spec.series = forces;
+    spec.series.push_back(bothHeads);
+    spec.series.push_back(estimated);
+    spec.legend = PlotSpec::Legend::TopLeft;
+    spec.yMin = 0;
+    spec.yMax = 2.4 * *std::max_element(estimated.y.begin(), estimated.y.end());  // room for the legend
+    t.writeCsv(ctx.outDir + "/mvc_angles_elbow.csv");
+    writePlotPng(ctx.outDir + "/mvc_angles_elbow.png", spec);
+    std::printf("  the estimate credits the biceps with the brachialis' and brachioradialis' torque, less the\n"
+                "  triceps' co-contraction; wrote %s/mvc_angles_elbow.csv, mvc_angles_elbow.png\n",
+                ctx.outDir.c_str());
+}
+
 const CommandRegistrar registerTrial(20, addTrialCommand);
-const MainJobStepRegistrar registerMvc(30, "Arm: MVC at the thesis's five elbow angles", runMvcAngles);
+const MainJobStepRegistrar registerMvc(30, "Thesis arm (biceps only): MVC at the thesis's five elbow angles", runMvcAngles);
+const MainJobStepRegistrar registerElbowMvc(32, "Elbow model (seven muscles): MVC at the thesis's five angles",
+                                            runElbowMvcAngles);
 
 }  // namespace
 

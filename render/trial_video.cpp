@@ -258,9 +258,14 @@ struct TrialRenderer::Impl {
                                 .setColor(kTickColor));
     }
 
+    // The force shown is the primary muscle's: name it when there are several.
+    std::string getForceLabel() const {
+        return setup.getNumMuscles() > 1 ? setup.muscles[setup.primary].params.name + " force" : "muscle force";
+    }
+
     void makeTraces() {
         const int maxPoints = 2 * overlayStyle.plotWidth;
-        traces.push_back(makeTrace("muscle force (N)", time, force, true, SimTK::Vec3(0.85, 0.25, 0.10), maxPoints));
+        traces.push_back(makeTrace(getForceLabel() + " (N)", time, force, true, SimTK::Vec3(0.85, 0.25, 0.10), maxPoints));
         if (isometric)
             traces.push_back(makeTrace("transducer (N)", time, strap, true, kArrowColor, maxPoints));
         else
@@ -371,7 +376,7 @@ struct TrialRenderer::Impl {
                                          {"time", format("%.3f s", time[row])},
                                          {"elbow angle", format("%.1f deg", angleDeg[row])},
                                          {"activation", format("%.2f", activation[row])},
-                                         {"muscle force", format("%.1f N", force[row])}};
+                                         {getForceLabel(), format("%.1f N", force[row])}};
         if (isometric)
             text.push_back({"transducer", format("%.1f N", strap[row]) +
                                               (!saturated.empty() && saturated[row] > 0.5 ? " (saturated)" : "")});

@@ -166,3 +166,28 @@ TEST(Cli, ModelShowWritesTablesAndPlots) {
     EXPECT_NE(bad.exitCode, 0);
     EXPECT_NE(bad.output.find("angle step = 0"), std::string::npos) << bad.output;
 }
+
+// armsim run on built-in defaults: the thesis arm where it reproduces the thesis, the seven-muscle
+// elbow as the virtual subject (issue 10), every result file written.
+TEST(Cli, MainJobRunsTheThesisArmAndTheElbowSubject) {
+    const fs::path d = freshDir("run");
+    const CommandResult r = runArmsim("run --jobs 2 --out " + d.string());
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    for (const char* f : {"force_length.csv", "force_length.png", "step_activation.csv", "mvc_angles.csv",
+                          "mvc_angles.png", "mvc_angles_elbow.csv", "mvc_angles_elbow.png", "model_elbow/muscles.csv",
+                          "model_elbow/moment_arms.png", "model_elbow/mvc_flexion.csv", "model_elbow/mvc_flexion.png",
+                          "protocol_mvc/summary.csv"})
+        EXPECT_TRUE(fs::exists(d / f) && fs::file_size(d / f) > 0) << f;
+    const armsim::Table t = armsim::Table::readCsv((d / "mvc_angles_elbow.csv").string());
+    ASSERT_EQ(t.getNumRows(), 5);
+    for (int i = 0; i < t.getNumRows(); ++i) {
+        EXPECT_NEAR(t.get(i, "elbow_angle_deg") + t.get(i, "flexion_deg"), 180.0, 1e-12);
+        // The thesis's estimate: tared torque over the primary muscle's moment arm (CSV: 10 digits).
+        const double estimate = t.get(i, "tared_torque_Nm") / t.get(i, "primary_moment_arm_m");
+        EXPECT_NEAR(t.get(i, "thesis_estimate_N"), estimate, 1e-8 * estimate) << i;
+        // The synergists' torque lands on the biceps: the estimate exceeds both heads' true force.
+        EXPECT_GT(t.get(i, "thesis_estimate_N"), t.get(i, "biceps_both_heads_N")) << i;
+        EXPECT_NEAR(t.get(i, "biceps_both_heads_N"), t.get(i, "force_BIClong_N") + t.get(i, "force_BICshort_N"), 1e-6);
+    }
+    EXPECT_NE(r.output.find("Elbow model (seven muscles)"), std::string::npos) << r.output;
+}
