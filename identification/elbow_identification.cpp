@@ -1,0 +1,403 @@
+#include "identification/elbow_identification.h"
+
+#include "identification/identifier.h"
+#include "identification/map_estimate.h"
+#include "model/geometry.h"
+#include "model/muscle_arm.h"
+#include "model/parallel.h"
+#include "model/trial.h"
+#include "muscles/param_file.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <random>
+
+namespace armsim {
+
+namespace {
+
+constexpr double kZ95 = 1.959963984540054;  // two-sided 95 % normal quantile
+
+// Path length and moment arm of every muscle at each angle (the geometry does not depend on the
+// muscle parameters an identifier changes).
+struct AngleGeometry {
+    std::vector<std::vector<double>> pathLength, momentArm;  // [angle][muscle]
+};
+
+AngleGeometry calcAngleGeometry(const ArmSetup& setup, const std::vector<double>& flexionDeg) {
+    AngleGeometry g;
+    ArmGeometry geometry(setup);
+    for (double q : flexionDeg) {
+        checkField("flexion angle", q, Bound::closed(setup.arm.getMinFlexionDeg(), setup.arm.getMaxFlexionDeg(), "deg"));
+        geometry.setElbowAngle(elbowAngleFromFlexion(degToRad(q)));
+        std::vector<double> P, h;
+        for (int i = 0; i < setup.getNumMuscles(); ++i) {
+            const PathGeometry path = geometry.calcPathGeometry(i);
+            P.push_back(path.length);
+            h.push_back(geometry.calcMomentArm(path));
+        }
+        g.pathLength.push_back(P);
+        g.momentArm.push_back(h);
+    }
+    return g;
+}
+
+// Tared steady flexion-effort torque at each angle for the given muscles; throws SimulationError when
+// a muscle has no steady state.
+std::vector<double> calcTaredTorque(const std::vector<MuscleSpec>& muscles, const AngleGeometry& g,
+                                    const SubjectEffort& effort, const std::vector<int>& leftOut = {}) {
+    std::vector<VirtualMuscle> vm;
+    for (const MuscleSpec& m : muscles) vm.emplace_back(m.params);
+    std::vector<double> torque;
+    for (std::size_t a = 0; a < g.pathLength.size(); ++a) {
+        double t = 0;
+        for (std::size_t i = 0; i < muscles.size(); ++i) {
+            if (std::find(leftOut.begin(), leftOut.end(), int(i)) != leftOut.end()) continue;
+            const double U = muscles[i].group == MuscleGroup::Flexor ? effort.voluntaryActivation : effort.coContraction;
+            const double P = g.pathLength[a][i];
+            const SteadyState active = vm[i].calcSteadyState(P, U), relaxed = vm[i].calcSteadyState(P, 0.0);
+            if (!active.converged || !relaxed.converged)
+                throw SimulationError("muscle '" + muscles[i].params.name + "': " +
+                                      (active.converged ? relaxed.message : active.message));
+            t += g.momentArm[a][i] * (active.force - relaxed.force);
+        }
+        torque.push_back(t);
+    }
+    return torque;
+}
+
+std::vector<int> findMuscles(const ArmSetup& setup, const std::vector<std::string>& names, const char* what) {
+    std::vector<int> out;
+    for (const std::string& n : names) {
+        try {
+            out.push_back(setup.findMuscle(n));
+        } catch (const InputError& e) {
+            throw InputError(std::string("synergist-aware identifier: ") + what + ": " + e.what());
+        }
+    }
+    return out;
+}
+
+// Relative torque sd pooled over the angles' repetitions; NaN without repetitions.
+double estimateNoiseLevel(const std::vector<TorqueObservation>& data) {
+    std::map<double, std::vector<double>> byAngle;
+    for (const TorqueObservation& o : data) byAngle[o.flexionDeg].push_back(o.torque);
+    double ss = 0;
+    int dof = 0;
+    for (const auto& [angle, v] : byAngle) {
+        if (v.size() < 2) continue;
+        double m = 0;
+        for (double x : v) m += x;
+        m /= double(v.size());
+        for (double x : v) ss += (x / m - 1) * (x / m - 1);
+        dof += int(v.size()) - 1;
+    }
+    return dof > 0 ? std::sqrt(ss / dof) : NAN;
+}
+
+// The synergist-aware problem: x = [ln s_b, ln t_b, ln s_s, ln s_e, VA, CC, ln f_b, ln t_s, ln f_s]
+// (f: fascicle length scales; the last three are nuisances whose population spread widens the
+// intervals of the first two as it should).
+struct SynergistProblem {
+    static constexpr int kSize = 9;
+    const ArmSetup* base;
+    AngleGeometry geometry;
+    std::vector<int> angleOf;                 // observation -> angle index
+    std::vector<double> torque, sd;           // observations and their sd [N m]
+    std::vector<int> biceps, synergists, extensors, leftOut;
+
+    std::vector<MuscleSpec> makeMuscles(const double* x) const {
+        std::vector<MuscleSpec> m = base->muscles;
+        for (int i : biceps) {
+            m[i].params.mass *= std::exp(x[0]);
+            m[i].params.optimalTendonLength *= std::exp(x[1]);
+            m[i].params.optimalFascicleLength *= std::exp(x[6]);
+        }
+        for (int i : synergists) {
+            m[i].params.mass *= std::exp(x[2]);
+            m[i].params.optimalTendonLength *= std::exp(x[7]);
+            m[i].params.optimalFascicleLength *= std::exp(x[8]);
+        }
+        for (int i : extensors) m[i].params.mass *= std::exp(x[3]);
+        return m;
+    }
+    std::vector<double> predict(const double* x) const {
+        SubjectEffort e;
+        e.voluntaryActivation = x[4];
+        e.coContraction = x[5];
+        return calcTaredTorque(makeMuscles(x), geometry, e, leftOut);
+    }
+    // Whitened data residuals; false where a muscle has no steady state.
+    bool calcResiduals(const double* x, double* residuals) const {
+        std::vector<double> t;
+        try {
+            t = predict(x);
+        } catch (const std::exception&) {
+            return false;
+        }
+        for (std::size_t k = 0; k < torque.size(); ++k) residuals[k] = (t[angleOf[k]] - torque[k]) / sd[k];
+        return true;
+    }
+};
+
+}  // namespace
+
+void TorqueProtocol::validate() const {
+    if (flexionDeg.empty()) throw FieldError("protocol.angles", "no angles: expected at least one");
+    checkField("protocol.repetitions", repetitions, Bound::closed(1, 100));
+    checkField("protocol.rest", restDuration, Bound::positive("s"));
+    checkField("protocol.hold", holdDuration, Bound::positive("s"));
+    checkField("protocol.averaging_window", averagingWindow, {0, holdDuration, true, false, "s, within the hold"});
+    checkField("protocol.sample_rate", sampleRate, Bound::positive("Hz"));
+}
+
+std::vector<double> calcTaredSteadyTorque(const ArmSetup& setup, const SubjectEffort& effort,
+                                          const std::vector<double>& flexionDeg) {
+    return calcTaredTorque(setup.muscles, calcAngleGeometry(setup, flexionDeg), effort);
+}
+
+std::vector<TorqueObservation> synthesizeMvcTorques(const VirtualSubject& subject, const TorqueProtocol& protocol,
+                                                    unsigned noiseSeed, int jobs) {
+    protocol.validate();
+    std::seed_seq seq{noiseSeed, subject.seed, unsigned(subject.index)};
+    std::mt19937_64 rng(seq);
+    std::normal_distribution<double> normal;
+    const SubjectEffort& e = subject.setup.effort;
+    std::vector<IsometricTrialSettings> trials;
+    std::vector<TorqueObservation> data;
+    std::vector<double> noise;
+    for (int r = 0; r < protocol.repetitions; ++r)
+        for (double q : protocol.flexionDeg) {
+            IsometricTrialSettings s;
+            s.elbowAngle = elbowAngleFromFlexion(degToRad(q));
+            s.activation = std::clamp(e.voluntaryActivation * (1 + e.trialCv * normal(rng)), 0.0, 1.0);
+            s.antagonistActivation = e.coContraction;
+            s.effort = MuscleGroup::Flexor;
+            s.restDuration = protocol.restDuration;
+            s.holdDuration = protocol.holdDuration;
+            s.averagingWindow = protocol.averagingWindow;
+            s.sampleRate = protocol.sampleRate;
+            trials.push_back(s);
+            noise.push_back(subject.transducerNoise * normal(rng));
+            data.push_back({q, r, 0.0, s.activation});
+        }
+    const std::vector<IsometricTrialResult> results = runIsometricTrials(subject.setup, trials, jobs);
+    for (std::size_t k = 0; k < data.size(); ++k) data[k].torque = results[k].summary.meanMuscleTorque * (1 + noise[k]);
+    return data;
+}
+
+BicepsEstimate identifyThesisMethod(const ArmSetup& assumed, const std::vector<TorqueObservation>& data) {
+    BicepsEstimate est;
+    est.method = "thesis";
+    std::vector<double> angles;
+    for (const TorqueObservation& o : data) angles.push_back(o.flexionDeg);
+    const AngleGeometry g = calcAngleGeometry(assumed, angles);
+    IdentificationProblem problem;
+    problem.base = assumed.calcBicepsParameters();
+    problem.data.source = "tared torque / biceps moment arm";
+    for (std::size_t k = 0; k < data.size(); ++k) {
+        Observation o;
+        o.pathLength = g.pathLength[k][assumed.primary];
+        o.activation = 1.0;  // the thesis assumes a maximal effort is full activation
+        o.force = data[k].torque / g.momentArm[k][assumed.primary];
+        o.angle = elbowAngleFromFlexion(degToRad(data[k].flexionDeg));
+        o.trial = data[k].repetition;
+        problem.data.points.push_back(o);
+    }
+    IdentificationOptions options;
+    options.noise = NoiseModel::Relative;
+    const IdentificationReport r = identify(problem, SteadyForceModel(), options);
+    est.converged = r.isConverged();
+    est.message = getStopReasonName(r.stopReason) + ": " + r.message;
+    est.mass = r.parameters.at(0).value;
+    est.tendonLength = r.parameters.at(1).value;
+    est.massLower = r.parameters[0].ciLower;
+    est.massUpper = r.parameters[0].ciUpper;
+    est.tendonLower = r.parameters[1].ciLower;
+    est.tendonUpper = r.parameters[1].ciUpper;
+    est.noiseLevel = r.residualSd;
+    if (r.hasUncertainty) est.massTendonCorrelation = r.correlation[0][1];
+    est.rmsResidual = r.rmsResidual;
+    return est;
+}
+
+BicepsEstimate identifySynergistAware(const Population& prior, const std::vector<TorqueObservation>& data,
+                                      const SynergistGroups& groups) {
+    if (data.empty()) throw InputError("synergist-aware identifier: no observations");
+    const ArmSetup& base = prior.base;
+    SynergistProblem p;
+    p.base = &base;
+    p.biceps = findMuscles(base, groups.biceps, "biceps");
+    p.synergists = findMuscles(base, groups.synergists, "synergists");
+    if (!groups.includeSynergists) p.leftOut = p.synergists;
+    for (int i = 0; i < base.getNumMuscles(); ++i)
+        if (base.muscles[i].group == MuscleGroup::Extensor) p.extensors.push_back(i);
+    if (std::find(p.biceps.begin(), p.biceps.end(), base.primary) == p.biceps.end())
+        throw InputError("synergist-aware identifier: the primary muscle '" + base.muscles[base.primary].params.name +
+                         "' is not in the biceps group");
+
+    std::vector<double> angles;
+    for (const TorqueObservation& o : data) {
+        auto it = std::find(angles.begin(), angles.end(), o.flexionDeg);
+        p.angleOf.push_back(int(it - angles.begin()));
+        if (it == angles.end()) angles.push_back(o.flexionDeg);
+        p.torque.push_back(o.torque);
+    }
+    p.geometry = calcAngleGeometry(base, angles);
+
+    BicepsEstimate est;
+    est.method = "synergist";
+    est.noiseLevel = estimateNoiseLevel(data);
+    if (!std::isfinite(est.noiseLevel)) est.noiseLevel = prior.transducerNoise;
+    est.noiseLevel = std::max(est.noiseLevel, 0.002);  // floor: the scatter of few repetitions can be ~0
+    for (double t : p.torque) p.sd.push_back(est.noiseLevel * std::max(std::abs(t), 1.0));
+
+    // Prior: strength levels share the person-level variance; lengths and effort independent.
+    constexpr int n = SynergistProblem::kSize;
+    const double s2 = prior.strengthSubjectSd * prior.strengthSubjectSd;
+    const double m2 = prior.strengthMuscleSd * prior.strengthMuscleSd;
+    auto uniformSd = [](const UniformRange& r) { return std::max((r.max - r.min) / std::sqrt(12.0), 1e-4); };
+    MapProblem map;
+    map.priorCovariance.assign(n, std::vector<double>(n, 0.0));
+    auto& cov = map.priorCovariance;
+    const int strength[3] = {0, 2, 3};
+    const double members[3] = {double(p.biceps.size()), double(std::max<std::size_t>(p.synergists.size(), 1)),
+                               double(std::max<std::size_t>(p.extensors.size(), 1))};
+    for (int a = 0; a < 3; ++a)
+        for (int b = 0; b < 3; ++b) cov[strength[a]][strength[b]] = s2 + (a == b ? m2 / members[a] : 0.0);
+    cov[1][1] = cov[7][7] = prior.tendonLengthSd * prior.tendonLengthSd;
+    cov[4][4] = std::pow(uniformSd(prior.voluntaryActivation), 2);
+    cov[5][5] = std::pow(uniformSd(prior.coContraction), 2);
+    cov[6][6] = cov[8][8] = prior.fascicleLengthSd * prior.fascicleLengthSd;
+    for (int j = 0; j < n; ++j) cov[j][j] = std::max(cov[j][j], 1e-10);  // a zero spread: the value is known
+    map.priorMean.assign(n, 0.0);
+    map.priorMean[4] = 0.5 * (prior.voluntaryActivation.min + prior.voluntaryActivation.max);
+    map.priorMean[5] = 0.5 * (prior.coContraction.min + prior.coContraction.max);
+    const double lnLo = std::log(0.25), lnHi = std::log(4.0), lenLo = std::log(0.6), lenHi = std::log(1.4);
+    map.lower = {lnLo, lenLo, lnLo, lnLo, prior.voluntaryActivation.min, prior.coContraction.min, lenLo, lenLo, lenLo};
+    map.upper = {lnHi, lenHi, lnHi, lnHi, std::max(prior.voluntaryActivation.max, prior.voluntaryActivation.min + 1e-6),
+                 std::max(prior.coContraction.max, prior.coContraction.min + 1e-6), lenHi, lenHi, lenHi};
+    map.numResiduals = int(p.torque.size());
+    map.residuals = [&p](const double* x, double* r) { return p.calcResiduals(x, r); };
+    const MapResult m = calcMapEstimate(map);
+    const std::vector<double>& x = m.x;
+    est.converged = m.converged;
+    est.message = m.message;
+
+    const MuscleParameters& b = base.muscles[base.primary].params;
+    est.mass = b.mass * std::exp(x[0]);
+    est.tendonLength = b.optimalTendonLength * std::exp(x[1]);
+    est.nuisanceNames = {"synergist_mass_scale", "extensor_mass_scale", "voluntary_activation", "co_contraction",
+                         "biceps_fascicle_scale", "synergist_tendon_scale", "synergist_fascicle_scale"};
+    est.nuisance = {std::exp(x[2]), std::exp(x[3]), x[4], x[5], std::exp(x[6]), std::exp(x[7]), std::exp(x[8])};
+    try {
+        const std::vector<double> t = p.predict(x.data());
+        double ss = 0;
+        for (std::size_t k = 0; k < p.torque.size(); ++k) ss += std::pow(t[p.angleOf[k]] - p.torque[k], 2);
+        est.rmsResidual = std::sqrt(ss / double(p.torque.size()));
+    } catch (const std::exception& e) {
+        est.converged = false;
+        est.message += "; no steady state at the estimate: " + std::string(e.what());
+        return est;
+    }
+    if (!m.covariance.empty()) {
+        const double sm = std::sqrt(m.covariance[0][0]), st = std::sqrt(m.covariance[1][1]);
+        est.massLower = b.mass * std::exp(x[0] - kZ95 * sm);
+        est.massUpper = b.mass * std::exp(x[0] + kZ95 * sm);
+        est.tendonLower = b.optimalTendonLength * std::exp(x[1] - kZ95 * st);
+        est.tendonUpper = b.optimalTendonLength * std::exp(x[1] + kZ95 * st);
+        est.massTendonCorrelation = m.covariance[0][1] / (sm * st);
+    }
+    return est;
+}
+
+std::vector<ElbowValidationRow> runElbowValidation(const Population& population, const ElbowValidationSettings& settings,
+                                                   const std::function<void(int, int)>& progress) {
+    population.validate();
+    settings.protocol.validate();
+    checkField("subjects", settings.subjects, Bound::closed(1, 1e6));
+    std::vector<double> levels = settings.noiseLevels;
+    if (levels.empty()) levels.push_back(population.transducerNoise);
+    for (double v : levels) checkField("noise", v, Bound{0, 0.5, false, true, "relative sd"});
+    const int primary = population.base.primary;
+    int bicepsShort = -1;  // the other biceps head
+    for (int i : findMuscles(population.base, SynergistGroups().biceps, "biceps"))
+        if (i != primary) bicepsShort = i;
+    const std::vector<int> synergists = findMuscles(population.base, SynergistGroups().synergists, "synergists");
+
+    std::vector<std::vector<ElbowValidationRow>> perSubject(settings.subjects);
+    runParallel(settings.subjects, settings.jobs, [&](int s) {
+        VirtualSubject v = drawSubject(population, settings.seed, s);
+        for (double level : levels) {
+            v.transducerNoise = level;
+            const std::vector<TorqueObservation> data = synthesizeMvcTorques(v, settings.protocol, settings.seed, 1);
+            const BicepsEstimate estimates[2] = {identifyThesisMethod(population.base, data),
+                                                 identifySynergistAware(population, data)};
+            for (const BicepsEstimate& e : estimates) {
+                ElbowValidationRow row;
+                row.subject = s;
+                row.noise = level;
+                row.method = e.method;
+                row.trueMass = v.setup.muscles[primary].params.mass;
+                row.trueTendonLength = v.setup.muscles[primary].params.optimalTendonLength;
+                row.estimate = e;
+                row.massError = e.mass / row.trueMass - 1;
+                row.tendonError = e.tendonLength - row.trueTendonLength;
+                if (std::isfinite(e.massLower))
+                    row.massCovered = row.trueMass >= e.massLower && row.trueMass <= e.massUpper;
+                if (std::isfinite(e.tendonLower))
+                    row.tendonCovered = row.trueTendonLength >= e.tendonLower && row.trueTendonLength <= e.tendonUpper;
+                row.voluntaryActivation = v.setup.effort.voluntaryActivation;
+                row.coContraction = v.setup.effort.coContraction;
+                row.strengthLevel = v.strengthLevel;
+                if (bicepsShort >= 0) row.bicepsShortScale = v.massScale[bicepsShort] / v.massScale[primary];
+                double syn = 0;
+                for (int i : synergists) syn += v.massScale[i];
+                row.synergistScale = syn / double(synergists.size()) / v.massScale[primary];
+                perSubject[s].push_back(row);
+            }
+        }
+    }, progress);
+    std::vector<ElbowValidationRow> rows;
+    for (auto& r : perSubject) rows.insert(rows.end(), r.begin(), r.end());
+    return rows;
+}
+
+std::vector<ElbowValidationSummary> summarizeElbowValidation(const std::vector<ElbowValidationRow>& rows) {
+    std::vector<ElbowValidationSummary> out;
+    for (const ElbowValidationRow& r : rows) {
+        auto it = std::find_if(out.begin(), out.end(),
+                               [&](const ElbowValidationSummary& s) { return s.method == r.method && s.noise == r.noise; });
+        if (it == out.end()) {
+            out.push_back({});
+            it = out.end() - 1;
+            it->method = r.method;
+            it->noise = r.noise;
+        }
+        ++it->subjects;
+    }
+    for (ElbowValidationSummary& s : out) {
+        double mb = 0, mm = 0, tb = 0, tm = 0;
+        int mc = 0, mn = 0, tc = 0, tn = 0, n = 0;
+        for (const ElbowValidationRow& r : rows) {
+            if (r.method != s.method || r.noise != s.noise) continue;
+            if (r.estimate.converged) ++s.converged;
+            if (!std::isfinite(r.massError) || !std::isfinite(r.tendonError)) continue;
+            ++n;
+            mb += r.massError, mm += r.massError * r.massError;
+            tb += r.tendonError, tm += r.tendonError * r.tendonError;
+            if (r.massCovered >= 0) ++mn, mc += r.massCovered;
+            if (r.tendonCovered >= 0) ++tn, tc += r.tendonCovered;
+        }
+        if (n > 0) {
+            s.massBias = mb / n, s.massRmse = std::sqrt(mm / n);
+            s.tendonBias = tb / n, s.tendonRmse = std::sqrt(tm / n);
+        }
+        if (mn > 0) s.massCoverage = double(mc) / mn;
+        if (tn > 0) s.tendonCoverage = double(tc) / tn;
+    }
+    return out;
+}
+
+}  // namespace armsim

@@ -1,0 +1,137 @@
+// Identifying the biceps on a realistic elbow (issue 11): MVC torque data synthesized from virtual
+// subjects (experiments/population.h) in the seven-muscle arm, and two identifiers of the biceps long
+// head's mass M and optimal tendon length L0T from them:
+//
+// "thesis"     The thesis's method as it is: the biceps force is the tared torque over the biceps
+//              moment arm, a biceps-only model at full activation is fitted to those forces (steady
+//              model, lm, relative noise; intervals from the residual scatter).
+// "synergist"  Maximum a posteriori fit of the net tared joint torque predicted by the whole elbow model:
+//              free are ln s_b (mass scale of both biceps heads), ln t_b (their tendon scale), ln s_s
+//              (mass scale of the other flexors), ln s_e (of the extensors), voluntary activation VA and
+//              co-contraction CC, with the population as prior (the strength levels with their shared
+//              person-level covariance, lengths and effort from their ranges). Data residuals are
+//              weighted by a relative noise level estimated from the repetitions' scatter. The
+//              posterior covariance is the inverse Gauss-Newton Hessian of all weighted residuals
+//              (Laplace approximation); 95 % intervals are normal in the log scales, so M and L0T
+//              intervals are exp-transformed.
+// The prediction is the steady isometric torque at the protocol's angles with the subject's effort
+// less the relaxed torque (the transducer is tared at rest), summed over every muscle.
+#pragma once
+
+#include "experiments/population.h"
+
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace armsim {
+
+/// The MVC protocol run on a virtual subject.
+struct TorqueProtocol {
+    std::vector<double> flexionDeg = {135, 120, 90, 60, 30};  ///< thesis's 45..150 deg included angles
+    int repetitions = 3;             ///< efforts per angle (thesis: 3)
+    double restDuration = 0.5;       ///< [s] relaxed, transducer tared at its start
+    double holdDuration = 3.0;       ///< [s] maximal effort (thesis: 3 s)
+    double averagingWindow = 1.0;    ///< [s] end of the hold averaged (thesis: last second)
+    double sampleRate = 200.0;       ///< [Hz] transducer samples
+    /// FieldError naming the field unless every value is in range (angles checked by the trials).
+    void validate() const;
+};
+
+/// One measured effort.
+struct TorqueObservation {
+    double flexionDeg = 0;     ///< [deg], 0 = extended
+    int repetition = 0;
+    double torque = 0;         ///< tared elbow torque, + = flexion [N m] (with transducer noise)
+    double activation = 0;     ///< agonist activation the subject actually produced (truth; not used by identifiers) [1]
+};
+
+/// Runs the protocol on the subject (flexion efforts; each effort's activation = VA (1 + cv z) capped
+/// at 1, antagonists at CC; tared torque averaged over the window) and adds relative transducer noise
+/// of the subject's sd. Reproducible from (subject, noiseSeed). Trials run on `jobs` threads.
+std::vector<TorqueObservation> synthesizeMvcTorques(const VirtualSubject& subject, const TorqueProtocol& protocol,
+                                                    unsigned noiseSeed, int jobs = 1);
+
+/// An identifier's estimate of the primary muscle (the biceps long head).
+struct BicepsEstimate {
+    std::string method;                  ///< "thesis" or "synergist"
+    bool converged = false;
+    std::string message;                 ///< solver summary or why it failed
+    double mass = 0.0 / 0.0;             ///< M [kg]
+    double tendonLength = 0.0 / 0.0;     ///< L0T [m]
+    double massLower = 0.0 / 0.0, massUpper = 0.0 / 0.0;        ///< 95 % interval [kg]
+    double tendonLower = 0.0 / 0.0, tendonUpper = 0.0 / 0.0;    ///< 95 % interval [m]
+    double noiseLevel = 0.0 / 0.0;       ///< relative torque sd used to weight the data [1]
+    std::vector<std::string> nuisanceNames;    ///< synergist: s_syn, s_ext, VA, CC
+    std::vector<double> nuisance;              ///< their estimates
+    double massTendonCorrelation = 0.0 / 0.0;  ///< posterior correlation of ln M and ln L0T
+    double rmsResidual = 0.0 / 0.0;            ///< of the torque [N m] (thesis: of the force [N])
+};
+
+/// The thesis's method on torque data, with `assumed` as the experimenter's model (geometry and the
+/// biceps's other parameters; its primary muscle is the biceps).
+BicepsEstimate identifyThesisMethod(const ArmSetup& assumed, const std::vector<TorqueObservation>& data);
+
+/// Which muscles the synergist-aware model groups (names in the population's base model).
+struct SynergistGroups {
+    std::vector<std::string> biceps = {"BIClong", "BICshort"};  ///< share s_b and t_b
+    std::vector<std::string> synergists = {"BRA", "BRD"};       ///< share s_s
+    /// false: the synergists are left out of the identifier's model (no torque from them): the
+    /// ablation that shows what they are for.
+    bool includeSynergists = true;
+    // Every extensor shares s_e.
+};
+
+/// The synergist-aware MAP identifier with the population as prior.
+BicepsEstimate identifySynergistAware(const Population& prior, const std::vector<TorqueObservation>& data,
+                                      const SynergistGroups& groups = {});
+
+/// Net tared steady torque of `setup` at the angles [N m]: every muscle at its steady state with the
+/// flexors at `effort`'s voluntary activation and the extensors at its co-contraction, less the same
+/// with every muscle relaxed (what a tared transducer reads at the plateau of a flexion MVC).
+std::vector<double> calcTaredSteadyTorque(const ArmSetup& setup, const SubjectEffort& effort,
+                                          const std::vector<double>& flexionDeg);
+
+/// One identification in a validation: truth, estimate, coverage.
+struct ElbowValidationRow {
+    int subject = 0;
+    double noise = 0;                  ///< transducer noise used [1]
+    std::string method;
+    double trueMass = 0, trueTendonLength = 0;   ///< the subject's primary muscle [kg], [m]
+    BicepsEstimate estimate;
+    double massError = 0.0 / 0.0;      ///< estimate / truth - 1 [1]
+    double tendonError = 0.0 / 0.0;    ///< estimate - truth [m]
+    int massCovered = -1;              ///< 1/0: truth inside/outside the interval; -1: no interval
+    int tendonCovered = -1;
+    // Nuisance truths, for error-vs-nuisance plots.
+    double voluntaryActivation = 0, coContraction = 0, strengthLevel = 0;
+    double bicepsShortScale = 0.0 / 0.0;  ///< second biceps head's mass scale / primary's [1]
+    double synergistScale = 0.0 / 0.0;    ///< mean mass scale of the synergists / primary's [1]
+};
+
+/// Bias, RMSE and coverage of one method at one noise level.
+struct ElbowValidationSummary {
+    std::string method;
+    double noise = 0;
+    int subjects = 0, converged = 0;
+    double massBias = 0, massRmse = 0;        ///< relative [1]
+    double tendonBias = 0, tendonRmse = 0;    ///< [m]
+    double massCoverage = 0.0 / 0.0, tendonCoverage = 0.0 / 0.0;  ///< fraction of subjects [1]
+};
+
+/// Settings of runElbowValidation.
+struct ElbowValidationSettings {
+    int subjects = 200;
+    unsigned seed = 1;                        ///< population and noise seed
+    std::vector<double> noiseLevels;          ///< transducer noise levels; empty: the population's
+    TorqueProtocol protocol;
+    int jobs = 2;                             ///< threads (over subjects)
+};
+
+/// Draws subjects 0..subjects-1, synthesizes each one's data once per noise level (common random
+/// numbers across levels), identifies with both methods. progress(done, total) per subject.
+std::vector<ElbowValidationRow> runElbowValidation(const Population& population, const ElbowValidationSettings& settings,
+                                                   const std::function<void(int, int)>& progress = {});
+std::vector<ElbowValidationSummary> summarizeElbowValidation(const std::vector<ElbowValidationRow>& rows);
+
+}  // namespace armsim
