@@ -2,6 +2,8 @@
 // with the steady or the faithful forward model; armsim validate: the identifiers against ground truth
 // on synthetic MVC data; and the main-job step that identifies the thesis's and our own MVC data.
 #include "cli/commands.h"
+#include "experiments/plot.h"
+#include "identification/elbow_identification.h"
 #include "identification/faithful_model.h"
 #include "identification/identifier.h"
 #include "identification/report_io.h"
@@ -12,6 +14,7 @@
 #include "muscles/muscle_file.h"
 #include "muscles/param_file.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -273,9 +276,82 @@ struct ValidateOptions {
     std::string estimate = "moment-arm";
     int jobs = 2;
     std::string out = "out/validate";
+    std::string truth = "thesis";
+    std::string population;
+    int subjects = 200;
+    bool noiseGiven = false;
 };
 
+// Identified vs true biceps mass per method, and the error against two nuisances.
+void writeElbowValidationPlots(const std::vector<ElbowValidationRow>& rows, const std::string& out) {
+    PlotSpec vsTruth;
+    vsTruth.title = "Biceps long-head mass: identified vs true (elbow model as truth)";
+    vsTruth.xLabel = "true mass (g)";
+    vsTruth.yLabel = "identified mass (g)";
+    PlotSpec vsActivation = vsTruth, vsSynergists = vsTruth;
+    vsActivation.title = "Mass error vs the subject's voluntary activation";
+    vsActivation.xLabel = "voluntary activation";
+    vsActivation.yLabel = "mass error (%)";
+    vsSynergists.title = "Mass error vs synergist strength relative to the biceps";
+    vsSynergists.xLabel = "synergists' mass scale / biceps's";
+    vsSynergists.yLabel = "mass error (%)";
+    double lo = 1e9, hi = 0;
+    for (const char* method : {"thesis", "synergist"}) {
+        const int color = std::string(method) == "thesis" ? 1 : 0;
+        PlotSeries a{method, {}, {}, true, color}, b = a, c = a;
+        for (const ElbowValidationRow& r : rows) {
+            if (r.method != method || !std::isfinite(r.estimate.mass)) continue;
+            a.x.push_back(1000 * r.trueMass);
+            a.y.push_back(1000 * r.estimate.mass);
+            b.x.push_back(r.voluntaryActivation);
+            b.y.push_back(100 * r.massError);
+            c.x.push_back(r.synergistScale);
+            c.y.push_back(100 * r.massError);
+            lo = std::min(lo, 1000 * r.trueMass);
+            hi = std::max(hi, 1000 * r.trueMass);
+        }
+        vsTruth.series.push_back(a);
+        vsActivation.series.push_back(b);
+        vsSynergists.series.push_back(c);
+    }
+    vsTruth.series.push_back({"identity", {lo, hi}, {lo, hi}, false, 7});
+    writePlotPng(out + "/mass_identified_vs_true.png", vsTruth);
+    writePlotPng(out + "/mass_error_vs_activation.png", vsActivation);
+    writePlotPng(out + "/mass_error_vs_synergists.png", vsSynergists);
+}
+
+void runElbowValidate(const ValidateOptions& o) {
+    const Population population = o.population.empty() ? loadDefaultPopulation() : loadPopulation(o.population);
+    ElbowValidationSettings s;
+    s.subjects = o.subjects;
+    s.seed = o.seed;
+    s.jobs = o.jobs;
+    if (o.noiseGiven)
+        for (const std::string& v : splitList(o.noise)) s.noiseLevels.push_back(parseNumber("--noise", v) / 100.0);
+    std::printf("validation on the elbow model as truth: population '%s' (%s), %d subjects, seed %u; five-angle "
+                "MVC (3 efforts each); identifiers: thesis (biceps only) and synergist-aware (MAP)\n",
+                population.name.c_str(), population.file.c_str(), s.subjects, s.seed);
+    std::fflush(stdout);
+    const std::vector<ElbowValidationRow> rows =
+        runElbowValidation(population, s, [](int d, int n) { printProgress("subjects", d, n); });
+    const std::vector<ElbowValidationSummary> summary = summarizeElbowValidation(rows);
+    std::printf("%-10s %6s %9s %14s %14s %9s %15s %15s %9s\n", "method", "noise", "converged", "mass bias",
+                "mass RMSE", "coverage", "L0T bias", "L0T RMSE", "coverage");
+    for (const ElbowValidationSummary& x : summary)
+        std::printf("%-10s %5.1f%% %5d/%-3d %+13.1f%% %13.1f%% %9.2f %+12.1f mm %12.1f mm %9.2f\n", x.method.c_str(),
+                    100 * x.noise, x.converged, x.subjects, 100 * x.massBias, 100 * x.massRmse, x.massCoverage,
+                    1000 * x.tendonBias, 1000 * x.tendonRmse, x.tendonCoverage);
+    std::printf("goal (issue 11, synergist-aware at 2 %% noise): |mass bias| <= 3 %%, mass RMSE <= 10 %%, "
+                "L0T RMSE <= 10 mm, coverage 0.90-0.98\n");
+    writeFileAtomically(o.out + "/elbow_validation.csv", formatElbowValidationCsv(rows));
+    writeFileAtomically(o.out + "/elbow_validation_summary.csv", formatElbowValidationSummaryCsv(summary));
+    writeElbowValidationPlots(rows, o.out);
+    std::printf("wrote %s/elbow_validation.csv, elbow_validation_summary.csv, mass_identified_vs_true.png, "
+                "mass_error_vs_activation.png, mass_error_vs_synergists.png\n", o.out.c_str());
+}
+
 void runValidate(const ValidateOptions& o) {
+    if (o.truth == "elbow") return runElbowValidate(o);
     const ArmSetup setup = o.muscle.loadSetup();
     ValidationSettings s;
     s.seeds = o.seeds;
@@ -317,7 +393,21 @@ void addValidateCommand(CLI::App& app) {
     c->add_option("--jobs", o->jobs, "trials run in parallel")->capture_default_str()->check(CLI::Range(1, 64));
     o->muscle.add(*c);
     c->add_option("--out", o->out, "output directory (validation.csv)")->capture_default_str();
-    c->callback([o] { runValidate(*o); });
+    c->add_option("--truth", o->truth,
+                  "thesis: biceps-only truths (the identifier's own model); elbow: virtual subjects of the "
+                  "seven-muscle elbow drawn from --population, identified by the thesis method and the "
+                  "synergist-aware identifier")
+        ->capture_default_str()
+        ->check(CLI::IsMember({"thesis", "elbow"}));
+    c->add_option("--population", o->population,
+                  "population file for --truth elbow (default assets/subjects/default_population.yaml)");
+    c->add_option("--subjects", o->subjects, "subjects for --truth elbow")->capture_default_str()->check(CLI::Range(1, 1000000));
+    c->callback([o, c] {
+        o->noiseGiven = c->count("--noise") > 0;
+        if (o->truth != "elbow" && (c->count("--population") || c->count("--subjects")))
+            throw InputError("--population and --subjects need --truth elbow");
+        runValidate(*o);
+    });
 }
 
 // ---- main job -----------------------------------------------------------------------------------

@@ -400,4 +400,45 @@ std::vector<ElbowValidationSummary> summarizeElbowValidation(const std::vector<E
     return out;
 }
 
+namespace {
+
+std::string formatCell(double v) { return std::isfinite(v) ? formatNumber(v) : ""; }
+
+}  // namespace
+
+std::string formatElbowValidationCsv(const std::vector<ElbowValidationRow>& rows) {
+    std::string out =
+        "subject,noise,method,converged,true_mass_kg,mass_kg,mass_lower_kg,mass_upper_kg,mass_error_pct,mass_covered,"
+        "true_tendon_length_m,tendon_length_m,tendon_lower_m,tendon_upper_m,tendon_error_mm,tendon_covered,"
+        "voluntary_activation,co_contraction,strength_level,biceps_short_scale,synergist_scale,noise_level_used,"
+        "rms_residual\n";
+    for (const ElbowValidationRow& r : rows) {
+        const BicepsEstimate& e = r.estimate;
+        const std::vector<double> cells = {r.trueMass, e.mass, e.massLower, e.massUpper, 100 * r.massError};
+        out += std::to_string(r.subject) + "," + formatNumber(r.noise) + "," + r.method + "," +
+               (e.converged ? "1" : "0");
+        for (double v : cells) out += "," + formatCell(v);
+        out += "," + (r.massCovered < 0 ? std::string() : std::to_string(r.massCovered));
+        for (double v : {r.trueTendonLength, e.tendonLength, e.tendonLower, e.tendonUpper, 1000 * r.tendonError})
+            out += "," + formatCell(v);
+        out += "," + (r.tendonCovered < 0 ? std::string() : std::to_string(r.tendonCovered));
+        for (double v : {r.voluntaryActivation, r.coContraction, r.strengthLevel, r.bicepsShortScale, r.synergistScale,
+                         e.noiseLevel, e.rmsResidual})
+            out += "," + formatCell(v);
+        out += "\n";
+    }
+    return out;
+}
+
+std::string formatElbowValidationSummaryCsv(const std::vector<ElbowValidationSummary>& summaries) {
+    std::string out = "method,noise,subjects,converged,mass_bias_pct,mass_rmse_pct,mass_coverage,tendon_bias_mm,"
+                      "tendon_rmse_mm,tendon_coverage\n";
+    for (const ElbowValidationSummary& s : summaries)
+        out += s.method + "," + formatNumber(s.noise) + "," + std::to_string(s.subjects) + "," +
+               std::to_string(s.converged) + "," + formatCell(100 * s.massBias) + "," + formatCell(100 * s.massRmse) +
+               "," + formatCell(s.massCoverage) + "," + formatCell(1000 * s.tendonBias) + "," +
+               formatCell(1000 * s.tendonRmse) + "," + formatCell(s.tendonCoverage) + "\n";
+    return out;
+}
+
 }  // namespace armsim

@@ -133,5 +133,9 @@ struct ElbowValidationSettings {
 std::vector<ElbowValidationRow> runElbowValidation(const Population& population, const ElbowValidationSettings& settings,
                                                    const std::function<void(int, int)>& progress = {});
 std::vector<ElbowValidationSummary> summarizeElbowValidation(const std::vector<ElbowValidationRow>& rows);
+/// One CSV line per row: truth, estimate, 95 % interval, coverage, nuisance truths (SI units, errors in %).
+std::string formatElbowValidationCsv(const std::vector<ElbowValidationRow>& rows);
+/// Per method and noise level: bias, RMSE, coverage (CSV).
+std::string formatElbowValidationSummaryCsv(const std::vector<ElbowValidationSummary>& summaries);
 
 }  // namespace armsim

@@ -3,6 +3,7 @@
 // the loop, warm-started from steady lm, and as corrections of the steady model. Counters:
 // forward_evaluations (ForceModel::calcForces calls; faithful: five arm trials each), iterations, and
 // thesis_iterations = 52 (thesis Table 7.2, one forward run per iteration) for comparison.
+#include "identification/elbow_identification.h"
 #include "identification/faithful_model.h"
 #include "identification/identifier.h"
 #include "model/muscle_arm.h"
@@ -132,8 +133,23 @@ void BM_FaithfulForwardEvaluation(benchmark::State& state) {
     state.counters["trials"] = double(c.problem.data.points.size());
 }
 
+// Issue 11: one synergist-aware identification (elbow model, five angles x 3 efforts of a drawn
+// subject; the data are synthesized once, outside the timing). Target: median <= 1 s.
+void BM_SynergistAwareIdentification(benchmark::State& state) {
+    setenv("ARMSIM_ASSETS", ARMSIM_ASSET_DIR, 0);
+    static const Population population = loadDefaultPopulation();
+    static const std::vector<TorqueObservation> data = synthesizeMvcTorques(drawSubject(population, 1, 0), {}, 1, 2);
+    double error = 0;
+    for (auto _ : state) {
+        const BicepsEstimate e = identifySynergistAware(population, data);
+        error = e.mass / drawSubject(population, 1, 0).setup.biceps().mass - 1;
+    }
+    state.counters["mass_error_pct"] = 100 * error;
+}
+
 }  // namespace
 
+BENCHMARK(BM_SynergistAwareIdentification)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_IdentifyFiveAnglesLm)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_IdentifyFiveAnglesSignSearch)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_SteadyForwardEvaluation)->Unit(benchmark::kMicrosecond);

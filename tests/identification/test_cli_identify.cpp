@@ -13,7 +13,9 @@
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <sstream>
 #include <string>
+#include <vector>
 #include <unistd.h>
 
 namespace fs = std::filesystem;
@@ -139,4 +141,43 @@ TEST(CliValidate, TinyConfigurationPrintsItsTableAndWritesTheCsv) {
     const CommandResult bad = runArmsim("validate --noise 80 --out " + d.string());
     EXPECT_EQ(bad.exitCode, kInputErrorExit) << bad.output;
     EXPECT_NE(bad.output.find("noise"), std::string::npos) << bad.output;
+}
+
+// validate --truth elbow: both identifiers on drawn subjects, per-subject and summary CSV, plots; the
+// elbow-only options are refused without it.
+TEST(CliValidate, ElbowTruthWritesPerSubjectAndSummaryFilesAndPlots) {
+    const fs::path d = freshDir("elbow_validate");
+    const CommandResult r = runArmsim("validate --truth elbow --subjects 3 --jobs 2 --out " + d.string());
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    auto readLines = [](const fs::path& p) {
+        std::vector<std::vector<std::string>> lines;
+        std::ifstream in(p);
+        for (std::string line; std::getline(in, line);) {
+            std::vector<std::string> cells;
+            std::stringstream ss(line);
+            for (std::string c; std::getline(ss, c, ',');) cells.push_back(c);
+            lines.push_back(cells);
+        }
+        return lines;
+    };
+    const auto rows = readLines(d / "elbow_validation.csv");
+    ASSERT_EQ(rows.size(), 7u);  // header + 3 subjects x 2 methods
+    ASSERT_EQ(rows[0][4], "true_mass_kg");
+    ASSERT_EQ(rows[0][5], "mass_kg");
+    ASSERT_EQ(rows[0][8], "mass_error_pct");
+    for (std::size_t i = 1; i < rows.size(); ++i) {
+        const double truth = std::stod(rows[i][4]), mass = std::stod(rows[i][5]), error = std::stod(rows[i][8]);
+        EXPECT_NEAR(error, 100 * (mass / truth - 1), 1e-6 * (1 + std::abs(error))) << i;
+    }
+    const auto summary = readLines(d / "elbow_validation_summary.csv");
+    ASSERT_EQ(summary.size(), 3u);  // header + thesis + synergist
+    EXPECT_EQ(summary[1][0], "thesis");
+    EXPECT_EQ(summary[2][0], "synergist");
+    for (const char* png : {"mass_identified_vs_true.png", "mass_error_vs_activation.png", "mass_error_vs_synergists.png"})
+        EXPECT_GT(fs::file_size(d / png), kMinPngBytes) << png;
+    EXPECT_NE(r.output.find("synergist"), std::string::npos) << r.output;
+
+    const CommandResult bad = runArmsim("validate --subjects 3 --out " + d.string());
+    EXPECT_EQ(bad.exitCode, kInputErrorExit) << bad.output;
+    EXPECT_NE(bad.output.find("--truth elbow"), std::string::npos) << bad.output;
 }
