@@ -279,6 +279,7 @@ struct ValidateOptions {
     std::string truth = "thesis";
     std::string population;
     int subjects = 200;
+    double activationSd = 0.02;
     bool noiseGiven = false;
 };
 
@@ -296,8 +297,8 @@ void writeElbowValidationPlots(const std::vector<ElbowValidationRow>& rows, cons
     vsSynergists.xLabel = "synergists' mass scale / biceps's";
     vsSynergists.yLabel = "mass error (%)";
     double lo = 1e9, hi = 0;
-    for (const char* method : {"thesis", "synergist"}) {
-        const int color = std::string(method) == "thesis" ? 1 : 0;
+    for (const char* method : {"thesis", "synergist", "synergist-va"}) {
+        const int color = std::string(method) == "thesis" ? 1 : std::string(method) == "synergist" ? 0 : 2;
         PlotSeries a{method, {}, {}, true, color}, b = a, c = a;
         for (const ElbowValidationRow& r : rows) {
             if (r.method != method || !std::isfinite(r.estimate.mass)) continue;
@@ -326,19 +327,21 @@ void runElbowValidate(const ValidateOptions& o) {
     s.subjects = o.subjects;
     s.seed = o.seed;
     s.jobs = o.jobs;
+    s.activationSd = o.activationSd;
     if (o.noiseGiven)
         for (const std::string& v : splitList(o.noise)) s.noiseLevels.push_back(parseNumber("--noise", v) / 100.0);
     std::printf("validation on the elbow model as truth: population '%s' (%s), %d subjects, seed %u; five-angle "
-                "MVC (3 efforts each); identifiers: thesis (biceps only) and synergist-aware (MAP)\n",
+                "MVC (3 efforts each); identifiers: thesis (biceps only), synergist-aware (MAP) and, with --activation-sd > 0, "
+                "synergist-aware with voluntary activation measured by twitch interpolation (synergist-va)\n",
                 population.name.c_str(), population.file.c_str(), s.subjects, s.seed);
     std::fflush(stdout);
     const std::vector<ElbowValidationRow> rows =
         runElbowValidation(population, s, [](int d, int n) { printProgress("subjects", d, n); });
     const std::vector<ElbowValidationSummary> summary = summarizeElbowValidation(rows);
-    std::printf("%-10s %6s %9s %14s %14s %9s %15s %15s %9s\n", "method", "noise", "converged", "mass bias",
+    std::printf("%-13s %6s %9s %14s %14s %9s %15s %15s %9s\n", "method", "noise", "converged", "mass bias",
                 "mass RMSE", "coverage", "L0T bias", "L0T RMSE", "coverage");
     for (const ElbowValidationSummary& x : summary)
-        std::printf("%-10s %5.1f%% %5d/%-3d %+13.1f%% %13.1f%% %9.2f %+12.1f mm %12.1f mm %9.2f\n", x.method.c_str(),
+        std::printf("%-13s %5.1f%% %5d/%-3d %+13.1f%% %13.1f%% %9.2f %+12.1f mm %12.1f mm %9.2f\n", x.method.c_str(),
                     100 * x.noise, x.converged, x.subjects, 100 * x.massBias, 100 * x.massRmse, x.massCoverage,
                     1000 * x.tendonBias, 1000 * x.tendonRmse, x.tendonCoverage);
     std::printf("goal (issue 11, synergist-aware at 2 %% noise): |mass bias| <= 3 %%, mass RMSE <= 10 %%, "
@@ -401,11 +404,16 @@ void addValidateCommand(CLI::App& app) {
         ->check(CLI::IsMember({"thesis", "elbow"}));
     c->add_option("--population", o->population,
                   "population file for --truth elbow (default assets/subjects/default_population.yaml)");
+    c->add_option("--activation-sd", o->activationSd,
+                  "--truth elbow: sd of a twitch-interpolation measurement of voluntary activation for the "
+                  "synergist-va identifier (0: leave it out)")
+        ->capture_default_str()
+        ->check(CLI::Range(0.0, 0.5));
     c->add_option("--subjects", o->subjects, "subjects for --truth elbow")->capture_default_str()->check(CLI::Range(1, 1000000));
     c->callback([o, c] {
         o->noiseGiven = c->count("--noise") > 0;
-        if (o->truth != "elbow" && (c->count("--population") || c->count("--subjects")))
-            throw InputError("--population and --subjects need --truth elbow");
+        if (o->truth != "elbow" && (c->count("--population") || c->count("--subjects") || c->count("--activation-sd")))
+            throw InputError("--population, --subjects and --activation-sd need --truth elbow");
         runValidate(*o);
     });
 }

@@ -96,36 +96,48 @@ double estimateNoiseLevel(const std::vector<TorqueObservation>& data) {
     return dof > 0 ? std::sqrt(ss / dof) : NAN;
 }
 
-// The synergist-aware problem: x = [ln s_b, ln t_b, ln s_s, ln s_e, VA, CC, ln f_b, ln t_s, ln f_s]
-// (f: fascicle length scales; the last three are nuisances whose population spread widens the
-// intervals of the first two as it should).
+// The synergist-aware problem. x = [ln t_b, VA, CC, ln f_b, ln t_s, ln f_s, ln s_e, then ln s_m for every
+// biceps head and every synergist m]: t tendon, f fascicle length and s mass scales; b the biceps heads
+// (one tendon and one fascicle scale), s the synergists, e the extensors (one mass scale).
 struct SynergistProblem {
-    static constexpr int kSize = 9;
+    static constexpr int kTendon = 0, kActivation = 1, kCoContraction = 2, kFascicle = 3, kSynergistTendon = 4,
+                         kSynergistFascicle = 5, kExtensorMass = 6, kFirstMass = 7;
     const ArmSetup* base;
     AngleGeometry geometry;
     std::vector<int> angleOf;                 // observation -> angle index
     std::vector<double> torque, sd;           // observations and their sd [N m]
     std::vector<int> biceps, synergists, extensors, leftOut;
 
+    int size() const { return kFirstMass + int(biceps.size() + synergists.size()); }
+    /// Index in x of muscle i's own mass scale (-1: extensor or ungrouped).
+    int findMassIndex(int i) const {
+        for (std::size_t k = 0; k < biceps.size(); ++k)
+            if (biceps[k] == i) return kFirstMass + int(k);
+        for (std::size_t k = 0; k < synergists.size(); ++k)
+            if (synergists[k] == i) return kFirstMass + int(biceps.size() + k);
+        return -1;
+    }
     std::vector<MuscleSpec> makeMuscles(const double* x) const {
         std::vector<MuscleSpec> m = base->muscles;
-        for (int i : biceps) {
-            m[i].params.mass *= std::exp(x[0]);
-            m[i].params.optimalTendonLength *= std::exp(x[1]);
-            m[i].params.optimalFascicleLength *= std::exp(x[6]);
+        for (std::size_t k = 0; k < biceps.size(); ++k) {
+            MuscleParameters& q = m[biceps[k]].params;
+            q.mass *= std::exp(x[kFirstMass + k]);
+            q.optimalTendonLength *= std::exp(x[kTendon]);
+            q.optimalFascicleLength *= std::exp(x[kFascicle]);
         }
-        for (int i : synergists) {
-            m[i].params.mass *= std::exp(x[2]);
-            m[i].params.optimalTendonLength *= std::exp(x[7]);
-            m[i].params.optimalFascicleLength *= std::exp(x[8]);
+        for (std::size_t k = 0; k < synergists.size(); ++k) {
+            MuscleParameters& q = m[synergists[k]].params;
+            q.mass *= std::exp(x[kFirstMass + biceps.size() + k]);
+            q.optimalTendonLength *= std::exp(x[kSynergistTendon]);
+            q.optimalFascicleLength *= std::exp(x[kSynergistFascicle]);
         }
-        for (int i : extensors) m[i].params.mass *= std::exp(x[3]);
+        for (int i : extensors) m[i].params.mass *= std::exp(x[kExtensorMass]);
         return m;
     }
     std::vector<double> predict(const double* x) const {
         SubjectEffort e;
-        e.voluntaryActivation = x[4];
-        e.coContraction = x[5];
+        e.voluntaryActivation = x[kActivation];
+        e.coContraction = x[kCoContraction];
         return calcTaredTorque(makeMuscles(x), geometry, e, leftOut);
     }
     // Whitened data residuals; false where a muscle has no steady state.
@@ -223,14 +235,19 @@ BicepsEstimate identifyThesisMethod(const ArmSetup& assumed, const std::vector<T
 }
 
 BicepsEstimate identifySynergistAware(const Population& prior, const std::vector<TorqueObservation>& data,
-                                      const SynergistGroups& groups) {
+                                      const SynergistOptions& options) {
     if (data.empty()) throw InputError("synergist-aware identifier: no observations");
     const ArmSetup& base = prior.base;
     SynergistProblem p;
     p.base = &base;
-    p.biceps = findMuscles(base, groups.biceps, "biceps");
-    p.synergists = findMuscles(base, groups.synergists, "synergists");
-    if (!groups.includeSynergists) p.leftOut = p.synergists;
+    p.biceps = findMuscles(base, options.biceps, "biceps");
+    p.synergists = findMuscles(base, options.synergists, "synergists");
+    if (!options.includeSynergists) p.leftOut = p.synergists;
+    const bool measured = std::isfinite(options.measuredActivation);
+    if (measured) {
+        checkField("measured voluntary activation", options.measuredActivation, Bound::closed(0, 1));
+        checkField("activation sd", options.activationSd, Bound::positive());
+    }
     for (int i = 0; i < base.getNumMuscles(); ++i)
         if (base.muscles[i].group == MuscleGroup::Extensor) p.extensors.push_back(i);
     if (std::find(p.biceps.begin(), p.biceps.end(), base.primary) == p.biceps.end())
@@ -247,50 +264,70 @@ BicepsEstimate identifySynergistAware(const Population& prior, const std::vector
     p.geometry = calcAngleGeometry(base, angles);
 
     BicepsEstimate est;
-    est.method = "synergist";
+    est.method = measured ? "synergist-va" : "synergist";
     est.noiseLevel = estimateNoiseLevel(data);
     if (!std::isfinite(est.noiseLevel)) est.noiseLevel = prior.transducerNoise;
     est.noiseLevel = std::max(est.noiseLevel, 0.002);  // floor: the scatter of few repetitions can be ~0
     for (double t : p.torque) p.sd.push_back(est.noiseLevel * std::max(std::abs(t), 1.0));
 
-    // Prior: strength levels share the person-level variance; lengths and effort independent.
-    constexpr int n = SynergistProblem::kSize;
+    // Prior: every mass scale shares the person-level variance (the extensors' one scale averages
+    // their muscle terms); lengths and effort independent.
+    using P = SynergistProblem;
+    const int n = p.size();
     const double s2 = prior.strengthSubjectSd * prior.strengthSubjectSd;
     const double m2 = prior.strengthMuscleSd * prior.strengthMuscleSd;
     auto uniformSd = [](const UniformRange& r) { return std::max((r.max - r.min) / std::sqrt(12.0), 1e-4); };
     MapProblem map;
     map.priorCovariance.assign(n, std::vector<double>(n, 0.0));
     auto& cov = map.priorCovariance;
-    const int strength[3] = {0, 2, 3};
-    const double members[3] = {double(p.biceps.size()), double(std::max<std::size_t>(p.synergists.size(), 1)),
-                               double(std::max<std::size_t>(p.extensors.size(), 1))};
-    for (int a = 0; a < 3; ++a)
-        for (int b = 0; b < 3; ++b) cov[strength[a]][strength[b]] = s2 + (a == b ? m2 / members[a] : 0.0);
-    cov[1][1] = cov[7][7] = prior.tendonLengthSd * prior.tendonLengthSd;
-    cov[4][4] = std::pow(uniformSd(prior.voluntaryActivation), 2);
-    cov[5][5] = std::pow(uniformSd(prior.coContraction), 2);
-    cov[6][6] = cov[8][8] = prior.fascicleLengthSd * prior.fascicleLengthSd;
+    for (int a = P::kExtensorMass; a < n; ++a)
+        for (int b = P::kExtensorMass; b < n; ++b) cov[a][b] = s2;
+    cov[P::kExtensorMass][P::kExtensorMass] += m2 / double(std::max<std::size_t>(p.extensors.size(), 1));
+    for (int a = P::kFirstMass; a < n; ++a) cov[a][a] += m2;
+    cov[P::kTendon][P::kTendon] = cov[P::kSynergistTendon][P::kSynergistTendon] = std::pow(prior.tendonLengthSd, 2);
+    cov[P::kFascicle][P::kFascicle] = cov[P::kSynergistFascicle][P::kSynergistFascicle] =
+        std::pow(prior.fascicleLengthSd, 2);
+    cov[P::kActivation][P::kActivation] = std::pow(uniformSd(prior.voluntaryActivation), 2);
+    cov[P::kCoContraction][P::kCoContraction] = std::pow(uniformSd(prior.coContraction), 2);
     for (int j = 0; j < n; ++j) cov[j][j] = std::max(cov[j][j], 1e-10);  // a zero spread: the value is known
     map.priorMean.assign(n, 0.0);
-    map.priorMean[4] = 0.5 * (prior.voluntaryActivation.min + prior.voluntaryActivation.max);
-    map.priorMean[5] = 0.5 * (prior.coContraction.min + prior.coContraction.max);
+    map.priorMean[P::kActivation] = 0.5 * (prior.voluntaryActivation.min + prior.voluntaryActivation.max);
+    map.priorMean[P::kCoContraction] = 0.5 * (prior.coContraction.min + prior.coContraction.max);
     const double lnLo = std::log(0.25), lnHi = std::log(4.0), lenLo = std::log(0.6), lenHi = std::log(1.4);
-    map.lower = {lnLo, lenLo, lnLo, lnLo, prior.voluntaryActivation.min, prior.coContraction.min, lenLo, lenLo, lenLo};
-    map.upper = {lnHi, lenHi, lnHi, lnHi, std::max(prior.voluntaryActivation.max, prior.voluntaryActivation.min + 1e-6),
-                 std::max(prior.coContraction.max, prior.coContraction.min + 1e-6), lenHi, lenHi, lenHi};
-    map.numResiduals = int(p.torque.size());
-    map.residuals = [&p](const double* x, double* r) { return p.calcResiduals(x, r); };
+    map.lower.assign(n, lnLo);
+    map.upper.assign(n, lnHi);
+    for (int j : {P::kTendon, P::kFascicle, P::kSynergistTendon, P::kSynergistFascicle}) {
+        map.lower[j] = lenLo;
+        map.upper[j] = lenHi;
+    }
+    map.lower[P::kActivation] = prior.voluntaryActivation.min;
+    map.upper[P::kActivation] = std::max(prior.voluntaryActivation.max, prior.voluntaryActivation.min + 1e-6);
+    map.lower[P::kCoContraction] = prior.coContraction.min;
+    map.upper[P::kCoContraction] = std::max(prior.coContraction.max, prior.coContraction.min + 1e-6);
+    map.numResiduals = int(p.torque.size()) + (measured ? 1 : 0);
+    map.residuals = [&](const double* x, double* r) {
+        if (measured) r[p.torque.size()] = (x[P::kActivation] - options.measuredActivation) / options.activationSd;
+        return p.calcResiduals(x, r);
+    };
     const MapResult m = calcMapEstimate(map);
     const std::vector<double>& x = m.x;
     est.converged = m.converged;
     est.message = m.message;
 
     const MuscleParameters& b = base.muscles[base.primary].params;
-    est.mass = b.mass * std::exp(x[0]);
-    est.tendonLength = b.optimalTendonLength * std::exp(x[1]);
-    est.nuisanceNames = {"synergist_mass_scale", "extensor_mass_scale", "voluntary_activation", "co_contraction",
-                         "biceps_fascicle_scale", "synergist_tendon_scale", "synergist_fascicle_scale"};
-    est.nuisance = {std::exp(x[2]), std::exp(x[3]), x[4], x[5], std::exp(x[6]), std::exp(x[7]), std::exp(x[8])};
+    const int im = p.findMassIndex(base.primary);
+    est.mass = b.mass * std::exp(x[im]);
+    est.tendonLength = b.optimalTendonLength * std::exp(x[P::kTendon]);
+    est.nuisanceNames = {"voluntary_activation", "co_contraction", "biceps_fascicle_scale", "synergist_tendon_scale",
+                         "synergist_fascicle_scale", "extensor_mass_scale"};
+    est.nuisance = {x[P::kActivation], x[P::kCoContraction], std::exp(x[P::kFascicle]),
+                    std::exp(x[P::kSynergistTendon]), std::exp(x[P::kSynergistFascicle]), std::exp(x[P::kExtensorMass])};
+    for (int i = 0; i < base.getNumMuscles(); ++i) {
+        const int k = p.findMassIndex(i);
+        if (k < 0 || i == base.primary) continue;
+        est.nuisanceNames.push_back(base.muscles[i].params.name + "_mass_scale");
+        est.nuisance.push_back(std::exp(x[k]));
+    }
     try {
         const std::vector<double> t = p.predict(x.data());
         double ss = 0;
@@ -302,14 +339,24 @@ BicepsEstimate identifySynergistAware(const Population& prior, const std::vector
         return est;
     }
     if (!m.covariance.empty()) {
-        const double sm = std::sqrt(m.covariance[0][0]), st = std::sqrt(m.covariance[1][1]);
-        est.massLower = b.mass * std::exp(x[0] - kZ95 * sm);
-        est.massUpper = b.mass * std::exp(x[0] + kZ95 * sm);
-        est.tendonLower = b.optimalTendonLength * std::exp(x[1] - kZ95 * st);
-        est.tendonUpper = b.optimalTendonLength * std::exp(x[1] + kZ95 * st);
-        est.massTendonCorrelation = m.covariance[0][1] / (sm * st);
+        const double sm = std::sqrt(m.covariance[im][im]), st = std::sqrt(m.covariance[P::kTendon][P::kTendon]);
+        est.massLower = b.mass * std::exp(x[im] - kZ95 * sm);
+        est.massUpper = b.mass * std::exp(x[im] + kZ95 * sm);
+        est.tendonLower = b.optimalTendonLength * std::exp(x[P::kTendon] - kZ95 * st);
+        est.tendonUpper = b.optimalTendonLength * std::exp(x[P::kTendon] + kZ95 * st);
+        est.massTendonCorrelation = m.covariance[im][P::kTendon] / (sm * st);
     }
     return est;
+}
+
+double measureVoluntaryActivation(const std::vector<TorqueObservation>& data, double sd, unsigned seed) {
+    if (data.empty()) throw InputError("measureVoluntaryActivation: no efforts");
+    checkField("activation sd", sd, Bound::nonNegative());
+    std::mt19937_64 rng(seed);
+    std::normal_distribution<double> normal;
+    double mean = 0;
+    for (const TorqueObservation& o : data) mean += o.activation / double(data.size());
+    return std::clamp(mean + sd * normal(rng), 0.0, 1.0);
 }
 
 std::vector<ElbowValidationRow> runElbowValidation(const Population& population, const ElbowValidationSettings& settings,
@@ -317,14 +364,15 @@ std::vector<ElbowValidationRow> runElbowValidation(const Population& population,
     population.validate();
     settings.protocol.validate();
     checkField("subjects", settings.subjects, Bound::closed(1, 1e6));
+    checkField("activation_sd", settings.activationSd, Bound::closed(0, 0.5));
     std::vector<double> levels = settings.noiseLevels;
     if (levels.empty()) levels.push_back(population.transducerNoise);
     for (double v : levels) checkField("noise", v, Bound{0, 0.5, false, true, "relative sd"});
     const int primary = population.base.primary;
     int bicepsShort = -1;  // the other biceps head
-    for (int i : findMuscles(population.base, SynergistGroups().biceps, "biceps"))
+    for (int i : findMuscles(population.base, SynergistOptions().biceps, "biceps"))
         if (i != primary) bicepsShort = i;
-    const std::vector<int> synergists = findMuscles(population.base, SynergistGroups().synergists, "synergists");
+    const std::vector<int> synergists = findMuscles(population.base, SynergistOptions().synergists, "synergists");
 
     std::vector<std::vector<ElbowValidationRow>> perSubject(settings.subjects);
     runParallel(settings.subjects, settings.jobs, [&](int s) {
@@ -332,8 +380,14 @@ std::vector<ElbowValidationRow> runElbowValidation(const Population& population,
         for (double level : levels) {
             v.transducerNoise = level;
             const std::vector<TorqueObservation> data = synthesizeMvcTorques(v, settings.protocol, settings.seed, 1);
-            const BicepsEstimate estimates[2] = {identifyThesisMethod(population.base, data),
-                                                 identifySynergistAware(population, data)};
+            std::vector<BicepsEstimate> estimates = {identifyThesisMethod(population.base, data),
+                                                     identifySynergistAware(population, data)};
+            if (settings.activationSd > 0) {
+                SynergistOptions withVa;
+                withVa.activationSd = settings.activationSd;
+                withVa.measuredActivation = measureVoluntaryActivation(data, settings.activationSd, settings.seed + 7919u * unsigned(s));
+                estimates.push_back(identifySynergistAware(population, data, withVa));
+            }
             for (const BicepsEstimate& e : estimates) {
                 ElbowValidationRow row;
                 row.subject = s;

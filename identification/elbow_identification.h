@@ -1,19 +1,20 @@
 // Identifying the biceps on a realistic elbow (issue 11): MVC torque data synthesized from virtual
-// subjects (experiments/population.h) in the seven-muscle arm, and two identifiers of the biceps long
+// subjects (experiments/population.h) in the seven-muscle arm, and identifiers of the biceps long
 // head's mass M and optimal tendon length L0T from them:
 //
-// "thesis"     The thesis's method as it is: the biceps force is the tared torque over the biceps
-//              moment arm, a biceps-only model at full activation is fitted to those forces (steady
-//              model, lm, relative noise; intervals from the residual scatter).
-// "synergist"  Maximum a posteriori fit of the net tared joint torque predicted by the whole elbow model:
-//              free are ln s_b (mass scale of both biceps heads), ln t_b (their tendon scale), ln s_s
-//              (mass scale of the other flexors), ln s_e (of the extensors), voluntary activation VA and
-//              co-contraction CC, with the population as prior (the strength levels with their shared
-//              person-level covariance, lengths and effort from their ranges). Data residuals are
-//              weighted by a relative noise level estimated from the repetitions' scatter. The
-//              posterior covariance is the inverse Gauss-Newton Hessian of all weighted residuals
-//              (Laplace approximation); 95 % intervals are normal in the log scales, so M and L0T
-//              intervals are exp-transformed.
+// "thesis"       The thesis's method as it is: the biceps force is the tared torque over the biceps
+//                moment arm, a biceps-only model at full activation is fitted to those forces (steady
+//                model, lm, relative noise; intervals from the residual scatter).
+// "synergist"    Maximum a posteriori fit of the net tared joint torque predicted by the whole elbow
+//                model (identification/map_estimate.h). Free: a log mass scale per biceps head and per
+//                synergist, one for the extensors, the biceps heads' tendon and fascicle length scales,
+//                the synergists' tendon and fascicle scales, voluntary activation VA and co-contraction
+//                CC. Prior: the population's (mass scales share the person-level variance and add the
+//                per-muscle one; lengths and effort from their spreads and ranges). Data residuals are
+//                weighted by a relative noise level estimated from the repetitions' scatter. The
+//                posterior covariance is the Laplace approximation; 95 % intervals are normal in the
+//                log scales, so the M and L0T intervals are exp-transformed.
+// "synergist-va" The same with VA measured by twitch interpolation (one more residual).
 // The prediction is the steady isometric torque at the protocol's angles with the subject's effort
 // less the relaxed torque (the transducer is tared at rest), summed over every muscle.
 #pragma once
@@ -54,7 +55,7 @@ std::vector<TorqueObservation> synthesizeMvcTorques(const VirtualSubject& subjec
 
 /// An identifier's estimate of the primary muscle (the biceps long head).
 struct BicepsEstimate {
-    std::string method;                  ///< "thesis" or "synergist"
+    std::string method;                  ///< "thesis", "synergist" or "synergist-va"
     bool converged = false;
     std::string message;                 ///< solver summary or why it failed
     double mass = 0.0 / 0.0;             ///< M [kg]
@@ -72,19 +73,29 @@ struct BicepsEstimate {
 /// biceps's other parameters; its primary muscle is the biceps).
 BicepsEstimate identifyThesisMethod(const ArmSetup& assumed, const std::vector<TorqueObservation>& data);
 
-/// Which muscles the synergist-aware model groups (names in the population's base model).
-struct SynergistGroups {
+/// The synergist-aware identifier's model and extra measurements.
+struct SynergistOptions {
+    /// Which muscles the model groups (names in the population's base model).
     std::vector<std::string> biceps = {"BIClong", "BICshort"};  ///< share s_b and t_b
     std::vector<std::string> synergists = {"BRA", "BRD"};       ///< share s_s
     /// false: the synergists are left out of the identifier's model (no torque from them): the
     /// ablation that shows what they are for.
     bool includeSynergists = true;
     // Every extensor shares s_e.
+    /// The subject's voluntary activation measured by twitch interpolation (superimposed stimulation
+    /// during the MVCs) [1]; NaN: not measured. Adds the residual (VA - measured) / activationSd.
+    double measuredActivation = 0.0 / 0.0;
+    double activationSd = 0.02;  ///< sd of that measurement [1] (an assumption, see measureVoluntaryActivation)
 };
 
 /// The synergist-aware MAP identifier with the population as prior.
 BicepsEstimate identifySynergistAware(const Population& prior, const std::vector<TorqueObservation>& data,
-                                      const SynergistGroups& groups = {});
+                                      const SynergistOptions& options = {});
+
+/// A twitch-interpolation measurement of the subject's voluntary activation: the mean activation of
+/// the efforts actually produced, plus N(0, sd^2) measurement error, within [0, 1]. The default sd
+/// 0.02 is an assumption for a practised lab, not a cited value.
+double measureVoluntaryActivation(const std::vector<TorqueObservation>& data, double sd, unsigned seed);
 
 /// Net tared steady torque of `setup` at the angles [N m]: every muscle at its steady state with the
 /// flexors at `effort`'s voluntary activation and the extensors at its co-contraction, less the same
@@ -124,6 +135,9 @@ struct ElbowValidationSettings {
     int subjects = 200;
     unsigned seed = 1;                        ///< population and noise seed
     std::vector<double> noiseLevels;          ///< transducer noise levels; empty: the population's
+    /// > 0: also run "synergist-va", the synergist-aware identifier with voluntary activation measured
+    /// by twitch interpolation to this sd [1]; 0: not.
+    double activationSd = 0.02;
     TorqueProtocol protocol;
     int jobs = 2;                             ///< threads (over subjects)
 };

@@ -161,7 +161,7 @@ TEST(CliValidate, ElbowTruthWritesPerSubjectAndSummaryFilesAndPlots) {
         return lines;
     };
     const auto rows = readLines(d / "elbow_validation.csv");
-    ASSERT_EQ(rows.size(), 7u);  // header + 3 subjects x 2 methods
+    ASSERT_EQ(rows.size(), 10u);  // header + 3 subjects x 3 methods
     ASSERT_EQ(rows[0][4], "true_mass_kg");
     ASSERT_EQ(rows[0][5], "mass_kg");
     ASSERT_EQ(rows[0][8], "mass_error_pct");
@@ -170,9 +170,10 @@ TEST(CliValidate, ElbowTruthWritesPerSubjectAndSummaryFilesAndPlots) {
         EXPECT_NEAR(error, 100 * (mass / truth - 1), 1e-6 * (1 + std::abs(error))) << i;
     }
     const auto summary = readLines(d / "elbow_validation_summary.csv");
-    ASSERT_EQ(summary.size(), 3u);  // header + thesis + synergist
+    ASSERT_EQ(summary.size(), 4u);  // header + thesis + synergist + synergist-va
     EXPECT_EQ(summary[1][0], "thesis");
     EXPECT_EQ(summary[2][0], "synergist");
+    EXPECT_EQ(summary[3][0], "synergist-va");
     for (const char* png : {"mass_identified_vs_true.png", "mass_error_vs_activation.png", "mass_error_vs_synergists.png"})
         EXPECT_GT(fs::file_size(d / png), kMinPngBytes) << png;
     EXPECT_NE(r.output.find("synergist"), std::string::npos) << r.output;
