@@ -414,6 +414,11 @@ void addValidateCommand(CLI::App& app) {
         o->noiseGiven = c->count("--noise") > 0;
         if (o->truth != "elbow" && (c->count("--population") || c->count("--subjects") || c->count("--activation-sd")))
             throw InputError("--population, --subjects and --activation-sd need --truth elbow");
+        if (o->truth == "elbow")
+            for (const char* option : {"--seeds", "--methods", "--forward", "--estimate"})
+                if (c->count(option))
+                    throw InputError(std::string(option) + " applies to --truth thesis only (--truth elbow runs the "
+                                     "thesis, synergist and synergist-va identifiers on --subjects drawn subjects)");
         runValidate(*o);
     });
 }

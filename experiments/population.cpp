@@ -1,11 +1,12 @@
 #include "experiments/population.h"
 
+#include "experiments/portable_random.h"
+
 #include "muscles/muscle_file.h"
 #include "muscles/param_file.h"
 
 #include <algorithm>
 #include <cmath>
-#include <random>
 
 namespace armsim {
 
@@ -29,10 +30,9 @@ UniformRange readRange(const ParamNode& node, const std::string& key, const Unif
 }
 
 // N(0, 1) truncated at +/- 3 (a length scale of 1 +/- 3 sd stays positive for sd < 1/3).
-double drawTruncatedNormal(std::mt19937_64& rng) {
-    std::normal_distribution<double> normal;
+double drawTruncatedNormal(PortableRandom& rng) {
     for (;;) {
-        const double z = normal(rng);
+        const double z = rng.drawNormal();
         if (std::abs(z) <= 3) return z;
     }
 }
@@ -106,25 +106,22 @@ Population loadDefaultPopulation() { return loadPopulation(findAsset("subjects/d
 VirtualSubject drawSubject(const Population& population, unsigned seed, int index) {
     population.validate();
     if (index < 0) throw InputError("subject index " + std::to_string(index) + ": expected >= 0");
-    std::seed_seq seq{seed, unsigned(index)};
-    std::mt19937_64 rng(seq);
-    std::normal_distribution<double> normal;
-    std::uniform_real_distribution<double> uniform;
+    PortableRandom rng{seed, unsigned(index)};
 
     VirtualSubject v;
     v.index = index;
     v.seed = seed;
     v.setup = population.base;
     v.transducerNoise = population.transducerNoise;
-    v.strengthLevel = population.strengthSubjectSd * normal(rng);
+    v.strengthLevel = population.strengthSubjectSd * rng.drawNormal();
     for (MuscleSpec& m : v.setup.muscles) {
         const MuscleParameters base = m.params;
-        const double mass = std::exp(v.strengthLevel + population.strengthMuscleSd * normal(rng));
-        const double slow = population.slowFractionSd * normal(rng);
+        const double mass = std::exp(v.strengthLevel + population.strengthMuscleSd * rng.drawNormal());
+        const double slow = population.slowFractionSd * rng.drawNormal();
         double tendon = 1, fascicle = 1;
         // Lengths are redrawn until the relaxed muscle stays inside the model's range at its longest
         // path (a person whose fascicle would pass the nf limit at full extension is not drawn).
-        for (int attempt = 0;; ++attempt) {
+        for (int attempt = 1;; ++attempt) {
             tendon = 1 + population.tendonLengthSd * drawTruncatedNormal(rng);
             fascicle = 1 + population.fascicleLengthSd * drawTruncatedNormal(rng);
             m.params = base;
@@ -144,7 +141,7 @@ VirtualSubject drawSubject(const Population& population, unsigned seed, int inde
         v.tendonLengthScale.push_back(tendon);
         v.fascicleLengthScale.push_back(fascicle);
     }
-    auto draw = [&](const UniformRange& r) { return r.min + (r.max - r.min) * uniform(rng); };
+    auto draw = [&](const UniformRange& r) { return r.min + (r.max - r.min) * rng.drawUniform(); };
     v.setup.effort.voluntaryActivation = draw(population.voluntaryActivation);
     v.setup.effort.coContraction = draw(population.coContraction);
     v.setup.effort.trialCv = population.trialCv;

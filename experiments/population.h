@@ -8,10 +8,10 @@
 // Slow fraction: F_slow + N(0, sd^2), clipped to [0.05, 0.95]. A muscle's lengths are redrawn while its
 // relaxed fascicle at the longest path (P_max) would pass 95 % of the model's nf limit (such a person
 // could not extend the elbow within the model's validity), so length draws are slightly narrower than
-// stated for muscles near that limit. Effort: voluntary activation and
-// co-contraction uniform in their ranges; trial CV as given. Every draw comes from one
-// std::mt19937_64 seeded with seed_seq{seed, index}, in a fixed order, so subject k does not depend
-// on how many subjects are drawn or in what order.
+// stated for muscles near that limit. Effort: voluntary activation and co-contraction uniform in
+// their ranges; trial CV as given. Every draw comes from one PortableRandom seeded with {seed, index}
+// (the same draws with every standard library), in a fixed order, so subject k does not depend on how
+// many subjects are drawn or in what order.
 #pragma once
 
 #include "model/model_file.h"

@@ -70,7 +70,7 @@ Table selectColumns(const Table& t, const std::vector<std::size_t>& columns) {
     for (int i = 0; i < t.getNumRows(); ++i) {
         std::vector<double> row;
         row.reserve(columns.size());
-        for (std::size_t c : columns) row.push_back(t.getRow(i)[c]);
+        for (std::size_t c : columns) row.push_back(t.get(i, int(c)));
         out.appendRow(std::move(row));
     }
     return out;

@@ -2,6 +2,8 @@
 
 #include "identification/identifier.h"
 #include "identification/map_estimate.h"
+#include "identification/statistics.h"
+#include "experiments/portable_random.h"
 #include "model/geometry.h"
 #include "model/muscle_arm.h"
 #include "model/parallel.h"
@@ -11,13 +13,11 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
-#include <random>
+#include <tuple>
 
 namespace armsim {
 
 namespace {
-
-constexpr double kZ95 = 1.959963984540054;  // two-sided 95 % normal quantile
 
 // Path length and moment arm of every muscle at each angle (the geometry does not depend on the
 // muscle parameters an identifier changes).
@@ -79,8 +79,9 @@ std::vector<int> findMuscles(const ArmSetup& setup, const std::vector<std::strin
     return out;
 }
 
-// Relative torque sd pooled over the angles' repetitions; NaN without repetitions.
-double estimateNoiseLevel(const std::vector<TorqueObservation>& data) {
+// Relative torque sd pooled over the angles' repetitions (NaN without repetitions) and its degrees of
+// freedom.
+std::pair<double, int> estimateNoiseLevel(const std::vector<TorqueObservation>& data) {
     std::map<double, std::vector<double>> byAngle;
     for (const TorqueObservation& o : data) byAngle[o.flexionDeg].push_back(o.torque);
     double ss = 0;
@@ -93,7 +94,7 @@ double estimateNoiseLevel(const std::vector<TorqueObservation>& data) {
         for (double x : v) ss += (x / m - 1) * (x / m - 1);
         dof += int(v.size()) - 1;
     }
-    return dof > 0 ? std::sqrt(ss / dof) : NAN;
+    return {dof > 0 ? std::sqrt(ss / dof) : NAN, dof};
 }
 
 // The synergist-aware problem. x = [ln t_b, VA, CC, ln f_b, ln t_s, ln f_s, ln s_e, then ln s_m for every
@@ -136,8 +137,9 @@ struct SynergistProblem {
     }
     std::vector<double> predict(const double* x) const {
         SubjectEffort e;
-        e.voluntaryActivation = x[kActivation];
-        e.coContraction = x[kCoContraction];
+        // Guard: the bounds keep difference probes inside [0, 1] (see identifySynergistAware).
+        e.voluntaryActivation = std::clamp(x[kActivation], 0.0, 1.0);
+        e.coContraction = std::clamp(x[kCoContraction], 0.0, 1.0);
         return calcTaredTorque(makeMuscles(x), geometry, e, leftOut);
     }
     // Whitened data residuals; false where a muscle has no steady state.
@@ -172,18 +174,15 @@ std::vector<double> calcTaredSteadyTorque(const ArmSetup& setup, const SubjectEf
 std::vector<TorqueObservation> synthesizeMvcTorques(const VirtualSubject& subject, const TorqueProtocol& protocol,
                                                     unsigned noiseSeed, int jobs) {
     protocol.validate();
-    std::seed_seq seq{noiseSeed, subject.seed, unsigned(subject.index)};
-    std::mt19937_64 rng(seq);
-    std::normal_distribution<double> normal;
+    PortableRandom rng{noiseSeed, subject.seed, unsigned(subject.index)};
     const SubjectEffort& e = subject.setup.effort;
     std::vector<IsometricTrialSettings> trials;
     std::vector<TorqueObservation> data;
-    std::vector<double> noise;
     for (int r = 0; r < protocol.repetitions; ++r)
         for (double q : protocol.flexionDeg) {
             IsometricTrialSettings s;
             s.elbowAngle = elbowAngleFromFlexion(degToRad(q));
-            s.activation = std::clamp(e.voluntaryActivation * (1 + e.trialCv * normal(rng)), 0.0, 1.0);
+            s.activation = std::clamp(e.voluntaryActivation * (1 + e.trialCv * rng.drawNormal()), 0.0, 1.0);
             s.antagonistActivation = e.coContraction;
             s.effort = MuscleGroup::Flexor;
             s.restDuration = protocol.restDuration;
@@ -191,11 +190,21 @@ std::vector<TorqueObservation> synthesizeMvcTorques(const VirtualSubject& subjec
             s.averagingWindow = protocol.averagingWindow;
             s.sampleRate = protocol.sampleRate;
             trials.push_back(s);
-            noise.push_back(subject.transducerNoise * normal(rng));
-            data.push_back({q, r, 0.0, s.activation});
+            TorqueObservation o;
+            o.flexionDeg = q;
+            o.repetition = r;
+            o.activation = s.activation;
+            o.noiseDraw = rng.drawNormal();
+            data.push_back(o);
         }
     const std::vector<IsometricTrialResult> results = runIsometricTrials(subject.setup, trials, jobs);
-    for (std::size_t k = 0; k < data.size(); ++k) data[k].torque = results[k].summary.meanMuscleTorque * (1 + noise[k]);
+    for (std::size_t k = 0; k < data.size(); ++k) data[k].cleanTorque = results[k].summary.meanMuscleTorque;
+    return setTransducerNoise(std::move(data), subject.transducerNoise);
+}
+
+std::vector<TorqueObservation> setTransducerNoise(std::vector<TorqueObservation> data, double sd) {
+    checkField("transducer noise", sd, Bound{0, 0.5, false, true, "relative sd"});
+    for (TorqueObservation& o : data) o.torque = o.cleanTorque * (1 + sd * o.noiseDraw);
     return data;
 }
 
@@ -265,8 +274,11 @@ BicepsEstimate identifySynergistAware(const Population& prior, const std::vector
 
     BicepsEstimate est;
     est.method = measured ? "synergist-va" : "synergist";
-    est.noiseLevel = estimateNoiseLevel(data);
-    if (!std::isfinite(est.noiseLevel)) est.noiseLevel = prior.transducerNoise;
+    std::tie(est.noiseLevel, est.noiseDegreesOfFreedom) = estimateNoiseLevel(data);
+    if (!std::isfinite(est.noiseLevel)) {
+        est.noiseLevel = prior.transducerNoise;
+        est.noiseDegreesOfFreedom = 0;
+    }
     est.noiseLevel = std::max(est.noiseLevel, 0.002);  // floor: the scatter of few repetitions can be ~0
     for (double t : p.torque) p.sd.push_back(est.noiseLevel * std::max(std::abs(t), 1.0));
 
@@ -300,10 +312,14 @@ BicepsEstimate identifySynergistAware(const Population& prior, const std::vector
         map.lower[j] = lenLo;
         map.upper[j] = lenHi;
     }
-    map.lower[P::kActivation] = prior.voluntaryActivation.min;
-    map.upper[P::kActivation] = std::max(prior.voluntaryActivation.max, prior.voluntaryActivation.min + 1e-6);
-    map.lower[P::kCoContraction] = prior.coContraction.min;
-    map.upper[P::kCoContraction] = std::max(prior.coContraction.max, prior.coContraction.min + 1e-6);
+    // Activations stay 1e-5 inside [0, 1], so the Jacobian's difference probes (relative step 1e-6) do
+    // not cross the model's domain; a range of zero width holds the value fixed.
+    auto inside = [](double v) { return std::clamp(v, 1e-5, 1 - 1e-5); };
+    map.lower[P::kActivation] = inside(prior.voluntaryActivation.min);
+    map.upper[P::kActivation] = inside(prior.voluntaryActivation.max);
+    map.lower[P::kCoContraction] = inside(prior.coContraction.min);
+    map.upper[P::kCoContraction] = inside(prior.coContraction.max);
+    for (int j : {P::kActivation, P::kCoContraction}) map.priorMean[j] = std::clamp(map.priorMean[j], map.lower[j], map.upper[j]);
     map.numResiduals = int(p.torque.size()) + (measured ? 1 : 0);
     map.residuals = [&](const double* x, double* r) {
         if (measured) r[p.torque.size()] = (x[P::kActivation] - options.measuredActivation) / options.activationSd;
@@ -313,6 +329,7 @@ BicepsEstimate identifySynergistAware(const Population& prior, const std::vector
     const std::vector<double>& x = m.x;
     est.converged = m.converged;
     est.message = m.message;
+    if (m.failed) return est;  // no estimate: mass and tendon length stay NaN
 
     const MuscleParameters& b = base.muscles[base.primary].params;
     const int im = p.findMassIndex(base.primary);
@@ -339,11 +356,13 @@ BicepsEstimate identifySynergistAware(const Population& prior, const std::vector
         return est;
     }
     if (!m.covariance.empty()) {
+        const double quantile = est.noiseDegreesOfFreedom > 0 ? calcStudentTQuantile(0.975, est.noiseDegreesOfFreedom)
+                                                          : calcNormalQuantile(0.975);
         const double sm = std::sqrt(m.covariance[im][im]), st = std::sqrt(m.covariance[P::kTendon][P::kTendon]);
-        est.massLower = b.mass * std::exp(x[im] - kZ95 * sm);
-        est.massUpper = b.mass * std::exp(x[im] + kZ95 * sm);
-        est.tendonLower = b.optimalTendonLength * std::exp(x[P::kTendon] - kZ95 * st);
-        est.tendonUpper = b.optimalTendonLength * std::exp(x[P::kTendon] + kZ95 * st);
+        est.massLower = b.mass * std::exp(x[im] - quantile * sm);
+        est.massUpper = b.mass * std::exp(x[im] + quantile * sm);
+        est.tendonLower = b.optimalTendonLength * std::exp(x[P::kTendon] - quantile * st);
+        est.tendonUpper = b.optimalTendonLength * std::exp(x[P::kTendon] + quantile * st);
         est.massTendonCorrelation = m.covariance[im][P::kTendon] / (sm * st);
     }
     return est;
@@ -352,11 +371,10 @@ BicepsEstimate identifySynergistAware(const Population& prior, const std::vector
 double measureVoluntaryActivation(const std::vector<TorqueObservation>& data, double sd, unsigned seed) {
     if (data.empty()) throw InputError("measureVoluntaryActivation: no efforts");
     checkField("activation sd", sd, Bound::nonNegative());
-    std::mt19937_64 rng(seed);
-    std::normal_distribution<double> normal;
+    PortableRandom rng{seed};
     double mean = 0;
     for (const TorqueObservation& o : data) mean += o.activation / double(data.size());
-    return std::clamp(mean + sd * normal(rng), 0.0, 1.0);
+    return std::clamp(mean + sd * rng.drawNormal(), 0.0, 1.0);
 }
 
 std::vector<ElbowValidationRow> runElbowValidation(const Population& population, const ElbowValidationSettings& settings,
@@ -376,10 +394,10 @@ std::vector<ElbowValidationRow> runElbowValidation(const Population& population,
 
     std::vector<std::vector<ElbowValidationRow>> perSubject(settings.subjects);
     runParallel(settings.subjects, settings.jobs, [&](int s) {
-        VirtualSubject v = drawSubject(population, settings.seed, s);
+        const VirtualSubject v = drawSubject(population, settings.seed, s);
+        const std::vector<TorqueObservation> clean = synthesizeMvcTorques(v, settings.protocol, settings.seed, 1);
         for (double level : levels) {
-            v.transducerNoise = level;
-            const std::vector<TorqueObservation> data = synthesizeMvcTorques(v, settings.protocol, settings.seed, 1);
+            const std::vector<TorqueObservation> data = setTransducerNoise(clean, level);
             std::vector<BicepsEstimate> estimates = {identifyThesisMethod(population.base, data),
                                                      identifySynergistAware(population, data)};
             if (settings.activationSd > 0) {

@@ -12,8 +12,9 @@
 //                CC. Prior: the population's (mass scales share the person-level variance and add the
 //                per-muscle one; lengths and effort from their spreads and ranges). Data residuals are
 //                weighted by a relative noise level estimated from the repetitions' scatter. The
-//                posterior covariance is the Laplace approximation; 95 % intervals are normal in the
-//                log scales, so the M and L0T intervals are exp-transformed.
+//                posterior covariance is the Laplace approximation; 95 % intervals are symmetric in the
+//                log scales (Student-t quantile with the noise estimate's degrees of freedom, since the
+//                noise level is estimated), so the M and L0T intervals are exp-transformed.
 // "synergist-va" The same with VA measured by twitch interpolation (one more residual).
 // The prediction is the steady isometric torque at the protocol's angles with the subject's effort
 // less the relaxed torque (the transducer is tared at rest), summed over every muscle.
@@ -45,6 +46,8 @@ struct TorqueObservation {
     int repetition = 0;
     double torque = 0;         ///< tared elbow torque, + = flexion [N m] (with transducer noise)
     double activation = 0;     ///< agonist activation the subject actually produced (truth; not used by identifiers) [1]
+    double cleanTorque = 0;    ///< the torque before transducer noise (truth) [N m]
+    double noiseDraw = 0;      ///< the standard normal draw of its noise: torque = cleanTorque (1 + sd noiseDraw)
 };
 
 /// Runs the protocol on the subject (flexion efforts; each effort's activation = VA (1 + cv z) capped
@@ -52,6 +55,10 @@ struct TorqueObservation {
 /// of the subject's sd. Reproducible from (subject, noiseSeed). Trials run on `jobs` threads.
 std::vector<TorqueObservation> synthesizeMvcTorques(const VirtualSubject& subject, const TorqueProtocol& protocol,
                                                     unsigned noiseSeed, int jobs = 1);
+
+/// The same efforts read through a transducer of another relative noise sd (the same noise draws:
+/// common random numbers across noise levels).
+std::vector<TorqueObservation> setTransducerNoise(std::vector<TorqueObservation> data, double sd);
 
 /// An identifier's estimate of the primary muscle (the biceps long head).
 struct BicepsEstimate {
@@ -63,7 +70,8 @@ struct BicepsEstimate {
     double massLower = 0.0 / 0.0, massUpper = 0.0 / 0.0;        ///< 95 % interval [kg]
     double tendonLower = 0.0 / 0.0, tendonUpper = 0.0 / 0.0;    ///< 95 % interval [m]
     double noiseLevel = 0.0 / 0.0;       ///< relative torque sd used to weight the data [1]
-    std::vector<std::string> nuisanceNames;    ///< synergist: s_syn, s_ext, VA, CC
+    int noiseDegreesOfFreedom = 0;       ///< of that sd's estimate (repetitions); 0: taken as known
+    std::vector<std::string> nuisanceNames;    ///< synergist: activation, co-contraction, length and mass scales
     std::vector<double> nuisance;              ///< their estimates
     double massTendonCorrelation = 0.0 / 0.0;  ///< posterior correlation of ln M and ln L0T
     double rmsResidual = 0.0 / 0.0;            ///< of the torque [N m] (thesis: of the force [N])

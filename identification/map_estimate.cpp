@@ -53,18 +53,31 @@ MapResult calcMapEstimate(const MapProblem& problem) {
     cost->SetNumResiduals(problem.numResiduals + n);
     ceres::Problem pr;
     pr.AddResidualBlock(cost, nullptr, result.x.data());
+    std::vector<int> fixed;
     for (int j = 0; j < n; ++j) {
+        if (!problem.lower.empty() && !problem.upper.empty() && problem.lower[j] >= problem.upper[j]) {
+            result.x[j] = problem.lower[j];
+            fixed.push_back(j);
+            continue;
+        }
         if (!problem.lower.empty()) pr.SetParameterLowerBound(result.x.data(), j, problem.lower[j]);
         if (!problem.upper.empty()) pr.SetParameterUpperBound(result.x.data(), j, problem.upper[j]);
     }
+    if (int(fixed.size()) == n) pr.SetParameterBlockConstant(result.x.data());
+    else if (!fixed.empty()) pr.SetManifold(result.x.data(), new ceres::SubsetManifold(n, fixed));
     ceres::Solver::Options so;
     so.max_num_iterations = problem.maxIterations;
-    so.function_tolerance = 1e-10;
+    so.function_tolerance = problem.functionTolerance;
     so.parameter_tolerance = 1e-10;
     ceres::Solver::Summary summary;
     ceres::Solve(so, &pr, &summary);
     result.converged = summary.termination_type == ceres::CONVERGENCE;
+    result.failed = summary.termination_type == ceres::FAILURE;
     result.message = summary.BriefReport();
+    if (result.failed) {
+        result.message += ": " + summary.message;
+        return result;
+    }
 
     std::vector<double> r(problem.numResiduals);
     if (problem.residuals(result.x.data(), r.data()))

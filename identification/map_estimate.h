@@ -23,15 +23,19 @@ struct MapProblem {
     int numResiduals = 0;
     std::vector<double> priorMean;                   ///< mu
     std::vector<std::vector<double>> priorCovariance;  ///< Sigma (symmetric positive definite)
-    std::vector<double> lower, upper;                ///< bounds (empty: none)
+    std::vector<double> lower, upper;                ///< bounds (empty: none); lower == upper holds x_j fixed
     std::vector<double> start;                       ///< empty: the prior mean
-    int maxIterations = 100;
+    int maxIterations = 300;
+    /// Stop when an iteration lowers the cost by less than this fraction (Ceres function_tolerance).
+    /// Piecewise-smooth models (a tendon going slack) can crawl in the last digits at 1e-10.
+    double functionTolerance = 1e-7;
 };
 
 struct MapResult {
     std::vector<double> x;                           ///< the estimate
     std::vector<std::vector<double>> covariance;     ///< posterior covariance (empty when singular)
     bool converged = false;
+    bool failed = false;                             ///< the solver failed (x is the start, no covariance)
     std::string message;                             ///< Ceres's brief report, and why no covariance
     double dataCost = 0;                             ///< 0.5 |r(x)|^2 at the estimate
 };

@@ -95,6 +95,9 @@ public:
         } catch (const std::exception& e) {
             lastError_ = e.what();
             return CPodes::RecoverableError;
+        } catch (...) {
+            lastError_ = "unknown exception";
+            return CPodes::RecoverableError;
         }
         return CPodes::Success;
     }
@@ -105,6 +108,7 @@ public:
         solverMessage_ = std::regex_replace(std::string(msg), timePrefix, "");
     }
     const std::string& getLastError() const { return lastError_; }
+    void clearLastError() { lastError_.clear(); }
     const std::string& getSolverMessage() const { return solverMessage_; }
 
 private:
@@ -152,6 +156,7 @@ IntegrationStats integrateSampled(const OdeRhs& f, double t0, std::vector<double
         ++stats.restarts;
         while (t < segmentEnd - run.getEpsilon()) {
             Real tret = t;
+            system.clearLastError();  // report only this step's model errors
             int res = cpodes.step(segmentEnd, &tret, yout, ypout, CPodes::OneStep);
             if (res == CPodes::TooClose) {  // segment shorter than CPodes can step: treat as reached
                 tret = segmentEnd;
