@@ -151,3 +151,23 @@ TEST(ElbowIdentification, SynergistAwareIdentifierMeetsItsBiasBoundWhereTheThesi
     // A measured activation removes the activation-strength confound: a smaller mass RMSE.
     EXPECT_LT(massSq[3], massSq[0]);
 }
+
+// A population whose effort is exactly known (zero-width ranges: VA = 1, no co-contraction) holds
+// those values fixed in the fit instead of probing outside [0, 1].
+TEST(ElbowIdentification, ZeroWidthEffortRangesAreHeldFixed) {
+    Population known = population();
+    known.voluntaryActivation = {1.0, 1.0};
+    known.coContraction = {0.0, 0.0};
+    TorqueProtocol protocol;
+    protocol.holdDuration = 1.5;
+    protocol.averagingWindow = 0.5;
+    const VirtualSubject v = drawSubject(known, 4, 0);
+    const std::vector<TorqueObservation> data = synthesizeMvcTorques(v, protocol, 4, 2);
+    const BicepsEstimate e = identifySynergistAware(known, data);
+    ASSERT_TRUE(std::isfinite(e.mass)) << e.message;
+    EXPECT_TRUE(e.converged) << e.message;
+    EXPECT_NEAR(e.nuisance[0], 1.0, 1e-5);  // voluntary_activation, within the probe margin
+    EXPECT_NEAR(e.nuisance[1], 0.0, 1e-5);  // co_contraction
+    EXPECT_LT(e.massLower, e.mass);
+    EXPECT_GT(e.massUpper, e.mass);
+}
