@@ -280,6 +280,8 @@ struct ValidateOptions {
     std::string population;
     int subjects = 200;
     double activationSd = 0.02;
+    std::string angles;     // flexion angles [deg] of the elbow protocol; empty: the thesis's five
+    int repetitions = 3;
     bool noiseGiven = false;
 };
 
@@ -328,12 +330,20 @@ void runElbowValidate(const ValidateOptions& o) {
     s.seed = o.seed;
     s.jobs = o.jobs;
     s.activationSd = o.activationSd;
+    s.protocol.repetitions = o.repetitions;
+    if (!o.angles.empty()) {
+        s.protocol.flexionDeg.clear();
+        for (const std::string& v : splitList(o.angles)) s.protocol.flexionDeg.push_back(parseNumber("--angles", v));
+    }
     if (o.noiseGiven)
         for (const std::string& v : splitList(o.noise)) s.noiseLevels.push_back(parseNumber("--noise", v) / 100.0);
-    std::printf("validation on the elbow model as truth: population '%s' (%s), %d subjects, seed %u; five-angle "
-                "MVC (3 efforts each); identifiers: thesis (biceps only), synergist-aware (MAP) and, with --activation-sd > 0, "
+    std::string angleList;
+    for (double a : s.protocol.flexionDeg) angleList += (angleList.empty() ? "" : ",") + formatNumber(a);
+    std::printf("validation on the elbow model as truth: population '%s' (%s), %d subjects, seed %u; MVC at "
+                "flexion %s deg (%d efforts each); identifiers: thesis (biceps only), synergist-aware (MAP) and, with --activation-sd > 0, "
                 "synergist-aware with voluntary activation measured by twitch interpolation (synergist-va)\n",
-                population.name.c_str(), population.file.c_str(), s.subjects, s.seed);
+                population.name.c_str(), population.file.c_str(), s.subjects, s.seed, angleList.c_str(),
+                s.protocol.repetitions);
     std::fflush(stdout);
     const std::vector<ElbowValidationRow> rows =
         runElbowValidation(population, s, [](int d, int n) { printProgress("subjects", d, n); });
@@ -409,11 +419,18 @@ void addValidateCommand(CLI::App& app) {
                   "synergist-va identifier (0: leave it out)")
         ->capture_default_str()
         ->check(CLI::Range(0.0, 0.5));
+    c->add_option("--angles", o->angles,
+                  "--truth elbow: comma-separated flexion angles of the MVC protocol [deg, 0 = extended] "
+                  "(default the thesis's 135,120,90,60,30)");
+    c->add_option("--repetitions", o->repetitions, "--truth elbow: efforts per angle")
+        ->capture_default_str()
+        ->check(CLI::Range(1, 100));
     c->add_option("--subjects", o->subjects, "subjects for --truth elbow")->capture_default_str()->check(CLI::Range(1, 1000000));
     c->callback([o, c] {
         o->noiseGiven = c->count("--noise") > 0;
-        if (o->truth != "elbow" && (c->count("--population") || c->count("--subjects") || c->count("--activation-sd")))
-            throw InputError("--population, --subjects and --activation-sd need --truth elbow");
+        for (const char* option : {"--population", "--subjects", "--activation-sd", "--angles", "--repetitions"})
+            if (o->truth != "elbow" && c->count(option))
+                throw InputError(std::string(option) + " needs --truth elbow");
         if (o->truth == "elbow")
             for (const char* option : {"--seeds", "--methods", "--forward", "--estimate"})
                 if (c->count(option))

@@ -178,7 +178,12 @@ TEST(CliValidate, ElbowTruthWritesPerSubjectAndSummaryFilesAndPlots) {
         EXPECT_GT(fs::file_size(d / png), kMinPngBytes) << png;
     EXPECT_NE(r.output.find("synergist"), std::string::npos) << r.output;
 
-    const CommandResult bad = runArmsim("validate --subjects 3 --out " + d.string());
-    EXPECT_EQ(bad.exitCode, kInputErrorExit) << bad.output;
-    EXPECT_NE(bad.output.find("--truth elbow"), std::string::npos) << bad.output;
+    for (const char* option : {"--subjects 3", "--angles 30,90", "--repetitions 2"}) {
+        const CommandResult bad = runArmsim("validate " + std::string(option) + " --out " + d.string());
+        EXPECT_EQ(bad.exitCode, kInputErrorExit) << bad.output;
+        EXPECT_NE(bad.output.find("needs --truth elbow"), std::string::npos) << bad.output;
+    }
+    const CommandResult outside = runArmsim("validate --truth elbow --subjects 1 --angles 30,170 --out " + d.string());
+    EXPECT_EQ(outside.exitCode, kInputErrorExit) << outside.output;
+    EXPECT_NE(outside.output.find("170"), std::string::npos) << outside.output;
 }
