@@ -84,18 +84,10 @@ Population loadPopulation(const std::string& path) {
     p.trialCv = root.getNumber("trial_cv", Bound::any(), p.trialCv);
     p.transducerNoise = root.getNumber("transducer_noise", Bound::any(), p.transducerNoise);
     root.finish();
-    static const std::vector<std::pair<std::string, std::string>> keyOf = {
-        {"strength.subject_sd", "strength"}, {"strength.muscle_sd", "strength"},
-        {"tendon_length.sd", "tendon_length"}, {"fascicle_length.sd", "fascicle_length"},
-        {"slow_fraction.sd", "slow_fraction"}, {"voluntary_activation.min", "voluntary_activation"},
-        {"voluntary_activation.max", "voluntary_activation"}, {"co_contraction.min", "co_contraction"},
-        {"co_contraction.max", "co_contraction"}, {"trial_cv", "trial_cv"}, {"transducer_noise", "transducer_noise"}};
     try {
         p.validate();
     } catch (const FieldError& e) {
-        std::string key;
-        for (const auto& [field, k] : keyOf)
-            if (field == e.getField()) key = k;
+        const std::string key = e.getField().substr(0, e.getField().find('.'));  // the top-level key
         throw InputError((root.has(key) ? root.where(key) : path) + ": field '" + e.getField() + "' " + e.getDetail());
     }
     return p;

@@ -5,7 +5,7 @@
 #include "identification/statistics.h"
 #include "experiments/portable_random.h"
 #include "model/geometry.h"
-#include "model/muscle_arm.h"
+#include "model/mvc_curve.h"
 #include "model/parallel.h"
 #include "model/trial.h"
 #include "muscles/param_file.h"
@@ -19,49 +19,18 @@ namespace armsim {
 
 namespace {
 
-// Path length and moment arm of every muscle at each angle (the geometry does not depend on the
-// muscle parameters an identifier changes).
-struct AngleGeometry {
-    std::vector<std::vector<double>> pathLength, momentArm;  // [angle][muscle]
-};
-
-AngleGeometry calcAngleGeometry(const ArmSetup& setup, const std::vector<double>& flexionDeg) {
-    AngleGeometry g;
-    ArmGeometry geometry(setup);
-    for (double q : flexionDeg) {
-        checkField("flexion angle", q, Bound::closed(setup.arm.getMinFlexionDeg(), setup.arm.getMaxFlexionDeg(), "deg"));
-        geometry.setElbowAngle(elbowAngleFromFlexion(degToRad(q)));
-        std::vector<double> P, h;
-        for (int i = 0; i < setup.getNumMuscles(); ++i) {
-            const PathGeometry path = geometry.calcPathGeometry(i);
-            P.push_back(path.length);
-            h.push_back(geometry.calcMomentArm(path));
-        }
-        g.pathLength.push_back(P);
-        g.momentArm.push_back(h);
-    }
-    return g;
-}
-
-// Tared steady flexion-effort torque at each angle for the given muscles; throws SimulationError when
-// a muscle has no steady state.
-std::vector<double> calcTaredTorque(const std::vector<MuscleSpec>& muscles, const AngleGeometry& g,
+// Tared steady flexion-effort torque at each angle of the geometry: the MVC curve less the relaxed
+// one, summed over the muscles not left out. Throws SimulationError when a muscle has no steady state.
+std::vector<double> calcTaredTorque(const std::vector<MuscleSpec>& muscles, const MvcGeometry& g,
                                     const SubjectEffort& effort, const std::vector<int>& leftOut = {}) {
-    std::vector<VirtualMuscle> vm;
-    for (const MuscleSpec& m : muscles) vm.emplace_back(m.params);
+    const SteadyMvcCurve active = calcSteadyMvcCurve(muscles, g, MuscleGroup::Flexor, effort);
+    const SteadyMvcCurve relaxed = calcSteadyMvcCurve(muscles, g, MuscleGroup::Flexor, SubjectEffort{0, 0});
     std::vector<double> torque;
-    for (std::size_t a = 0; a < g.pathLength.size(); ++a) {
+    for (std::size_t a = 0; a < g.flexionDeg.size(); ++a) {
         double t = 0;
-        for (std::size_t i = 0; i < muscles.size(); ++i) {
-            if (std::find(leftOut.begin(), leftOut.end(), int(i)) != leftOut.end()) continue;
-            const double U = muscles[i].group == MuscleGroup::Flexor ? effort.voluntaryActivation : effort.coContraction;
-            const double P = g.pathLength[a][i];
-            const SteadyState active = vm[i].calcSteadyState(P, U), relaxed = vm[i].calcSteadyState(P, 0.0);
-            if (!active.converged || !relaxed.converged)
-                throw SimulationError("muscle '" + muscles[i].params.name + "': " +
-                                      (active.converged ? relaxed.message : active.message));
-            t += g.momentArm[a][i] * (active.force - relaxed.force);
-        }
+        for (std::size_t i = 0; i < muscles.size(); ++i)
+            if (std::find(leftOut.begin(), leftOut.end(), int(i)) == leftOut.end())
+                t += active.points[a][i].torque - relaxed.points[a][i].torque;
         torque.push_back(t);
     }
     return torque;
@@ -104,7 +73,7 @@ struct SynergistProblem {
     static constexpr int kTendon = 0, kActivation = 1, kCoContraction = 2, kFascicle = 3, kSynergistTendon = 4,
                          kSynergistFascicle = 5, kExtensorMass = 6, kFirstMass = 7;
     const ArmSetup* base;
-    AngleGeometry geometry;
+    MvcGeometry geometry;
     std::vector<int> angleOf;                 // observation -> angle index
     std::vector<double> torque, sd;           // observations and their sd [N m]
     std::vector<int> biceps, synergists, extensors, leftOut;
@@ -168,7 +137,7 @@ void TorqueProtocol::validate() const {
 
 std::vector<double> calcTaredSteadyTorque(const ArmSetup& setup, const SubjectEffort& effort,
                                           const std::vector<double>& flexionDeg) {
-    return calcTaredTorque(setup.muscles, calcAngleGeometry(setup, flexionDeg), effort);
+    return calcTaredTorque(setup.muscles, calcMvcGeometry(setup, flexionDeg), effort);
 }
 
 std::vector<TorqueObservation> synthesizeMvcTorques(const VirtualSubject& subject, const TorqueProtocol& protocol,
@@ -213,7 +182,7 @@ BicepsEstimate identifyThesisMethod(const ArmSetup& assumed, const std::vector<T
     est.method = "thesis";
     std::vector<double> angles;
     for (const TorqueObservation& o : data) angles.push_back(o.flexionDeg);
-    const AngleGeometry g = calcAngleGeometry(assumed, angles);
+    const MvcGeometry g = calcMvcGeometry(assumed, angles);
     IdentificationProblem problem;
     problem.base = assumed.calcBicepsParameters();
     problem.data.source = "tared torque / biceps moment arm";
@@ -270,7 +239,7 @@ BicepsEstimate identifySynergistAware(const Population& prior, const std::vector
         if (it == angles.end()) angles.push_back(o.flexionDeg);
         p.torque.push_back(o.torque);
     }
-    p.geometry = calcAngleGeometry(base, angles);
+    p.geometry = calcMvcGeometry(base, angles);
 
     BicepsEstimate est;
     est.method = measured ? "synergist-va" : "synergist";

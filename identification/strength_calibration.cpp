@@ -30,6 +30,9 @@ struct CalibrationProblem {
     const MvcTorqueTarget* target;
     const StrengthCalibrationOptions* options;
     std::vector<int> members;   // muscle indices of the target's group
+    // The target's effort at the target angles, the mid-range angle and the feasibility angles; the
+    // other effort at the feasibility angles (the calibration changes no geometry).
+    MvcGeometry effortGeometry, feasibilityGeometry;
 
     std::vector<MuscleCalibration> calcCalibration(const double* x) const {
         std::vector<MuscleCalibration> c;
@@ -49,15 +52,10 @@ struct CalibrationProblem {
     bool operator()(double const* const* x, double* r) const {
         try {
             const ArmSetup s = applyCalibration(*setup, calcCalibration(x[0]));
-            // One curve of the target's effort: the target angles, the mid-range angle, the feasibility
-            // angles; the other effort only needs to be feasible.
             const std::size_t numTarget = target->flexionDeg.size();
-            std::vector<double> angles = target->flexionDeg;
-            angles.push_back(options->midRangeDeg);
-            angles.insert(angles.end(), options->feasibilityDeg.begin(), options->feasibilityDeg.end());
-            const SteadyMvcCurve c = calcSteadyMvcCurve(s, target->effort, s.effort, angles);
+            const SteadyMvcCurve c = calcSteadyMvcCurve(s.muscles, effortGeometry, target->effort, s.effort);
             const MuscleGroup other = target->effort == MuscleGroup::Flexor ? MuscleGroup::Extensor : MuscleGroup::Flexor;
-            calcSteadyMvcCurve(s, other, s.effort, options->feasibilityDeg);
+            calcSteadyMvcCurve(s.muscles, feasibilityGeometry, other, s.effort);
             const std::vector<SteadyMusclePoint>& mid = c.points[numTarget];
             int k = 0;
             for (std::size_t a = 0; a < numTarget; ++a)
@@ -100,14 +98,17 @@ StrengthCalibrationResult calibrateStrength(const ArmSetup& setup, const MvcTorq
     StrengthCalibrationOptions opts = options;
     if (opts.feasibilityDeg.empty())
         opts.feasibilityDeg = {setup.arm.getMinFlexionDeg(), setup.arm.getMaxFlexionDeg()};
-    CalibrationProblem problem{&setup, &target, &opts, {}};
+    std::vector<double> angles = target.flexionDeg;
+    angles.push_back(opts.midRangeDeg);
+    angles.insert(angles.end(), opts.feasibilityDeg.begin(), opts.feasibilityDeg.end());
+    // The geometry checks the angles before fitting (InputError with the model's range).
+    CalibrationProblem problem{&setup, &target, &opts, {}, calcMvcGeometry(setup, angles),
+                               calcMvcGeometry(setup, opts.feasibilityDeg)};
     for (int i = 0; i < setup.getNumMuscles(); ++i)
         if (setup.muscles[i].group == target.effort) problem.members.push_back(i);
     if (problem.members.empty())
         throw InputError("strength calibration: model '" + setup.name + "' has no " +
                          getMuscleGroupName(target.effort) + " muscles");
-    // Check the angles before fitting: this throws InputError with the model's range.
-    calcSteadyMvcCurve(setup, target.effort, setup.effort, target.flexionDeg);
 
     const int n = int(problem.members.size());
     std::vector<double> x(n + 2, 1.0);

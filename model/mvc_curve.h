@@ -30,6 +30,23 @@ struct SteadyMvcCurve {
     double calcFlexorShare(int a, int m) const;
 };
 
+/// Path length and moment arm of every muscle at each flexion angle: the part of the curve that muscle
+/// parameters do not change, so fits that vary the parameters compute it once.
+struct MvcGeometry {
+    std::vector<double> flexionDeg;                     ///< 0 = full extension
+    std::vector<std::vector<double>> pathLength;        ///< [angle][muscle] P [m]
+    std::vector<std::vector<double>> momentArm;         ///< [angle][muscle] h, + = flexes [m] (virtual work)
+};
+
+/// The geometry of `setup` at the flexion angles [deg]. Throws InputError for an angle outside the
+/// elbow's range.
+MvcGeometry calcMvcGeometry(const ArmSetup& setup, const std::vector<double>& flexionDeg);
+
+/// The curve of `muscles` (setup.muscles, or the same muscles with other parameters) on a geometry
+/// computed for them; as calcSteadyMvcCurve below.
+SteadyMvcCurve calcSteadyMvcCurve(const std::vector<MuscleSpec>& muscles, const MvcGeometry& geometry,
+                                  MuscleGroup effort, const SubjectEffort& subject);
+
 /// Every muscle of `setup` at its steady isometric state at each flexion angle [deg], the agonists of
 /// `effort` at subject.voluntaryActivation and the others at subject.coContraction (both in [0, 1]; 0 and 0
 /// give the passive torque). Net torque is the

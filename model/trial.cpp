@@ -26,12 +26,18 @@ std::vector<std::string> withMuscleColumns(std::vector<std::string> names, const
     return names;
 }
 
-void appendMuscleForces(std::vector<double>& row, const MuscleArm& model, const std::vector<double>& forces,
-                        double t) {
-    if (model.getNumMuscles() == 1) return;
+// The muscles' activation profiles, looked up once (each lookup is a Simbody handle downcast).
+std::vector<const ActivationProfile*> getActivationProfiles(const MuscleArm& model) {
+    std::vector<const ActivationProfile*> profiles;
+    for (int i = 0; i < model.getNumMuscles(); ++i) profiles.push_back(&model.getMuscleForce(i).getActivationProfile());
+    return profiles;
+}
+
+void appendMuscleForces(std::vector<double>& row, const std::vector<const ActivationProfile*>& activations,
+                        const std::vector<double>& forces, double t) {
+    if (forces.size() == 1) return;
     row.insert(row.end(), forces.begin(), forces.end());
-    for (int i = 0; i < model.getNumMuscles(); ++i)
-        row.push_back(model.getMuscleForce(i).getActivationProfile().getValue(t));
+    for (const ActivationProfile* a : activations) row.push_back(a->getValue(t));
 }
 
 double mean(const std::vector<double>& v, std::size_t from) {
@@ -143,11 +149,8 @@ IsometricTrialResult runIsometricTrial(const ArmSetup& setup, const IsometricTri
     const double h = sum.momentArm;
     const double L0 = model.getMuscle(primary).getParameters().optimalFascicleLength;
     std::vector<const VirtualMuscle*> muscles;
-    std::vector<const ActivationProfile*> activations;
-    for (int i = 0; i < n; ++i) {
-        muscles.push_back(&model.getMuscle(i));
-        activations.push_back(&model.getMuscleForce(i).getActivationProfile());
-    }
+    for (int i = 0; i < n; ++i) muscles.push_back(&model.getMuscle(i));
+    const std::vector<const ActivationProfile*> activations = getActivationProfiles(model);
     // Where each muscle's states sit in y = [q u z].
     const int nqu = state.getNQ() + state.getNU();
     std::vector<int> firstState(n);
@@ -187,7 +190,7 @@ IsometricTrialResult runIsometricTrial(const ArmSetup& setup, const IsometricTri
         row.assign({t, profile.getValue(t), radToDeg(settings.elbowAngle), 0.0, F, yp[VirtualMuscle::kL] * L0,
                     yp[VirtualMuscle::kV] * L0, torque, muscleTorque, strap, saturated ? 1.0 : 0.0, byMomentArm,
                     byFixedRatio, pct(byMomentArm), pct(byFixedRatio)});
-        appendMuscleForces(row, model, forces, t);
+        appendMuscleForces(row, activations, forces, t);
         for (int i = 0; i < n; ++i) row.insert(row.end(), y + firstState[i], y + firstState[i] + muscles[i]->getNumStates());
         result.series.appendRow(row);
     };
@@ -281,6 +284,7 @@ Table runFreeMovement(const ArmSetup& setup, const FreeMovementSettings& setting
                               model));
     const double L0 = model.getMuscle(primary).getParameters().optimalFascicleLength;
     std::vector<double> forces(n);
+    const std::vector<const ActivationProfile*> activations = getActivationProfiles(model);
     const IntegrationStats st = simulateSampled(
         system, state, settings.duration, settings.sampleRate, settings.activation.getBreakpoints(),
         settings.integration,
@@ -291,7 +295,7 @@ Table runFreeMovement(const ArmSetup& setup, const FreeMovementSettings& setting
             std::vector<double> row{s.getTime(), biceps.getActivation(s), radToDeg(arm.getElbowAngle(s)),
                                     radToDeg(arm.getElbowAngularVelocity(s)), model.calcPathLength(s, primary),
                                     model.calcMomentArm(s, primary), o.Fse, o.L * L0, o.V * L0, o.activeFraction};
-            appendMuscleForces(row, model, forces, s.getTime());
+            appendMuscleForces(row, activations, forces, s.getTime());
             model.appendMuscleStates(s, row);
             t.appendRow(std::move(row));
         },

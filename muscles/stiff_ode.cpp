@@ -132,9 +132,8 @@ IntegrationStats integrateSampled(const OdeRhs& f, double t0, std::vector<double
     detail::SampledRun run(t0, duration, sampleRate, breakpoints, n);
     IntegrationStats stats;
     RhsSystem system(f, stats.realizations);
-    auto evaluate = [&](double t, const double* yIn, Vector& ydot) {
-        const Vector yv(n, yIn);
-        if (system.explicitODE(t, yv, ydot) != CPodes::Success)
+    auto evaluate = [&](double t, const Vector& yIn, Vector& ydot) {
+        if (system.explicitODE(t, yIn, ydot) != CPodes::Success)
             throw SimulationError("t = " + formatNumber(t) + " s: " + system.getLastError());
     };
 
@@ -146,7 +145,7 @@ IntegrationStats integrateSampled(const OdeRhs& f, double t0, std::vector<double
     double t = t0;
     Vector yv(n, y.data()), ydot(n), yout(n), ypout(n);
     for (double segmentEnd : run.getSegmentEnds()) {
-        evaluate(t, &yv[0], ydot);
+        evaluate(t, yv, ydot);
         run.restart(t, &yv[0], &ydot[0]);
         CPodes cpodes(CPodes::ExplicitODE, CPodes::BDF, CPodes::Newton);
         cpodes.init(system, t, yv, ydot, CPodes::ScalarScalar, relTol, const_cast<Real*>(&absTol));
@@ -181,7 +180,7 @@ IntegrationStats integrateSampled(const OdeRhs& f, double t0, std::vector<double
             yv = yout;
             if (check) check(t, &yv[0]);
             checkFinite(t, &yv[0], n);
-            evaluate(t, &yv[0], ydot);
+            evaluate(t, yv, ydot);
             run.advance(t, &yv[0], &ydot[0], run.isBreakpoint(t, segmentEnd), sample);
         }
         int steps = 0;

@@ -12,20 +12,31 @@ using namespace armsim;
 
 namespace {
 
+ArmSetup loadShippedModel(const char* name) {
+    setenv("ARMSIM_ASSETS", ARMSIM_ASSET_DIR, 0);
+    return loadModel(name);
+}
+
 const ArmSetup& subject() {
-    static const ArmSetup s = [] {
-        setenv("ARMSIM_ASSETS", ARMSIM_ASSET_DIR, 0);
-        return ArmSetup::loadDefault();
-    }();
+    static const ArmSetup s = loadShippedModel("thesis");
     return s;
 }
 
-void BM_IsometricMvcTrial(benchmark::State& state) {
-    IsometricTrialSettings s;  // 0.5 s rest + 3 s hold at 90 deg, 1000 Hz
+const ArmSetup& elbow() {
+    static const ArmSetup s = loadShippedModel("elbow");
+    return s;
+}
+
+// One isometric trial per iteration; arg = sample rate.
+void measureIsometricTrial(benchmark::State& state, const ArmSetup& setup, IsometricTrialSettings s) {
     s.sampleRate = double(state.range(0));
     int steps = 0;
-    for (auto _ : state) steps = runIsometricTrial(subject(), s).summary.stats.steps;
+    for (auto _ : state) steps = runIsometricTrial(setup, s).summary.stats.steps;
     state.counters["steps"] = steps;
+}
+
+void BM_IsometricMvcTrial(benchmark::State& state) {
+    measureIsometricTrial(state, subject(), {});  // 0.5 s rest + 3 s hold at 90 deg
 }
 BENCHMARK(BM_IsometricMvcTrial)->Arg(1000)->Arg(100)->Unit(benchmark::kMillisecond);
 
@@ -46,23 +57,12 @@ void BM_FreeMovement2s(benchmark::State& state) {
 }
 BENCHMARK(BM_FreeMovement2s)->Unit(benchmark::kMillisecond);
 
-const ArmSetup& elbow() {
-    static const ArmSetup s = [] {
-        setenv("ARMSIM_ASSETS", ARMSIM_ASSET_DIR, 0);
-        return loadModel("elbow");
-    }();
-    return s;
-}
-
 // Issue 10: 0.5 s rest + 3 s hold at 90 deg flexion, agonists 0.95, antagonists 0.10; arg = sample rate.
 void BM_ElbowMvcTrial(benchmark::State& state) {
     IsometricTrialSettings s;
     s.activation = elbow().effort.voluntaryActivation;
     s.antagonistActivation = elbow().effort.coContraction;
-    s.sampleRate = double(state.range(0));
-    int steps = 0;
-    for (auto _ : state) steps = runIsometricTrial(elbow(), s).summary.stats.steps;
-    state.counters["steps"] = steps;
+    measureIsometricTrial(state, elbow(), s);
 }
 BENCHMARK(BM_ElbowMvcTrial)->Arg(1000)->Arg(100)->Unit(benchmark::kMillisecond);
 
