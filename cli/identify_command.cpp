@@ -282,6 +282,7 @@ struct ValidateOptions {
     double activationSd = 0.02;
     std::string angles;     // flexion angles [deg] of the elbow protocol; empty: the thesis's five
     int repetitions = 3;
+    std::string protocol;   // torque protocol file (replaces --angles/--repetitions)
     bool noiseGiven = false;
 };
 
@@ -330,20 +331,24 @@ void runElbowValidate(const ValidateOptions& o) {
     s.seed = o.seed;
     s.jobs = o.jobs;
     s.activationSd = o.activationSd;
-    s.protocol.repetitions = o.repetitions;
-    if (!o.angles.empty()) {
-        s.protocol.flexionDeg.clear();
-        for (const std::string& v : splitList(o.angles)) s.protocol.flexionDeg.push_back(parseNumber("--angles", v));
+    if (!o.protocol.empty()) {
+        s.protocol = readTorqueProtocol(o.protocol);
+    } else {
+        std::vector<double> angles = {135, 120, 90, 60, 30};
+        if (!o.angles.empty()) {
+            angles.clear();
+            for (const std::string& v : splitList(o.angles)) angles.push_back(parseNumber("--angles", v));
+        }
+        s.protocol.conditions = TorqueProtocol::makeFlexionMvcs(angles, o.repetitions);
     }
     if (o.noiseGiven)
         for (const std::string& v : splitList(o.noise)) s.noiseLevels.push_back(parseNumber("--noise", v) / 100.0);
-    std::string angleList;
-    for (double a : s.protocol.flexionDeg) angleList += (angleList.empty() ? "" : ",") + formatNumber(a);
-    std::printf("validation on the elbow model as truth: population '%s' (%s), %d subjects, seed %u; MVC at "
-                "flexion %s deg (%d efforts each); identifiers: thesis (biceps only), synergist-aware (MAP) and, with --activation-sd > 0, "
-                "synergist-aware with voluntary activation measured by twitch interpolation (synergist-va)\n",
-                population.name.c_str(), population.file.c_str(), s.subjects, s.seed, angleList.c_str(),
-                s.protocol.repetitions);
+    std::printf("validation on the elbow model as truth: population '%s' (%s), %d subjects, seed %u; protocol "
+                "'%s' (%d trials: %s); identifiers: thesis (biceps only), synergist-aware (MAP) and, with "
+                "--activation-sd > 0, synergist-aware with voluntary activation measured by twitch interpolation "
+                "(synergist-va)\n",
+                population.name.c_str(), population.file.c_str(), s.subjects, s.seed, s.protocol.name.c_str(),
+                s.protocol.getNumTrials(), describeConditions(s.protocol).c_str());
     std::fflush(stdout);
     const std::vector<ElbowValidationRow> rows =
         runElbowValidation(population, s, [](int d, int n) { printProgress("subjects", d, n); });
@@ -425,10 +430,15 @@ void addValidateCommand(CLI::App& app) {
     c->add_option("--repetitions", o->repetitions, "--truth elbow: efforts per angle")
         ->capture_default_str()
         ->check(CLI::Range(1, 100));
+    c->add_option("--protocol", o->protocol,
+                  "--truth elbow: torque protocol file (kind: torque, e.g. written by `armsim design`) instead of "
+                  "--angles/--repetitions");
     c->add_option("--subjects", o->subjects, "subjects for --truth elbow")->capture_default_str()->check(CLI::Range(1, 1000000));
     c->callback([o, c] {
         o->noiseGiven = c->count("--noise") > 0;
-        for (const char* option : {"--population", "--subjects", "--activation-sd", "--angles", "--repetitions"})
+        if (c->count("--protocol") && (c->count("--angles") || c->count("--repetitions")))
+            throw InputError("--protocol replaces --angles and --repetitions: give one or the other");
+        for (const char* option : {"--population", "--subjects", "--activation-sd", "--angles", "--repetitions", "--protocol"})
             if (o->truth != "elbow" && c->count(option))
                 throw InputError(std::string(option) + " needs --truth elbow");
         if (o->truth == "elbow")

@@ -19,12 +19,13 @@ namespace armsim {
 
 namespace {
 
-// Tared steady flexion-effort torque at each angle of the geometry: the MVC curve less the relaxed
-// one, summed over the muscles not left out. Throws SimulationError when a muscle has no steady state.
-std::vector<double> calcTaredTorque(const std::vector<MuscleSpec>& muscles, const MvcGeometry& g,
-                                    const SubjectEffort& effort, const std::vector<int>& leftOut = {}) {
-    const SteadyMvcCurve active = calcSteadyMvcCurve(muscles, g, MuscleGroup::Flexor, effort);
-    const SteadyMvcCurve relaxed = calcSteadyMvcCurve(muscles, g, MuscleGroup::Flexor, SubjectEffort{0, 0});
+// Tared steady torque at each angle of the geometry: the curve of an effort of `group` less the
+// relaxed one, summed over the muscles not left out. Throws SimulationError when a muscle has no steady
+// state.
+std::vector<double> calcTaredTorque(const std::vector<MuscleSpec>& muscles, const MvcGeometry& g, MuscleGroup group,
+                                    const SubjectEffort& effort, const SteadyMvcCurve& relaxed,
+                                    const std::vector<int>& leftOut = {}) {
+    const SteadyMvcCurve active = calcSteadyMvcCurve(muscles, g, group, effort);
     std::vector<double> torque;
     for (std::size_t a = 0; a < g.flexionDeg.size(); ++a) {
         double t = 0;
@@ -34,6 +35,18 @@ std::vector<double> calcTaredTorque(const std::vector<MuscleSpec>& muscles, cons
         torque.push_back(t);
     }
     return torque;
+}
+
+SteadyMvcCurve calcRelaxedCurve(const std::vector<MuscleSpec>& muscles, const MvcGeometry& g) {
+    return calcSteadyMvcCurve(muscles, g, MuscleGroup::Flexor, SubjectEffort{0, 0});
+}
+
+// The effort of a condition at level l: agonists l VA, antagonists l CC.
+SubjectEffort makeEffort(double level, double voluntaryActivation, double coContraction) {
+    SubjectEffort e;
+    e.voluntaryActivation = level * voluntaryActivation;
+    e.coContraction = level * coContraction;
+    return e;
 }
 
 std::vector<int> findMuscles(const ArmSetup& setup, const std::vector<std::string>& names, const char* what) {
@@ -48,14 +61,14 @@ std::vector<int> findMuscles(const ArmSetup& setup, const std::vector<std::strin
     return out;
 }
 
-// Relative torque sd pooled over the angles' repetitions (NaN without repetitions) and its degrees of
-// freedom.
+// Relative torque sd pooled over the conditions' repetitions (NaN without repetitions) and its degrees
+// of freedom.
 std::pair<double, int> estimateNoiseLevel(const std::vector<TorqueObservation>& data) {
-    std::map<double, std::vector<double>> byAngle;
-    for (const TorqueObservation& o : data) byAngle[o.flexionDeg].push_back(o.torque);
+    std::map<std::tuple<double, int, double>, std::vector<double>> byCondition;
+    for (const TorqueObservation& o : data) byCondition[{o.flexionDeg, int(o.effort), o.level}].push_back(o.torque);
     double ss = 0;
     int dof = 0;
-    for (const auto& [angle, v] : byAngle) {
+    for (const auto& [condition, v] : byCondition) {
         if (v.size() < 2) continue;
         double m = 0;
         for (double x : v) m += x;
@@ -72,9 +85,15 @@ std::pair<double, int> estimateNoiseLevel(const std::vector<TorqueObservation>& 
 struct SynergistProblem {
     static constexpr int kTendon = 0, kActivation = 1, kCoContraction = 2, kFascicle = 3, kSynergistTendon = 4,
                          kSynergistFascicle = 5, kExtensorMass = 6, kFirstMass = 7;
+    // The distinct effort kinds of the data, each predicted at every angle.
+    struct EffortKind {
+        MuscleGroup group;
+        double level;
+    };
     const ArmSetup* base;
     MvcGeometry geometry;
-    std::vector<int> angleOf;                 // observation -> angle index
+    std::vector<EffortKind> kinds;
+    std::vector<int> angleOf, kindOf;         // observation -> angle index, effort kind
     std::vector<double> torque, sd;           // observations and their sd [N m]
     std::vector<int> biceps, synergists, extensors, leftOut;
 
@@ -104,82 +123,46 @@ struct SynergistProblem {
         for (int i : extensors) m[i].params.mass *= std::exp(x[kExtensorMass]);
         return m;
     }
-    std::vector<double> predict(const double* x) const {
-        SubjectEffort e;
+    /// [kind][angle] tared torque.
+    std::vector<std::vector<double>> predict(const double* x) const {
         // Guard: the bounds keep difference probes inside [0, 1] (see identifySynergistAware).
-        e.voluntaryActivation = std::clamp(x[kActivation], 0.0, 1.0);
-        e.coContraction = std::clamp(x[kCoContraction], 0.0, 1.0);
-        return calcTaredTorque(makeMuscles(x), geometry, e, leftOut);
+        const double va = std::clamp(x[kActivation], 0.0, 1.0), cc = std::clamp(x[kCoContraction], 0.0, 1.0);
+        const std::vector<MuscleSpec> muscles = makeMuscles(x);
+        const SteadyMvcCurve relaxed = calcRelaxedCurve(muscles, geometry);
+        std::vector<std::vector<double>> t;
+        for (const EffortKind& k : kinds)
+            t.push_back(calcTaredTorque(muscles, geometry, k.group, makeEffort(k.level, va, cc), relaxed, leftOut));
+        return t;
     }
+    double predicted(const std::vector<std::vector<double>>& t, std::size_t k) const { return t[kindOf[k]][angleOf[k]]; }
     // Whitened data residuals; false where a muscle has no steady state.
     bool calcResiduals(const double* x, double* residuals) const {
-        std::vector<double> t;
+        std::vector<std::vector<double>> t;
         try {
             t = predict(x);
         } catch (const std::exception&) {
             return false;
         }
-        for (std::size_t k = 0; k < torque.size(); ++k) residuals[k] = (t[angleOf[k]] - torque[k]) / sd[k];
+        for (std::size_t k = 0; k < torque.size(); ++k) residuals[k] = (predicted(t, k) - torque[k]) / sd[k];
         return true;
     }
 };
 
 }  // namespace
 
-void TorqueProtocol::validate() const {
-    if (flexionDeg.empty()) throw FieldError("protocol.angles", "no angles: expected at least one");
-    checkField("protocol.repetitions", repetitions, Bound::closed(1, 100));
-    checkField("protocol.rest", restDuration, Bound::positive("s"));
-    checkField("protocol.hold", holdDuration, Bound::positive("s"));
-    checkField("protocol.averaging_window", averagingWindow, {0, holdDuration, true, false, "s, within the hold"});
-    checkField("protocol.sample_rate", sampleRate, Bound::positive("Hz"));
-}
-
 std::vector<double> calcTaredSteadyTorque(const ArmSetup& setup, const SubjectEffort& effort,
-                                          const std::vector<double>& flexionDeg) {
-    return calcTaredTorque(setup.muscles, calcMvcGeometry(setup, flexionDeg), effort);
+                                          const std::vector<double>& flexionDeg, MuscleGroup group) {
+    const MvcGeometry g = calcMvcGeometry(setup, flexionDeg);
+    return calcTaredTorque(setup.muscles, g, group, effort, calcRelaxedCurve(setup.muscles, g));
 }
 
-std::vector<TorqueObservation> synthesizeMvcTorques(const VirtualSubject& subject, const TorqueProtocol& protocol,
-                                                    unsigned noiseSeed, int jobs) {
-    protocol.validate();
-    PortableRandom rng{noiseSeed, subject.seed, unsigned(subject.index)};
-    const SubjectEffort& e = subject.setup.effort;
-    std::vector<IsometricTrialSettings> trials;
-    std::vector<TorqueObservation> data;
-    for (int r = 0; r < protocol.repetitions; ++r)
-        for (double q : protocol.flexionDeg) {
-            IsometricTrialSettings s;
-            s.elbowAngle = elbowAngleFromFlexion(degToRad(q));
-            s.activation = std::clamp(e.voluntaryActivation * (1 + e.trialCv * rng.drawNormal()), 0.0, 1.0);
-            s.antagonistActivation = e.coContraction;
-            s.effort = MuscleGroup::Flexor;
-            s.restDuration = protocol.restDuration;
-            s.holdDuration = protocol.holdDuration;
-            s.averagingWindow = protocol.averagingWindow;
-            s.sampleRate = protocol.sampleRate;
-            trials.push_back(s);
-            TorqueObservation o;
-            o.flexionDeg = q;
-            o.repetition = r;
-            o.activation = s.activation;
-            o.noiseDraw = rng.drawNormal();
-            data.push_back(o);
-        }
-    const std::vector<IsometricTrialResult> results = runIsometricTrials(subject.setup, trials, jobs);
-    for (std::size_t k = 0; k < data.size(); ++k) data[k].cleanTorque = results[k].summary.meanMuscleTorque;
-    return setTransducerNoise(std::move(data), subject.transducerNoise);
-}
-
-std::vector<TorqueObservation> setTransducerNoise(std::vector<TorqueObservation> data, double sd) {
-    checkField("transducer noise", sd, Bound{0, 0.5, false, true, "relative sd"});
-    for (TorqueObservation& o : data) o.torque = o.cleanTorque * (1 + sd * o.noiseDraw);
-    return data;
-}
-
-BicepsEstimate identifyThesisMethod(const ArmSetup& assumed, const std::vector<TorqueObservation>& data) {
+BicepsEstimate identifyThesisMethod(const ArmSetup& assumed, const std::vector<TorqueObservation>& allData) {
     BicepsEstimate est;
     est.method = "thesis";
+    std::vector<TorqueObservation> data;  // the method knows flexion MVCs only
+    for (const TorqueObservation& o : allData)
+        if (o.effort == MuscleGroup::Flexor && o.level == 1) data.push_back(o);
+    if (data.empty()) throw InputError("thesis method: no flexion MVC in the data (it uses those only)");
     std::vector<double> angles;
     for (const TorqueObservation& o : data) angles.push_back(o.flexionDeg);
     const MvcGeometry g = calcMvcGeometry(assumed, angles);
@@ -237,6 +220,11 @@ BicepsEstimate identifySynergistAware(const Population& prior, const std::vector
         auto it = std::find(angles.begin(), angles.end(), o.flexionDeg);
         p.angleOf.push_back(int(it - angles.begin()));
         if (it == angles.end()) angles.push_back(o.flexionDeg);
+        auto kt = std::find_if(p.kinds.begin(), p.kinds.end(), [&](const SynergistProblem::EffortKind& k) {
+            return k.group == o.effort && k.level == o.level;
+        });
+        p.kindOf.push_back(int(kt - p.kinds.begin()));
+        if (kt == p.kinds.end()) p.kinds.push_back({o.effort, o.level});
         p.torque.push_back(o.torque);
     }
     p.geometry = calcMvcGeometry(base, angles);
@@ -315,9 +303,9 @@ BicepsEstimate identifySynergistAware(const Population& prior, const std::vector
         est.nuisance.push_back(std::exp(x[k]));
     }
     try {
-        const std::vector<double> t = p.predict(x.data());
+        const std::vector<std::vector<double>> t = p.predict(x.data());
         double ss = 0;
-        for (std::size_t k = 0; k < p.torque.size(); ++k) ss += std::pow(t[p.angleOf[k]] - p.torque[k], 2);
+        for (std::size_t k = 0; k < p.torque.size(); ++k) ss += std::pow(p.predicted(t, k) - p.torque[k], 2);
         est.rmsResidual = std::sqrt(ss / double(p.torque.size()));
     } catch (const std::exception& e) {
         est.converged = false;
@@ -338,11 +326,14 @@ BicepsEstimate identifySynergistAware(const Population& prior, const std::vector
 }
 
 double measureVoluntaryActivation(const std::vector<TorqueObservation>& data, double sd, unsigned seed) {
-    if (data.empty()) throw InputError("measureVoluntaryActivation: no efforts");
     checkField("activation sd", sd, Bound::nonNegative());
     PortableRandom rng{seed};
     double mean = 0;
-    for (const TorqueObservation& o : data) mean += o.activation / double(data.size());
+    int n = 0;
+    for (const TorqueObservation& o : data)
+        if (o.level == 1) mean += o.activation, ++n;
+    if (n == 0) throw InputError("measureVoluntaryActivation: no maximal efforts (twitch interpolation needs MVCs)");
+    mean /= n;
     return std::clamp(mean + sd * rng.drawNormal(), 0.0, 1.0);
 }
 
@@ -364,7 +355,7 @@ std::vector<ElbowValidationRow> runElbowValidation(const Population& population,
     std::vector<std::vector<ElbowValidationRow>> perSubject(settings.subjects);
     runParallel(settings.subjects, settings.jobs, [&](int s) {
         const VirtualSubject v = drawSubject(population, settings.seed, s);
-        const std::vector<TorqueObservation> clean = synthesizeMvcTorques(v, settings.protocol, settings.seed, 1);
+        const std::vector<TorqueObservation> clean = synthesizeTorqueData(v, settings.protocol, settings.seed, 1);
         for (double level : levels) {
             const std::vector<TorqueObservation> data = setTransducerNoise(clean, level);
             std::vector<BicepsEstimate> estimates = {identifyThesisMethod(population.base, data),

@@ -20,45 +20,13 @@
 // less the relaxed torque (the transducer is tared at rest), summed over every muscle.
 #pragma once
 
-#include "experiments/population.h"
+#include "experiments/torque_protocol.h"
 
 #include <functional>
 #include <string>
 #include <vector>
 
 namespace armsim {
-
-/// The MVC protocol run on a virtual subject.
-struct TorqueProtocol {
-    std::vector<double> flexionDeg = {135, 120, 90, 60, 30};  ///< thesis's 45..150 deg included angles
-    int repetitions = 3;             ///< efforts per angle (thesis: 3)
-    double restDuration = 0.5;       ///< [s] relaxed, transducer tared at its start
-    double holdDuration = 3.0;       ///< [s] maximal effort (thesis: 3 s)
-    double averagingWindow = 1.0;    ///< [s] end of the hold averaged (thesis: last second)
-    double sampleRate = 200.0;       ///< [Hz] transducer samples
-    /// FieldError naming the field unless every value is in range (angles checked by the trials).
-    void validate() const;
-};
-
-/// One measured effort.
-struct TorqueObservation {
-    double flexionDeg = 0;     ///< [deg], 0 = extended
-    int repetition = 0;
-    double torque = 0;         ///< tared elbow torque, + = flexion [N m] (with transducer noise)
-    double activation = 0;     ///< agonist activation the subject actually produced (truth; not used by identifiers) [1]
-    double cleanTorque = 0;    ///< the torque before transducer noise (truth) [N m]
-    double noiseDraw = 0;      ///< the standard normal draw of its noise: torque = cleanTorque (1 + sd noiseDraw)
-};
-
-/// Runs the protocol on the subject (flexion efforts; each effort's activation = VA (1 + cv z) capped
-/// at 1, antagonists at CC; tared torque averaged over the window) and adds relative transducer noise
-/// of the subject's sd. Reproducible from (subject, noiseSeed). Trials run on `jobs` threads.
-std::vector<TorqueObservation> synthesizeMvcTorques(const VirtualSubject& subject, const TorqueProtocol& protocol,
-                                                    unsigned noiseSeed, int jobs = 1);
-
-/// The same efforts read through a transducer of another relative noise sd (the same noise draws:
-/// common random numbers across noise levels).
-std::vector<TorqueObservation> setTransducerNoise(std::vector<TorqueObservation> data, double sd);
 
 /// An identifier's estimate of the primary muscle (the biceps long head).
 struct BicepsEstimate {
@@ -106,10 +74,10 @@ BicepsEstimate identifySynergistAware(const Population& prior, const std::vector
 double measureVoluntaryActivation(const std::vector<TorqueObservation>& data, double sd, unsigned seed);
 
 /// Net tared steady torque of `setup` at the angles [N m]: every muscle at its steady state with the
-/// flexors at `effort`'s voluntary activation and the extensors at its co-contraction, less the same
-/// with every muscle relaxed (what a tared transducer reads at the plateau of a flexion MVC).
+/// agonists of `group` at `effort`'s voluntary activation and the antagonists at its co-contraction,
+/// less the same with every muscle relaxed (what a tared transducer reads at the plateau of an effort).
 std::vector<double> calcTaredSteadyTorque(const ArmSetup& setup, const SubjectEffort& effort,
-                                          const std::vector<double>& flexionDeg);
+                                          const std::vector<double>& flexionDeg, MuscleGroup group = MuscleGroup::Flexor);
 
 /// One identification in a validation: truth, estimate, coverage.
 struct ElbowValidationRow {

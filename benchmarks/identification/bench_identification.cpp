@@ -138,7 +138,7 @@ void BM_FaithfulForwardEvaluation(benchmark::State& state) {
 void BM_SynergistAwareIdentification(benchmark::State& state) {
     setenv("ARMSIM_ASSETS", ARMSIM_ASSET_DIR, 0);
     static const Population population = loadDefaultPopulation();
-    static const std::vector<TorqueObservation> data = synthesizeMvcTorques(drawSubject(population, 1, 0), {}, 1, 2);
+    static const std::vector<TorqueObservation> data = synthesizeTorqueData(drawSubject(population, 1, 0), {}, 1, 2);
     double error = 0;
     for (auto _ : state) {
         const BicepsEstimate e = identifySynergistAware(population, data);

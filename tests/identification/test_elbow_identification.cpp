@@ -107,7 +107,7 @@ TEST(ElbowIdentification, SynergistAwareIdentifierMeetsItsBiasBoundWhereTheThesi
     std::vector<VirtualSubject> subjects(kSubjects);
     runParallel(kSubjects, 2, [&](int s) {
         subjects[s] = drawSubject(population(), 1, s);
-        data[s] = synthesizeMvcTorques(subjects[s], protocol, 1);
+        data[s] = synthesizeTorqueData(subjects[s], protocol, 1);
     });
     SynergistOptions dropped;
     dropped.includeSynergists = false;
@@ -162,7 +162,7 @@ TEST(ElbowIdentification, ZeroWidthEffortRangesAreHeldFixed) {
     protocol.holdDuration = 1.5;
     protocol.averagingWindow = 0.5;
     const VirtualSubject v = drawSubject(known, 4, 0);
-    const std::vector<TorqueObservation> data = synthesizeMvcTorques(v, protocol, 4, 2);
+    const std::vector<TorqueObservation> data = synthesizeTorqueData(v, protocol, 4, 2);
     const BicepsEstimate e = identifySynergistAware(known, data);
     ASSERT_TRUE(std::isfinite(e.mass)) << e.message;
     EXPECT_TRUE(e.converged) << e.message;

@@ -1,0 +1,103 @@
+// Torque protocols (issue 11): isometric efforts of a (virtual) subject at elbow angles, read by a
+// tared joint-torque transducer. A condition is one effort kind at one angle: a flexion or an extension
+// effort, maximal (level 1) or held at a fraction of the agonists' MVC EMG by EMG feedback (level < 1),
+// repeated. The thesis's protocol is five flexion MVCs x 3. Protocol files (kind: torque) are what
+// `armsim design` writes and `armsim protocol` and `armsim validate --protocol` run; torque data files
+// (CSV) are what a run writes and the identifiers read.
+//
+// Efforts: at level l the agonists get U = l VA (1 + cv z) (clipped to [0, 1]) and the antagonists
+// l CC, with VA the subject's voluntary activation, CC its co-contraction, cv its trial-to-trial
+// variation and z ~ N(0, 1) per trial. Each trial's tared torque is averaged over the end of the hold,
+// then multiplied by (1 + noise z') for the transducer.
+#pragma once
+
+#include "experiments/population.h"
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+namespace armsim {
+
+/// One condition of a torque protocol.
+struct TorqueCondition {
+    double flexionDeg = 90;                     ///< elbow flexion [deg], 0 = extended
+    MuscleGroup effort = MuscleGroup::Flexor;   ///< which group the subject drives
+    double level = 1.0;                         ///< drive as a fraction of maximal (1 = MVC) [1]
+    int repetitions = 3;                        ///< trials of this condition
+};
+
+/// "flexion" or "extension".
+const char* getEffortName(MuscleGroup effort);
+
+/// A protocol of isometric efforts read by a tared torque transducer.
+struct TorqueProtocol {
+    std::string name = "thesis_mvc";
+    std::string description;
+    /// Default: the thesis's five flexion MVCs (45..150 deg included = 135..30 deg flexion) x 3.
+    std::vector<TorqueCondition> conditions = makeFlexionMvcs({135, 120, 90, 60, 30}, 3);
+    double restDuration = 0.5;       ///< [s] relaxed, transducer tared at its start
+    double holdDuration = 3.0;       ///< [s] effort (thesis: 3 s)
+    double averagingWindow = 1.0;    ///< [s] end of the hold averaged (thesis: last second)
+    double sampleRate = 200.0;       ///< [Hz] transducer samples
+    /// Who `armsim protocol` runs it on: person `subjectIndex` of this population file, or, when it is
+    /// empty, the model `model` (name or file) with its own effort and `transducerNoise`.
+    std::string population;
+    int subjectIndex = 0;
+    std::string model = "elbow";
+    double transducerNoise = 0.02;   ///< relative sd (model subject only) [1]
+    unsigned seed = 1;               ///< population and noise seed
+
+    /// Flexion MVCs at the angles, each repeated.
+    static std::vector<TorqueCondition> makeFlexionMvcs(const std::vector<double>& flexionDeg, int repetitions);
+    int getNumTrials() const;        ///< sum of the repetitions
+    /// true when some condition is a submaximal (EMG-feedback) effort.
+    bool usesEmg() const;
+    /// FieldError naming the field ("conditions[2].level", ...) unless every value is in range.
+    void validate() const;
+};
+
+/// One line, e.g. "flexion MVC at 135, 120, 90 deg x 3; extension 50 % at 90 deg x 2".
+std::string describeConditions(const TorqueProtocol& protocol);
+
+/// Reads a protocol file of kind torque strictly (unknown keys, values out of range and duplicate
+/// conditions are InputErrors naming file, line and key).
+TorqueProtocol readTorqueProtocol(const std::string& path);
+/// The file text readTorqueProtocol reads back (same conditions and settings).
+std::string formatTorqueProtocol(const TorqueProtocol& protocol);
+
+/// One measured effort.
+struct TorqueObservation {
+    double flexionDeg = 0;     ///< [deg], 0 = extended
+    MuscleGroup effort = MuscleGroup::Flexor;
+    double level = 1.0;        ///< drive as a fraction of maximal [1]
+    int repetition = 0;
+    double torque = 0;         ///< tared elbow torque, + = flexion [N m] (with transducer noise)
+    double activation = NAN;   ///< agonist activation the subject actually produced (truth; not used by identifiers) [1]
+    double cleanTorque = NAN;  ///< the torque before transducer noise (truth) [N m]
+    double noiseDraw = NAN;    ///< the standard normal draw of its noise: torque = cleanTorque (1 + sd noiseDraw)
+    int line = 0;              ///< line in the file it was read from (0: synthesized)
+};
+
+/// true when a and b are the same condition (angle, effort, level).
+bool isSameCondition(const TorqueObservation& a, const TorqueObservation& b);
+
+/// Runs the protocol on the subject and adds relative transducer noise of the subject's sd.
+/// Reproducible from (subject, noiseSeed); trials run on `jobs` threads. Trial order: repetition-major
+/// (every condition's first trial, then every second one, ...).
+std::vector<TorqueObservation> synthesizeTorqueData(const VirtualSubject& subject, const TorqueProtocol& protocol,
+                                                    unsigned noiseSeed, int jobs = 1);
+
+/// The same efforts read through a transducer of another relative noise sd (the same noise draws:
+/// common random numbers across noise levels).
+std::vector<TorqueObservation> setTransducerNoise(std::vector<TorqueObservation> data, double sd);
+
+/// Torque data as CSV: flexion_deg, effort (1 = flexion, -1 = extension), level, repetition, torque_Nm;
+/// with truth=true also activation, clean_torque_Nm (synthetic data).
+std::string formatTorqueData(const std::vector<TorqueObservation>& data, bool truth);
+/// Reads a torque data file (Table::readCsv: '#' comments, header line). Required columns flexion_deg
+/// and torque_Nm; effort (default 1), level (default 1), repetition (default: count per condition)
+/// optional; other columns are errors. Errors name file, line, column, value and the expected range.
+std::vector<TorqueObservation> readTorqueData(const std::string& path);
+
+}  // namespace armsim
