@@ -2,6 +2,7 @@
 // protocol as a main-job step.
 #include "cli/commands.h"
 #include "experiments/protocol.h"
+#include "experiments/torque_protocol.h"
 #include "muscles/muscle_file.h"
 #include "model/parallel.h"
 #include "muscles/param_file.h"
@@ -112,11 +113,36 @@ void printResult(const Protocol& p, const ProtocolResult& r, const std::string& 
 
 std::string defaultOut(const Protocol& p) { return "out/" + p.name; }
 
+/// A torque protocol (kind: torque, e.g. from `armsim design`): its trials on the subject it names,
+/// tared torque per trial as a data file the identifiers read.
+void runTorqueProtocolCommand(const ProtocolOptions& o, const std::string& file) {
+    if (o.video) throw InputError("--video: torque protocols have no per-trial series to render; run `armsim trial`");
+    const TorqueProtocol protocol = readTorqueProtocol(file);
+    const VirtualSubject subject = loadTorqueProtocolSubject(protocol);
+    const std::string out = o.out.empty() ? "out/" + protocol.name : o.out;
+    std::printf("protocol %s (torque): %s\n  %d trials: %s\n  subject: %s\n", protocol.name.c_str(),
+                protocol.description.c_str(), protocol.getNumTrials(), describeConditions(protocol).c_str(),
+                protocol.population.empty() ? ("model " + protocol.model).c_str()
+                                            : (protocol.population + " person " + std::to_string(protocol.subjectIndex)).c_str());
+    std::fflush(stdout);
+    const std::vector<TorqueObservation> data = synthesizeTorqueData(subject, protocol, protocol.seed, o.jobs);
+    std::printf("  %-9s %6s %6s %4s %12s\n", "effort", "angle", "level", "rep", "torque (N m)");
+    for (const TorqueObservation& d : data)
+        std::printf("  %-9s %6.1f %6.2f %4d %12.2f\n", getEffortName(d.effort), d.flexionDeg, d.level, d.repetition, d.torque);
+    writeFileAtomically(out + "/torque_data.csv", formatTorqueData(data, true));
+    writeFileAtomically(out + "/protocol.yaml", formatTorqueProtocol(protocol));
+    writeTorquePlot(out + "/torque_angle.png", data, "Protocol " + protocol.name + ": tared torque per trial");
+    std::printf("wrote %s/torque_data.csv (identify with `armsim identify --torque-data`), protocol.yaml, torque_angle.png\n",
+                out.c_str());
+}
+
 void runProtocolCommand(const ProtocolOptions& o) {
 #ifndef ARMSIM_WITH_RENDER
     if (o.video) throw InputError("--video: this armsim was built without the renderer (-DARMSIM_RENDER=OFF)");
 #endif
-    const Protocol protocol = readProtocol(findAsset(o.file));
+    const std::string file = findAsset(o.file);
+    if (isTorqueProtocolFile(file)) return runTorqueProtocolCommand(o, file);
+    const Protocol protocol = readProtocol(file);
     const ArmSetup subject = loadProtocolSubject(protocol);
     const std::string out = o.out.empty() ? defaultOut(protocol) : o.out;
     std::printf("protocol %s (%s): %s\n", protocol.name.c_str(), getProtocolKindName(protocol.kind).c_str(),

@@ -1,5 +1,6 @@
 #include "experiments/torque_protocol.h"
 
+#include "experiments/plot.h"
 #include "experiments/portable_random.h"
 #include "model/geometry.h"
 #include "model/trial.h"
@@ -149,6 +150,23 @@ std::string formatTorqueProtocol(const TorqueProtocol& p) {
     return out;
 }
 
+bool isTorqueProtocolFile(const std::string& path) {
+    const ParamNode root = ParamNode::loadFile(path);
+    return root.has("kind") && root.getString("kind") == "torque";
+}
+
+VirtualSubject loadTorqueProtocolSubject(const TorqueProtocol& protocol) {
+    if (!protocol.population.empty())
+        return drawSubject(loadPopulation(protocol.population), protocol.seed, protocol.subjectIndex);
+    VirtualSubject v;
+    v.seed = protocol.seed;
+    v.setup = loadModel(protocol.model);
+    v.transducerNoise = protocol.transducerNoise;
+    v.massScale.assign(v.setup.muscles.size(), 1.0);
+    v.tendonLengthScale = v.fascicleLengthScale = v.massScale;
+    return v;
+}
+
 bool isSameCondition(const TorqueObservation& a, const TorqueObservation& b) {
     return conditionKey(a.flexionDeg, a.effort, a.level) == conditionKey(b.flexionDeg, b.effort, b.level);
 }
@@ -265,6 +283,29 @@ std::vector<TorqueObservation> readTorqueData(const std::string& path) {
         data.push_back(o);
     }
     return data;
+}
+
+void writeTorquePlot(const std::string& path, const std::vector<TorqueObservation>& data, const std::string& title) {
+    PlotSpec plot;
+    plot.title = title;
+    plot.xLabel = "elbow flexion (deg, 0 = extended)";
+    plot.yLabel = "tared torque (N m, + = flexion)";
+    std::vector<std::pair<int, double>> kinds;
+    for (const TorqueObservation& o : data) {
+        const std::pair<int, double> k{int(o.effort), o.level};
+        auto it = std::find(kinds.begin(), kinds.end(), k);
+        if (it == kinds.end()) {
+            kinds.push_back(k);
+            plot.series.push_back({std::string(getEffortName(o.effort)) +
+                                       (o.level == 1 ? " MVC" : " " + formatNumber(100 * o.level) + " %"),
+                                   {}, {}, true, int(kinds.size() - 1) % 8});
+            it = kinds.end() - 1;
+        }
+        PlotSeries& series = plot.series[it - kinds.begin()];
+        series.x.push_back(o.flexionDeg);
+        series.y.push_back(o.torque);
+    }
+    writePlotPng(path, plot);
 }
 
 }  // namespace armsim

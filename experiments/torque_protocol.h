@@ -66,6 +66,12 @@ TorqueProtocol readTorqueProtocol(const std::string& path);
 /// The file text readTorqueProtocol reads back (same conditions and settings).
 std::string formatTorqueProtocol(const TorqueProtocol& protocol);
 
+/// true when the protocol file's kind is torque (it is read with readTorqueProtocol, not readProtocol).
+bool isTorqueProtocolFile(const std::string& path);
+/// The subject the protocol names: person subjectIndex of its population (seeded with its seed), or its
+/// model with the model's effort and the protocol's transducer noise.
+VirtualSubject loadTorqueProtocolSubject(const TorqueProtocol& protocol);
+
 /// One measured effort.
 struct TorqueObservation {
     double flexionDeg = 0;     ///< [deg], 0 = extended
@@ -99,5 +105,9 @@ std::string formatTorqueData(const std::vector<TorqueObservation>& data, bool tr
 /// and torque_Nm; effort (default 1), level (default 1), repetition (default: count per condition)
 /// optional; other columns are errors. Errors name file, line, column, value and the expected range.
 std::vector<TorqueObservation> readTorqueData(const std::string& path);
+
+/// PNG of tared torque vs flexion angle, one series per effort kind (flexion/extension, level), every
+/// trial as a marker. Written whole or not at all.
+void writeTorquePlot(const std::string& path, const std::vector<TorqueObservation>& data, const std::string& title);
 
 }  // namespace armsim

@@ -79,75 +79,6 @@ std::pair<double, int> estimateNoiseLevel(const std::vector<TorqueObservation>& 
     return {dof > 0 ? std::sqrt(ss / dof) : NAN, dof};
 }
 
-// The synergist-aware problem. x = [ln t_b, VA, CC, ln f_b, ln t_s, ln f_s, ln s_e, then ln s_m for every
-// biceps head and every synergist m]: t tendon, f fascicle length and s mass scales; b the biceps heads
-// (one tendon and one fascicle scale), s the synergists, e the extensors (one mass scale).
-struct SynergistProblem {
-    static constexpr int kTendon = 0, kActivation = 1, kCoContraction = 2, kFascicle = 3, kSynergistTendon = 4,
-                         kSynergistFascicle = 5, kExtensorMass = 6, kFirstMass = 7;
-    // The distinct effort kinds of the data, each predicted at every angle.
-    struct EffortKind {
-        MuscleGroup group;
-        double level;
-    };
-    const ArmSetup* base;
-    MvcGeometry geometry;
-    std::vector<EffortKind> kinds;
-    std::vector<int> angleOf, kindOf;         // observation -> angle index, effort kind
-    std::vector<double> torque, sd;           // observations and their sd [N m]
-    std::vector<int> biceps, synergists, extensors, leftOut;
-
-    int size() const { return kFirstMass + int(biceps.size() + synergists.size()); }
-    /// Index in x of muscle i's own mass scale (-1: extensor or ungrouped).
-    int findMassIndex(int i) const {
-        for (std::size_t k = 0; k < biceps.size(); ++k)
-            if (biceps[k] == i) return kFirstMass + int(k);
-        for (std::size_t k = 0; k < synergists.size(); ++k)
-            if (synergists[k] == i) return kFirstMass + int(biceps.size() + k);
-        return -1;
-    }
-    std::vector<MuscleSpec> makeMuscles(const double* x) const {
-        std::vector<MuscleSpec> m = base->muscles;
-        for (std::size_t k = 0; k < biceps.size(); ++k) {
-            MuscleParameters& q = m[biceps[k]].params;
-            q.mass *= std::exp(x[kFirstMass + k]);
-            q.optimalTendonLength *= std::exp(x[kTendon]);
-            q.optimalFascicleLength *= std::exp(x[kFascicle]);
-        }
-        for (std::size_t k = 0; k < synergists.size(); ++k) {
-            MuscleParameters& q = m[synergists[k]].params;
-            q.mass *= std::exp(x[kFirstMass + biceps.size() + k]);
-            q.optimalTendonLength *= std::exp(x[kSynergistTendon]);
-            q.optimalFascicleLength *= std::exp(x[kSynergistFascicle]);
-        }
-        for (int i : extensors) m[i].params.mass *= std::exp(x[kExtensorMass]);
-        return m;
-    }
-    /// [kind][angle] tared torque.
-    std::vector<std::vector<double>> predict(const double* x) const {
-        // Guard: the bounds keep difference probes inside [0, 1] (see identifySynergistAware).
-        const double va = std::clamp(x[kActivation], 0.0, 1.0), cc = std::clamp(x[kCoContraction], 0.0, 1.0);
-        const std::vector<MuscleSpec> muscles = makeMuscles(x);
-        const SteadyMvcCurve relaxed = calcRelaxedCurve(muscles, geometry);
-        std::vector<std::vector<double>> t;
-        for (const EffortKind& k : kinds)
-            t.push_back(calcTaredTorque(muscles, geometry, k.group, makeEffort(k.level, va, cc), relaxed, leftOut));
-        return t;
-    }
-    double predicted(const std::vector<std::vector<double>>& t, std::size_t k) const { return t[kindOf[k]][angleOf[k]]; }
-    // Whitened data residuals; false where a muscle has no steady state.
-    bool calcResiduals(const double* x, double* residuals) const {
-        std::vector<std::vector<double>> t;
-        try {
-            t = predict(x);
-        } catch (const std::exception&) {
-            return false;
-        }
-        for (std::size_t k = 0; k < torque.size(); ++k) residuals[k] = (predicted(t, k) - torque[k]) / sd[k];
-        return true;
-    }
-};
-
 }  // namespace
 
 std::vector<double> calcTaredSteadyTorque(const ArmSetup& setup, const SubjectEffort& effort,
@@ -192,95 +123,185 @@ BicepsEstimate identifyThesisMethod(const ArmSetup& assumed, const std::vector<T
     est.noiseLevel = r.residualSd;
     if (r.hasUncertainty) est.massTendonCorrelation = r.correlation[0][1];
     est.rmsResidual = r.rmsResidual;
+    est.numParameters = 2;
+    std::size_t k = 0;
+    for (const TorqueObservation& o : allData) {
+        const bool used = o.effort == MuscleGroup::Flexor && o.level == 1;
+        est.predictedTorque.push_back(used ? r.modelForces[k] * g.momentArm[k][assumed.primary] : NAN);
+        k += used;
+    }
     return est;
+}
+
+SynergistModel::SynergistModel(const Population& prior, const SynergistOptions& options,
+                               const std::vector<TorqueCondition>& conditions)
+    : base_(&prior.base) {
+    const ArmSetup& base = prior.base;
+    biceps_ = findMuscles(base, options.biceps, "biceps");
+    synergists_ = findMuscles(base, options.synergists, "synergists");
+    if (!options.includeSynergists) leftOut_ = synergists_;
+    for (int i = 0; i < base.getNumMuscles(); ++i)
+        if (base.muscles[i].group == MuscleGroup::Extensor) extensors_.push_back(i);
+    if (std::find(biceps_.begin(), biceps_.end(), base.primary) == biceps_.end())
+        throw InputError("synergist-aware identifier: the primary muscle '" + base.muscles[base.primary].params.name +
+                         "' is not in the biceps group");
+    std::vector<double> angles;
+    for (const TorqueCondition& c : conditions) {
+        auto it = std::find(angles.begin(), angles.end(), c.flexionDeg);
+        angleOf_.push_back(int(it - angles.begin()));
+        if (it == angles.end()) angles.push_back(c.flexionDeg);
+        auto kt = std::find_if(kinds_.begin(), kinds_.end(),
+                               [&](const EffortKind& k) { return k.group == c.effort && k.level == c.level; });
+        kindOf_.push_back(int(kt - kinds_.begin()));
+        if (kt == kinds_.end()) kinds_.push_back({c.effort, c.level});
+    }
+    geometry_ = calcMvcGeometry(base, angles);
+
+    const int n = getNumParameters();
+    const double s2 = prior.strengthSubjectSd * prior.strengthSubjectSd;
+    const double m2 = prior.strengthMuscleSd * prior.strengthMuscleSd;
+    auto uniformSd = [](const UniformRange& r) { return std::max((r.max - r.min) / std::sqrt(12.0), 1e-4); };
+    priorCovariance_.assign(n, std::vector<double>(n, 0.0));
+    auto& cov = priorCovariance_;
+    for (int a = kExtensorMass; a < n; ++a)
+        for (int b = kExtensorMass; b < n; ++b) cov[a][b] = s2;
+    cov[kExtensorMass][kExtensorMass] += m2 / double(std::max<std::size_t>(extensors_.size(), 1));
+    for (int a = kFirstMass; a < n; ++a) cov[a][a] += m2;
+    cov[kTendon][kTendon] = cov[kSynergistTendon][kSynergistTendon] = std::pow(prior.tendonLengthSd, 2);
+    cov[kFascicle][kFascicle] = cov[kSynergistFascicle][kSynergistFascicle] = std::pow(prior.fascicleLengthSd, 2);
+    cov[kActivation][kActivation] = std::pow(uniformSd(prior.voluntaryActivation), 2);
+    cov[kCoContraction][kCoContraction] = std::pow(uniformSd(prior.coContraction), 2);
+    for (int j = 0; j < n; ++j) cov[j][j] = std::max(cov[j][j], 1e-10);  // a zero spread: the value is known
+    priorMean_.assign(n, 0.0);
+    priorMean_[kActivation] = 0.5 * (prior.voluntaryActivation.min + prior.voluntaryActivation.max);
+    priorMean_[kCoContraction] = 0.5 * (prior.coContraction.min + prior.coContraction.max);
+    const double lnLo = std::log(0.25), lnHi = std::log(4.0), lenLo = std::log(0.6), lenHi = std::log(1.4);
+    lower_.assign(n, lnLo);
+    upper_.assign(n, lnHi);
+    for (int j : {kTendon, kFascicle, kSynergistTendon, kSynergistFascicle}) {
+        lower_[j] = lenLo;
+        upper_[j] = lenHi;
+    }
+    // Activations stay 1e-5 inside [0, 1], so the Jacobian's difference probes (relative step 1e-6) do
+    // not cross the model's domain; a range of zero width holds the value fixed.
+    auto inside = [](double v) { return std::clamp(v, 1e-5, 1 - 1e-5); };
+    lower_[kActivation] = inside(prior.voluntaryActivation.min);
+    upper_[kActivation] = inside(prior.voluntaryActivation.max);
+    lower_[kCoContraction] = inside(prior.coContraction.min);
+    upper_[kCoContraction] = inside(prior.coContraction.max);
+    for (int j : {kActivation, kCoContraction}) priorMean_[j] = std::clamp(priorMean_[j], lower_[j], upper_[j]);
+}
+
+std::vector<std::string> SynergistModel::getParameterNames() const {
+    std::vector<std::string> names = {"ln_biceps_tendon_scale", "voluntary_activation", "co_contraction",
+                                      "ln_biceps_fascicle_scale", "ln_synergist_tendon_scale",
+                                      "ln_synergist_fascicle_scale", "ln_extensor_mass_scale"};
+    for (int i : biceps_) names.push_back("ln_" + base_->muscles[i].params.name + "_mass_scale");
+    for (int i : synergists_) names.push_back("ln_" + base_->muscles[i].params.name + "_mass_scale");
+    return names;
+}
+
+int SynergistModel::findMassIndex(int muscle) const {
+    for (std::size_t k = 0; k < biceps_.size(); ++k)
+        if (biceps_[k] == muscle) return kFirstMass + int(k);
+    for (std::size_t k = 0; k < synergists_.size(); ++k)
+        if (synergists_[k] == muscle) return kFirstMass + int(biceps_.size() + k);
+    return -1;
+}
+
+int SynergistModel::getMassIndex() const { return findMassIndex(base_->primary); }
+
+std::vector<int> SynergistModel::getFlexorMassIndices() const {
+    std::vector<int> out;
+    for (std::size_t k = 0; k < biceps_.size() + synergists_.size(); ++k) out.push_back(kFirstMass + int(k));
+    return out;
+}
+
+std::vector<MuscleSpec> SynergistModel::makeMuscles(const double* x) const {
+    std::vector<MuscleSpec> m = base_->muscles;
+    for (std::size_t k = 0; k < biceps_.size(); ++k) {
+        MuscleParameters& q = m[biceps_[k]].params;
+        q.mass *= std::exp(x[kFirstMass + k]);
+        q.optimalTendonLength *= std::exp(x[kTendon]);
+        q.optimalFascicleLength *= std::exp(x[kFascicle]);
+    }
+    for (std::size_t k = 0; k < synergists_.size(); ++k) {
+        MuscleParameters& q = m[synergists_[k]].params;
+        q.mass *= std::exp(x[kFirstMass + biceps_.size() + k]);
+        q.optimalTendonLength *= std::exp(x[kSynergistTendon]);
+        q.optimalFascicleLength *= std::exp(x[kSynergistFascicle]);
+    }
+    for (int i : extensors_) m[i].params.mass *= std::exp(x[kExtensorMass]);
+    return m;
+}
+
+std::vector<double> SynergistModel::calcTorques(const double* x) const {
+    // Guard: the bounds keep difference probes inside [0, 1].
+    const double va = std::clamp(x[kActivation], 0.0, 1.0), cc = std::clamp(x[kCoContraction], 0.0, 1.0);
+    const std::vector<MuscleSpec> muscles = makeMuscles(x);
+    const SteadyMvcCurve relaxed = calcRelaxedCurve(muscles, geometry_);
+    std::vector<std::vector<double>> byKind;
+    for (const EffortKind& k : kinds_)
+        byKind.push_back(calcTaredTorque(muscles, geometry_, k.group, makeEffort(k.level, va, cc), relaxed, leftOut_));
+    std::vector<double> t;
+    for (std::size_t c = 0; c < angleOf_.size(); ++c) t.push_back(byKind[kindOf_[c]][angleOf_[c]]);
+    return t;
 }
 
 BicepsEstimate identifySynergistAware(const Population& prior, const std::vector<TorqueObservation>& data,
                                       const SynergistOptions& options) {
     if (data.empty()) throw InputError("synergist-aware identifier: no observations");
-    const ArmSetup& base = prior.base;
-    SynergistProblem p;
-    p.base = &base;
-    p.biceps = findMuscles(base, options.biceps, "biceps");
-    p.synergists = findMuscles(base, options.synergists, "synergists");
-    if (!options.includeSynergists) p.leftOut = p.synergists;
     const bool measured = std::isfinite(options.measuredActivation);
     if (measured) {
         checkField("measured voluntary activation", options.measuredActivation, Bound::closed(0, 1));
         checkField("activation sd", options.activationSd, Bound::positive());
     }
-    for (int i = 0; i < base.getNumMuscles(); ++i)
-        if (base.muscles[i].group == MuscleGroup::Extensor) p.extensors.push_back(i);
-    if (std::find(p.biceps.begin(), p.biceps.end(), base.primary) == p.biceps.end())
-        throw InputError("synergist-aware identifier: the primary muscle '" + base.muscles[base.primary].params.name +
-                         "' is not in the biceps group");
-
-    std::vector<double> angles;
+    // The data's distinct conditions; each observation indexes one.
+    std::vector<TorqueCondition> conditions;
+    std::vector<int> conditionOf;
+    std::vector<double> torque;
     for (const TorqueObservation& o : data) {
-        auto it = std::find(angles.begin(), angles.end(), o.flexionDeg);
-        p.angleOf.push_back(int(it - angles.begin()));
-        if (it == angles.end()) angles.push_back(o.flexionDeg);
-        auto kt = std::find_if(p.kinds.begin(), p.kinds.end(), [&](const SynergistProblem::EffortKind& k) {
-            return k.group == o.effort && k.level == o.level;
+        auto it = std::find_if(conditions.begin(), conditions.end(), [&](const TorqueCondition& c) {
+            return c.flexionDeg == o.flexionDeg && c.effort == o.effort && c.level == o.level;
         });
-        p.kindOf.push_back(int(kt - p.kinds.begin()));
-        if (kt == p.kinds.end()) p.kinds.push_back({o.effort, o.level});
-        p.torque.push_back(o.torque);
+        conditionOf.push_back(int(it - conditions.begin()));
+        if (it == conditions.end()) conditions.push_back({o.flexionDeg, o.effort, o.level, 1});
+        torque.push_back(o.torque);
     }
-    p.geometry = calcMvcGeometry(base, angles);
+    const SynergistModel model(prior, options, conditions);
 
     BicepsEstimate est;
     est.method = measured ? "synergist-va" : "synergist";
     std::tie(est.noiseLevel, est.noiseDegreesOfFreedom) = estimateNoiseLevel(data);
-    if (!std::isfinite(est.noiseLevel)) {
+    if (std::isfinite(options.noiseLevel)) {
+        checkField("noise level", options.noiseLevel, Bound{0, 0.5, true, true, "relative sd"});
+        est.noiseLevel = options.noiseLevel;
+        est.noiseDegreesOfFreedom = 0;
+    } else if (!std::isfinite(est.noiseLevel)) {
         est.noiseLevel = prior.transducerNoise;
         est.noiseDegreesOfFreedom = 0;
     }
     est.noiseLevel = std::max(est.noiseLevel, 0.002);  // floor: the scatter of few repetitions can be ~0
-    for (double t : p.torque) p.sd.push_back(est.noiseLevel * std::max(std::abs(t), 1.0));
+    std::vector<double> sd;
+    for (double t : torque) sd.push_back(est.noiseLevel * std::max(std::abs(t), 1.0));
 
-    // Prior: every mass scale shares the person-level variance (the extensors' one scale averages
-    // their muscle terms); lengths and effort independent.
-    using P = SynergistProblem;
-    const int n = p.size();
-    const double s2 = prior.strengthSubjectSd * prior.strengthSubjectSd;
-    const double m2 = prior.strengthMuscleSd * prior.strengthMuscleSd;
-    auto uniformSd = [](const UniformRange& r) { return std::max((r.max - r.min) / std::sqrt(12.0), 1e-4); };
+    using P = SynergistModel;
     MapProblem map;
-    map.priorCovariance.assign(n, std::vector<double>(n, 0.0));
-    auto& cov = map.priorCovariance;
-    for (int a = P::kExtensorMass; a < n; ++a)
-        for (int b = P::kExtensorMass; b < n; ++b) cov[a][b] = s2;
-    cov[P::kExtensorMass][P::kExtensorMass] += m2 / double(std::max<std::size_t>(p.extensors.size(), 1));
-    for (int a = P::kFirstMass; a < n; ++a) cov[a][a] += m2;
-    cov[P::kTendon][P::kTendon] = cov[P::kSynergistTendon][P::kSynergistTendon] = std::pow(prior.tendonLengthSd, 2);
-    cov[P::kFascicle][P::kFascicle] = cov[P::kSynergistFascicle][P::kSynergistFascicle] =
-        std::pow(prior.fascicleLengthSd, 2);
-    cov[P::kActivation][P::kActivation] = std::pow(uniformSd(prior.voluntaryActivation), 2);
-    cov[P::kCoContraction][P::kCoContraction] = std::pow(uniformSd(prior.coContraction), 2);
-    for (int j = 0; j < n; ++j) cov[j][j] = std::max(cov[j][j], 1e-10);  // a zero spread: the value is known
-    map.priorMean.assign(n, 0.0);
-    map.priorMean[P::kActivation] = 0.5 * (prior.voluntaryActivation.min + prior.voluntaryActivation.max);
-    map.priorMean[P::kCoContraction] = 0.5 * (prior.coContraction.min + prior.coContraction.max);
-    const double lnLo = std::log(0.25), lnHi = std::log(4.0), lenLo = std::log(0.6), lenHi = std::log(1.4);
-    map.lower.assign(n, lnLo);
-    map.upper.assign(n, lnHi);
-    for (int j : {P::kTendon, P::kFascicle, P::kSynergistTendon, P::kSynergistFascicle}) {
-        map.lower[j] = lenLo;
-        map.upper[j] = lenHi;
-    }
-    // Activations stay 1e-5 inside [0, 1], so the Jacobian's difference probes (relative step 1e-6) do
-    // not cross the model's domain; a range of zero width holds the value fixed.
-    auto inside = [](double v) { return std::clamp(v, 1e-5, 1 - 1e-5); };
-    map.lower[P::kActivation] = inside(prior.voluntaryActivation.min);
-    map.upper[P::kActivation] = inside(prior.voluntaryActivation.max);
-    map.lower[P::kCoContraction] = inside(prior.coContraction.min);
-    map.upper[P::kCoContraction] = inside(prior.coContraction.max);
-    for (int j : {P::kActivation, P::kCoContraction}) map.priorMean[j] = std::clamp(map.priorMean[j], map.lower[j], map.upper[j]);
-    map.numResiduals = int(p.torque.size()) + (measured ? 1 : 0);
+    map.priorMean = model.getPriorMean();
+    map.priorCovariance = model.getPriorCovariance();
+    map.lower = model.getLower();
+    map.upper = model.getUpper();
+    map.numResiduals = int(torque.size()) + (measured ? 1 : 0);
     map.residuals = [&](const double* x, double* r) {
-        if (measured) r[p.torque.size()] = (x[P::kActivation] - options.measuredActivation) / options.activationSd;
-        return p.calcResiduals(x, r);
+        if (measured) r[torque.size()] = (x[P::kActivation] - options.measuredActivation) / options.activationSd;
+        std::vector<double> t;
+        try {
+            t = model.calcTorques(x);
+        } catch (const std::exception&) {
+            return false;
+        }
+        for (std::size_t k = 0; k < torque.size(); ++k) r[k] = (t[conditionOf[k]] - torque[k]) / sd[k];
+        return true;
     };
     const MapResult m = calcMapEstimate(map);
     const std::vector<double>& x = m.x;
@@ -288,8 +309,10 @@ BicepsEstimate identifySynergistAware(const Population& prior, const std::vector
     est.message = m.message;
     if (m.failed) return est;  // no estimate: mass and tendon length stay NaN
 
+    const ArmSetup& base = prior.base;
     const MuscleParameters& b = base.muscles[base.primary].params;
-    const int im = p.findMassIndex(base.primary);
+    const int im = model.getMassIndex();
+    est.numParameters = model.getNumParameters();
     est.mass = b.mass * std::exp(x[im]);
     est.tendonLength = b.optimalTendonLength * std::exp(x[P::kTendon]);
     est.nuisanceNames = {"voluntary_activation", "co_contraction", "biceps_fascicle_scale", "synergist_tendon_scale",
@@ -297,16 +320,19 @@ BicepsEstimate identifySynergistAware(const Population& prior, const std::vector
     est.nuisance = {x[P::kActivation], x[P::kCoContraction], std::exp(x[P::kFascicle]),
                     std::exp(x[P::kSynergistTendon]), std::exp(x[P::kSynergistFascicle]), std::exp(x[P::kExtensorMass])};
     for (int i = 0; i < base.getNumMuscles(); ++i) {
-        const int k = p.findMassIndex(i);
+        const int k = model.findMassIndex(i);
         if (k < 0 || i == base.primary) continue;
         est.nuisanceNames.push_back(base.muscles[i].params.name + "_mass_scale");
         est.nuisance.push_back(std::exp(x[k]));
     }
     try {
-        const std::vector<std::vector<double>> t = p.predict(x.data());
+        const std::vector<double> t = model.calcTorques(x.data());
         double ss = 0;
-        for (std::size_t k = 0; k < p.torque.size(); ++k) ss += std::pow(p.predicted(t, k) - p.torque[k], 2);
-        est.rmsResidual = std::sqrt(ss / double(p.torque.size()));
+        for (std::size_t k = 0; k < torque.size(); ++k) {
+            est.predictedTorque.push_back(t[conditionOf[k]]);
+            ss += std::pow(t[conditionOf[k]] - torque[k], 2);
+        }
+        est.rmsResidual = std::sqrt(ss / double(torque.size()));
     } catch (const std::exception& e) {
         est.converged = false;
         est.message += "; no steady state at the estimate: " + std::string(e.what());
@@ -358,13 +384,29 @@ std::vector<ElbowValidationRow> runElbowValidation(const Population& population,
         const std::vector<TorqueObservation> clean = synthesizeTorqueData(v, settings.protocol, settings.seed, 1);
         for (double level : levels) {
             const std::vector<TorqueObservation> data = setTransducerNoise(clean, level);
-            std::vector<BicepsEstimate> estimates = {identifyThesisMethod(population.base, data),
-                                                     identifySynergistAware(population, data)};
+            // A method that cannot use these data (the thesis method with fewer flexion-MVC angles than
+            // unknowns) is recorded as failed, not fatal.
+            auto attempt = [](const char* method, const std::function<BicepsEstimate()>& run) {
+                try {
+                    return run();
+                } catch (const std::exception& e) {
+                    BicepsEstimate failed;
+                    failed.method = method;
+                    failed.message = e.what();
+                    return failed;
+                }
+            };
+            std::vector<BicepsEstimate> estimates = {
+                attempt("thesis", [&] { return identifyThesisMethod(population.base, data); }),
+                attempt("synergist", [&] { return identifySynergistAware(population, data); })};
             if (settings.activationSd > 0) {
-                SynergistOptions withVa;
-                withVa.activationSd = settings.activationSd;
-                withVa.measuredActivation = measureVoluntaryActivation(data, settings.activationSd, settings.seed + 7919u * unsigned(s));
-                estimates.push_back(identifySynergistAware(population, data, withVa));
+                estimates.push_back(attempt("synergist-va", [&] {
+                    SynergistOptions withVa;
+                    withVa.activationSd = settings.activationSd;
+                    withVa.measuredActivation =
+                        measureVoluntaryActivation(data, settings.activationSd, settings.seed + 7919u * unsigned(s));
+                    return identifySynergistAware(population, data, withVa);
+                }));
             }
             for (const BicepsEstimate& e : estimates) {
                 ElbowValidationRow row;
@@ -410,7 +452,7 @@ std::vector<ElbowValidationSummary> summarizeElbowValidation(const std::vector<E
         ++it->subjects;
     }
     for (ElbowValidationSummary& s : out) {
-        double mb = 0, mm = 0, tb = 0, tm = 0;
+        double mb = 0, mm = 0, tb = 0, tm = 0, mw = 0, tw = 0;
         int mc = 0, mn = 0, tc = 0, tn = 0, n = 0;
         for (const ElbowValidationRow& r : rows) {
             if (r.method != s.method || r.noise != s.noise) continue;
@@ -419,15 +461,21 @@ std::vector<ElbowValidationSummary> summarizeElbowValidation(const std::vector<E
             ++n;
             mb += r.massError, mm += r.massError * r.massError;
             tb += r.tendonError, tm += r.tendonError * r.tendonError;
-            if (r.massCovered >= 0) ++mn, mc += r.massCovered;
-            if (r.tendonCovered >= 0) ++tn, tc += r.tendonCovered;
+            if (r.massCovered >= 0) {
+                ++mn, mc += r.massCovered;
+                mw += (r.estimate.massUpper - r.estimate.massLower) / r.estimate.mass;
+            }
+            if (r.tendonCovered >= 0) {
+                ++tn, tc += r.tendonCovered;
+                tw += r.estimate.tendonUpper - r.estimate.tendonLower;
+            }
         }
         if (n > 0) {
             s.massBias = mb / n, s.massRmse = std::sqrt(mm / n);
             s.tendonBias = tb / n, s.tendonRmse = std::sqrt(tm / n);
         }
-        if (mn > 0) s.massCoverage = double(mc) / mn;
-        if (tn > 0) s.tendonCoverage = double(tc) / tn;
+        if (mn > 0) s.massCoverage = double(mc) / mn, s.massIntervalWidth = mw / mn;
+        if (tn > 0) s.tendonCoverage = double(tc) / tn, s.tendonIntervalWidth = tw / tn;
     }
     return out;
 }

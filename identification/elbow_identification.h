@@ -21,6 +21,7 @@
 #pragma once
 
 #include "experiments/torque_protocol.h"
+#include "model/mvc_curve.h"
 
 #include <functional>
 #include <string>
@@ -43,6 +44,10 @@ struct BicepsEstimate {
     std::vector<double> nuisance;              ///< their estimates
     double massTendonCorrelation = 0.0 / 0.0;  ///< posterior correlation of ln M and ln L0T
     double rmsResidual = 0.0 / 0.0;            ///< of the torque [N m] (thesis: of the force [N])
+    /// Per observation: the torque the method predicts at the estimate [N m] (thesis: the fitted biceps
+    /// force x the biceps moment arm, flexion MVCs only; NaN elsewhere).
+    std::vector<double> predictedTorque;
+    int numParameters = 0;                     ///< free parameters of the fit
 };
 
 /// The thesis's method on torque data, with `assumed` as the experimenter's model (geometry and the
@@ -62,6 +67,56 @@ struct SynergistOptions {
     /// during the MVCs) [1]; NaN: not measured. Adds the residual (VA - measured) / activationSd.
     double measuredActivation = 0.0 / 0.0;
     double activationSd = 0.02;  ///< sd of that measurement [1] (an assumption, see measureVoluntaryActivation)
+    /// Relative sd of one trial's torque [1]; NaN: estimated from the repetitions (pooled over the
+    /// conditions), or the population's transducer noise when nothing is repeated.
+    double noiseLevel = 0.0 / 0.0;
+};
+
+/// The synergist-aware identifier's model: its parameters x, their prior and bounds, and the tared
+/// steady torque it predicts for a list of effort conditions (also used by experiment design).
+/// x = [ln t_b, VA, CC, ln f_b, ln t_s, ln f_s, ln s_e, then ln s_m for every biceps head and synergist
+/// m]: t tendon, f fascicle length and s mass scales; b the biceps heads (one tendon and one fascicle
+/// scale), s the synergists, e the extensors (one mass scale). Prior: every mass scale shares the
+/// person-level variance (the extensors' one scale averages their muscle terms); lengths and effort
+/// independent, effort uniform ranges as their mean and sd.
+class SynergistModel {
+public:
+    /// Throws InputError for muscle names not in the population's model or a primary muscle that is
+    /// not in the biceps group. Conditions' repetitions are ignored.
+    SynergistModel(const Population& prior, const SynergistOptions& options,
+                   const std::vector<TorqueCondition>& conditions);
+    int getNumParameters() const { return kFirstMass + int(biceps_.size() + synergists_.size()); }
+    std::vector<std::string> getParameterNames() const;
+    int getMassIndex() const;                 ///< ln M of the primary muscle
+    std::vector<int> getFlexorMassIndices() const;  ///< the biceps heads' and synergists' ln mass scales
+    static constexpr int getTendonIndex() { return kTendon; }          ///< ln t_b
+    static constexpr int getActivationIndex() { return kActivation; }  ///< VA
+    const std::vector<double>& getPriorMean() const { return priorMean_; }
+    const std::vector<std::vector<double>>& getPriorCovariance() const { return priorCovariance_; }
+    const std::vector<double>& getLower() const { return lower_; }
+    const std::vector<double>& getUpper() const { return upper_; }
+    /// Tared torque of every condition at x [N m]; throws SimulationError where a muscle has no steady state.
+    std::vector<double> calcTorques(const double* x) const;
+    /// The population's model with x's muscles.
+    std::vector<MuscleSpec> makeMuscles(const double* x) const;
+
+private:
+    static constexpr int kTendon = 0, kActivation = 1, kCoContraction = 2, kFascicle = 3, kSynergistTendon = 4,
+                         kSynergistFascicle = 5, kExtensorMass = 6, kFirstMass = 7;
+    struct EffortKind {
+        MuscleGroup group;
+        double level;
+    };
+    int findMassIndex(int muscle) const;
+    const ArmSetup* base_;
+    std::vector<int> biceps_, synergists_, extensors_, leftOut_;
+    MvcGeometry geometry_;
+    std::vector<EffortKind> kinds_;
+    std::vector<int> angleOf_, kindOf_;       // condition -> angle index, effort kind
+    std::vector<double> priorMean_, lower_, upper_;
+    std::vector<std::vector<double>> priorCovariance_;
+    friend BicepsEstimate identifySynergistAware(const Population&, const std::vector<TorqueObservation>&,
+                                                 const SynergistOptions&);
 };
 
 /// The synergist-aware MAP identifier with the population as prior.
@@ -104,6 +159,8 @@ struct ElbowValidationSummary {
     double massBias = 0, massRmse = 0;        ///< relative [1]
     double tendonBias = 0, tendonRmse = 0;    ///< [m]
     double massCoverage = 0.0 / 0.0, tendonCoverage = 0.0 / 0.0;  ///< fraction of subjects [1]
+    double massIntervalWidth = 0.0 / 0.0;     ///< mean 95 % interval width / estimate [1]
+    double tendonIntervalWidth = 0.0 / 0.0;   ///< mean 95 % interval width [m]
 };
 
 /// Settings of runElbowValidation.

@@ -79,4 +79,39 @@ double calcNormalQuantile(double p) {
     return calcStudentTQuantile(p, std::numeric_limits<double>::infinity());
 }
 
+double calcUpperIncompleteGamma(double a, double x) {
+    if (!(a > 0 && x >= 0)) throw std::invalid_argument("calcUpperIncompleteGamma: bad arguments");
+    if (x == 0) return 1.0;
+    const double front = std::exp(-x + a * std::log(x) - std::lgamma(a));
+    if (x < a + 1.0) {  // P by its series, Q = 1 - P
+        double term = 1.0 / a, sum = term;
+        for (int n = 1; n < 10000 && std::abs(term) > 1e-16 * std::abs(sum); ++n) {
+            term *= x / (a + n);
+            sum += term;
+        }
+        return 1.0 - front * sum;
+    }
+    // Continued fraction for Q (modified Lentz).
+    constexpr double tiny = 1e-300;
+    double b = x + 1.0 - a, c = 1.0 / tiny, d = 1.0 / b, h = d;
+    for (int i = 1; i < 10000; ++i) {
+        const double an = -i * (i - a);
+        b += 2.0;
+        d = an * d + b;
+        if (std::abs(d) < tiny) d = tiny;
+        c = b + an / c;
+        if (std::abs(c) < tiny) c = tiny;
+        d = 1.0 / d;
+        const double delta = d * c;
+        h *= delta;
+        if (std::abs(delta - 1.0) < 1e-16) break;
+    }
+    return front * h;
+}
+
+double calcChiSquareSurvival(double x, double dof) {
+    if (!(dof > 0)) throw std::invalid_argument("calcChiSquareSurvival: dof must be > 0");
+    return calcUpperIncompleteGamma(0.5 * dof, 0.5 * std::max(x, 0.0));
+}
+
 }  // namespace armsim

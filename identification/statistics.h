@@ -12,5 +12,10 @@ double calcStudentTCdf(double t, double dof);
 double calcStudentTQuantile(double p, double dof);
 /// Standard normal quantile, p in (0, 1).
 double calcNormalQuantile(double p);
+/// Regularised upper incomplete gamma Q(a, x) = Gamma(a, x) / Gamma(a), a > 0, x >= 0 (series for
+/// x < a + 1, else continued fraction; Numerical Recipes 3rd ed., 6.2).
+double calcUpperIncompleteGamma(double a, double x);
+/// P(X >= x) for X chi-square with dof > 0 degrees of freedom.
+double calcChiSquareSurvival(double x, double dof);
 
 }  // namespace armsim

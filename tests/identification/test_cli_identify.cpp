@@ -187,3 +187,43 @@ TEST(CliValidate, ElbowTruthWritesPerSubjectAndSummaryFilesAndPlots) {
     EXPECT_EQ(outside.exitCode, kInputErrorExit) << outside.output;
     EXPECT_NE(outside.output.find("170"), std::string::npos) << outside.output;
 }
+
+// The design pipeline end to end: `design` writes a protocol file, `protocol` runs it on the subject it
+// names and writes torque data, `identify-torque` fits those data with every method that applies.
+TEST(CliDesign, DesignedProtocolRunsAndItsDataAreIdentified) {
+    const fs::path d = freshDir("design_pipeline");
+    CommandResult r = runArmsim("design --draws 4 --trials 6 --repetitions 2 --levels 0.5 --out " + (d / "design").string());
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    const fs::path protocol = d / "design" / "designed_protocol.yaml";
+    ASSERT_TRUE(fs::exists(protocol)) << r.output;
+    EXPECT_NE(r.output.find("designed protocol:"), std::string::npos) << r.output;
+    for (const char* f : {"design_predictions.csv", "design_steps.csv", "design_criterion.png"})
+        EXPECT_TRUE(fs::exists(d / "design" / f)) << f;
+
+    r = runArmsim("protocol " + protocol.string() + " --out " + (d / "run").string());
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    std::ifstream in(d / "run" / "torque_data.csv");
+    int rows = 0;
+    for (std::string line; std::getline(in, line);)
+        if (!line.empty() && line[0] != '#' && line.rfind("flexion_deg", 0) != 0) ++rows;
+    EXPECT_EQ(rows, 6);  // the budget
+
+    r = runArmsim("identify-torque " + (d / "run" / "torque_data.csv").string() + " --activation 0.9 --out " +
+                  (d / "fit").string());
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    std::ifstream est(d / "fit" / "torque_estimates.csv");
+    std::string header, line;
+    std::getline(est, header);
+    int fits = 0;
+    while (std::getline(est, line)) {
+        const std::string method = line.substr(0, line.find(','));
+        EXPECT_TRUE(method == "thesis" || method == "synergist" || method == "synergist-va") << line;
+        fits += method != "thesis";
+    }
+    EXPECT_EQ(fits, 2);  // synergist and synergist-va
+    EXPECT_TRUE(fs::exists(d / "fit" / "torque_fit.png"));
+
+    r = runArmsim("identify-torque " + (d / "missing.csv").string());
+    EXPECT_NE(r.exitCode, 0);
+    EXPECT_NE(r.output.find("missing.csv"), std::string::npos) << r.output;
+}

@@ -26,6 +26,21 @@ TEST(Statistics, StudentTQuantilesMatchTables) {
     EXPECT_NEAR(calcStudentTCdf(0.0, 4), 0.5, 1e-15);
 }
 
+// Chi-square tail probabilities against table values (Abramowitz & Stegun 26.4) and the closed forms
+// for 2 degrees of freedom, P = exp(-x/2), and for 1, P = erfc(sqrt(x/2)).
+TEST(Statistics, ChiSquareSurvivalMatchesTablesAndClosedForms) {
+    constexpr double kTableTol = 2e-5;  // the table's critical values have 3-4 decimals
+    EXPECT_NEAR(calcChiSquareSurvival(3.841459, 1), 0.05, kTableTol);
+    EXPECT_NEAR(calcChiSquareSurvival(18.307038, 10), 0.05, kTableTol);
+    EXPECT_NEAR(calcChiSquareSurvival(2.558212, 10), 0.99, kTableTol);
+    EXPECT_NEAR(calcChiSquareSurvival(124.342, 100), 0.05, kTableTol);
+    for (double x : {0.1, 1.0, 5.0, 30.0}) {
+        EXPECT_NEAR(calcChiSquareSurvival(x, 2), std::exp(-x / 2), 1e-13 * std::max(1.0, std::exp(-x / 2))) << x;
+        EXPECT_NEAR(calcChiSquareSurvival(x, 1), std::erfc(std::sqrt(x / 2)), 1e-12) << x;
+    }
+    EXPECT_EQ(calcChiSquareSurvival(0, 3), 1.0);
+}
+
 TEST(Uncertainty, AsManyPointsAsUnknownsNeedAGivenNoiseLevel) {
     const ObservationSet data = makeSyntheticData(makeTruth(), {0.375, 0.40});
     const IdentificationReport r = identify(makeProblem(data), SteadyForceModel());

@@ -1,0 +1,191 @@
+// armsim design: the torque protocol that minimises the synergist-aware identifier's expected posterior
+// uncertainty of the biceps mass and tendon length over a population (identification/experiment_design.h),
+// compared with the thesis's five-angle protocol, predicted and (with --validate-subjects) obtained.
+#include "cli/commands.h"
+#include "experiments/plot.h"
+#include "identification/experiment_design.h"
+#include "muscles/param_file.h"
+
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <sstream>
+
+namespace armsim::cli {
+
+namespace {
+
+struct DesignOptions {
+    std::string population;
+    std::string angles = "15,30,45,60,75,90,105,120,135";
+    std::string levels;
+    bool noExtension = false;
+    int trials = 15;
+    int repetitions = 3;
+    int draws = 32;
+    unsigned seed = 1;
+    double activationSd = 0.02;
+    int jobs = 2;
+    int validateSubjects = 0;
+    std::string out = "out/design";
+};
+
+std::vector<double> parseList(const std::string& option, const std::string& text) {
+    std::vector<double> v;
+    std::stringstream in(text);
+    std::string item;
+    while (std::getline(in, item, ',')) {
+        try {
+            std::size_t used = 0;
+            v.push_back(std::stod(item, &used));
+            if (used != item.size()) throw std::invalid_argument(item);
+        } catch (const std::exception&) {
+            throw InputError(option + ": '" + item + "' is not a number: expected comma-separated numbers");
+        }
+    }
+    return v;
+}
+
+void printPrediction(const ProtocolPrediction& p) {
+    std::printf("  %-10s %3d trials  sd(ln M) %5.1f %%  sd(L0T) %5.1f mm  sd(total flexor strength) %4.1f %%  "
+                "criterion %.2f  (prior: %.1f %%, %.1f mm, %.1f %%; %d draws)\n",
+                p.name.c_str(), p.trials, 100 * p.massSd, 1000 * p.tendonSd, 100 * p.flexorStrengthSd, p.criterion,
+                100 * p.priorMassSd, 1000 * p.priorTendonSd, 100 * p.priorFlexorStrengthSd, p.drawsUsed);
+    std::printf("             posterior correlation of ln M with:");
+    for (std::size_t j = 0; j < p.parameterNames.size(); ++j)
+        if (std::abs(p.massCorrelation[j]) >= 0.3 && p.massCorrelation[j] < 0.999)
+            std::printf(" %s %+.2f;", p.parameterNames[j].c_str(), p.massCorrelation[j]);
+    std::printf("\n");
+}
+
+void runDesign(const DesignOptions& o) {
+    const Population population = o.population.empty() ? loadDefaultPopulation() : loadPopulation(o.population);
+    DesignSettings s;
+    s.flexionDeg = parseList("--angles", o.angles);
+    if (!o.levels.empty()) s.levels = parseList("--levels", o.levels);
+    s.extension = !o.noExtension;
+    s.trials = o.trials;
+    s.repetitions = o.repetitions;
+    s.draws = o.draws;
+    s.seed = o.seed;
+    s.activationSd = o.activationSd;
+    s.jobs = o.jobs;
+    s.validate();
+    std::printf("experiment design for the synergist-aware identifier: population '%s', budget %d trials in blocks "
+                "of %d, angles %s deg, extension MVCs %s, submaximal EMG-feedback levels %s, VA %s; %d prior draws\n",
+                population.name.c_str(), s.trials, s.repetitions, o.angles.c_str(), s.extension ? "allowed" : "not allowed",
+                o.levels.empty() ? "none" : o.levels.c_str(),
+                s.activationSd > 0 ? ("measured (sd " + formatNumber(s.activationSd) + ")").c_str() : "not measured",
+                s.draws);
+    std::fflush(stdout);
+    TorqueProtocol thesis;
+    thesis.name = "thesis";
+    const DesignResult d = designProtocol(population, s, thesis, [](int done, int n) { printProgress("design", done, n); });
+    const ProtocolPrediction& reference = d.reference;
+
+    std::printf("greedy picks (block of %d trials each, criterion after the pick; 1 = both sds at the goals 10 %%, 1 cm):\n",
+                s.repetitions);
+    for (std::size_t k = 0; k < d.steps.size(); ++k)
+        std::printf("  %2zu. %-9s %s at %5.1f deg   criterion %.3f\n", k + 1, getEffortName(d.steps[k].condition.effort),
+                    d.steps[k].condition.level == 1 ? "MVC " : (formatNumber(100 * d.steps[k].condition.level) + " %").c_str(),
+                    d.steps[k].condition.flexionDeg, d.steps[k].criterion);
+    std::printf("designed protocol: %s\n", describeConditions(d.protocol).c_str());
+    std::printf("predicted uncertainty (Laplace, mean over prior draws):\n");
+    printPrediction(reference);
+    printPrediction(d.predicted);
+
+    const std::string protocolPath = o.out + "/designed_protocol.yaml";
+    writeFileAtomically(protocolPath,
+                        "# Written by `armsim design` (identification/experiment_design.h). Run it with\n"
+                        "#   armsim protocol " + protocolPath + "\n#   armsim validate --truth elbow --protocol " +
+                            protocolPath + "\n" + formatTorqueProtocol(d.protocol));
+    writeFileAtomically(o.out + "/design_predictions.csv", formatPredictionsCsv({reference, d.predicted}));
+    std::string steps = "step,effort,flexion_deg,level,repetitions,criterion\n";
+    for (std::size_t k = 0; k < d.steps.size(); ++k)
+        steps += std::to_string(k + 1) + "," + getEffortName(d.steps[k].condition.effort) + "," +
+                 formatNumber(d.steps[k].condition.flexionDeg) + "," + formatNumber(d.steps[k].condition.level) + "," +
+                 std::to_string(d.steps[k].condition.repetitions) + "," + formatNumber(d.steps[k].criterion) + "\n";
+    writeFileAtomically(o.out + "/design_steps.csv", steps);
+    PlotSpec plot;
+    plot.title = "Greedy design: expected criterion after each block of trials";
+    plot.xLabel = "trials";
+    plot.yLabel = "criterion (1 = sds at the goals)";
+    PlotSeries greedy{"designed", {}, {}, false, 0};
+    for (std::size_t k = 0; k < d.steps.size(); ++k) {
+        greedy.x.push_back(double((k + 1) * s.repetitions));
+        greedy.y.push_back(d.steps[k].criterion);
+    }
+    plot.series = {greedy, {"thesis five angles", {double(reference.trials)}, {reference.criterion}, true, 1}};
+    writePlotPng(o.out + "/design_criterion.png", plot);
+    std::printf("wrote %s, %s/design_predictions.csv, design_steps.csv, design_criterion.png\n", protocolPath.c_str(),
+                o.out.c_str());
+
+    if (o.validateSubjects <= 0) return;
+    std::printf("validation of both protocols on %d subjects (seed %u):\n", o.validateSubjects, o.seed);
+    std::string csv = "protocol,method,subjects,converged,mass_bias_pct,mass_rmse_pct,mass_coverage,"
+                      "mass_interval_width_pct,tendon_bias_mm,tendon_rmse_mm,tendon_coverage,tendon_interval_width_mm,"
+                      "predicted_mass_sd_pct,predicted_tendon_sd_mm\n";
+    for (const auto& [protocol, predicted] : {std::pair{thesis, reference}, std::pair{d.protocol, d.predicted}}) {
+        ElbowValidationSettings v;
+        v.subjects = o.validateSubjects;
+        v.seed = o.seed;
+        v.jobs = o.jobs;
+        v.activationSd = o.activationSd;
+        v.protocol = protocol;
+        const std::vector<ElbowValidationRow> rows = runElbowValidation(
+            population, v, [&](int done, int n) { printProgress("validate " + protocol.name, done, n); });
+        for (const ElbowValidationSummary& x : summarizeElbowValidation(rows)) {
+            if (x.method == "thesis") continue;
+            std::printf("  %-9s %-13s mass bias %+5.1f %%  RMSE %5.1f %% (predicted sd %4.1f %%)  coverage %.2f  "
+                        "95 %% width %5.1f %%   L0T RMSE %5.1f mm (predicted %4.1f mm)  coverage %.2f\n",
+                        protocol.name.c_str(), x.method.c_str(), 100 * x.massBias, 100 * x.massRmse,
+                        100 * predicted.massSd, x.massCoverage, 100 * x.massIntervalWidth, 1000 * x.tendonRmse,
+                        1000 * predicted.tendonSd, x.tendonCoverage);
+            csv += protocol.name + "," + x.method + "," + std::to_string(x.subjects) + "," + std::to_string(x.converged) +
+                   "," + formatNumber(100 * x.massBias) + "," + formatNumber(100 * x.massRmse) + "," +
+                   formatNumber(x.massCoverage) + "," + formatNumber(100 * x.massIntervalWidth) + "," +
+                   formatNumber(1000 * x.tendonBias) + "," + formatNumber(1000 * x.tendonRmse) + "," +
+                   formatNumber(x.tendonCoverage) + "," + formatNumber(1000 * x.tendonIntervalWidth) + "," +
+                   formatNumber(100 * predicted.massSd) + "," + formatNumber(1000 * predicted.tendonSd) + "\n";
+        }
+    }
+    std::printf("  (predicted: synergist-%s; the RMSE is the obtained counterpart of the predicted sd)\n",
+                o.activationSd > 0 ? "va" : "aware");
+    writeFileAtomically(o.out + "/design_validation.csv", csv);
+    std::printf("wrote %s/design_validation.csv\n", o.out.c_str());
+}
+
+void addDesignCommand(CLI::App& app) {
+    auto o = std::make_shared<DesignOptions>();
+    CLI::App* c = app.add_subcommand(
+        "design", "torque protocol minimising the synergist-aware identifier's expected uncertainty of biceps mass "
+                  "and tendon length (Bayesian, Laplace approximation, greedy), vs the thesis's five angles");
+    c->add_option("--population", o->population, "prior population (default assets/subjects/default_population.yaml)");
+    c->add_option("--angles", o->angles, "allowed flexion angles [deg, 0 = extended], comma-separated")->capture_default_str();
+    c->add_option("--levels", o->levels,
+                  "allowed submaximal levels (EMG feedback, fractions of MVC in (0, 1)), comma-separated; default none");
+    c->add_flag("--no-extension", o->noExtension, "no extension MVCs");
+    c->add_option("--trials", o->trials, "budget: total trials")->capture_default_str()->check(CLI::Range(1, 10000));
+    c->add_option("--repetitions", o->repetitions, "trials per picked condition (>= 2 lets the identifier estimate its noise)")
+        ->capture_default_str()
+        ->check(CLI::Range(1, 100));
+    c->add_option("--draws", o->draws, "prior draws the expected uncertainty averages over")->capture_default_str()->check(CLI::Range(1, 100000));
+    c->add_option("--seed", o->seed, "seed of the prior draws and of --validate-subjects")->capture_default_str();
+    c->add_option("--activation-sd", o->activationSd,
+                  "voluntary activation measured by twitch interpolation to this sd (0: not measured)")
+        ->capture_default_str()
+        ->check(CLI::Range(0.0, 0.5));
+    c->add_option("--jobs", o->jobs, "threads")->capture_default_str()->check(CLI::Range(1, 64));
+    c->add_option("--validate-subjects", o->validateSubjects,
+                  "also run `validate --truth elbow` with the thesis's and the designed protocol on this many subjects")
+        ->capture_default_str()
+        ->check(CLI::Range(0, 1000000));
+    c->add_option("--out", o->out, "output directory")->capture_default_str();
+    c->callback([o] { runDesign(*o); });
+}
+
+const CommandRegistrar registerDesign(57, addDesignCommand);
+
+}  // namespace
+
+}  // namespace armsim::cli

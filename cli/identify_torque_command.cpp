@@ -1,0 +1,161 @@
+// armsim identify-torque: the biceps long head's mass and tendon length from tared elbow torque data
+// (a torque data file: measured, or written by `armsim protocol` for a torque protocol) with every
+// elbow method (thesis, synergist, synergist-va), with residuals checked against the measurement noise.
+#include "cli/commands.h"
+#include "experiments/plot.h"
+#include "identification/elbow_identification.h"
+#include "identification/statistics.h"
+#include "muscles/muscle_file.h"
+#include "muscles/param_file.h"
+
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <set>
+
+namespace armsim::cli {
+
+namespace {
+
+struct IdentifyTorqueOptions {
+    std::string data;
+    std::string population;
+    double noiseLevel = NAN;     // relative sd of one trial's torque; NaN: from repetitions
+    double activation = NAN;     // measured voluntary activation (twitch interpolation); NaN: not measured
+    double activationSd = 0.02;
+    std::string out = "out/identify_torque";
+};
+
+// Chi-square of the method's torque residuals with sd = noise |torque| (the noise the synergist methods
+// weight with), its degrees of freedom and the tail probability.
+struct NoiseCheck {
+    double chiSquare = 0;
+    int n = 0, dof = 0;
+    double p = NAN;
+};
+
+NoiseCheck checkResiduals(const std::vector<TorqueObservation>& data, const BicepsEstimate& e, double noise) {
+    NoiseCheck c;
+    for (std::size_t k = 0; k < data.size() && k < e.predictedTorque.size(); ++k) {
+        if (!std::isfinite(e.predictedTorque[k])) continue;
+        const double sd = noise * std::max(std::abs(data[k].torque), 1.0);
+        c.chiSquare += std::pow((e.predictedTorque[k] - data[k].torque) / sd, 2);
+        ++c.n;
+    }
+    // The MAP fit's prior keeps its effective parameter count below its nominal one: the thesis's 2
+    // free parameters are subtracted, the synergist fits' are not (a conservative test for them).
+    c.dof = std::max(1, c.n - (e.method == "thesis" ? e.numParameters : 0));
+    c.p = calcChiSquareSurvival(c.chiSquare, c.dof);
+    return c;
+}
+
+void runIdentifyTorque(const IdentifyTorqueOptions& o) {
+    const std::string file = findAsset(o.data);
+    const std::vector<TorqueObservation> data = readTorqueData(file);
+    const Population prior = o.population.empty() ? loadDefaultPopulation() : loadPopulation(o.population);
+    std::printf("torque data %s: %zu trials; prior population '%s' (model '%s')\n", file.c_str(), data.size(),
+                prior.name.c_str(), prior.base.name.c_str());
+    std::vector<BicepsEstimate> estimates;
+    std::set<double> mvcAngles;  // the thesis method fits flexion MVCs only, two unknowns
+    for (const TorqueObservation& d : data)
+        if (d.effort == MuscleGroup::Flexor && d.level == 1) mvcAngles.insert(d.flexionDeg);
+    if (mvcAngles.size() >= 2)
+        estimates.push_back(identifyThesisMethod(prior.base, data));
+    else
+        std::printf("thesis method: skipped (it fits flexion MVCs at >= 2 angles; these data have %zu)\n", mvcAngles.size());
+    SynergistOptions so;
+    so.noiseLevel = o.noiseLevel;
+    estimates.push_back(identifySynergistAware(prior, data, so));
+    if (std::isfinite(o.activation)) {
+        so.measuredActivation = o.activation;
+        so.activationSd = o.activationSd;
+        estimates.push_back(identifySynergistAware(prior, data, so));
+    }
+    // The noise the residuals are judged against: given, or the synergist fit's estimate from repeats.
+    const double noise = std::isfinite(o.noiseLevel) ? o.noiseLevel : estimates.back().noiseLevel;
+    const MuscleParameters& b = prior.base.biceps();
+    std::printf("prior (population base) %s: M %.1f g, L0T %.1f cm; residuals judged against a relative torque sd of "
+                "%.1f %% (%s)\n",
+                b.name.c_str(), 1000 * b.mass, 100 * b.optimalTendonLength, 100 * noise,
+                std::isfinite(o.noiseLevel) ? "--noise-level" : "estimated from the repetitions");
+    std::printf("%-13s %9s %21s %9s %21s %10s %12s %6s %8s\n", "method", "M (g)", "95 % interval", "L0T (cm)",
+                "95 % interval", "rms (N m)", "chi2 / dof", "p", "verdict");
+    std::string csv = "method,converged,mass_kg,mass_lower_kg,mass_upper_kg,tendon_length_m,tendon_lower_m,"
+                      "tendon_upper_m,rms_residual_Nm,chi_square,dof,p_value,noise_level\n";
+    std::string residuals = "flexion_deg,effort,level,repetition,torque_Nm";
+    for (const BicepsEstimate& e : estimates) residuals += "," + e.method + "_Nm";
+    residuals += "\n";
+    for (const BicepsEstimate& e : estimates) {
+        const NoiseCheck c = checkResiduals(data, e, noise);
+        double ss = 0;
+        for (std::size_t k = 0; k < data.size(); ++k)
+            if (std::isfinite(e.predictedTorque[k])) ss += std::pow(e.predictedTorque[k] - data[k].torque, 2);
+        const double rms = std::sqrt(ss / std::max(c.n, 1));
+        std::printf("%-13s %9.1f   [%7.1f, %7.1f] %9.2f   [%7.2f, %7.2f] %10.2f %6.1f / %-4d %6.3f %8s%s\n",
+                    e.method.c_str(), 1000 * e.mass, 1000 * e.massLower, 1000 * e.massUpper, 100 * e.tendonLength,
+                    100 * e.tendonLower, 100 * e.tendonUpper, rms, c.chiSquare, c.dof, c.p,
+                    c.p >= 0.05 ? "noise" : "misfit", e.converged ? "" : "  (not converged)");
+        csv += e.method + "," + (e.converged ? "1" : "0") + "," + formatNumber(e.mass) + "," + formatNumber(e.massLower) +
+               "," + formatNumber(e.massUpper) + "," + formatNumber(e.tendonLength) + "," + formatNumber(e.tendonLower) +
+               "," + formatNumber(e.tendonUpper) + "," + formatNumber(rms) + "," + formatNumber(c.chiSquare) + "," +
+               std::to_string(c.dof) + "," + formatNumber(c.p) + "," + formatNumber(noise) + "\n";
+    }
+    std::printf("verdict: 'noise' = residuals consistent with the measurement noise (chi-square p >= 0.05), "
+                "'misfit' = larger than the noise explains\n");
+    std::printf("%-9s %6s %6s %4s %11s", "effort", "angle", "level", "rep", "measured");
+    for (const BicepsEstimate& e : estimates) std::printf(" %13s", e.method.c_str());
+    std::printf("   (predicted torque, N m)\n");
+    for (std::size_t k = 0; k < data.size(); ++k) {
+        const TorqueObservation& d = data[k];
+        std::printf("%-9s %6.1f %6.2f %4d %11.2f", getEffortName(d.effort), d.flexionDeg, d.level, d.repetition, d.torque);
+        residuals += formatNumber(d.flexionDeg) + "," + (d.effort == MuscleGroup::Flexor ? "1" : "-1") + "," +
+                     formatNumber(d.level) + "," + std::to_string(d.repetition) + "," + formatNumber(d.torque);
+        for (const BicepsEstimate& e : estimates) {
+            std::printf(" %13.2f", e.predictedTorque[k]);
+            residuals += "," + (std::isfinite(e.predictedTorque[k]) ? formatNumber(e.predictedTorque[k]) : std::string());
+        }
+        std::printf("\n");
+        residuals += "\n";
+    }
+    writeFileAtomically(o.out + "/torque_estimates.csv", csv);
+    writeFileAtomically(o.out + "/torque_predictions.csv", residuals);
+    PlotSpec plot;
+    plot.title = "Torque data and each method's fit";
+    plot.xLabel = "elbow flexion (deg, 0 = extended)";
+    plot.yLabel = "tared torque (N m, + = flexion)";
+    PlotSeries measured{"measured", {}, {}, true, 7};
+    for (const TorqueObservation& d : data) measured.x.push_back(d.flexionDeg), measured.y.push_back(d.torque);
+    plot.series.push_back(measured);
+    for (std::size_t m = 0; m < estimates.size(); ++m) {
+        PlotSeries s{estimates[m].method, {}, {}, true, int(m)};
+        for (std::size_t k = 0; k < data.size(); ++k)
+            if (std::isfinite(estimates[m].predictedTorque[k]))
+                s.x.push_back(data[k].flexionDeg), s.y.push_back(estimates[m].predictedTorque[k]);
+        plot.series.push_back(s);
+    }
+    writePlotPng(o.out + "/torque_fit.png", plot);
+    std::printf("wrote %s/torque_estimates.csv, torque_predictions.csv, torque_fit.png\n", o.out.c_str());
+}
+
+void addIdentifyTorqueCommand(CLI::App& app) {
+    auto o = std::make_shared<IdentifyTorqueOptions>();
+    CLI::App* c = app.add_subcommand("identify-torque",
+                                     "biceps mass and tendon length from tared elbow torque data with the thesis, "
+                                     "synergist and (with --activation) synergist-va methods");
+    c->add_option("data", o->data, "torque CSV: flexion_deg, torque_Nm [, effort, level, repetition]")->required();
+    c->add_option("--population", o->population, "prior population (default assets/subjects/default_population.yaml)");
+    c->add_option("--noise-level", o->noiseLevel,
+                  "relative sd of one trial's torque (default: estimated from repeated trials)")
+        ->check(CLI::Range(1e-4, 0.5));
+    c->add_option("--activation", o->activation, "measured voluntary activation (twitch interpolation): adds synergist-va")
+        ->check(CLI::Range(0.0, 1.0));
+    c->add_option("--activation-sd", o->activationSd, "sd of that measurement")->capture_default_str()->check(CLI::Range(1e-4, 0.5));
+    c->add_option("--out", o->out, "output directory")->capture_default_str();
+    c->callback([o] { runIdentifyTorque(*o); });
+}
+
+const CommandRegistrar registerIdentifyTorque(56, addIdentifyTorqueCommand);
+
+}  // namespace
+
+}  // namespace armsim::cli

@@ -1,0 +1,138 @@
+// Torque protocols and torque data files: files read back what was written, bad files are refused
+// with file, line and field, and synthesized trials follow the stated effort model.
+#include "experiments/torque_protocol.h"
+#include "muscles/param_file.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+using namespace armsim;
+
+namespace {
+
+std::string writeTemp(const std::string& name, const std::string& text) {
+    const auto path = std::filesystem::temp_directory_path() / name;
+    std::ofstream(path) << text;
+    return path.string();
+}
+
+template <class F> std::string errorOf(F&& f) {
+    try {
+        f();
+    } catch (const InputError& e) {
+        return e.what();
+    }
+    return "";
+}
+
+TorqueProtocol makeMixedProtocol() {
+    TorqueProtocol p;
+    p.name = "mixed";
+    p.description = "flexion, extension and submaximal";
+    p.conditions = {{90, MuscleGroup::Flexor, 1.0, 2}, {45, MuscleGroup::Extensor, 1.0, 3},
+                    {120, MuscleGroup::Flexor, 0.3, 1}};
+    p.holdDuration = 1.5;
+    p.averagingWindow = 0.5;
+    p.seed = 11;
+    return p;
+}
+
+}  // namespace
+
+TEST(TorqueProtocol, FileReadsBackWhatWasWritten) {
+    const TorqueProtocol p = makeMixedProtocol();
+    const TorqueProtocol q = readTorqueProtocol(writeTemp("armsim_torque_protocol.yaml", formatTorqueProtocol(p)));
+    EXPECT_TRUE(isTorqueProtocolFile(writeTemp("armsim_torque_protocol.yaml", formatTorqueProtocol(p))));
+    ASSERT_EQ(q.conditions.size(), p.conditions.size());
+    for (std::size_t k = 0; k < p.conditions.size(); ++k) {
+        EXPECT_EQ(q.conditions[k].flexionDeg, p.conditions[k].flexionDeg);
+        EXPECT_EQ(q.conditions[k].effort, p.conditions[k].effort);
+        EXPECT_EQ(q.conditions[k].level, p.conditions[k].level);
+        EXPECT_EQ(q.conditions[k].repetitions, p.conditions[k].repetitions);
+    }
+    EXPECT_EQ(q.name, p.name);
+    EXPECT_EQ(q.description, p.description);
+    EXPECT_EQ(q.holdDuration, p.holdDuration);
+    EXPECT_EQ(q.seed, p.seed);
+    EXPECT_EQ(q.getNumTrials(), 6);
+    EXPECT_TRUE(q.usesEmg());
+    EXPECT_EQ(describeConditions(q), "flexion MVC at 90 deg x 2; extension MVC at 45 deg x 3; flexion 30 % at 120 deg x 1");
+}
+
+TEST(TorqueProtocol, BadFilesNameTheFileLineAndField) {
+    const std::string head = "name: t\nkind: torque\nconditions:\n";
+    auto read = [&](const std::string& body) {
+        return errorOf([&] { readTorqueProtocol(writeTemp("armsim_bad_torque.yaml", head + body)); });
+    };
+    std::string e = read("  - {effort: flexion, flexion_deg: 90, level: 0}\n");
+    EXPECT_NE(e.find("armsim_bad_torque.yaml:4"), std::string::npos) << e;
+    EXPECT_NE(e.find("level"), std::string::npos) << e;
+    e = read("  - {effort: sideways, flexion_deg: 90}\n");
+    EXPECT_NE(e.find("sideways"), std::string::npos) << e;
+    EXPECT_NE(e.find("extension"), std::string::npos) << e;
+    e = read("  - {effort: flexion, flexion_deg: 190}\n");
+    EXPECT_NE(e.find("flexion_deg"), std::string::npos) << e;
+    e = read("  - {effort: flexion, flexion_deg: 90, repeats: 2}\n");
+    EXPECT_NE(e.find("repeats"), std::string::npos) << e;
+    e = read("  - {flexion_deg: 90}\n  - {flexion_deg: 90, repetitions: 2}\n");
+    EXPECT_NE(e.find("listed twice"), std::string::npos) << e;
+    e = errorOf([&] { readTorqueProtocol(writeTemp("armsim_bad_torque.yaml", "name: t\nkind: mvc\nconditions: []\n")); });
+    EXPECT_NE(e.find("kind"), std::string::npos) << e;
+}
+
+TEST(TorqueData, FileReadsBackAndBadRowsNameLineAndColumn) {
+    std::vector<TorqueObservation> data(3);
+    data[0] = {90, MuscleGroup::Flexor, 1.0, 0, 60.5};
+    data[1] = {90, MuscleGroup::Flexor, 1.0, 1, 58.25};
+    data[2] = {45, MuscleGroup::Extensor, 0.5, 0, -20.125};
+    const std::vector<TorqueObservation> back = readTorqueData(writeTemp("armsim_torque.csv", formatTorqueData(data, false)));
+    ASSERT_EQ(back.size(), 3u);
+    for (std::size_t k = 0; k < 3; ++k) {
+        EXPECT_EQ(back[k].flexionDeg, data[k].flexionDeg);
+        EXPECT_EQ(back[k].effort, data[k].effort);
+        EXPECT_EQ(back[k].level, data[k].level);
+        EXPECT_EQ(back[k].repetition, data[k].repetition);
+        EXPECT_EQ(back[k].torque, data[k].torque);
+    }
+    EXPECT_TRUE(isSameCondition(back[0], back[1]));
+    EXPECT_FALSE(isSameCondition(back[0], back[2]));
+    auto read = [&](const std::string& text) {
+        return errorOf([&] { readTorqueData(writeTemp("armsim_bad_torque.csv", text)); });
+    };
+    std::string e = read("flexion_deg,torque_Nm\n90,50\n90,-5\n");
+    EXPECT_NE(e.find("armsim_bad_torque.csv:3"), std::string::npos) << e;
+    EXPECT_NE(e.find("torque_Nm"), std::string::npos) << e;
+    e = read("flexion_deg,effort,torque_Nm\n90,2,50\n");
+    EXPECT_NE(e.find("'effort' = 2"), std::string::npos) << e;
+    e = read("flexion_deg,torque,repetition\n90,50,0\n");
+    EXPECT_NE(e.find("unknown column 'torque'"), std::string::npos) << e;
+    e = read("flexion_deg,torque_Nm,repetition\n90,50,0\n90,51,0\n");
+    EXPECT_NE(e.find("appears earlier"), std::string::npos) << e;
+    e = read("flexion_deg,torque_Nm,level\n90,50,1.5\n");
+    EXPECT_NE(e.find("level"), std::string::npos) << e;
+}
+
+// Synthesized trials follow the effort model: extension efforts read negative torque, a submaximal
+// level scales the drive (activation = level x VA x (1 + cv z)), and the same seed gives the same data.
+TEST(TorqueProtocol, SynthesizedEffortsFollowTheStatedModel) {
+    const Population population = loadDefaultPopulation();
+    const VirtualSubject v = drawSubject(population, 3, 1);
+    const TorqueProtocol p = makeMixedProtocol();
+    const std::vector<TorqueObservation> a = synthesizeTorqueData(v, p, 5, 2), b = synthesizeTorqueData(v, p, 5, 1);
+    ASSERT_EQ(a.size(), 6u);
+    const double va = v.setup.effort.voluntaryActivation, cv = v.setup.effort.trialCv;
+    for (std::size_t k = 0; k < a.size(); ++k) {
+        EXPECT_EQ(a[k].torque, b[k].torque) << "threads changed the data";
+        EXPECT_EQ(a[k].effort == MuscleGroup::Flexor, a[k].torque > 0) << k;
+        EXPECT_NEAR(a[k].activation / (a[k].level * va), 1.0, 4 * cv) << k;  // |z| < 4
+        EXPECT_NEAR(a[k].torque, a[k].cleanTorque * (1 + v.transducerNoise * a[k].noiseDraw), 1e-12);
+    }
+    // Repetition-major order: every condition's first trial, then the second ones.
+    EXPECT_EQ(a[0].repetition, 0);
+    EXPECT_EQ(a[3].repetition, 1);
+    EXPECT_EQ(a[5].repetition, 2);
+    EXPECT_EQ(a[5].effort, MuscleGroup::Extensor);
+}
