@@ -27,6 +27,7 @@ struct DesignOptions {
     double activationSd = 0.02;
     int jobs = 2;
     int validateSubjects = 0;
+    bool freeSlowFraction = false;
     std::string out = "out/design";
 };
 
@@ -70,6 +71,7 @@ void runDesign(const DesignOptions& o) {
     s.seed = o.seed;
     s.activationSd = o.activationSd;
     s.jobs = o.jobs;
+    s.freeSlowFraction = o.freeSlowFraction;
     s.validate();
     std::printf("experiment design for the synergist-aware identifier: population '%s', budget %d trials in blocks "
                 "of %d, angles %s deg, extension MVCs %s, submaximal EMG-feedback levels %s, VA %s; %d prior draws\n",
@@ -132,6 +134,7 @@ void runDesign(const DesignOptions& o) {
         v.jobs = o.jobs;
         v.activationSd = o.activationSd;
         v.protocol = protocol;
+        v.freeSlowFraction = o.freeSlowFraction;
         const std::vector<ElbowValidationRow> rows = runElbowValidation(
             population, v, [&](int done, int n) { printProgress("validate " + protocol.name, done, n); });
         for (const ElbowValidationSummary& x : summarizeElbowValidation(rows)) {
@@ -165,6 +168,8 @@ void addDesignCommand(CLI::App& app) {
     c->add_option("--levels", o->levels,
                   "allowed submaximal levels (EMG feedback, fractions of MVC in (0, 1)), comma-separated; default none");
     c->add_flag("--no-extension", o->noExtension, "no extension MVCs");
+    c->add_flag("--free-slow-fraction", o->freeSlowFraction,
+                "the identifier frees the flexors' slow-fibre fractions (biceps heads, synergists)");
     c->add_option("--trials", o->trials, "budget: total trials")->capture_default_str()->check(CLI::Range(1, 10000));
     c->add_option("--repetitions", o->repetitions, "trials per picked condition (>= 2 lets the identifier estimate its noise)")
         ->capture_default_str()

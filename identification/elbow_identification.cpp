@@ -163,8 +163,11 @@ SynergistModel::SynergistModel(const Population& prior, const SynergistOptions& 
     auto uniformSd = [](const UniformRange& r) { return std::max((r.max - r.min) / std::sqrt(12.0), 1e-4); };
     priorCovariance_.assign(n, std::vector<double>(n, 0.0));
     auto& cov = priorCovariance_;
-    for (int a = kExtensorMass; a < n; ++a)
-        for (int b = kExtensorMass; b < n; ++b) cov[a][b] = s2;
+    std::vector<int> masses = {kExtensorMass};
+    for (int a = kFirstMass; a < n; ++a) masses.push_back(a);
+    for (int a : masses)
+        for (int b : masses) cov[a][b] = s2;
+    cov[kBicepsSlow][kBicepsSlow] = cov[kSynergistSlow][kSynergistSlow] = std::pow(prior.slowFractionSd, 2);
     cov[kExtensorMass][kExtensorMass] += m2 / double(std::max<std::size_t>(extensors_.size(), 1));
     for (int a = kFirstMass; a < n; ++a) cov[a][a] += m2;
     cov[kTendon][kTendon] = cov[kSynergistTendon][kSynergistTendon] = std::pow(prior.tendonLengthSd, 2);
@@ -185,6 +188,10 @@ SynergistModel::SynergistModel(const Population& prior, const SynergistOptions& 
     // Activations stay 1e-5 inside [0, 1], so the Jacobian's difference probes (relative step 1e-6) do
     // not cross the model's domain; a range of zero width holds the value fixed.
     auto inside = [](double v) { return std::clamp(v, 1e-5, 1 - 1e-5); };
+    for (int j : {kBicepsSlow, kSynergistSlow}) {
+        lower_[j] = options.freeSlowFraction ? -0.3 : 0.0;
+        upper_[j] = options.freeSlowFraction ? 0.3 : 0.0;
+    }
     lower_[kActivation] = inside(prior.voluntaryActivation.min);
     upper_[kActivation] = inside(prior.voluntaryActivation.max);
     lower_[kCoContraction] = inside(prior.coContraction.min);
@@ -195,7 +202,8 @@ SynergistModel::SynergistModel(const Population& prior, const SynergistOptions& 
 std::vector<std::string> SynergistModel::getParameterNames() const {
     std::vector<std::string> names = {"ln_biceps_tendon_scale", "voluntary_activation", "co_contraction",
                                       "ln_biceps_fascicle_scale", "ln_synergist_tendon_scale",
-                                      "ln_synergist_fascicle_scale", "ln_extensor_mass_scale"};
+                                      "ln_synergist_fascicle_scale", "ln_extensor_mass_scale",
+                                      "biceps_slow_fraction_shift", "synergist_slow_fraction_shift"};
     for (int i : biceps_) names.push_back("ln_" + base_->muscles[i].params.name + "_mass_scale");
     for (int i : synergists_) names.push_back("ln_" + base_->muscles[i].params.name + "_mass_scale");
     return names;
@@ -224,12 +232,14 @@ std::vector<MuscleSpec> SynergistModel::makeMuscles(const double* x) const {
         q.mass *= std::exp(x[kFirstMass + k]);
         q.optimalTendonLength *= std::exp(x[kTendon]);
         q.optimalFascicleLength *= std::exp(x[kFascicle]);
+        q.slowFraction = std::clamp(q.slowFraction + x[kBicepsSlow], 0.05, 0.95);
     }
     for (std::size_t k = 0; k < synergists_.size(); ++k) {
         MuscleParameters& q = m[synergists_[k]].params;
         q.mass *= std::exp(x[kFirstMass + biceps_.size() + k]);
         q.optimalTendonLength *= std::exp(x[kSynergistTendon]);
         q.optimalFascicleLength *= std::exp(x[kSynergistFascicle]);
+        q.slowFraction = std::clamp(q.slowFraction + x[kSynergistSlow], 0.05, 0.95);
     }
     for (int i : extensors_) m[i].params.mass *= std::exp(x[kExtensorMass]);
     return m;
@@ -319,6 +329,10 @@ BicepsEstimate identifySynergistAware(const Population& prior, const std::vector
                          "synergist_fascicle_scale", "extensor_mass_scale"};
     est.nuisance = {x[P::kActivation], x[P::kCoContraction], std::exp(x[P::kFascicle]),
                     std::exp(x[P::kSynergistTendon]), std::exp(x[P::kSynergistFascicle]), std::exp(x[P::kExtensorMass])};
+    if (options.freeSlowFraction) {
+        est.nuisanceNames.insert(est.nuisanceNames.end(), {"biceps_slow_fraction_shift", "synergist_slow_fraction_shift"});
+        est.nuisance.insert(est.nuisance.end(), {x[P::kBicepsSlow], x[P::kSynergistSlow]});
+    }
     for (int i = 0; i < base.getNumMuscles(); ++i) {
         const int k = model.findMassIndex(i);
         if (k < 0 || i == base.primary) continue;
@@ -378,6 +392,8 @@ std::vector<ElbowValidationRow> runElbowValidation(const Population& population,
         if (i != primary) bicepsShort = i;
     const std::vector<int> synergists = findMuscles(population.base, SynergistOptions().synergists, "synergists");
 
+    SynergistOptions base;
+    base.freeSlowFraction = settings.freeSlowFraction;
     std::vector<std::vector<ElbowValidationRow>> perSubject(settings.subjects);
     runParallel(settings.subjects, settings.jobs, [&](int s) {
         const VirtualSubject v = drawSubject(population, settings.seed, s);
@@ -398,10 +414,10 @@ std::vector<ElbowValidationRow> runElbowValidation(const Population& population,
             };
             std::vector<BicepsEstimate> estimates = {
                 attempt("thesis", [&] { return identifyThesisMethod(population.base, data); }),
-                attempt("synergist", [&] { return identifySynergistAware(population, data); })};
+                attempt("synergist", [&] { return identifySynergistAware(population, data, base); })};
             if (settings.activationSd > 0) {
                 estimates.push_back(attempt("synergist-va", [&] {
-                    SynergistOptions withVa;
+                    SynergistOptions withVa = base;
                     withVa.activationSd = settings.activationSd;
                     withVa.measuredActivation =
                         measureVoluntaryActivation(data, settings.activationSd, settings.seed + 7919u * unsigned(s));

@@ -67,6 +67,9 @@ struct SynergistOptions {
     /// during the MVCs) [1]; NaN: not measured. Adds the residual (VA - measured) / activationSd.
     double measuredActivation = 0.0 / 0.0;
     double activationSd = 0.02;  ///< sd of that measurement [1] (an assumption, see measureVoluntaryActivation)
+    /// Free the flexors' slow-fibre fractions (one shift for the biceps heads, one for the synergists;
+    /// prior sd the population's): submaximal efforts depend on them.
+    bool freeSlowFraction = false;
     /// Relative sd of one trial's torque [1]; NaN: estimated from the repetitions (pooled over the
     /// conditions), or the population's transducer noise when nothing is repeated.
     double noiseLevel = 0.0 / 0.0;
@@ -74,9 +77,10 @@ struct SynergistOptions {
 
 /// The synergist-aware identifier's model: its parameters x, their prior and bounds, and the tared
 /// steady torque it predicts for a list of effort conditions (also used by experiment design).
-/// x = [ln t_b, VA, CC, ln f_b, ln t_s, ln f_s, ln s_e, then ln s_m for every biceps head and synergist
-/// m]: t tendon, f fascicle length and s mass scales; b the biceps heads (one tendon and one fascicle
-/// scale), s the synergists, e the extensors (one mass scale). Prior: every mass scale shares the
+/// x = [ln t_b, VA, CC, ln f_b, ln t_s, ln f_s, ln s_e, d_b, d_s, then ln s_m for every biceps head and
+/// synergist m]: t tendon, f fascicle length and s mass scales; b the biceps heads (one tendon and one
+/// fascicle scale), s the synergists, e the extensors (one mass scale); d the change of the slow-fibre
+/// fraction F_slow (added, biceps heads and synergists; held at 0 unless freeSlowFraction). Prior: every mass scale shares the
 /// person-level variance (the extensors' one scale averages their muscle terms); lengths and effort
 /// independent, effort uniform ranges as their mean and sd.
 class SynergistModel {
@@ -102,7 +106,8 @@ public:
 
 private:
     static constexpr int kTendon = 0, kActivation = 1, kCoContraction = 2, kFascicle = 3, kSynergistTendon = 4,
-                         kSynergistFascicle = 5, kExtensorMass = 6, kFirstMass = 7;
+                         kSynergistFascicle = 5, kExtensorMass = 6, kBicepsSlow = 7, kSynergistSlow = 8,
+                         kFirstMass = 9;
     struct EffortKind {
         MuscleGroup group;
         double level;
@@ -172,6 +177,7 @@ struct ElbowValidationSettings {
     /// by twitch interpolation to this sd [1]; 0: not.
     double activationSd = 0.02;
     TorqueProtocol protocol;
+    bool freeSlowFraction = false;            ///< the synergist identifiers free the slow fractions (SynergistOptions)
     int jobs = 2;                             ///< threads (over subjects)
 };
 

@@ -64,7 +64,9 @@ namespace {
 
 Sensitivities calcSensitivities(const Population& prior, const std::vector<TorqueCondition>& conditions,
                                 const DesignSettings& settings, const std::function<void(int, int)>& progress) {
-    const SynergistModel model(prior, SynergistOptions{}, conditions);
+    SynergistOptions options;
+    options.freeSlowFraction = settings.freeSlowFraction;
+    const SynergistModel model(prior, options, conditions);
     const int n = model.getNumParameters();
     Sensitivities s;
     s.names = model.getParameterNames();

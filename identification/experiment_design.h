@@ -37,6 +37,7 @@ struct DesignSettings {
     int draws = 32;                      ///< prior draws the criterion averages over
     unsigned seed = 1;
     double activationSd = 0.02;          ///< > 0: VA measured by twitch interpolation to this sd; 0: not
+    bool freeSlowFraction = false;       ///< the identifier frees the slow fractions (SynergistOptions)
     int jobs = 2;                        ///< threads (over draws)
     /// FieldError naming the field for values out of range.
     void validate() const;
