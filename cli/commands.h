@@ -12,6 +12,7 @@
 #include <functional>
 #include <optional>
 #include <string>
+#include <vector>
 
 namespace armsim::cli {
 
@@ -54,6 +55,13 @@ struct MainJobStepRegistrar {
 
 /// Adds every registered command to app (called by main).
 void addRegisteredCommands(CLI::App& app);
+
+/// A finite number given to `option`; InputError naming the option and the text otherwise.
+double parseNumber(const std::string& option, const std::string& text);
+/// The non-empty items of a comma-separated list.
+std::vector<std::string> splitList(const std::string& text);
+/// A comma-separated list of finite numbers given to `option` (each checked by parseNumber).
+std::vector<double> parseNumberList(const std::string& option, const std::string& text);
 
 /// Prints a one-line progress bar to stderr ("label [#####     ] 5/10").
 void printProgress(const std::string& label, int done, int total);

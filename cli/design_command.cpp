@@ -9,7 +9,6 @@
 #include <cmath>
 #include <cstdio>
 #include <memory>
-#include <sstream>
 
 namespace armsim::cli {
 
@@ -31,22 +30,6 @@ struct DesignOptions {
     std::string out = "out/design";
 };
 
-std::vector<double> parseList(const std::string& option, const std::string& text) {
-    std::vector<double> v;
-    std::stringstream in(text);
-    std::string item;
-    while (std::getline(in, item, ',')) {
-        try {
-            std::size_t used = 0;
-            v.push_back(std::stod(item, &used));
-            if (used != item.size()) throw std::invalid_argument(item);
-        } catch (const std::exception&) {
-            throw InputError(option + ": '" + item + "' is not a number: expected comma-separated numbers");
-        }
-    }
-    return v;
-}
-
 void printPrediction(const ProtocolPrediction& p) {
     std::printf("  %-10s %3d trials  sd(ln M) %5.1f %%  sd(L0T) %5.1f mm  sd(total flexor strength) %4.1f %%  "
                 "criterion %.2f  (prior: %.1f %%, %.1f mm, %.1f %%; %d draws)\n",
@@ -62,8 +45,8 @@ void printPrediction(const ProtocolPrediction& p) {
 void runDesign(const DesignOptions& o) {
     const Population population = o.population.empty() ? loadDefaultPopulation() : loadPopulation(o.population);
     DesignSettings s;
-    s.flexionDeg = parseList("--angles", o.angles);
-    if (!o.levels.empty()) s.levels = parseList("--levels", o.levels);
+    s.flexionDeg = parseNumberList("--angles", o.angles);
+    if (!o.levels.empty()) s.levels = parseNumberList("--levels", o.levels);
     s.extension = !o.noExtension;
     s.trials = o.trials;
     s.repetitions = o.repetitions;

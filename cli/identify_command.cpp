@@ -28,27 +28,6 @@ namespace {
 constexpr double kThesisMeasuredMass = 0.3377;          // kg, thesis Table 7.3
 constexpr double kThesisMeasuredTendonLength = 0.244;   // m, thesis Table 7.3
 
-double parseNumber(const std::string& option, const std::string& text) {
-    std::size_t used = 0;
-    double v = 0;
-    try {
-        v = std::stod(text, &used);
-    } catch (const std::exception&) {
-        used = 0;
-    }
-    if (used != text.size() || text.empty() || !std::isfinite(v))
-        throw InputError(option + " '" + text + "': expected a finite number");
-    return v;
-}
-
-std::vector<std::string> splitList(const std::string& text) {
-    std::vector<std::string> items;
-    std::stringstream s(text);
-    for (std::string item; std::getline(s, item, ',');)
-        if (!item.empty()) items.push_back(item);
-    return items;
-}
-
 /// Parameter name with the short aliases of the command line (tendon_length, fascicle_length).
 ParameterId parseParameter(const std::string& option, const std::string& name) {
     const std::string full = name == "tendon_length" ? "optimal_tendon_length"
@@ -336,8 +315,7 @@ void runElbowValidate(const ValidateOptions& o) {
     } else {
         std::vector<double> angles = {135, 120, 90, 60, 30};
         if (!o.angles.empty()) {
-            angles.clear();
-            for (const std::string& v : splitList(o.angles)) angles.push_back(parseNumber("--angles", v));
+            angles = parseNumberList("--angles", o.angles);
         }
         s.protocol.conditions = TorqueProtocol::makeFlexionMvcs(angles, o.repetitions);
     }

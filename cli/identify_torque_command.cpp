@@ -29,6 +29,7 @@ struct IdentifyTorqueOptions {
 // Chi-square of the method's torque residuals with sd = noise |torque| (the noise the synergist methods
 // weight with), its degrees of freedom and the tail probability.
 struct NoiseCheck {
+    double rms = 0;        // [N m]
     double chiSquare = 0;
     int n = 0, dof = 0;
     double p = NAN;
@@ -38,10 +39,13 @@ NoiseCheck checkResiduals(const std::vector<TorqueObservation>& data, const Bice
     NoiseCheck c;
     for (std::size_t k = 0; k < data.size() && k < e.predictedTorque.size(); ++k) {
         if (!std::isfinite(e.predictedTorque[k])) continue;
+        const double residual = e.predictedTorque[k] - data[k].torque;
         const double sd = noise * std::max(std::abs(data[k].torque), 1.0);
-        c.chiSquare += std::pow((e.predictedTorque[k] - data[k].torque) / sd, 2);
+        c.rms += residual * residual;
+        c.chiSquare += std::pow(residual / sd, 2);
         ++c.n;
     }
+    c.rms = std::sqrt(c.rms / std::max(c.n, 1));
     // The MAP fit's prior keeps its effective parameter count below its nominal one: the thesis's 2
     // free parameters are subtracted, the synergist fits' are not (a conservative test for them).
     c.dof = std::max(1, c.n - (e.method == "thesis" ? e.numParameters : 0));
@@ -58,7 +62,7 @@ void runIdentifyTorque(const IdentifyTorqueOptions& o) {
     std::vector<BicepsEstimate> estimates;
     std::set<double> mvcAngles;  // the thesis method fits flexion MVCs only, two unknowns
     for (const TorqueObservation& d : data)
-        if (d.effort == MuscleGroup::Flexor && d.level == 1) mvcAngles.insert(d.flexionDeg);
+        if (d.isFlexionMvc()) mvcAngles.insert(d.flexionDeg);
     if (mvcAngles.size() >= 2)
         estimates.push_back(identifyThesisMethod(prior.base, data));
     else
@@ -87,17 +91,13 @@ void runIdentifyTorque(const IdentifyTorqueOptions& o) {
     residuals += "\n";
     for (const BicepsEstimate& e : estimates) {
         const NoiseCheck c = checkResiduals(data, e, noise);
-        double ss = 0;
-        for (std::size_t k = 0; k < data.size(); ++k)
-            if (std::isfinite(e.predictedTorque[k])) ss += std::pow(e.predictedTorque[k] - data[k].torque, 2);
-        const double rms = std::sqrt(ss / std::max(c.n, 1));
         std::printf("%-13s %9.1f   [%7.1f, %7.1f] %9.2f   [%7.2f, %7.2f] %10.2f %6.1f / %-4d %6.3f %8s%s\n",
                     e.method.c_str(), 1000 * e.mass, 1000 * e.massLower, 1000 * e.massUpper, 100 * e.tendonLength,
-                    100 * e.tendonLower, 100 * e.tendonUpper, rms, c.chiSquare, c.dof, c.p,
+                    100 * e.tendonLower, 100 * e.tendonUpper, c.rms, c.chiSquare, c.dof, c.p,
                     c.p >= 0.05 ? "noise" : "misfit", e.converged ? "" : "  (not converged)");
         csv += e.method + "," + (e.converged ? "1" : "0") + "," + formatNumber(e.mass) + "," + formatNumber(e.massLower) +
                "," + formatNumber(e.massUpper) + "," + formatNumber(e.tendonLength) + "," + formatNumber(e.tendonLower) +
-               "," + formatNumber(e.tendonUpper) + "," + formatNumber(rms) + "," + formatNumber(c.chiSquare) + "," +
+               "," + formatNumber(e.tendonUpper) + "," + formatNumber(c.rms) + "," + formatNumber(c.chiSquare) + "," +
                std::to_string(c.dof) + "," + formatNumber(c.p) + "," + formatNumber(noise) + "\n";
     }
     std::printf("verdict: 'noise' = residuals consistent with the measurement noise (chi-square p >= 0.05), "

@@ -1,6 +1,10 @@
 #include "cli/commands.h"
 
+#include "muscles/param_file.h"
+
 #include <algorithm>
+#include <cmath>
+#include <sstream>
 #include <cstdio>
 #include <memory>
 #include <unistd.h>
@@ -38,6 +42,33 @@ CommandRegistrar::CommandRegistrar(int order, std::function<void(CLI::App&)> add
 MainJobStepRegistrar::MainJobStepRegistrar(int order, std::string name,
                                            std::function<void(const MainJobContext&)> run) {
     steps().push_back({order, std::move(name), std::move(run)});
+}
+
+double parseNumber(const std::string& option, const std::string& text) {
+    std::size_t used = 0;
+    double v = 0;
+    try {
+        v = std::stod(text, &used);
+    } catch (const std::exception&) {
+        used = 0;
+    }
+    if (used != text.size() || text.empty() || !std::isfinite(v))
+        throw InputError(option + " '" + text + "': expected a finite number");
+    return v;
+}
+
+std::vector<std::string> splitList(const std::string& text) {
+    std::vector<std::string> items;
+    std::stringstream s(text);
+    for (std::string item; std::getline(s, item, ',');)
+        if (!item.empty()) items.push_back(item);
+    return items;
+}
+
+std::vector<double> parseNumberList(const std::string& option, const std::string& text) {
+    std::vector<double> v;
+    for (const std::string& item : splitList(text)) v.push_back(parseNumber(option, item));
+    return v;
 }
 
 void printProgress(const std::string& label, int done, int total) {

@@ -83,6 +83,8 @@ struct TorqueObservation {
     double cleanTorque = NAN;  ///< the torque before transducer noise (truth) [N m]
     double noiseDraw = NAN;    ///< the standard normal draw of its noise: torque = cleanTorque (1 + sd noiseDraw)
     int line = 0;              ///< line in the file it was read from (0: synthesized)
+    /// A maximal flexion effort (what the thesis's method uses).
+    bool isFlexionMvc() const { return effort == MuscleGroup::Flexor && level == 1; }
 };
 
 /// true when a and b are the same condition (angle, effort, level).

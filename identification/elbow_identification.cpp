@@ -92,7 +92,7 @@ BicepsEstimate identifyThesisMethod(const ArmSetup& assumed, const std::vector<T
     est.method = "thesis";
     std::vector<TorqueObservation> data;  // the method knows flexion MVCs only
     for (const TorqueObservation& o : allData)
-        if (o.effort == MuscleGroup::Flexor && o.level == 1) data.push_back(o);
+        if (o.isFlexionMvc()) data.push_back(o);
     if (data.empty()) throw InputError("thesis method: no flexion MVC in the data (it uses those only)");
     std::vector<double> angles;
     for (const TorqueObservation& o : data) angles.push_back(o.flexionDeg);
@@ -126,9 +126,8 @@ BicepsEstimate identifyThesisMethod(const ArmSetup& assumed, const std::vector<T
     est.numParameters = 2;
     std::size_t k = 0;
     for (const TorqueObservation& o : allData) {
-        const bool used = o.effort == MuscleGroup::Flexor && o.level == 1;
-        est.predictedTorque.push_back(used ? r.modelForces[k] * g.momentArm[k][assumed.primary] : NAN);
-        k += used;
+        est.predictedTorque.push_back(o.isFlexionMvc() ? r.modelForces[k] * g.momentArm[k][assumed.primary] : NAN);
+        k += o.isFlexionMvc();
     }
     return est;
 }
@@ -266,16 +265,11 @@ BicepsEstimate identifySynergistAware(const Population& prior, const std::vector
         checkField("measured voluntary activation", options.measuredActivation, Bound::closed(0, 1));
         checkField("activation sd", options.activationSd, Bound::positive());
     }
-    // The data's distinct conditions; each observation indexes one.
+    // One condition per observation: the model computes each distinct angle and effort kind once.
     std::vector<TorqueCondition> conditions;
-    std::vector<int> conditionOf;
     std::vector<double> torque;
     for (const TorqueObservation& o : data) {
-        auto it = std::find_if(conditions.begin(), conditions.end(), [&](const TorqueCondition& c) {
-            return c.flexionDeg == o.flexionDeg && c.effort == o.effort && c.level == o.level;
-        });
-        conditionOf.push_back(int(it - conditions.begin()));
-        if (it == conditions.end()) conditions.push_back({o.flexionDeg, o.effort, o.level, 1});
+        conditions.push_back({o.flexionDeg, o.effort, o.level, 1});
         torque.push_back(o.torque);
     }
     const SynergistModel model(prior, options, conditions);
@@ -310,7 +304,7 @@ BicepsEstimate identifySynergistAware(const Population& prior, const std::vector
         } catch (const std::exception&) {
             return false;
         }
-        for (std::size_t k = 0; k < torque.size(); ++k) r[k] = (t[conditionOf[k]] - torque[k]) / sd[k];
+        for (std::size_t k = 0; k < torque.size(); ++k) r[k] = (t[k] - torque[k]) / sd[k];
         return true;
     };
     const MapResult m = calcMapEstimate(map);
@@ -343,8 +337,8 @@ BicepsEstimate identifySynergistAware(const Population& prior, const std::vector
         const std::vector<double> t = model.calcTorques(x.data());
         double ss = 0;
         for (std::size_t k = 0; k < torque.size(); ++k) {
-            est.predictedTorque.push_back(t[conditionOf[k]]);
-            ss += std::pow(t[conditionOf[k]] - torque[k], 2);
+            est.predictedTorque.push_back(t[k]);
+            ss += std::pow(t[k] - torque[k], 2);
         }
         est.rmsResidual = std::sqrt(ss / double(torque.size()));
     } catch (const std::exception& e) {

@@ -86,7 +86,8 @@ struct SynergistOptions {
 class SynergistModel {
 public:
     /// Throws InputError for muscle names not in the population's model or a primary muscle that is
-    /// not in the biceps group. Conditions' repetitions are ignored.
+    /// not in the biceps group. Conditions may repeat (each distinct angle and effort kind is computed
+    /// once); their repetitions are ignored.
     SynergistModel(const Population& prior, const SynergistOptions& options,
                    const std::vector<TorqueCondition>& conditions);
     int getNumParameters() const { return kFirstMass + int(biceps_.size() + synergists_.size()); }

@@ -17,6 +17,13 @@ constexpr double kMassGoal = 0.10;     // issue 11: mass RMSE <= 10 %
 constexpr double kTendonGoal = 0.010;  // issue 11: tendon-length RMSE <= 1 cm [m]
 constexpr double kStep = 1e-4;         // central-difference step in x (ln scales and activations)
 
+Eigen::MatrixXd toMatrix(const std::vector<std::vector<double>>& rows) {
+    Eigen::MatrixXd m(int(rows.size()), rows.empty() ? 0 : int(rows.front().size()));
+    for (int a = 0; a < m.rows(); ++a)
+        for (int b = 0; b < m.cols(); ++b) m(a, b) = rows[a][b];
+    return m;
+}
+
 // Tared torques of every candidate condition and their gradients at one prior draw.
 struct DrawSensitivity {
     bool ok = false;
@@ -29,7 +36,7 @@ struct Sensitivities {
     int massIndex = 0, tendonIndex = 0, activationIndex = 0;
     Eigen::VectorXd flexorMean;    // weights of the mean of the flexors' ln mass scales
     Eigen::MatrixXd priorPrecision;
-    double priorMassSd = 0, priorTendonSd = 0, baseTendonLength = 0;
+    double priorMassSd = 0, priorTendonSd = 0, priorFlexorStrengthSd = 0, baseTendonLength = 0;
     double relativeSd = 0;         // sigma: relative sd of one trial's torque
     double activationSd = 0;
     std::vector<DrawSensitivity> draws;
@@ -39,21 +46,26 @@ struct Sensitivities {
 
 std::vector<std::vector<double>> drawFromPrior(const SynergistModel& model, unsigned seed, int draws) {
     const int n = model.getNumParameters();
-    Eigen::MatrixXd sigma(n, n);
-    for (int a = 0; a < n; ++a)
-        for (int b = 0; b < n; ++b) sigma(a, b) = model.getPriorCovariance()[a][b];
-    const Eigen::MatrixXd L = Eigen::LLT<Eigen::MatrixXd>(sigma).matrixL();
+    // Only the free coordinates are drawn (held ones stay at their mean), so the draws do not depend on
+    // which held parameters the model carries.
+    std::vector<int> free;
+    for (int j = 0; j < n; ++j)
+        if (model.getLower()[j] + 2 * kStep < model.getUpper()[j] - 2 * kStep) free.push_back(j);
+    const Eigen::MatrixXd sigma = toMatrix(model.getPriorCovariance());
+    Eigen::MatrixXd freeSigma(free.size(), free.size());
+    for (std::size_t a = 0; a < free.size(); ++a)
+        for (std::size_t b = 0; b < free.size(); ++b) freeSigma(a, b) = sigma(free[a], free[b]);
+    const Eigen::MatrixXd L = Eigen::LLT<Eigen::MatrixXd>(freeSigma).matrixL();
     std::vector<std::vector<double>> out;
     for (int d = 0; d < draws; ++d) {
         PortableRandom rng{seed, 0x5EED1u, unsigned(d)};
-        Eigen::VectorXd z(n);
-        for (int j = 0; j < n; ++j) z(j) = rng.drawNormal();
+        Eigen::VectorXd z(free.size());
+        for (int j = 0; j < z.size(); ++j) z(j) = rng.drawNormal();
         const Eigen::VectorXd v = L * z;
-        std::vector<double> x(n);
-        for (int j = 0; j < n; ++j) {
-            // Inside the bounds by more than the difference step.
-            const double lo = model.getLower()[j] + 2 * kStep, hi = model.getUpper()[j] - 2 * kStep;
-            x[j] = lo < hi ? std::clamp(model.getPriorMean()[j] + v(j), lo, hi) : model.getPriorMean()[j];
+        std::vector<double> x = model.getPriorMean();
+        for (std::size_t k = 0; k < free.size(); ++k) {
+            const int j = free[k];  // kept inside the bounds by more than the difference step
+            x[j] = std::clamp(x[j] + v(k), model.getLower()[j] + 2 * kStep, model.getUpper()[j] - 2 * kStep);
         }
         out.push_back(x);
     }
@@ -73,13 +85,12 @@ Sensitivities calcSensitivities(const Population& prior, const std::vector<Torqu
     s.massIndex = model.getMassIndex();
     s.tendonIndex = SynergistModel::getTendonIndex();
     s.activationIndex = SynergistModel::getActivationIndex();
-    Eigen::MatrixXd sigma(n, n);
-    for (int a = 0; a < n; ++a)
-        for (int b = 0; b < n; ++b) sigma(a, b) = model.getPriorCovariance()[a][b];
+    const Eigen::MatrixXd sigma = toMatrix(model.getPriorCovariance());
     s.priorPrecision = sigma.inverse();
     s.flexorMean = Eigen::VectorXd::Zero(n);
     const std::vector<int> flexors = model.getFlexorMassIndices();
     for (int j : flexors) s.flexorMean(j) = 1.0 / double(flexors.size());
+    s.priorFlexorStrengthSd = std::sqrt(s.flexorMean.dot(sigma * s.flexorMean));
     s.baseTendonLength = prior.base.muscles[prior.base.primary].params.optimalTendonLength;
     s.priorMassSd = std::sqrt(sigma(s.massIndex, s.massIndex));
     s.priorTendonSd = s.baseTendonLength * std::sqrt(sigma(s.tendonIndex, s.tendonIndex));
@@ -163,7 +174,7 @@ ProtocolPrediction evaluate(const Sensitivities& s, const std::vector<int>& coun
     p.massSd = std::sqrt(vm / used);
     p.tendonSd = s.baseTendonLength * std::sqrt(vt / used);
     p.flexorStrengthSd = std::sqrt(vf / used);
-    p.priorFlexorStrengthSd = std::sqrt(s.flexorMean.dot(s.priorPrecision.inverse() * s.flexorMean));
+    p.priorFlexorStrengthSd = s.priorFlexorStrengthSd;
     for (int j = 0; j < n; ++j) {
         p.massCorrelation[j] /= used;
         p.posteriorSd[j] /= used;

@@ -192,13 +192,25 @@ TEST(CliValidate, ElbowTruthWritesPerSubjectAndSummaryFilesAndPlots) {
 // names and writes torque data, `identify-torque` fits those data with every method that applies.
 TEST(CliDesign, DesignedProtocolRunsAndItsDataAreIdentified) {
     const fs::path d = freshDir("design_pipeline");
-    CommandResult r = runArmsim("design --draws 4 --trials 6 --repetitions 2 --levels 0.5 --out " + (d / "design").string());
+    CommandResult r = runArmsim("design --draws 4 --trials 6 --repetitions 2 --levels 0.5 --validate-subjects 1 --out " +
+                                (d / "design").string());
     ASSERT_EQ(r.exitCode, 0) << r.output;
     const fs::path protocol = d / "design" / "designed_protocol.yaml";
     ASSERT_TRUE(fs::exists(protocol)) << r.output;
     EXPECT_NE(r.output.find("designed protocol:"), std::string::npos) << r.output;
     for (const char* f : {"design_predictions.csv", "design_steps.csv", "design_criterion.png"})
         EXPECT_TRUE(fs::exists(d / "design" / f)) << f;
+    {  // --validate-subjects: both protocols, both synergist methods
+        std::ifstream v(d / "design" / "design_validation.csv");
+        std::vector<std::string> lines;
+        for (std::string line; std::getline(v, line);) lines.push_back(line);
+        ASSERT_EQ(lines.size(), 5u);
+        EXPECT_EQ(lines[1].rfind("thesis,synergist,1,", 0), 0u) << lines[1];
+        EXPECT_EQ(lines[4].rfind("designed,synergist-va,1,", 0), 0u) << lines[4];
+    }
+    r = runArmsim("validate --truth elbow --protocol " + protocol.string() + " --angles 90");
+    EXPECT_NE(r.exitCode, 0);
+    EXPECT_NE(r.output.find("--protocol replaces --angles"), std::string::npos) << r.output;
 
     r = runArmsim("protocol " + protocol.string() + " --out " + (d / "run").string());
     ASSERT_EQ(r.exitCode, 0) << r.output;
