@@ -114,6 +114,7 @@ BicepsEstimate identifyThesisMethod(const ArmSetup& assumed, const std::vector<T
     const IdentificationReport r = identify(problem, SteadyForceModel(), options);
     est.converged = r.isConverged();
     est.message = getStopReasonName(r.stopReason) + ": " + r.message;
+    est.iterations = r.iterations;
     est.mass = r.parameters.at(0).value;
     est.tendonLength = r.parameters.at(1).value;
     est.massLower = r.parameters[0].ciLower;
@@ -311,6 +312,7 @@ BicepsEstimate identifySynergistAware(const Population& prior, const std::vector
     const std::vector<double>& x = m.x;
     est.converged = m.converged;
     est.message = m.message;
+    est.iterations = m.iterations;
     if (m.failed) return est;  // no estimate: mass and tendon length stay NaN
 
     const ArmSetup& base = prior.base;
@@ -371,6 +373,59 @@ double measureVoluntaryActivation(const std::vector<TorqueObservation>& data, do
     return std::clamp(mean + sd * rng.drawNormal(), 0.0, 1.0);
 }
 
+const std::vector<std::string>& getElbowMethodKinds() {
+    static const std::vector<std::string> kinds = {"thesis", "synergist", "synergist-va"};
+    return kinds;
+}
+
+BicepsEstimate identifyElbowMethod(const ElbowMethod& method, const Population& population,
+                                   const std::vector<TorqueObservation>& data, unsigned seed, int subject) {
+    BicepsEstimate e;
+    if (method.kind == "thesis") {
+        e = identifyThesisMethod(population.base, data);
+    } else if (method.kind == "synergist") {
+        SynergistOptions o = method.options;
+        o.measuredActivation = 0.0 / 0.0;
+        e = identifySynergistAware(population, data, o);
+    } else if (method.kind == "synergist-va") {
+        SynergistOptions o = method.options;
+        checkField("activation_sd", o.activationSd, Bound{0, 0.5, true, false});
+        o.measuredActivation = measureVoluntaryActivation(data, o.activationSd, seed + 7919u * unsigned(subject));
+        e = identifySynergistAware(population, data, o);
+    } else {
+        throw InputError("identifier '" + method.kind + "': expected thesis, synergist or synergist-va");
+    }
+    e.method = method.label.empty() ? method.kind : method.label;
+    return e;
+}
+
+ElbowValidationRow makeElbowValidationRow(const Population& population, const VirtualSubject& v, double noise,
+                                          const std::string& method, const BicepsEstimate& e) {
+    const int primary = population.base.primary;
+    ElbowValidationRow row;
+    row.subject = v.index;
+    row.noise = noise;
+    row.method = method;
+    row.trueMass = v.setup.muscles[primary].params.mass;
+    row.trueTendonLength = v.setup.muscles[primary].params.optimalTendonLength;
+    row.estimate = e;
+    row.massError = e.mass / row.trueMass - 1;
+    row.tendonError = e.tendonLength - row.trueTendonLength;
+    if (std::isfinite(e.massLower)) row.massCovered = row.trueMass >= e.massLower && row.trueMass <= e.massUpper;
+    if (std::isfinite(e.tendonLower))
+        row.tendonCovered = row.trueTendonLength >= e.tendonLower && row.trueTendonLength <= e.tendonUpper;
+    row.voluntaryActivation = v.setup.effort.voluntaryActivation;
+    row.coContraction = v.setup.effort.coContraction;
+    row.strengthLevel = v.strengthLevel;
+    for (int i : findMuscles(population.base, SynergistOptions().biceps, "biceps"))
+        if (i != primary) row.bicepsShortScale = v.massScale[i] / v.massScale[primary];
+    const std::vector<int> synergists = findMuscles(population.base, SynergistOptions().synergists, "synergists");
+    double syn = 0;
+    for (int i : synergists) syn += v.massScale[i];
+    row.synergistScale = syn / double(synergists.size()) / v.massScale[primary];
+    return row;
+}
+
 std::vector<ElbowValidationRow> runElbowValidation(const Population& population, const ElbowValidationSettings& settings,
                                                    const std::function<void(int, int)>& progress) {
     population.validate();
@@ -380,66 +435,30 @@ std::vector<ElbowValidationRow> runElbowValidation(const Population& population,
     std::vector<double> levels = settings.noiseLevels;
     if (levels.empty()) levels.push_back(population.transducerNoise);
     for (double v : levels) checkField("noise", v, Bound{0, 0.5, false, true, "relative sd"});
-    const int primary = population.base.primary;
-    int bicepsShort = -1;  // the other biceps head
-    for (int i : findMuscles(population.base, SynergistOptions().biceps, "biceps"))
-        if (i != primary) bicepsShort = i;
-    const std::vector<int> synergists = findMuscles(population.base, SynergistOptions().synergists, "synergists");
+    std::vector<ElbowMethod> methods(settings.activationSd > 0 ? 3 : 2);
+    for (std::size_t k = 0; k < methods.size(); ++k) {
+        methods[k].kind = getElbowMethodKinds()[k];
+        methods[k].options.freeSlowFraction = settings.freeSlowFraction;
+        methods[k].options.activationSd = settings.activationSd;
+    }
 
-    SynergistOptions base;
-    base.freeSlowFraction = settings.freeSlowFraction;
     std::vector<std::vector<ElbowValidationRow>> perSubject(settings.subjects);
     runParallel(settings.subjects, settings.jobs, [&](int s) {
         const VirtualSubject v = drawSubject(population, settings.seed, s);
         const std::vector<TorqueObservation> clean = synthesizeTorqueData(v, settings.protocol, settings.seed, 1);
         for (double level : levels) {
             const std::vector<TorqueObservation> data = setTransducerNoise(clean, level);
-            // A method that cannot use these data (the thesis method with fewer flexion-MVC angles than
-            // unknowns) is recorded as failed, not fatal.
-            auto attempt = [](const char* method, const std::function<BicepsEstimate()>& run) {
+            for (const ElbowMethod& m : methods) {
+                // A method that cannot use these data (the thesis method with fewer flexion-MVC angles
+                // than unknowns) is recorded as failed, not fatal.
+                BicepsEstimate e;
                 try {
-                    return run();
-                } catch (const std::exception& e) {
-                    BicepsEstimate failed;
-                    failed.method = method;
-                    failed.message = e.what();
-                    return failed;
+                    e = identifyElbowMethod(m, population, data, settings.seed, s);
+                } catch (const std::exception& x) {
+                    e.method = m.kind;
+                    e.message = x.what();
                 }
-            };
-            std::vector<BicepsEstimate> estimates = {
-                attempt("thesis", [&] { return identifyThesisMethod(population.base, data); }),
-                attempt("synergist", [&] { return identifySynergistAware(population, data, base); })};
-            if (settings.activationSd > 0) {
-                estimates.push_back(attempt("synergist-va", [&] {
-                    SynergistOptions withVa = base;
-                    withVa.activationSd = settings.activationSd;
-                    withVa.measuredActivation =
-                        measureVoluntaryActivation(data, settings.activationSd, settings.seed + 7919u * unsigned(s));
-                    return identifySynergistAware(population, data, withVa);
-                }));
-            }
-            for (const BicepsEstimate& e : estimates) {
-                ElbowValidationRow row;
-                row.subject = s;
-                row.noise = level;
-                row.method = e.method;
-                row.trueMass = v.setup.muscles[primary].params.mass;
-                row.trueTendonLength = v.setup.muscles[primary].params.optimalTendonLength;
-                row.estimate = e;
-                row.massError = e.mass / row.trueMass - 1;
-                row.tendonError = e.tendonLength - row.trueTendonLength;
-                if (std::isfinite(e.massLower))
-                    row.massCovered = row.trueMass >= e.massLower && row.trueMass <= e.massUpper;
-                if (std::isfinite(e.tendonLower))
-                    row.tendonCovered = row.trueTendonLength >= e.tendonLower && row.trueTendonLength <= e.tendonUpper;
-                row.voluntaryActivation = v.setup.effort.voluntaryActivation;
-                row.coContraction = v.setup.effort.coContraction;
-                row.strengthLevel = v.strengthLevel;
-                if (bicepsShort >= 0) row.bicepsShortScale = v.massScale[bicepsShort] / v.massScale[primary];
-                double syn = 0;
-                for (int i : synergists) syn += v.massScale[i];
-                row.synergistScale = syn / double(synergists.size()) / v.massScale[primary];
-                perSubject[s].push_back(row);
+                perSubject[s].push_back(makeElbowValidationRow(population, v, level, m.kind, e));
             }
         }
     }, progress);
@@ -480,6 +499,7 @@ std::vector<ElbowValidationSummary> summarizeElbowValidation(const std::vector<E
                 tw += r.estimate.tendonUpper - r.estimate.tendonLower;
             }
         }
+        s.massBias = s.massRmse = s.tendonBias = s.tendonRmse = 0.0 / 0.0;  // no estimate
         if (n > 0) {
             s.massBias = mb / n, s.massRmse = std::sqrt(mm / n);
             s.tendonBias = tb / n, s.tendonRmse = std::sqrt(tm / n);

@@ -48,6 +48,7 @@ struct BicepsEstimate {
     /// force x the biceps moment arm, flexion MVCs only; NaN elsewhere).
     std::vector<double> predictedTorque;
     int numParameters = 0;                     ///< free parameters of the fit
+    int iterations = 0;                        ///< solver iterations
 };
 
 /// The thesis's method on torque data, with `assumed` as the experimenter's model (geometry and the
@@ -157,12 +158,33 @@ struct ElbowValidationRow {
     double synergistScale = 0.0 / 0.0;    ///< mean mass scale of the synergists / primary's [1]
 };
 
+/// One identifier of a validation or a study, with its options.
+struct ElbowMethod {
+    std::string label;           ///< its name in results (default: the kind)
+    std::string kind = "synergist";  ///< "thesis", "synergist" or "synergist-va"
+    /// synergist kinds: freeSlowFraction, includeSynergists, noiseLevel; synergist-va also activationSd
+    /// (the twitch-interpolation measurement's sd, drawn per subject by measureVoluntaryActivation).
+    SynergistOptions options;
+};
+/// The kinds ElbowMethod::kind may name.
+const std::vector<std::string>& getElbowMethodKinds();
+
+/// Identifies `data` of person `subject` with `method` (population as the synergist prior, its base
+/// model as the thesis method's assumed model). seed: of the study or validation (the VA measurement's
+/// seed derives from it and the subject). Throws what the identifier throws.
+BicepsEstimate identifyElbowMethod(const ElbowMethod& method, const Population& population,
+                                   const std::vector<TorqueObservation>& data, unsigned seed, int subject);
+
+/// A validation row: the subject's truth beside the estimate.
+ElbowValidationRow makeElbowValidationRow(const Population& population, const VirtualSubject& subject, double noise,
+                                          const std::string& method, const BicepsEstimate& estimate);
+
 /// Bias, RMSE and coverage of one method at one noise level.
 struct ElbowValidationSummary {
     std::string method;
     double noise = 0;
     int subjects = 0, converged = 0;
-    double massBias = 0, massRmse = 0;        ///< relative [1]
+    double massBias = 0, massRmse = 0;        ///< relative [1]; NaN when no subject has an estimate
     double tendonBias = 0, tendonRmse = 0;    ///< [m]
     double massCoverage = 0.0 / 0.0, tendonCoverage = 0.0 / 0.0;  ///< fraction of subjects [1]
     double massIntervalWidth = 0.0 / 0.0;     ///< mean 95 % interval width / estimate [1]

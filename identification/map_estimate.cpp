@@ -74,6 +74,7 @@ MapResult calcMapEstimate(const MapProblem& problem) {
     result.converged = summary.termination_type == ceres::CONVERGENCE;
     result.failed = summary.termination_type == ceres::FAILURE;
     result.message = summary.BriefReport();
+    result.iterations = summary.num_successful_steps + summary.num_unsuccessful_steps;
     if (result.failed) {
         result.message += ": " + summary.message;
         return result;

@@ -38,6 +38,7 @@ struct MapResult {
     bool failed = false;                             ///< the solver failed (x is the start, no covariance)
     std::string message;                             ///< Ceres's brief report, and why no covariance
     double dataCost = 0;                             ///< 0.5 |r(x)|^2 at the estimate
+    int iterations = 0;                              ///< solver iterations (successful and rejected steps)
 };
 
 /// Throws std::invalid_argument for inconsistent sizes or a prior covariance that is not positive definite.

@@ -245,6 +245,19 @@ std::vector<double> ParamNode::getNumbers(const std::string& key, const Bound& b
     return out;
 }
 
+std::vector<std::string> ParamNode::getStrings(const std::string& key) const {
+    YAML::Node n = requireKey(key);
+    if (!n.IsSequence()) throw InputError(where(key) + ": field '" + path(key) + "' must be a list of strings");
+    std::vector<std::string> out;
+    for (std::size_t i = 0; i < n.size(); ++i) {
+        if (!n[i].IsScalar() || n[i].Scalar().empty())
+            throw InputError(impl_->source + ":" + std::to_string(n[i].Mark().line + 1) + ": field '" + path(key) +
+                             "[" + std::to_string(i) + "]' must be a non-empty string");
+        out.push_back(n[i].Scalar());
+    }
+    return out;
+}
+
 std::vector<std::string> ParamNode::getKeys() const {
     std::vector<std::string> keys;
     for (auto it = node().begin(); it != node().end(); ++it) keys.push_back(it->first.as<std::string>());

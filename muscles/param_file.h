@@ -96,6 +96,8 @@ public:
     std::string getChoice(const std::string& key, const std::vector<std::string>& allowed,
                           const std::string& defaultValue) const;
     std::vector<double> getNumbers(const std::string& key, const Bound& bound) const;
+    /// The non-empty strings of the list under key (required).
+    std::vector<std::string> getStrings(const std::string& key) const;
     /// The keys of this mapping in file order (marks none used).
     std::vector<std::string> getKeys() const;
     /// Throws InputError naming file, line and key for every key this node has that was not read.

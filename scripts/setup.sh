@@ -8,6 +8,7 @@ packages=(
   libsimbody-dev libeigen3-dev libceres-dev libopencv-dev libosmesa6-dev
   libgtest-dev libgmock-dev libbenchmark-dev libyaml-cpp-dev libcli11-dev nlohmann-json3-dev
   libplplot-dev plplot-driver-cairo libfftw3-dev
+  libopenmpi-dev openmpi-bin
 )
 
 missing=()

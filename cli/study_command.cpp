@@ -1,0 +1,97 @@
+// armsim study STUDY.yaml: a population study on threads, or over MPI ranks under mpirun.
+#include "cli/commands.h"
+#include "identification/study.h"
+#include "identification/study_mpi.h"
+#include "muscles/param_file.h"
+
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <unistd.h>
+
+namespace armsim::cli {
+
+namespace {
+
+struct StudyOptions {
+    std::string file;
+    std::string out;
+    int threads = 0;
+    bool restart = false;
+    bool quiet = false;
+};
+
+std::string formatDuration(double seconds) {
+    if (!std::isfinite(seconds)) return "?";
+    char buf[32];
+    const long s = long(std::lround(seconds));
+    if (s >= 3600) std::snprintf(buf, sizeof buf, "%ldh%02ldm", s / 3600, s / 60 % 60);
+    else if (s >= 60) std::snprintf(buf, sizeof buf, "%ldm%02lds", s / 60, s % 60);
+    else std::snprintf(buf, sizeof buf, "%lds", s);
+    return buf;
+}
+
+// One line per report on a log; one updated line on a terminal.
+void printStudyProgress(const StudyProgress& p) {
+    std::fflush(stdout);
+    const bool tty = isatty(fileno(stderr));
+    std::fprintf(stderr, "%sstudy: %ld/%ld tasks done (%ld resumed), %ld failed, %.2f tasks/s, %s left%s",
+                 tty ? "\r" : "", p.done, p.total, p.resumed, p.failed, p.rate, formatDuration(p.remaining).c_str(),
+                 tty && p.done < p.total ? "   " : "\n");
+    std::fflush(stderr);
+}
+
+void runStudyCommand(const StudyOptions& o) {
+    const Study study = readStudy(o.file);
+    StudyRunOptions run;
+    run.output = o.out;
+    run.threads = o.threads;
+    run.restart = o.restart;
+    if (!o.quiet) run.progress = printStudyProgress;
+
+    std::optional<StudyOutcome> outcome;
+    const bool mpi = isLaunchedByMpi();
+    if (mpi) {
+        outcome = runStudyOnMpi(study, run);
+        if (!outcome) return;  // a worker rank: rank 0 reports
+    } else {
+        outcome = runStudy(study, run);
+    }
+    const StudyOutcome& r = *outcome;
+    std::printf("study '%s': %ld tasks (%d subjects x %zu protocols x %zu noise levels x %zu methods); %ld computed "
+                "in %.1f s on %d rank%s x %d thread%s, %ld resumed from the journal\n",
+                study.name.c_str(), r.total, study.subjects, study.protocols.size(), study.noiseLevels.size(),
+                study.methods.size(), r.computed, r.wallTime, r.ranks, r.ranks == 1 ? "" : "s", r.threads,
+                r.threads == 1 ? "" : "s", r.resumed);
+    if (r.computed > 0)
+        std::printf("  task time %.1f s (synthesis %.0f %%, identification %.0f %%); %.2f tasks/s\n", r.taskTime,
+                    100 * r.synthesisTime / r.taskTime, 100 * (1 - r.synthesisTime / r.taskTime),
+                    double(r.computed) / r.wallTime);
+    if (r.failed + r.notConverged > 0)
+        std::printf("  %ld failed, %ld not converged: their reasons are in results.csv (status, reason)\n", r.failed,
+                    r.notConverged);
+    std::printf("wrote to %s:", r.output.c_str());
+    for (const std::string& f : r.files) std::printf(" %s", f.c_str());
+    std::printf("\n");
+}
+
+void addStudyCommand(CLI::App& app) {
+    auto o = std::make_shared<StudyOptions>();
+    CLI::App* c = app.add_subcommand(
+        "study", "Monte Carlo study of identifiers over virtual subjects, protocols and noise levels (threads; "
+                 "`mpirun -n K armsim study` spreads it over MPI ranks); resumes after an interruption");
+    c->add_option("study", o->file, "study file (kind: study)")->required();
+    c->add_option("--out", o->out, "output folder (default: the study's `output`)");
+    c->add_option("--threads", o->threads, "worker threads per process (default: all cores, shared by the ranks "
+                                           "of a node under mpirun)")
+        ->check(CLI::Range(1, 1024));
+    c->add_flag("--restart", o->restart, "discard the output folder's journal and compute every task again");
+    c->add_flag("--quiet", o->quiet, "no progress lines");
+    c->callback([o] { runStudyCommand(*o); });
+}
+
+const CommandRegistrar registerStudy(58, addStudyCommand);
+
+}  // namespace
+
+}  // namespace armsim::cli

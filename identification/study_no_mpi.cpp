@@ -1,0 +1,21 @@
+// Stand-in for study_mpi.cpp when armsim is built without MPI: studies run on threads only.
+#include "identification/study_mpi.h"
+
+#include "muscles/param_file.h"
+
+#include <cstdlib>
+
+namespace armsim {
+
+bool isLaunchedByMpi() {
+    return std::getenv("OMPI_COMM_WORLD_SIZE") || std::getenv("PMIX_RANK") || std::getenv("PMI_RANK");
+}
+
+bool hasMpi() { return false; }
+
+std::optional<StudyOutcome> runStudyOnMpi(const Study&, const StudyRunOptions&) {
+    throw InputError("this armsim was built without MPI (install libopenmpi-dev and rebuild); run the study "
+                     "without mpirun to use threads");
+}
+
+}  // namespace armsim
