@@ -167,4 +167,7 @@ StudyOutcome runStudy(const Study& study, const StudyRunOptions& options, StudyC
 /// the results back, until the coordinator has no more.
 void runStudyWorker(const Study& study, int threads, StudyWorkerLink& link);
 
+/// true when this process was started by mpirun/mpiexec/srun (OpenMPI, PMIx or PMI environment).
+bool isLaunchedByMpi();
+
 }  // namespace armsim

@@ -78,10 +78,6 @@ int getEnvInt(const char* name, int fallback) {
 
 }  // namespace
 
-bool isLaunchedByMpi() {
-    return std::getenv("OMPI_COMM_WORLD_SIZE") || std::getenv("PMIX_RANK") || std::getenv("PMI_RANK");
-}
-
 bool hasMpi() { return true; }
 
 std::optional<StudyOutcome> runStudyOnMpi(const Study& study, const StudyRunOptions& options) {

@@ -11,8 +11,6 @@
 
 namespace armsim {
 
-/// true when this process was started by mpirun/mpiexec (OpenMPI or PMIx environment variables).
-bool isLaunchedByMpi();
 /// true when armsim was built with MPI.
 bool hasMpi();
 

@@ -3,13 +3,7 @@
 
 #include "muscles/param_file.h"
 
-#include <cstdlib>
-
 namespace armsim {
-
-bool isLaunchedByMpi() {
-    return std::getenv("OMPI_COMM_WORLD_SIZE") || std::getenv("PMIX_RANK") || std::getenv("PMI_RANK");
-}
 
 bool hasMpi() { return false; }
 

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <condition_variable>
 #include <cstdio>
+#include <cstdlib>
 #include <deque>
 #include <exception>
 #include <filesystem>
@@ -379,6 +380,10 @@ StudyOutcome runStudy(const Study& study, const StudyRunOptions& options, StudyC
     }
     outcome.wallTime = std::chrono::duration<double>(Clock::now() - start).count();
     return outcome;
+}
+
+bool isLaunchedByMpi() {
+    return std::getenv("OMPI_COMM_WORLD_SIZE") || std::getenv("PMIX_RANK") || std::getenv("PMI_RANK");
 }
 
 void runStudyWorker(const Study& study, int threads, StudyWorkerLink& link) {

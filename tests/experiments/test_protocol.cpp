@@ -1,6 +1,7 @@
 // Experiment protocols: the shipped files, malformed files, determinism (seed, threads), agreement
 // of the summary tables with the per-trial files, %MVC resolution and EMG normalisation, the
 // composition grid, and runs that fail without leaving output behind.
+#include "tests/support/temp_files.h"
 #include "experiments/data_files.h"
 #include "experiments/protocol.h"
 #include "model/geometry.h"
@@ -18,25 +19,13 @@ namespace fs = std::filesystem;
 
 namespace {
 
+fs::path freshDir(const std::string& name) { return armsim::testing::makeFreshDir("protocol", name); }
+std::string readText(const fs::path& p) { return armsim::testing::readFileText(p); }
+
 const std::string kProtocols = std::string(ARMSIM_ASSET_DIR) + "/protocols/";
 constexpr double kAngleTol = 1e-9;       // deg, degree -> radian -> degree round trip
 constexpr double kNormTol = 1e-12;       // quantities that are 1 by construction
 constexpr double kForceTol = 1e-6;       // N, bisection to 1e-12 in U at ~1000 N per unit U
-
-/// A fresh directory for one test.
-fs::path freshDir(const std::string& name) {
-    const fs::path d = fs::temp_directory_path() / ("armsim_protocol_" + name + "_" + std::to_string(::getpid()));
-    fs::remove_all(d);
-    fs::create_directories(d);
-    return d;
-}
-
-std::string readText(const fs::path& p) {
-    std::ifstream in(p, std::ios::binary);
-    std::stringstream s;
-    s << in.rdbuf();
-    return s.str();
-}
 
 fs::path writeProtocol(const fs::path& dir, const std::string& name, const std::string& text) {
     const fs::path p = dir / name;

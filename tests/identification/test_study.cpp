@@ -1,6 +1,7 @@
 // Population studies (issue 13): task numbering, the journal line format, a study cell against the
 // validation's own computation (a second path to the same numbers), failures recorded, resume from a
 // partial and torn journal, thread-count independence, and bad study files.
+#include "tests/support/temp_files.h"
 #include "identification/study.h"
 #include "muscles/param_file.h"
 
@@ -17,19 +18,8 @@ namespace fs = std::filesystem;
 
 namespace {
 
-fs::path freshDir(const std::string& name) {
-    const fs::path d = fs::temp_directory_path() / ("armsim_study_" + name + "_" + std::to_string(::getpid()));
-    fs::remove_all(d);
-    fs::create_directories(d);
-    return d;
-}
-
-std::string readText(const fs::path& p) {
-    std::ifstream in(p, std::ios::binary);
-    std::ostringstream s;
-    s << in.rdbuf();
-    return s.str();
-}
+fs::path freshDir(const std::string& name) { return armsim::testing::makeFreshDir("study", name); }
+std::string readText(const fs::path& p) { return armsim::testing::readFileText(p); }
 
 // 3 subjects x {thesis, one angle} x {1 %, 5 %} x {thesis, synergist-va}: the thesis method cannot
 // identify two unknowns from one angle, so 6 of its cells fail by design.

@@ -1,6 +1,7 @@
 // armsim study end to end: threads, one MPI rank and two MPI ranks write byte-identical results; a
 // study killed with SIGKILL (the whole process, or one MPI rank) and started again with the same command
 // finishes with the files of an uninterrupted run.
+#include "tests/support/temp_files.h"
 #include "tests/support/run_armsim.h"
 
 #include <gtest/gtest.h>
@@ -18,21 +19,10 @@ using armsim::testing::runArmsim;
 
 namespace {
 
+fs::path freshDir(const std::string& name) { return armsim::testing::makeFreshDir("study_cli", name); }
+std::string readText(const fs::path& p) { return armsim::testing::readFileText(p); }
+
 constexpr int kTasks = 4 * 2 * 1 * 2;  // subjects x protocols x noise levels x methods
-
-fs::path freshDir(const std::string& name) {
-    const fs::path d = fs::temp_directory_path() / ("armsim_study_cli_" + name + "_" + std::to_string(::getpid()));
-    fs::remove_all(d);
-    fs::create_directories(d);
-    return d;
-}
-
-std::string readText(const fs::path& p) {
-    std::ifstream in(p, std::ios::binary);
-    std::ostringstream s;
-    s << in.rdbuf();
-    return s.str();
-}
 
 // The study: the thesis protocol and a one-angle protocol on which the thesis method fails by design.
 fs::path writeStudy(const fs::path& d) {
