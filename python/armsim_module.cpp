@@ -1,0 +1,290 @@
+// The Python module armsim._armsim (issue 12): models, steady states, muscle and arm trials and
+// population studies on the C++ libraries, numpy arrays out. SI units and the YAML files' names;
+// errors keep the C++ messages (InputError -> ValueError, a missing file -> FileNotFoundError,
+// SimulationError -> RuntimeError). Long calls release the GIL.
+#include "identification/study.h"
+#include "model/mvc_curve.h"
+#include "model/trial.h"
+#include "muscles/param_file.h"
+#include "muscles/simbody_isometric.h"
+#include "muscles/table.h"
+
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <filesystem>
+#include <cmath>
+
+namespace py = pybind11;
+using namespace armsim;
+
+namespace {
+
+// A table's columns as a dict of float64 arrays, in column order.
+py::dict toDict(const Table& t) {
+    py::dict d;
+    const int n = t.getNumRows(), m = t.getNumColumns();
+    for (int c = 0; c < m; ++c) {
+        py::array_t<double> a(n);
+        double* p = a.mutable_data();
+        for (int r = 0; r < n; ++r) p[r] = t.get(r, c);
+        d[py::str(t.getColumnNames()[c])] = a;
+    }
+    return d;
+}
+
+py::array_t<double> toArray(const std::vector<std::vector<double>>& rows) {
+    const std::size_t n = rows.size(), m = rows.empty() ? 0 : rows[0].size();
+    py::array_t<double> a({n, m});
+    auto w = a.mutable_unchecked<2>();
+    for (std::size_t i = 0; i < n; ++i)
+        for (std::size_t j = 0; j < m; ++j) w(i, j) = rows[i][j];
+    return a;
+}
+
+// FileNotFoundError with the CLI's wording.
+[[noreturn]] void throwFileNotFound(const std::string& path, const char* what) {
+    PyErr_SetString(PyExc_FileNotFoundError, (path + ": cannot open " + what + " (no such file)").c_str());
+    throw py::error_already_set();
+}
+
+// A model name (under assets/models/) or an existing model file.
+ArmSetup loadModelChecked(const std::string& nameOrFile) {
+    const bool looksLikePath = nameOrFile.find('/') != std::string::npos || (nameOrFile.size() > 5 &&
+                               nameOrFile.compare(nameOrFile.size() - 5, 5, ".yaml") == 0);
+    if (looksLikePath && !std::filesystem::is_regular_file(nameOrFile)) throwFileNotFound(nameOrFile, "model file");
+    return loadModel(nameOrFile);
+}
+
+int findMuscleIndex(const ArmSetup& s, const py::object& muscle) {
+    if (muscle.is_none()) return s.primary;
+    return s.findMuscle(muscle.cast<std::string>());
+}
+
+py::dict toDict(const MuscleParameters& p) {
+    py::dict d;
+    d["name"] = p.name;
+    d["mass"] = p.mass;
+    d["optimal_fascicle_length"] = p.optimalFascicleLength;
+    d["optimal_tendon_length"] = p.optimalTendonLength;
+    d["max_path_length"] = p.maxPathLength;
+    d["slow_fraction"] = p.slowFraction;
+    d["slow_units"] = p.numSlowUnits;
+    d["fast_units"] = p.numFastUnits;
+    return d;
+}
+
+// Applies keyword overrides with the YAML names (mass, optimal_tendon_length, ...) to muscle i.
+void applyOverrides(ArmSetup& s, int i, const py::kwargs& kw) {
+    MuscleParameters& p = s.muscles[i].params;
+    for (auto item : kw) {
+        const std::string k = item.first.cast<std::string>();
+        if (k == "mass") p.mass = item.second.cast<double>();
+        else if (k == "optimal_fascicle_length") p.optimalFascicleLength = item.second.cast<double>();
+        else if (k == "optimal_tendon_length") p.optimalTendonLength = item.second.cast<double>();
+        else if (k == "max_path_length") p.maxPathLength = item.second.cast<double>(), s.muscles[i].maxPathFromRange = false;
+        else if (k == "slow_fraction") p.slowFraction = item.second.cast<double>();
+        else if (k == "slow_units") p.numSlowUnits = item.second.cast<int>();
+        else if (k == "fast_units") p.numFastUnits = item.second.cast<int>();
+        else
+            throw InputError("unknown muscle parameter '" + k + "': expected mass, optimal_fascicle_length, "
+                             "optimal_tendon_length, max_path_length, slow_fraction, slow_units or fast_units");
+    }
+}
+
+/// The Python face of an ArmSetup: immutable; with_muscle returns a changed copy.
+struct Model {
+    ArmSetup setup;
+};
+
+VirtualMuscle buildMuscle(const Model& m, const py::object& muscle) {
+    return VirtualMuscle(m.setup.calcMuscleParameters(findMuscleIndex(m.setup, muscle)));
+}
+
+MuscleGroup parseEffort(const std::string& effort) {
+    if (effort == "flexion") return MuscleGroup::Flexor;
+    if (effort == "extension") return MuscleGroup::Extensor;
+    throw InputError("effort = '" + effort + "': expected flexion or extension");
+}
+
+}  // namespace
+
+PYBIND11_MODULE(_armsim, mod) {
+    mod.doc() = "armsim: a musculoskeletal arm simulator with Virtual Muscle force elements (C++ core).";
+
+    py::register_exception_translator([](std::exception_ptr p) {
+        try {
+            if (p) std::rethrow_exception(p);
+        } catch (const SimulationError& e) {
+            PyErr_SetString(PyExc_RuntimeError, e.what());
+        }
+    });
+
+    py::class_<Model>(mod, "Model", "An arm with its muscles (a model file of assets/models/ or your own).")
+        .def_static(
+            "load", [](const std::string& nameOrFile) { return Model{loadModelChecked(nameOrFile)}; }, py::arg("name_or_file"),
+            "Loads a model: a name under assets/models/ ('thesis', 'elbow') or a model file path.\n"
+            "Raises FileNotFoundError for a missing file, ValueError (the CLI's message) for a bad one.")
+        .def_property_readonly("name", [](const Model& m) { return m.setup.name; }, "the model's name")
+        .def_property_readonly(
+            "muscles", [](const Model& m) {
+                std::vector<std::string> names;
+                for (const MuscleSpec& s : m.setup.muscles) names.push_back(s.params.name);
+                return names;
+            },
+            "muscle names in model order")
+        .def_property_readonly("primary", [](const Model& m) { return m.setup.muscles[m.setup.primary].params.name; },
+                               "the primary muscle (the thesis's biceps)")
+        .def(
+            "parameters", [](const Model& m, const py::object& muscle) {
+                return toDict(m.setup.calcMuscleParameters(findMuscleIndex(m.setup, muscle)));
+            },
+            py::arg("muscle") = py::none(),
+            "A muscle's parameters (default: the primary's) with the muscle files' names and SI units:\n"
+            "mass [kg], optimal_fascicle_length, optimal_tendon_length, max_path_length [m], slow_fraction,\n"
+            "slow_units, fast_units.")
+        .def(
+            "with_muscle", [](const Model& m, const py::object& muscle, const py::kwargs& kw) {
+                Model c = m;
+                const int i = findMuscleIndex(c.setup, muscle);
+                applyOverrides(c.setup, i, kw);
+                c.setup.calcMuscleParameters(i);  // validates: ValueError naming the field
+                return c;
+            },
+            py::arg("muscle") = py::none(),
+            "A copy with a muscle's parameters changed by keyword (the names of parameters()), e.g.\n"
+            "model.with_muscle(mass=0.3, optimal_tendon_length=0.24). Raises ValueError for a bad value.")
+        .def(
+            "geometry", [](const Model& m, const std::vector<double>& flexionDeg) {
+                const MvcGeometry g = calcMvcGeometry(m.setup, flexionDeg);
+                py::dict d;
+                d["flexion_deg"] = py::array_t<double>(py::ssize_t(g.flexionDeg.size()), g.flexionDeg.data());
+                d["path_length_m"] = toArray(g.pathLength);
+                d["moment_arm_m"] = toArray(g.momentArm);
+                return d;
+            },
+            py::arg("flexion_deg"),
+            "Muscle path lengths and moment arms (from virtual work; + flexes) at elbow flexion angles [deg,\n"
+            "0 = extended]: dict of flexion_deg (n,), path_length_m and moment_arm_m (n, muscles).")
+        .def("__repr__", [](const Model& m) {
+            return "<armsim.Model '" + m.setup.name + "', " + std::to_string(m.setup.getNumMuscles()) + " muscles>";
+        });
+
+    mod.def(
+        "steady_state", [](const Model& m, double pathLength, double activation, const py::object& muscle) {
+            const VirtualMuscle vm = buildMuscle(m, muscle);
+            checkField("activation", activation, Bound::closed(0, 1));
+            const SteadyState s = vm.calcSteadyState(pathLength, activation);
+            if (!s.converged) throw SimulationError("steady state at path " + formatNumber(pathLength) + " m: " + s.message);
+            py::dict d;
+            d["force"] = s.force;
+            d["fascicle_length"] = s.fascicleLength;
+            d["normalized_fascicle_length"] = s.L;
+            return d;
+        },
+        py::arg("model"), py::arg("path_length"), py::arg("activation") = 1.0, py::arg("muscle") = py::none(),
+        "The steady isometric state of one muscle (default the primary) at path length P [m] and activation\n"
+        "U in [0, 1]: dict of force [N] (Fse = Fce), fascicle_length [m], normalized_fascicle_length.");
+
+    mod.def(
+        "muscle_trial",
+        [](const Model& m, double pathLength, double activation, double onset, double rise, double duration,
+           double rate, bool steadyStart, const py::object& muscle) {
+            const VirtualMuscle vm = buildMuscle(m, muscle);
+            checkField("activation", activation, Bound::closed(0, 1));
+            checkField("onset", onset, Bound::nonNegative("s"));
+            checkField("rise", rise, Bound::nonNegative("s"));
+            MuscleIsometricSettings s;
+            s.pathLength = pathLength;
+            s.duration = duration;
+            s.sampleRate = rate;
+            s.startSteady = steadyStart;
+            if (rise > 0) s.activation = ActivationProfile::ramp(onset, onset + rise, 0.0, activation);
+            else if (onset > 0) s.activation = ActivationProfile::step(onset, 0.0, activation);
+            else s.activation = ActivationProfile::constant(activation);
+            Table t;
+            {
+                py::gil_scoped_release release;
+                t = runMuscleIsometric(vm, s);
+            }
+            return toDict(t);
+        },
+        py::arg("model"), py::arg("path_length") = 0.375, py::arg("activation") = 1.0, py::arg("onset") = 0.0,
+        py::arg("rise") = 0.0, py::arg("duration") = 3.0, py::arg("rate") = 1000.0, py::arg("steady_start") = false,
+        py::arg("muscle") = py::none(),
+        "An isometric trial of one muscle at a fixed path length (as `armsim muscle trial`): activation 0\n"
+        "until onset [s], then a ramp of `rise` [s] (0: a step) to `activation`. Returns a dict of float64\n"
+        "arrays: time_s, activation, force_N, fce_N, fascicle_length_m, fascicle_velocity_mps,\n"
+        "tendon_length_m, active_fraction, and the states. Releases the GIL.");
+
+    mod.def(
+        "arm_trial",
+        [](const Model& m, double angleDeg, double activation, const std::string& effort, double antagonist,
+           double rest, double rise, double hold, double rate, double window) {
+            IsometricTrialSettings s;
+            s.elbowAngle = angleDeg * M_PI / 180;
+            s.activation = activation;
+            s.effort = parseEffort(effort);
+            s.antagonistActivation = antagonist;
+            s.restDuration = rest;
+            s.riseTime = rise;
+            s.holdDuration = hold;
+            s.sampleRate = rate;
+            s.averagingWindow = window;
+            IsometricTrialResult r;
+            {
+                py::gil_scoped_release release;
+                r = runIsometricTrial(m.setup, s);
+            }
+            py::dict summary;
+            summary["mean_force"] = r.summary.meanForce;
+            summary["mean_muscle_torque"] = r.summary.meanMuscleTorque;
+            summary["mean_strap_force"] = r.summary.meanStrapForce;
+            summary["path_length"] = r.summary.pathLength;
+            summary["moment_arm"] = r.summary.momentArm;
+            summary["mean_forces"] = r.summary.meanForces;
+            summary["saturated"] = r.summary.saturated;
+            return py::make_tuple(toDict(r.series), summary);
+        },
+        py::arg("model"), py::arg("angle_deg") = 90.0, py::arg("activation") = 1.0, py::arg("effort") = "flexion",
+        py::arg("antagonist_activation") = 0.0, py::arg("rest") = 0.5, py::arg("rise") = 0.0, py::arg("hold") = 3.0,
+        py::arg("rate") = 1000.0, py::arg("averaging_window") = 1.0,
+        "An isometric arm trial with the elbow locked at angle_deg (included angle, as `armsim trial`):\n"
+        "rest [s] relaxed (the transducer is tared), then the agonists of `effort` ('flexion' or\n"
+        "'extension') rise to `activation` over `rise` [s] and hold for `hold` [s]; the antagonists go to\n"
+        "antagonist_activation. Returns (series, summary): series a dict of float64 arrays (time_s,\n"
+        "activation, elbow_angle_deg, muscle_force_N, holding_torque_Nm, muscle_torque_Nm, strap_force_N,\n"
+        "per-muscle force_<muscle>_N with several muscles, states); summary the means over the last\n"
+        "averaging_window [s]. Releases the GIL.");
+
+    mod.def(
+        "run_study",
+        [](const std::string& file, int threads, const std::string& out, bool restart) {
+            if (!std::filesystem::is_regular_file(file)) throwFileNotFound(file, "study file");
+            const Study study = readStudy(file);
+            StudyRunOptions o;
+            o.threads = threads;
+            o.output = out;
+            o.restart = restart;
+            StudyOutcome r;
+            {
+                py::gil_scoped_release release;
+                r = runStudy(study, o);
+            }
+            py::dict d;
+            d["output"] = r.output;
+            d["total"] = r.total;
+            d["computed"] = r.computed;
+            d["resumed"] = r.resumed;
+            d["failed"] = r.failed;
+            d["not_converged"] = r.notConverged;
+            d["wall_time"] = r.wallTime;
+            d["files"] = r.files;
+            return d;
+        },
+        py::arg("study_file"), py::arg("threads") = 0, py::arg("out") = "", py::arg("restart") = false,
+        "Runs a population study file (as `armsim study`, on threads) and returns what it did: output\n"
+        "folder, total, computed, resumed, failed and not_converged task counts, wall_time [s], files.\n"
+        "Resumes from the folder's journal like the command. Releases the GIL.");
+}
