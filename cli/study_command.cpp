@@ -42,22 +42,22 @@ void printStudyProgress(const StudyProgress& p) {
 }
 
 void runStudyCommand(const StudyOptions& o) {
-    const Study study = readStudy(o.file);
     StudyRunOptions run;
     run.output = o.out;
     run.threads = o.threads;
     run.restart = o.restart;
     if (!o.quiet) run.progress = printStudyProgress;
 
-    std::optional<StudyOutcome> outcome;
-    const bool mpi = isLaunchedByMpi();
-    if (mpi) {
-        outcome = runStudyOnMpi(study, run);
-        if (!outcome) return;  // a worker rank: rank 0 reports
+    std::optional<std::pair<Study, StudyOutcome>> done;
+    if (isLaunchedByMpi()) {
+        done = runStudyOnMpi(o.file, run);  // every rank reads the study after MPI starts
+        if (!done) return;                  // a worker rank: rank 0 reports
     } else {
-        outcome = runStudy(study, run);
+        const Study study = readStudy(o.file);
+        done.emplace(study, runStudy(study, run));
     }
-    const StudyOutcome& r = *outcome;
+    const Study& study = done->first;
+    const StudyOutcome& r = done->second;
     std::printf("study '%s': %ld tasks (%d subjects x %zu protocols x %zu noise levels x %zu methods); %ld computed "
                 "in %.1f s on %d rank%s x %d thread%s, %ld resumed from the journal\n",
                 study.name.c_str(), r.total, study.subjects, study.protocols.size(), study.noiseLevels.size(),

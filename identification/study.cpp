@@ -119,6 +119,15 @@ void Study::validate() const {
                                  "= '" + protocols[i].reference + "': its name '" + protocols[i].protocol.name +
                                      "' is also protocols[" + std::to_string(j) + "]'s: expected unique protocol names");
     }
+    // Names go into CSV cells and journal lines: no control characters (they would not round-trip).
+    auto checkName = [](const std::string& field, const std::string& name) {
+        for (unsigned char c : name)
+            if (c < 0x20 || c == 0x7f)
+                throw FieldError(field, "= '" + name + "': expected a name without tabs, newlines or control characters");
+    };
+    for (std::size_t i = 0; i < protocols.size(); ++i)
+        checkName("protocols[" + std::to_string(i) + "].name", protocols[i].protocol.name);
+    for (std::size_t i = 0; i < methods.size(); ++i) checkName("methods[" + std::to_string(i) + "].label", methods[i].label);
     const auto& kinds = getElbowMethodKinds();
     for (std::size_t i = 0; i < methods.size(); ++i) {
         const std::string f = "methods[" + std::to_string(i) + "]";
@@ -267,7 +276,16 @@ std::vector<StudyResult> runStudyGroup(const Study& study, long group, const std
             if (!e.converged) r.reason = e.message;
         }
         if (synthesisError.empty()) {
-            r.row = makeElbowValidationRow(study.population, v, level, m.label, e);
+            try {
+                r.row = makeElbowValidationRow(study.population, v, level, m.label, e);
+            } catch (const std::exception& x) {
+                r.status = "failed";
+                r.reason = std::string("recording: ") + x.what();
+                r.row.subject = subject;
+                r.row.noise = level;
+                r.row.method = m.label;
+                r.row.estimate = e;
+            }
         } else {  // no subject: no truth
             r.row.subject = subject;
             r.row.noise = level;

@@ -80,12 +80,16 @@ int getEnvInt(const char* name, int fallback) {
 
 bool hasMpi() { return true; }
 
-std::optional<StudyOutcome> runStudyOnMpi(const Study& study, const StudyRunOptions& options) {
+std::optional<std::pair<Study, StudyOutcome>> runStudyOnMpi(const std::string& studyFile, const StudyRunOptions& options) {
     // Shared-memory transfers through CMA need ptrace rights that containers often lack; copy-in/out
     // costs nothing at these message sizes. A user's own setting wins.
     setenv("OMPI_MCA_btl_vader_single_copy_mechanism", "none", 0);
     int provided = 0;
     check(MPI_Init_thread(nullptr, nullptr, MPI_THREAD_FUNNELED, &provided), "MPI_Init_thread");
+    if (provided < MPI_THREAD_FUNNELED) {
+        std::fprintf(stderr, "error: this MPI library cannot host threads (MPI_THREAD_FUNNELED not provided)\n");
+        MPI_Abort(MPI_COMM_WORLD, 1);
+    }
     int rank = 0, size = 1;
     MPI_Comm_rank(MPI_COMM_WORLD, &rank);
     MPI_Comm_size(MPI_COMM_WORLD, &size);
@@ -94,11 +98,12 @@ std::optional<StudyOutcome> runStudyOnMpi(const Study& study, const StudyRunOpti
         const int cores = int(std::max(1u, std::thread::hardware_concurrency()));
         o.threads = std::max(1, cores / std::max(1, getEnvInt("OMPI_COMM_WORLD_LOCAL_SIZE", 1)));
     }
-    std::optional<StudyOutcome> outcome;
+    std::optional<std::pair<Study, StudyOutcome>> outcome;
     try {
+        const Study study = readStudy(studyFile);
         if (rank == 0) {
             Coordinator link(size, o.threads);
-            outcome = runStudy(study, o, &link);
+            outcome.emplace(study, runStudy(study, o, &link));
         } else {
             Worker link(rank);
             runStudyWorker(study, o.threads, link);

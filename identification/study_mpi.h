@@ -8,15 +8,17 @@
 #include "identification/study.h"
 
 #include <optional>
+#include <utility>
 
 namespace armsim {
 
 /// true when armsim was built with MPI.
 bool hasMpi();
 
-/// Runs the study over MPI_COMM_WORLD (initialising and finalising MPI). Returns the outcome on rank 0
-/// and nothing on the other ranks. threads: per rank (0: the node's cores shared by its ranks). An
-/// error on any rank is printed and aborts every rank (MPI_Abort) with exit code 1.
-std::optional<StudyOutcome> runStudyOnMpi(const Study& study, const StudyRunOptions& options);
+/// Reads the study file on every rank and runs it over MPI_COMM_WORLD (initialising and finalising
+/// MPI). Returns the study and its outcome on rank 0, nothing on the other ranks. threads: per rank
+/// (0: the node's cores shared by its ranks). An error on any rank (a file missing on one node, a
+/// study that differs between ranks) is printed and aborts every rank (MPI_Abort) with exit code 1.
+std::optional<std::pair<Study, StudyOutcome>> runStudyOnMpi(const std::string& studyFile, const StudyRunOptions& options);
 
 }  // namespace armsim

@@ -7,7 +7,7 @@ namespace armsim {
 
 bool hasMpi() { return false; }
 
-std::optional<StudyOutcome> runStudyOnMpi(const Study&, const StudyRunOptions&) {
+std::optional<std::pair<Study, StudyOutcome>> runStudyOnMpi(const std::string&, const StudyRunOptions&) {
     throw InputError("this armsim was built without MPI (install libopenmpi-dev and rebuild); run the study "
                      "without mpirun to use threads");
 }

@@ -67,16 +67,17 @@ std::vector<GroupWork> parseWork(const std::string& text, bool& noMore) {
     return out;
 }
 
-std::string formatRequest(int want, const std::vector<StudyResult>& results) {
-    std::string s = "R " + std::to_string(want) + '\n';
+// A request carries the worker's study fingerprint: every rank must have read the same study.
+std::string formatRequest(int want, const std::string& fingerprint, const std::vector<StudyResult>& results) {
+    std::string s = "R " + std::to_string(want) + ' ' + fingerprint + '\n';
     for (const StudyResult& r : results) s += formatStudyJournalLine(r) + '\n';
     return s;
 }
 
-std::vector<StudyResult> parseRequest(const std::string& text, int& want) {
+std::vector<StudyResult> parseRequest(const std::string& text, int& want, std::string& fingerprint) {
     std::istringstream in(text);
     std::string tag, line;
-    if (!(in >> tag >> want) || tag != "R") throw std::logic_error("study: malformed request message");
+    if (!(in >> tag >> want >> fingerprint) || tag != "R") throw std::logic_error("study: malformed request message");
     std::getline(in, line);
     std::vector<StudyResult> out;
     while (std::getline(in, line)) {
@@ -91,40 +92,14 @@ std::vector<StudyResult> parseRequest(const std::string& text, int& want) {
 class LocalWorkers {
 public:
     LocalWorkers(const Study& study, int threads, int rank) {
-        for (int i = 0; i < threads; ++i)
-            threads_.emplace_back([this, &study, rank] {
-                for (;;) {
-                    GroupWork w;
-                    {
-                        std::unique_lock<std::mutex> lock(mutex_);
-                        workReady_.wait(lock, [this] { return closed_ || !work_.empty(); });
-                        if (work_.empty()) return;
-                        w = std::move(work_.front());
-                        work_.pop_front();
-                    }
-                    std::vector<StudyResult> r;
-                    std::exception_ptr error;
-                    try {
-                        r = runStudyGroup(study, w.group, w.tasks, rank);
-                    } catch (...) {
-                        error = std::current_exception();
-                    }
-                    std::lock_guard<std::mutex> lock(mutex_);
-                    if (error && !error_) error_ = error;
-                    results_.push_back(std::move(r));
-                    resultReady_.notify_all();
-                }
-            });
-    }
-    ~LocalWorkers() {
-        {
-            std::lock_guard<std::mutex> lock(mutex_);
-            closed_ = true;
-            work_.clear();
+        try {
+            start(study, threads, rank);
+        } catch (...) {  // a thread could not be created: stop the ones that were
+            stop();
+            throw;
         }
-        workReady_.notify_all();
-        for (std::thread& t : threads_) t.join();
     }
+    ~LocalWorkers() { stop(); }
     int getNumThreads() const { return int(threads_.size()); }
     void add(GroupWork w) {
         std::lock_guard<std::mutex> lock(mutex_);
@@ -144,6 +119,44 @@ public:
     }
 
 private:
+    void start(const Study& study, int threads, int rank) {
+        for (int i = 0; i < threads; ++i)
+            threads_.emplace_back([this, &study, rank] { work(study, rank); });
+    }
+    void stop() {
+        {
+            std::lock_guard<std::mutex> lock(mutex_);
+            closed_ = true;
+            work_.clear();
+        }
+        workReady_.notify_all();
+        for (std::thread& t : threads_) t.join();
+        threads_.clear();
+    }
+    void work(const Study& study, int rank) {
+        for (;;) {
+            GroupWork w;
+            {
+                std::unique_lock<std::mutex> lock(mutex_);
+                workReady_.wait(lock, [this] { return closed_ || !work_.empty(); });
+                if (work_.empty()) return;
+                w = std::move(work_.front());
+                work_.pop_front();
+            }
+            std::vector<StudyResult> r;
+            std::exception_ptr error;
+            try {
+                r = runStudyGroup(study, w.group, w.tasks, rank);
+            } catch (...) {
+                error = std::current_exception();
+            }
+            std::lock_guard<std::mutex> lock(mutex_);
+            if (error && !error_) error_ = error;
+            results_.push_back(std::move(r));
+            resultReady_.notify_all();
+        }
+    }
+
     std::mutex mutex_;
     std::condition_variable workReady_, resultReady_;
     std::deque<GroupWork> work_;
@@ -295,7 +308,8 @@ StudyOutcome runStudy(const Study& study, const StudyRunOptions& options, StudyC
     StudyOutcome outcome;
     outcome.output = options.output.empty() ? study.output : options.output;
     if (outcome.output.empty()) throw InputError("study: no output folder (set `output:` or --out)");
-    OutputFolder folder(outcome.output, calcStudyFingerprint(study), study, options.restart);
+    const std::string fingerprint = calcStudyFingerprint(study);
+    OutputFolder folder(outcome.output, fingerprint, study, options.restart);
 
     // Missing cells, grouped, in task order.
     std::deque<GroupWork> pending;
@@ -353,7 +367,13 @@ StudyOutcome runStudy(const Study& study, const StudyRunOptions& options, StudyC
             std::string message;
             while (link && link->receive(worker, message)) {
                 int want = 0;
-                record(parseRequest(message, want));
+                std::string theirs;
+                const std::vector<StudyResult> results = parseRequest(message, want, theirs);
+                if (theirs != fingerprint)
+                    throw InputError("rank " + std::to_string(worker) + " read a different study (fingerprint " + theirs +
+                                     ", rank 0: " + fingerprint + "): the study, protocol and population files must "
+                                     "be the same on every node");
+                record(results);
                 std::vector<GroupWork> give;
                 while (int(give.size()) < want && !pending.empty()) {
                     give.push_back(std::move(pending.front()));
@@ -389,6 +409,7 @@ bool isLaunchedByMpi() {
 void runStudyWorker(const Study& study, int threads, StudyWorkerLink& link) {
     study.validate();
     threads = threads > 0 ? threads : defaultThreads();
+    const std::string fingerprint = calcStudyFingerprint(study);
     LocalWorkers local(study, threads, link.getRank());
     const int capacity = threads;  // no prefetch: a queued group could leave another rank idle at the end
     int inFlight = 0;
@@ -397,7 +418,7 @@ void runStudyWorker(const Study& study, int threads, StudyWorkerLink& link) {
     for (;;) {
         const int want = noMore ? 0 : capacity - inFlight;
         if (want > 0 || !finished.empty()) {
-            const std::vector<GroupWork> work = parseWork(link.exchange(formatRequest(want, finished)), noMore);
+            const std::vector<GroupWork> work = parseWork(link.exchange(formatRequest(want, fingerprint, finished)), noMore);
             finished.clear();
             for (const GroupWork& w : work) local.add(w);
             inFlight += int(work.size());

@@ -255,6 +255,8 @@ TEST(Study, ReadsAStudyFileAndNamesTheFileLineAndFieldOfEveryError) {
         {"kind: study\nsubjects: 2\nprotocols: [thesis, thesis]\nmethods:\n  - {method: thesis}\n",
          "expected unique protocol names"},
         {"kind: study\nsubjects: 2\nprotocols: []\nmethods:\n  - {method: thesis}\n", "protocols"},
+        {"kind: study\nsubjects: 2\nprotocols: [thesis]\nmethods:\n  - {method: thesis, label: \"a\\tb\"}\n",
+         "methods[0].label"},
     };
     for (std::size_t i = 0; i < cases.size(); ++i) {
         const fs::path p = d / ("bad" + std::to_string(i) + ".yaml");
