@@ -8,9 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <map>
-#include <sstream>
 
 namespace fs = std::filesystem;
 
@@ -22,14 +20,6 @@ std::string fmt(const char* format, double v) {
     char buf[64];
     std::snprintf(buf, sizeof buf, format, v);
     return buf;
-}
-
-std::string readText(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw InputError(path + ": cannot open file (does it exist and is it readable?)");
-    std::stringstream s;
-    s << in.rdbuf();
-    return s.str();
 }
 
 // ---- Reading --------------------------------------------------------------------------------------
@@ -142,7 +132,7 @@ std::string getProtocolKindName(ProtocolKind kind) {
 Protocol readProtocol(const std::string& path) {
     Protocol p;
     p.sourcePath = path;
-    p.sourceText = readText(path);
+    p.sourceText = readFileText(path);
     const ParamNode root = ParamNode::loadString(p.sourceText, path);
     p.name = root.getString("name");
     if (p.name.empty() || p.name.find_first_of("/\\ \t") != std::string::npos)

@@ -8,7 +8,6 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <map>
 #include <sstream>
 
@@ -29,13 +28,6 @@ std::string toHex(std::uint64_t v) {
     char buf[17];
     std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(v));
     return buf;
-}
-
-std::string readBytes(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    std::ostringstream s;
-    s << in.rdbuf();
-    return s.str();
 }
 
 // NaN as an empty cell, integers without exponent.
@@ -198,8 +190,8 @@ std::string calcStudyFingerprint(const Study& s) {
         t << "\nmethod " << m.label << ' ' << m.kind << ' ' << formatNumber(m.options.activationSd) << ' '
           << m.options.freeSlowFraction << ' ' << m.options.includeSynergists << ' ' << num(m.options.noiseLevel);
     for (const StudyProtocol& p : s.protocols) t << "\nprotocol\n" << formatTorqueProtocol(p.protocol);
-    if (!s.population.file.empty()) t << "\npopulation\n" << readBytes(s.population.file);
-    if (!s.population.base.file.empty()) t << "\nmodel\n" << readBytes(s.population.base.file);
+    if (!s.population.file.empty()) t << "\npopulation\n" << readFileText(s.population.file);
+    if (!s.population.base.file.empty()) t << "\nmodel\n" << readFileText(s.population.base.file);
     for (const MuscleSpec& m : s.population.base.muscles) {
         const MuscleParameters& p = m.params;
         t << "\nmuscle " << p.name << ' ' << formatNumber(p.mass) << ' ' << formatNumber(p.optimalFascicleLength) << ' '

@@ -146,7 +146,6 @@ public:
     /// A worker's message if one has arrived (does not block).
     virtual bool receive(int& worker, std::string& message) = 0;
     virtual void send(int worker, const std::string& message) = 0;
-    virtual int getThreadsPerWorker() const = 0;    ///< for the report
 };
 /// Byte transport from a worker rank to the coordinator.
 class StudyWorkerLink {

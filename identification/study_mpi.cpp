@@ -40,9 +40,8 @@ void sendTo(int rank, int tag, const std::string& message) {
 
 class Coordinator : public StudyCoordinatorLink {
 public:
-    Coordinator(int size, int threads) : size_(size), threads_(threads) {}
+    explicit Coordinator(int size) : size_(size) {}
     int getNumWorkers() const override { return size_ - 1; }
-    int getThreadsPerWorker() const override { return threads_; }
     bool receive(int& worker, std::string& message) override {
         MPI_Status status;
         if (!probeMessage(MPI_ANY_SOURCE, kRequestTag, status)) return false;
@@ -53,7 +52,7 @@ public:
     void send(int worker, const std::string& message) override { sendTo(worker, kWorkTag, message); }
 
 private:
-    int size_, threads_;
+    int size_;
 };
 
 class Worker : public StudyWorkerLink {
@@ -102,7 +101,7 @@ std::optional<std::pair<Study, StudyOutcome>> runStudyOnMpi(const std::string& s
     try {
         const Study study = readStudy(studyFile);
         if (rank == 0) {
-            Coordinator link(size, o.threads);
+            Coordinator link(size);
             outcome.emplace(study, runStudy(study, o, &link));
         } else {
             Worker link(rank);

@@ -272,10 +272,7 @@ std::vector<std::string> writeStudyFiles(const Study& study, const std::string& 
     writeFileAtomically(dir + "/summary.csv", formatStudySummaryCsv(summary));
     std::vector<std::string> files = {"results.csv", "summary.csv", "timing.csv"};
     if (!study.file.empty()) {
-        std::ifstream in(study.file, std::ios::binary);
-        std::ostringstream s;
-        s << in.rdbuf();
-        writeFileAtomically(dir + "/study.yaml", s.str());
+        writeFileAtomically(dir + "/study.yaml", readFileText(study.file));
         files.push_back("study.yaml");
     }
     const struct {

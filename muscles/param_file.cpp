@@ -74,13 +74,15 @@ ParamNode ParamNode::loadString(const std::string& text, const std::string& sour
     return ParamNode(impl);
 }
 
-ParamNode ParamNode::loadFile(const std::string& path) {
-    std::ifstream in(path);
+std::string readFileText(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
     if (!in) throw InputError(path + ": cannot open file (does it exist and is it readable?)");
     std::stringstream buf;
     buf << in.rdbuf();
-    return loadString(buf.str(), path);
+    return buf.str();
 }
+
+ParamNode ParamNode::loadFile(const std::string& path) { return loadString(readFileText(path), path); }
 
 const YAML::Node& ParamNode::node() const { return impl_->node; }
 const std::string& ParamNode::getSourceName() const { return impl_->source; }

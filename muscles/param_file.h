@@ -131,6 +131,9 @@ private:
     std::shared_ptr<Impl> impl_;
 };
 
+/// The whole file as bytes. Throws InputError naming the path when it cannot be read.
+std::string readFileText(const std::string& path);
+
 /// Writes text to path atomically: to a temporary beside it, then rename. Throws InputError naming
 /// the path when it cannot be written. Parent directories are created.
 void writeFileAtomically(const std::string& path, const std::string& text);
