@@ -5,6 +5,7 @@
 #include "experiments/plot.h"
 #include "identification/elbow_identification.h"
 #include "identification/faithful_model.h"
+#include "identification/forward_choice.h"
 #include "identification/identifier.h"
 #include "identification/report_io.h"
 #include "identification/thesis_cases.h"
@@ -60,7 +61,7 @@ struct ModelOptions {
             c.add_option("--forward", model, "forward model: steady | faithful (Simbody arm in the loop) | corrected "
                                            "(steady iterations corrected by the faithful model)")
                 ->capture_default_str()
-                ->check(CLI::IsMember({"steady", "faithful", "corrected"}));
+                ->check(CLI::IsMember(getForwardModelNames()));
         c.add_option("--estimate", estimate, "faithful: force the experimenter reports: moment-arm | fixed-ratio | true")
             ->capture_default_str()
             ->check(CLI::IsMember({"moment-arm", "fixed-ratio", "true"}));
@@ -69,19 +70,15 @@ struct ModelOptions {
         c.add_option("--rate", rate, "faithful: transducer sample rate in iterations [Hz]")->capture_default_str();
         c.add_option("--jobs", jobs, "faithful: trials run in parallel")->capture_default_str()->check(CLI::Range(1, 64));
     }
-    FaithfulModelOptions makeFast() const {
-        FaithfulModelOptions o;
-        o.estimate = parseForceEstimateName(estimate);
-        o.protocol.holdDuration = hold;
-        o.protocol.averagingWindow = std::min(o.protocol.averagingWindow, hold / 3);
-        o.protocol.sampleRate = rate;
-        o.jobs = jobs;
-        return o;
-    }
-    FaithfulModelOptions makeReference() const {
-        FaithfulModelOptions o = makeFast();
-        o.protocol = FaithfulProtocol::makeReference();
-        return o;
+    ForwardModelChoice makeChoice() const {
+        ForwardModelChoice c;
+        c.model = model;
+        c.estimate = parseForceEstimateName(estimate);
+        c.holdDuration = hold;
+        c.sampleRate = rate;
+        c.warmStart = !noWarmStart;
+        c.jobs = jobs;
+        return c;
     }
 };
 
@@ -103,34 +100,11 @@ struct IdentifyOptions {
     std::string out = "out/identify";
 };
 
-/// Reads a force file; angle columns are converted with the arm's own geometry.
-ObservationSet readData(const std::string& file, const ArmParameters& arm, int subject) {
-    ObservationOptions oo;
-    const double A = arm.originDistance, B = arm.insertionDistance;
-    oo.pathFromAngle = [A, B](double theta) { return calcBicepsPathLength(A, B, theta); };
-    oo.subject = subject;
-    return readObservations(file, oo);
-}
-
-/// Identifies with the chosen model, then re-checks the estimate with the steady model and with the
-/// faithful model at the reference protocol (1000 Hz).
 IdentificationReport runIdentification(const IdentificationProblem& pr, const IdentificationOptions& o,
                                        const ArmParameters& arm, const ModelOptions& m, bool verbose = true) {
-    const SteadyForceModel steady;
-    const FaithfulForceModel fast(arm, m.makeFast()), reference(arm, m.makeReference());
-    IdentificationReport r;
-    if (m.model == "steady") {
-        r = identify(pr, steady, o);
-    } else {
-        fast.calcElbowAngles(pr.data);  // InputError naming file and line for a path outside the elbow range
-        if (m.model == "faithful")
-            r = m.noWarmStart ? identify(pr, fast, o) : identifyWarmStarted(pr, steady, fast, o);
-        else
-            r = identifyCorrected(pr, steady, fast, o);
-        if (verbose) std::printf("in the iterations: %s\n", fast.describe().c_str());
-    }
-    addModelCheck(r, steady, "steady model (isometric solve)");
-    addModelCheck(r, reference, reference.describe());
+    std::string iterationModel;
+    IdentificationReport r = identifyAndRecheck(pr, o, arm, m.makeChoice(), &iterationModel);
+    if (verbose && !iterationModel.empty()) std::printf("in the iterations: %s\n", iterationModel.c_str());
     return r;
 }
 
@@ -161,7 +135,7 @@ void runIdentify(const IdentifyOptions& o) {
         if (o.model.model == "steady") {
             printThesisCases(base, SteadyForceModel(), o.out);
         } else {
-            const FaithfulForceModel fast(setup.arm, o.model.makeFast());
+            const FaithfulForceModel fast(setup.arm, o.model.makeChoice().makeIterationOptions());
             std::printf("thesis cases with the %s\n", fast.describe().c_str());
             printThesisCases(base, fast, o.out);
         }
@@ -171,7 +145,7 @@ void runIdentify(const IdentifyOptions& o) {
 
     IdentificationProblem pr;
     pr.base = base;
-    pr.data = readData(findAsset(o.data), setup.arm, o.subject);
+    pr.data = readArmObservations(findAsset(o.data), setup.arm, o.subject);
     pr.unknowns.clear();
     for (const std::string& name : splitList(o.freeList)) pr.unknowns.push_back(makeUnknown(parseParameter("--free", name)));
     if (pr.unknowns.empty()) throw InputError("--free '" + o.freeList + "': expected at least one parameter");
@@ -463,9 +437,9 @@ void runIdentificationStep(const MainJobContext& ctx) {
 
     // 1. The thesis's measured forces (600 N at 41 cm, 458 N at 37.5 cm).
     std::printf("faithful model in the iterations: %s; re-checks at 1000 Hz\n",
-                FaithfulForceModel(setup.arm, faithful.makeFast()).describe().c_str());
+                FaithfulForceModel(setup.arm, faithful.makeChoice().makeIterationOptions()).describe().c_str());
     std::printf("thesis measured data (Table 7.3: 600 N at 41 cm, 458 N at 37.5 cm), lm from 330 g / 22 cm:\n");
-    const IdentificationProblem measured = problemFor(readData(findAsset("measured/thesis_measured.csv"), setup.arm, -1));
+    const IdentificationProblem measured = problemFor(readArmObservations(findAsset("measured/thesis_measured.csv"), setup.arm));
     IdentificationOptions lm;
     struct Run {
         const char* label;
@@ -483,7 +457,7 @@ void runIdentificationStep(const MainJobContext& ctx) {
     }
 
     // 2. Our own MVC data: five angles, the faithful model at the thesis protocol, the default subject.
-    FaithfulModelOptions ro = faithful.makeReference();
+    const FaithfulModelOptions ro = faithful.makeChoice().makeReferenceOptions();
     const FaithfulForceModel reference(setup.arm, ro);
     ObservationSet angles;
     for (double deg : {45.0, 60.0, 90.0, 120.0, 150.0}) {
@@ -505,7 +479,7 @@ void runIdentificationStep(const MainJobContext& ctx) {
     writeFileAtomically(dataPath, csv.str());
     std::printf("own MVC data (%s; truth %.2f g, %.3f cm), from 330 g / 22 cm:\n", dataPath.c_str(), 1000 * base.mass,
                 100 * base.optimalTendonLength);
-    const IdentificationProblem own = problemFor(readData(dataPath, setup.arm, -1));
+    const IdentificationProblem own = problemFor(readArmObservations(dataPath, setup.arm));
     for (Method m : {Method::LevenbergMarquardt, Method::IlcSignSearch}) {
         IdentificationOptions o;
         o.method = m;

@@ -4,14 +4,12 @@
 #include "cli/commands.h"
 #include "experiments/plot.h"
 #include "identification/elbow_identification.h"
-#include "identification/statistics.h"
 #include "muscles/muscle_file.h"
 #include "muscles/param_file.h"
 
 #include <cmath>
 #include <cstdio>
 #include <memory>
-#include <set>
 
 namespace armsim::cli {
 
@@ -26,55 +24,19 @@ struct IdentifyTorqueOptions {
     std::string out = "out/identify_torque";
 };
 
-// Chi-square of the method's torque residuals with sd = noise |torque| (the noise the synergist methods
-// weight with), its degrees of freedom and the tail probability.
-struct NoiseCheck {
-    double rms = 0;        // [N m]
-    double chiSquare = 0;
-    int n = 0, dof = 0;
-    double p = NAN;
-};
-
-NoiseCheck checkResiduals(const std::vector<TorqueObservation>& data, const BicepsEstimate& e, double noise) {
-    NoiseCheck c;
-    for (std::size_t k = 0; k < data.size() && k < e.predictedTorque.size(); ++k) {
-        if (!std::isfinite(e.predictedTorque[k])) continue;
-        const double residual = e.predictedTorque[k] - data[k].torque;
-        const double sd = noise * std::max(std::abs(data[k].torque), 1.0);
-        c.rms += residual * residual;
-        c.chiSquare += std::pow(residual / sd, 2);
-        ++c.n;
-    }
-    c.rms = std::sqrt(c.rms / std::max(c.n, 1));
-    // The MAP fit's prior keeps its effective parameter count below its nominal one: the thesis's 2
-    // free parameters are subtracted, the synergist fits' are not (a conservative test for them).
-    c.dof = std::max(1, c.n - (e.method == "thesis" ? e.numParameters : 0));
-    c.p = calcChiSquareSurvival(c.chiSquare, c.dof);
-    return c;
-}
-
 void runIdentifyTorque(const IdentifyTorqueOptions& o) {
     const std::string file = findAsset(o.data);
     const std::vector<TorqueObservation> data = readTorqueData(file);
     const Population prior = o.population.empty() ? loadDefaultPopulation() : loadPopulation(o.population);
     std::printf("torque data %s: %zu trials; prior population '%s' (model '%s')\n", file.c_str(), data.size(),
                 prior.name.c_str(), prior.base.name.c_str());
-    std::vector<BicepsEstimate> estimates;
-    std::set<double> mvcAngles;  // the thesis method fits flexion MVCs only, two unknowns
-    for (const TorqueObservation& d : data)
-        if (d.isFlexionMvc()) mvcAngles.insert(d.flexionDeg);
-    if (mvcAngles.size() >= 2)
-        estimates.push_back(identifyThesisMethod(prior.base, data));
-    else
-        std::printf("thesis method: skipped (it fits flexion MVCs at >= 2 angles; these data have %zu)\n", mvcAngles.size());
-    SynergistOptions so;
-    so.noiseLevel = o.noiseLevel;
-    estimates.push_back(identifySynergistAware(prior, data, so));
-    if (std::isfinite(o.activation)) {
-        so.measuredActivation = o.activation;
-        so.activationSd = o.activationSd;
-        estimates.push_back(identifySynergistAware(prior, data, so));
-    }
+    TorqueIdentificationOptions to;
+    to.noiseLevel = o.noiseLevel;
+    to.activation = o.activation;
+    to.activationSd = o.activationSd;
+    std::string skipped;
+    const std::vector<BicepsEstimate> estimates = identifyTorqueData(prior, data, to, &skipped);
+    if (!skipped.empty()) std::printf("%s\n", skipped.c_str());
     // The noise the residuals are judged against: given, or the synergist fit's estimate from repeats.
     const double noise = std::isfinite(o.noiseLevel) ? o.noiseLevel : estimates.back().noiseLevel;
     const MuscleParameters& b = prior.base.biceps();
@@ -90,7 +52,7 @@ void runIdentifyTorque(const IdentifyTorqueOptions& o) {
     for (const BicepsEstimate& e : estimates) residuals += "," + e.method + "_Nm";
     residuals += "\n";
     for (const BicepsEstimate& e : estimates) {
-        const NoiseCheck c = checkResiduals(data, e, noise);
+        const TorqueResidualCheck c = checkTorqueResiduals(data, e, noise);
         std::printf("%-13s %9.1f   [%7.1f, %7.1f] %9.2f   [%7.2f, %7.2f] %10.2f %6.1f / %-4d %6.3f %8s%s\n",
                     e.method.c_str(), 1000 * e.mass, 1000 * e.massLower, 1000 * e.massUpper, 100 * e.tendonLength,
                     100 * e.tendonLower, 100 * e.tendonUpper, c.rms, c.chiSquare, c.dof, c.p,

@@ -129,9 +129,7 @@ void runTorqueProtocolCommand(const ProtocolOptions& o, const std::string& file)
     std::printf("  %-9s %6s %6s %4s %12s\n", "effort", "angle", "level", "rep", "torque (N m)");
     for (const TorqueObservation& d : data)
         std::printf("  %-9s %6.1f %6.2f %4d %12.2f\n", getEffortName(d.effort), d.flexionDeg, d.level, d.repetition, d.torque);
-    writeFileAtomically(out + "/torque_data.csv", formatTorqueData(data, true));
-    writeFileAtomically(out + "/protocol.yaml", formatTorqueProtocol(protocol));
-    writeTorquePlot(out + "/torque_angle.png", data, "Protocol " + protocol.name + ": tared torque per trial");
+    writeTorqueProtocolRun(out, protocol, data);
     std::printf("wrote %s/torque_data.csv (identify with `armsim identify --torque-data`), protocol.yaml, torque_angle.png\n",
                 out.c_str());
 }

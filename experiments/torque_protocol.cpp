@@ -228,7 +228,10 @@ std::string formatTorqueData(const std::vector<TorqueObservation>& data, bool tr
 }
 
 std::vector<TorqueObservation> readTorqueData(const std::string& path) {
-    const Table t = Table::readCsv(path);
+    return makeTorqueData(Table::readCsv(path), path);
+}
+
+std::vector<TorqueObservation> makeTorqueData(const Table& t, const std::string& path) {
     static const std::set<std::string> known = {"flexion_deg", "effort", "level", "repetition", "torque_Nm",
                                                 "activation", "clean_torque_Nm"};
     for (const std::string& c : t.getColumnNames())
@@ -243,7 +246,7 @@ std::vector<TorqueObservation> readTorqueData(const std::string& path) {
     std::map<std::tuple<double, int, double>, int> count;
     std::set<std::tuple<double, int, double, int>> seen;
     for (int r = 0; r < t.getNumRows(); ++r) {
-        const std::string at = path + ":" + std::to_string(t.getSourceLine(r));
+        const std::string at = t.describeRow(path, r);
         auto fail = [&](const std::string& column, double v, const std::string& expected) {
             throw InputError(at + ": column '" + column + "' = " + formatNumber(v) + ": expected " + expected);
         };
@@ -306,6 +309,15 @@ void writeTorquePlot(const std::string& path, const std::vector<TorqueObservatio
         series.y.push_back(o.torque);
     }
     writePlotPng(path, plot);
+}
+
+std::vector<std::string> writeTorqueProtocolRun(const std::string& dir, const TorqueProtocol& protocol,
+                                                const std::vector<TorqueObservation>& data) {
+    const std::vector<std::string> paths = {dir + "/torque_data.csv", dir + "/protocol.yaml", dir + "/torque_angle.png"};
+    writeFileAtomically(paths[0], formatTorqueData(data, true));
+    writeFileAtomically(paths[1], formatTorqueProtocol(protocol));
+    writeTorquePlot(paths[2], data, "Protocol " + protocol.name + ": tared torque per trial");
+    return paths;
 }
 
 }  // namespace armsim

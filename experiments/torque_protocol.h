@@ -19,6 +19,8 @@
 
 namespace armsim {
 
+class Table;
+
 /// One condition of a torque protocol.
 struct TorqueCondition {
     double flexionDeg = 90;                     ///< elbow flexion [deg], 0 = extended
@@ -107,9 +109,16 @@ std::string formatTorqueData(const std::vector<TorqueObservation>& data, bool tr
 /// and torque_Nm; effort (default 1), level (default 1), repetition (default: count per condition)
 /// optional; other columns are errors. Errors name file, line, column, value and the expected range.
 std::vector<TorqueObservation> readTorqueData(const std::string& path);
+/// The same from a table already in memory; `source` names it in messages.
+std::vector<TorqueObservation> makeTorqueData(const Table& table, const std::string& source);
 
 /// PNG of tared torque vs flexion angle, one series per effort kind (flexion/extension, level), every
 /// trial as a marker. Written whole or not at all.
 void writeTorquePlot(const std::string& path, const std::vector<TorqueObservation>& data, const std::string& title);
+
+/// What `armsim protocol` writes for a torque protocol's run into dir: torque_data.csv (with the
+/// truth columns), protocol.yaml and torque_angle.png, each whole or not at all. Returns the paths.
+std::vector<std::string> writeTorqueProtocolRun(const std::string& dir, const TorqueProtocol& protocol,
+                                                const std::vector<TorqueObservation>& data);
 
 }  // namespace armsim

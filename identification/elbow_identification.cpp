@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <set>
 #include <tuple>
 
 namespace armsim {
@@ -557,6 +558,55 @@ std::string formatElbowValidationSummaryCsv(const std::vector<ElbowValidationSum
                "," + formatCell(s.massCoverage) + "," + formatCell(1000 * s.tendonBias) + "," +
                formatCell(1000 * s.tendonRmse) + "," + formatCell(s.tendonCoverage) + "\n";
     return out;
+}
+
+void TorqueIdentificationOptions::validate() const {
+    if (!std::isnan(noiseLevel)) checkField("noise_level", noiseLevel, Bound::closed(1e-4, 0.5));
+    if (!std::isnan(activation)) checkField("activation", activation, Bound::closed(0, 1));
+    checkField("activation_sd", activationSd, Bound::closed(1e-4, 0.5));
+}
+
+std::vector<BicepsEstimate> identifyTorqueData(const Population& prior, const std::vector<TorqueObservation>& data,
+                                               const TorqueIdentificationOptions& o, std::string* skipped) {
+    o.validate();
+    std::vector<BicepsEstimate> estimates;
+    std::set<double> mvcAngles;
+    for (const TorqueObservation& d : data)
+        if (d.isFlexionMvc()) mvcAngles.insert(d.flexionDeg);
+    if (skipped) skipped->clear();
+    if (mvcAngles.size() >= 2)
+        estimates.push_back(identifyThesisMethod(prior.base, data));
+    else if (skipped)
+        *skipped = "thesis method: skipped (it fits flexion MVCs at >= 2 angles; these data have " +
+                   std::to_string(mvcAngles.size()) + ")";
+    SynergistOptions so;
+    so.noiseLevel = o.noiseLevel;
+    estimates.push_back(identifySynergistAware(prior, data, so));
+    if (std::isfinite(o.activation)) {
+        so.measuredActivation = o.activation;
+        so.activationSd = o.activationSd;
+        estimates.push_back(identifySynergistAware(prior, data, so));
+    }
+    return estimates;
+}
+
+TorqueResidualCheck checkTorqueResiduals(const std::vector<TorqueObservation>& data, const BicepsEstimate& e,
+                                         double noise) {
+    TorqueResidualCheck c;
+    double sum = 0, chi = 0;
+    for (std::size_t k = 0; k < data.size() && k < e.predictedTorque.size(); ++k) {
+        if (!std::isfinite(e.predictedTorque[k])) continue;
+        const double residual = e.predictedTorque[k] - data[k].torque;
+        const double sd = noise * std::max(std::abs(data[k].torque), 1.0);
+        sum += residual * residual;
+        chi += std::pow(residual / sd, 2);
+        ++c.n;
+    }
+    c.rms = std::sqrt(sum / std::max(c.n, 1));
+    c.chiSquare = chi;
+    c.dof = std::max(1, c.n - (e.method == "thesis" ? e.numParameters : 0));
+    c.p = calcChiSquareSurvival(c.chiSquare, c.dof);
+    return c;
 }
 
 }  // namespace armsim

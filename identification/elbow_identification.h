@@ -130,6 +130,35 @@ private:
 BicepsEstimate identifySynergistAware(const Population& prior, const std::vector<TorqueObservation>& data,
                                       const SynergistOptions& options = {});
 
+/// Which identifiers identifyTorqueData runs on one person's torque data (as `armsim identify-torque`).
+struct TorqueIdentificationOptions {
+    double noiseLevel = 0.0 / 0.0;   ///< relative sd of one trial's torque [1]; NaN: estimated from repetitions
+    double activation = 0.0 / 0.0;   ///< measured voluntary activation [1]; NaN: not measured (no synergist-va)
+    double activationSd = 0.02;      ///< sd of that measurement [1]
+    /// InputError naming the field (noise_level in [1e-4, 0.5], activation in [0, 1], activation_sd
+    /// in [1e-4, 0.5]).
+    void validate() const;
+};
+
+/// Runs "thesis" (when the data hold flexion MVCs at two or more angles; otherwise *skipped says why),
+/// "synergist" and, with a measured activation, "synergist-va", each with the prior population.
+std::vector<BicepsEstimate> identifyTorqueData(const Population& prior, const std::vector<TorqueObservation>& data,
+                                               const TorqueIdentificationOptions& options = {},
+                                               std::string* skipped = nullptr);
+
+/// An estimate's torque residuals judged against a relative noise level: chi-square with
+/// sd_k = noise * max(|torque_k|, 1 N m). The thesis method's two free parameters are subtracted from
+/// the degrees of freedom; the MAP fits' are not (their prior keeps the effective count lower: a
+/// conservative test for them).
+struct TorqueResidualCheck {
+    double rms = 0.0 / 0.0;      ///< of predicted - measured [N m], over the observations it predicts
+    double chiSquare = 0.0 / 0.0;
+    int n = 0, dof = 0;
+    double p = 0.0 / 0.0;        ///< chi-square tail probability; >= 0.05: consistent with the noise
+};
+TorqueResidualCheck checkTorqueResiduals(const std::vector<TorqueObservation>& data, const BicepsEstimate& estimate,
+                                         double noiseLevel);
+
 /// A twitch-interpolation measurement of the subject's voluntary activation: the mean activation of
 /// the efforts actually produced, plus N(0, sd^2) measurement error, within [0, 1]. The default sd
 /// 0.02 is an assumption for a practised lab, not a cited value.

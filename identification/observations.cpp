@@ -64,7 +64,10 @@ void validateObservations(const ObservationSet& set) {
 }
 
 ObservationSet readObservations(const std::string& path, const ObservationOptions& options) {
-    const Table t = Table::readCsv(path);
+    return makeObservations(Table::readCsv(path), path, options);
+}
+
+ObservationSet makeObservations(const Table& t, const std::string& path, const ObservationOptions& options) {
     static const std::set<std::string> known = {"path_m", "path_cm", "angle_deg", "force_N",
                                                 "trial", "subject", "activation"};
     for (const std::string& c : t.getColumnNames())
@@ -84,7 +87,7 @@ ObservationSet readObservations(const std::string& path, const ObservationOption
     ObservationSet set;
     set.source = path;
     for (int r = 0; r < t.getNumRows(); ++r) {
-        const std::string at = path + ":" + std::to_string(t.getSourceLine(r));
+        const std::string at = t.describeRow(path, r);
         auto fail = [&](const std::string& column, double v, const std::string& expected) {
             throw InputError(at + ": column '" + column + "' = " + fmt(v) + ": expected " + expected);
         };

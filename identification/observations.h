@@ -8,6 +8,8 @@
 
 namespace armsim {
 
+class Table;
+
 /// One measured isometric force.
 struct Observation {
     double pathLength = 0;   ///< musculotendon path length P [m]
@@ -56,6 +58,8 @@ struct ObservationOptions {
 /// a path <= 0, an angle outside (0, 180] deg, an activation outside [0, 1], a non-integer trial or
 /// subject, and a duplicate point (same subject, trial, path and activation as an earlier line).
 ObservationSet readObservations(const std::string& path, const ObservationOptions& options = {});
+/// The same from a table already in memory (columns as in the file); `source` names it in messages.
+ObservationSet makeObservations(const Table& table, const std::string& source, const ObservationOptions& options = {});
 
 /// Validates an in-memory set with the same rules as readObservations (InputError naming source,
 /// line or index, field and value).

@@ -27,6 +27,13 @@ public:
     double get(int row, int column) const { return data_[std::size_t(row) * names_.size() + column]; }
     double get(int row, const std::string& column) const { return get(row, findColumn(column)); }
     std::vector<double> getColumn(const std::string& name) const;
+    /// Moves the values out (row-major, rows x columns) and leaves the table without rows: for
+    /// handing a large table to another owner without a copy (the Python module's arrays).
+    std::vector<double> releaseData() {
+        numRows_ = 0;
+        lines_.clear();
+        return std::move(data_);
+    }
     /// CSV text: a header line of column names, then rows with `digits` significant digits (1..17;
     /// 17 round-trips every double). Numbers are locale-free; NaN is written "NaN".
     std::string toCsv(int digits = 10) const;
@@ -39,6 +46,12 @@ public:
     static Table readCsv(const std::string& path);
     /// Line in the source file of data row i (1-based), for messages; 0 when not read from a file.
     int getSourceLine(int row) const { return row < int(lines_.size()) ? lines_[row] : 0; }
+    /// Where data row i came from, for messages: "source:line" when read from a file, else
+    /// "source row i+1".
+    std::string describeRow(const std::string& source, int row) const {
+        const int line = getSourceLine(row);
+        return line > 0 ? source + ":" + std::to_string(line) : source + " row " + std::to_string(row + 1);
+    }
 
 private:
     std::vector<std::string> names_;

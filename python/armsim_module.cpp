@@ -7,47 +7,15 @@
 #include "model/trial.h"
 #include "muscles/param_file.h"
 #include "muscles/simbody_isometric.h"
-#include "muscles/table.h"
-
-#include <pybind11/numpy.h>
-#include <pybind11/pybind11.h>
-#include <pybind11/stl.h>
+#include "python/module_support.h"
 
 #include <filesystem>
 #include <cmath>
 
-namespace py = pybind11;
 using namespace armsim;
+using namespace armsim::python;
 
 namespace {
-
-// A table's columns as a dict of float64 arrays, in column order.
-py::dict toDict(const Table& t) {
-    py::dict d;
-    const int n = t.getNumRows(), m = t.getNumColumns();
-    for (int c = 0; c < m; ++c) {
-        py::array_t<double> a(n);
-        double* p = a.mutable_data();
-        for (int r = 0; r < n; ++r) p[r] = t.get(r, c);
-        d[py::str(t.getColumnNames()[c])] = a;
-    }
-    return d;
-}
-
-py::array_t<double> toArray(const std::vector<std::vector<double>>& rows) {
-    const std::size_t n = rows.size(), m = rows.empty() ? 0 : rows[0].size();
-    py::array_t<double> a({n, m});
-    auto w = a.mutable_unchecked<2>();
-    for (std::size_t i = 0; i < n; ++i)
-        for (std::size_t j = 0; j < m; ++j) w(i, j) = rows[i][j];
-    return a;
-}
-
-// FileNotFoundError with the CLI's wording.
-[[noreturn]] void throwFileNotFound(const std::string& path, const char* what) {
-    PyErr_SetString(PyExc_FileNotFoundError, (path + ": cannot open " + what + " (no such file)").c_str());
-    throw py::error_already_set();
-}
 
 // A model name (under assets/models/) or an existing model file.
 ArmSetup loadModelChecked(const std::string& nameOrFile) {
@@ -93,11 +61,6 @@ void applyOverrides(ArmSetup& s, int i, const py::kwargs& kw) {
     }
 }
 
-/// The Python face of an ArmSetup: immutable; with_muscle returns a changed copy.
-struct Model {
-    ArmSetup setup;
-};
-
 VirtualMuscle buildMuscle(const Model& m, const py::object& muscle) {
     return VirtualMuscle(m.setup.calcMuscleParameters(findMuscleIndex(m.setup, muscle)));
 }
@@ -121,7 +84,10 @@ PYBIND11_MODULE(_armsim, mod) {
         }
     });
 
-    py::class_<Model>(mod, "Model", "An arm with its muscles (a model file of assets/models/ or your own).")
+    py::class_<Model>(mod, "Model",
+                      "An arm with its muscles: a model file of assets/models/ ('thesis': the thesis's biceps-only\n"
+                      "arm; 'elbow': seven muscles on wrapped paths) or your own. Immutable: with_muscle returns a\n"
+                      "changed copy. Pass it to the trial, identification and render functions.")
         .def_static(
             "load", [](const std::string& nameOrFile) { return Model{loadModelChecked(nameOrFile)}; }, py::arg("name_or_file"),
             "Loads a model: a name under assets/models/ ('thesis', 'elbow') or a model file path.\n"
@@ -159,7 +125,7 @@ PYBIND11_MODULE(_armsim, mod) {
             "geometry", [](const Model& m, const std::vector<double>& flexionDeg) {
                 const MvcGeometry g = calcMvcGeometry(m.setup, flexionDeg);
                 py::dict d;
-                d["flexion_deg"] = py::array_t<double>(py::ssize_t(g.flexionDeg.size()), g.flexionDeg.data());
+                d["flexion_deg"] = toArray(g.flexionDeg);
                 d["path_length_m"] = toArray(g.pathLength);
                 d["moment_arm_m"] = toArray(g.momentArm);
                 return d;
@@ -208,7 +174,7 @@ PYBIND11_MODULE(_armsim, mod) {
                 py::gil_scoped_release release;
                 t = runMuscleIsometric(vm, s);
             }
-            return toDict(t);
+            return toDict(std::move(t));
         },
         py::arg("model"), py::arg("path_length") = 0.375, py::arg("activation") = 1.0, py::arg("onset") = 0.0,
         py::arg("rise") = 0.0, py::arg("duration") = 3.0, py::arg("rate") = 1000.0, py::arg("steady_start") = false,
@@ -245,7 +211,7 @@ PYBIND11_MODULE(_armsim, mod) {
             summary["moment_arm"] = r.summary.momentArm;
             summary["mean_forces"] = r.summary.meanForces;
             summary["saturated"] = r.summary.saturated;
-            return py::make_tuple(toDict(r.series), summary);
+            return py::make_tuple(toDict(std::move(r.series)), summary);
         },
         py::arg("model"), py::arg("angle_deg") = 90.0, py::arg("activation") = 1.0, py::arg("effort") = "flexion",
         py::arg("antagonist_activation") = 0.0, py::arg("rest") = 0.5, py::arg("rise") = 0.0, py::arg("hold") = 3.0,
@@ -287,4 +253,6 @@ PYBIND11_MODULE(_armsim, mod) {
         "Runs a population study file (as `armsim study`, on threads) and returns what it did: output\n"
         "folder, total, computed, resumed, failed and not_converged task counts, wall_time [s], files.\n"
         "Resumes from the folder's journal like the command. Releases the GIL.");
+
+    addIdentificationBindings(mod);
 }

@@ -1,14 +1,43 @@
 """armsim: a musculoskeletal arm simulator with Virtual Muscle force elements.
 
-Models, steady states, muscle and arm trials and population studies on the C++ core, with numpy
-arrays out. Units are SI; parameter names are those of the YAML files. Errors carry the command
-line's messages: ValueError for bad input, FileNotFoundError for a missing file, RuntimeError for a
-simulation that cannot go on. Long calls release the GIL, so threads can run trials in parallel.
+Models, steady states, muscle and arm trials, protocols, identification with its reports,
+validation, experiment design, population studies and rendering on the C++ core, with numpy arrays
+out. Units are SI; keyword names are those of the YAML files and the command's options. Errors carry
+the command line's messages: ValueError for bad input, FileNotFoundError for a missing file,
+RuntimeError for a simulation that cannot go on. Long calls release the GIL, so threads can run
+trials in parallel.
 
     import armsim
     model = armsim.Model.load("elbow")
     series, summary = armsim.arm_trial(model, angle_deg=90, activation=1.0)
+    report = armsim.identify(armsim.Model.load("thesis"), "measured/thesis_measured.csv")
+    armsim.render_video(model, series, "mvc.mp4")
 """
-from ._armsim import Model, arm_trial, muscle_trial, run_study, steady_state
+from ._armsim import (Model, arm_trial, design_protocol, identify, identify_torque, muscle_trial, read_torque_data,
+                      run_protocol, run_study, steady_state, validate, validate_elbow)
 
-__all__ = ["Model", "arm_trial", "muscle_trial", "run_study", "steady_state"]
+
+def render_video(model, series, path, fps=30.0, width=1280, height=720, playback_speed=1.0, overlay=True,
+                 codec="h264", supersample=2, color_by="activation"):
+    """Renders a recorded trial (the series dict arm_trial returns) to an .mp4 (h264) or .avi (mjpg).
+
+    Offscreen (OSMesa, no display). fps: video frames per second; playback_speed: trial seconds per
+    video second; width, height: even, in [16, 4096]; color_by: 'activation' or 'force'. Written
+    whole or not at all. Returns {'path', 'frames'}. Releases the GIL.
+    """
+    from . import _render  # the render stack loads on first use only
+    return _render.render_video(model, series, path, fps, width, height, playback_speed, overlay, codec,
+                                supersample, color_by)
+
+
+def render_frame(model, series, time, width=640, height=360, overlay=True, supersample=2, color_by="activation"):
+    """One frame of a recorded trial at the sample nearest to `time` [s] as an (H, W, 3) uint8 RGB array.
+
+    The same pixels as the video's frame at that sample; show it with matplotlib's imshow.
+    """
+    from . import _render
+    return _render.render_frame(model, series, time, width, height, overlay, supersample, color_by)
+
+
+__all__ = ["Model", "arm_trial", "design_protocol", "identify", "identify_torque", "muscle_trial", "read_torque_data", "render_frame",
+           "render_video", "run_protocol", "run_study", "steady_state", "validate", "validate_elbow"]

@@ -1,9 +1,6 @@
 """The Python module (issue 12): every bound function called, results equal to the C++ API's
 (tests/python/reference.cpp, 17 digits) to 1e-12 relative, numpy dtypes and shapes, errors with the
 command line's messages, and the GIL released during long calls."""
-import json
-import os
-import subprocess
 import threading
 import time
 
@@ -12,23 +9,7 @@ import pytest
 
 import armsim
 
-REL_TOL = 1e-12  # the same C++ computation through pybind11: equal up to printing
-
-
-@pytest.fixture(scope="module")
-def reference():
-    out = subprocess.run([os.environ["ARMSIM_REFERENCE"]], check=True, capture_output=True, text=True).stdout
-    return json.loads(out)
-
-
-@pytest.fixture(scope="module")
-def thesis():
-    return armsim.Model.load("thesis")
-
-
-@pytest.fixture(scope="module")
-def elbow():
-    return armsim.Model.load("elbow")
+from conftest import REL_TOL
 
 
 def test_model_lists_muscles_and_parameters_with_the_files_names(thesis, elbow):

@@ -1,0 +1,612 @@
+// armsim.identify, identify_torque, validate, validate_elbow, design_protocol and run_protocol: the
+// library functions the commands call (identifyAndRecheck, identifyTorqueData, runValidation,
+// runElbowValidation, designProtocol, runProtocol), with keyword arguments named as the YAML files
+// and the command's options, numpy arrays out. The identification report has the keys of the JSON
+// report `armsim identify` writes (report_io.h).
+#include "experiments/protocol.h"
+#include "identification/elbow_identification.h"
+#include "identification/experiment_design.h"
+#include "identification/forward_choice.h"
+#include "identification/report_io.h"
+#include "identification/validation.h"
+#include "muscles/param_file.h"
+#include "python/module_support.h"
+
+#include <cmath>
+#include <filesystem>
+
+namespace armsim::python {
+
+namespace {
+
+using python::toDict;
+
+// ---- conversions ---------------------------------------------------------------------------------
+
+bool isNumberArray(const nlohmann::json& j) {
+    if (!j.is_array() || j.empty()) return j.is_array();
+    for (const auto& x : j)
+        if (!x.is_number() && !x.is_null()) return false;
+    return true;
+}
+
+/// JSON (as report_io.h writes it) to Python: arrays of numbers become float64 arrays, null (written
+/// for a non-finite number) NaN.
+py::object toPython(const nlohmann::json& j) {
+    switch (j.type()) {
+    case nlohmann::json::value_t::null: return py::float_(NAN);
+    case nlohmann::json::value_t::boolean: return py::bool_(j.get<bool>());
+    case nlohmann::json::value_t::number_integer:
+    case nlohmann::json::value_t::number_unsigned: return py::int_(j.get<long long>());
+    case nlohmann::json::value_t::number_float: return py::float_(j.get<double>());
+    case nlohmann::json::value_t::string: return py::str(j.get<std::string>());
+    case nlohmann::json::value_t::array: {
+        if (isNumberArray(j)) {
+            std::vector<double> v;
+            for (const auto& x : j) v.push_back(x.is_null() ? NAN : x.get<double>());
+            return toArray(v);
+        }
+        py::list l;
+        for (const auto& x : j) l.append(toPython(x));
+        return std::move(l);
+    }
+    case nlohmann::json::value_t::object: {
+        py::dict d;
+        for (auto it = j.begin(); it != j.end(); ++it) d[py::str(it.key())] = toPython(it.value());
+        return std::move(d);
+    }
+    default: return py::none();
+    }
+}
+
+/// An array of flat objects (the report's observations) as a dict of float64 arrays.
+py::dict toColumns(const nlohmann::json& rows) {
+    py::dict d;
+    if (rows.empty()) return d;
+    for (auto it = rows[0].begin(); it != rows[0].end(); ++it) {
+        std::vector<double> v;
+        for (const auto& r : rows) v.push_back(r[it.key()].is_null() ? NAN : r[it.key()].get<double>());
+        d[py::str(it.key())] = toArray(v);
+    }
+    return d;
+}
+
+py::dict toPython(const IdentificationReport& r) {
+    const nlohmann::json j = toJson(r);
+    py::dict d = toPython(j).cast<py::dict>();
+    d["observations"] = toColumns(j["observations"]);
+    py::dict estimate;
+    for (const ParameterEstimate& e : r.parameters) estimate[py::str(e.name)] = e.value;
+    d["estimate"] = estimate;
+    py::dict u = d["uncertainty"].cast<py::dict>();
+    u["covariance"] = toArray(r.covariance);
+    u["correlation"] = toArray(r.correlation);
+    d["history"] = toDict(makeHistoryTable(r));
+    return d;
+}
+
+std::string pathOf(const py::object& o) {
+    return py::str(py::module_::import("os").attr("fspath")(o));
+}
+
+bool isPath(const py::object& o) {
+    return py::isinstance<py::str>(o) || py::hasattr(o, "__fspath__");
+}
+
+/// Identification data: a CSV path (as `armsim identify DATA.csv`) or a dict of columns with the
+/// file's names (force_N and one of path_m, path_cm, angle_deg; optional activation, trial, subject).
+ObservationSet toObservations(const py::object& data, const ArmSetup& setup, int subject) {
+    if (isPath(data)) return readArmObservations(findFile(pathOf(data)), setup.arm, subject);
+    if (!py::isinstance<py::dict>(data))
+        throw InputError("data: expected a CSV path or a dict of columns (force_N and one of path_m, path_cm, angle_deg)");
+    ObservationOptions oo;
+    oo.pathFromAngle = makeArmPathFromAngle(setup.arm);
+    oo.subject = subject;
+    return makeObservations(toTable(data.cast<py::dict>(), "data"), "data", oo);
+}
+
+std::vector<TorqueObservation> toTorqueData(const py::object& data) {
+    if (isPath(data)) return readTorqueData(findFile(pathOf(data)));
+    if (!py::isinstance<py::dict>(data))
+        throw InputError("data: expected a torque CSV path or a dict of columns (flexion_deg, torque_Nm, and "
+                         "optionally effort, level, repetition)");
+    return makeTorqueData(toTable(data.cast<py::dict>(), "data"), "data");
+}
+
+/// Torque data as columns with the torque data file's names (formatTorqueData with the truth).
+py::dict toDict(const std::vector<TorqueObservation>& data) {
+    std::vector<double> deg, effort, level, rep, torque, activation, clean;
+    for (const TorqueObservation& o : data) {
+        deg.push_back(o.flexionDeg);
+        effort.push_back(o.effort == MuscleGroup::Flexor ? 1 : -1);
+        level.push_back(o.level);
+        rep.push_back(o.repetition);
+        torque.push_back(o.torque);
+        activation.push_back(o.activation);
+        clean.push_back(o.cleanTorque);
+    }
+    py::dict d;
+    d["flexion_deg"] = toArray(deg);
+    d["effort"] = toArray(effort);
+    d["level"] = toArray(level);
+    d["repetition"] = toArray(rep);
+    d["torque_Nm"] = toArray(torque);
+    d["activation"] = toArray(activation);
+    d["clean_torque_Nm"] = toArray(clean);
+    return d;
+}
+
+py::dict toDict(const BicepsEstimate& e) {
+    py::dict d;
+    d["method"] = e.method;
+    d["converged"] = e.converged;
+    d["message"] = e.message;
+    d["mass"] = e.mass;
+    d["tendon_length"] = e.tendonLength;
+    d["mass_interval"] = py::make_tuple(e.massLower, e.massUpper);
+    d["tendon_interval"] = py::make_tuple(e.tendonLower, e.tendonUpper);
+    d["noise_level"] = e.noiseLevel;
+    d["noise_degrees_of_freedom"] = e.noiseDegreesOfFreedom;
+    py::dict nuisance;
+    for (std::size_t k = 0; k < e.nuisanceNames.size() && k < e.nuisance.size(); ++k)
+        nuisance[py::str(e.nuisanceNames[k])] = e.nuisance[k];
+    d["nuisance"] = nuisance;
+    d["mass_tendon_correlation"] = e.massTendonCorrelation;
+    d["rms_residual"] = e.rmsResidual;
+    d["predicted_torque"] = toArray(e.predictedTorque);
+    d["parameters"] = e.numParameters;
+    d["iterations"] = e.iterations;
+    return d;
+}
+
+Population toPopulation(const py::object& population) {
+    if (population.is_none()) return loadDefaultPopulation();
+    return loadPopulation(findFile(pathOf(population)));
+}
+
+double optionalNumber(const py::object& o) { return o.is_none() ? NAN : o.cast<double>(); }
+
+std::vector<double> toNumbers(const py::object& o) {
+    return o.is_none() ? std::vector<double>{} : o.cast<std::vector<double>>();
+}
+
+/// A list of rows as columns: numbers become float64 arrays, strings lists.
+struct Columns {
+    py::dict d;
+    void add(const char* name, double v) { column(name).append(v); }
+    void add(const char* name, const std::string& v) { column(name).append(v); }
+    py::list column(const char* name) {
+        if (!d.contains(name)) d[name] = py::list();
+        return d[name].cast<py::list>();
+    }
+    py::dict finish() {
+        py::dict out;
+        for (auto item : d) {
+            py::list l = item.second.cast<py::list>();
+            out[item.first] = l.size() && py::isinstance<py::str>(l[0]) ? py::object(l)
+                                                                       : py::object(py::array_t<double>(l));
+        }
+        return out;
+    }
+};
+
+py::dict toDict(const TorqueCondition& c) {
+    py::dict d;
+    d["flexion_deg"] = c.flexionDeg;
+    d["effort"] = getEffortName(c.effort);
+    d["level"] = c.level;
+    d["repetitions"] = c.repetitions;
+    return d;
+}
+
+py::dict toDict(const ProtocolPrediction& p) {
+    py::dict d;
+    d["name"] = p.name;
+    d["trials"] = p.trials;
+    d["draws_used"] = p.drawsUsed;
+    d["criterion"] = p.criterion;
+    d["mass_sd"] = p.massSd;
+    d["tendon_sd"] = p.tendonSd;
+    d["flexor_strength_sd"] = p.flexorStrengthSd;
+    d["prior_mass_sd"] = p.priorMassSd;
+    d["prior_tendon_sd"] = p.priorTendonSd;
+    d["prior_flexor_strength_sd"] = p.priorFlexorStrengthSd;
+    d["parameter_names"] = p.parameterNames;
+    d["mass_correlation"] = toArray(p.massCorrelation);
+    d["posterior_sd"] = toArray(p.posteriorSd);
+    return d;
+}
+
+py::dict toDict(const QuadraticFit& q) {
+    py::dict d;
+    d["coefficients"] = toArray(q.fit.coefficients);
+    d["r_squared"] = q.fit.rSquared;
+    d["rms_residual"] = q.fit.rmsResidual;
+    d["has_maximum"] = q.hasMaximum;
+    d["peak_x"] = q.peakX;
+    d["peak_y"] = q.peakY;
+    return d;
+}
+
+// ---- the functions -------------------------------------------------------------------------------
+
+py::dict identifyPy(const Model& m, const py::object& data, const std::string& method, const std::vector<std::string>& free,
+                    const py::object& bounds, const py::object& start, const std::string& forward,
+                    const std::string& estimate, double hold, double rate, bool warmStart, int jobs,
+                    const py::object& forceSd, const std::string& noise, int multistart, unsigned seed,
+                    int maxIterations, double tolerance, int subject, const std::string& out) {
+    IdentificationProblem pr;
+    pr.base = m.setup.calcBicepsParameters();
+    pr.data = toObservations(data, m.setup, subject);
+    pr.unknowns.clear();
+    for (const std::string& name : free) pr.unknowns.push_back(makeUnknown(parseParameterName(name)));
+    if (pr.unknowns.empty()) throw InputError("free: expected at least one parameter");
+    auto findUnknown = [&](const std::string& what, const std::string& name) -> Unknown& {
+        const ParameterId id = parseParameterName(name);
+        for (Unknown& u : pr.unknowns)
+            if (u.id == id) return u;
+        throw InputError(what + " '" + name + "': not a free parameter (free: " + py::str(py::cast(free)).cast<std::string>() + ")");
+    };
+    if (!bounds.is_none())
+        for (auto item : bounds.cast<py::dict>()) {
+            const std::string name = py::str(item.first);
+            const auto lohi = item.second.cast<std::pair<double, double>>();
+            Unknown& u = findUnknown("bounds", name);
+            u.lower = lohi.first;
+            u.upper = lohi.second;
+        }
+    if (!start.is_none())
+        for (auto item : start.cast<py::dict>())
+            findUnknown("start", py::str(item.first)).start = item.second.cast<double>();
+
+    IdentificationOptions io;
+    io.method = parseMethodName(method);
+    io.noise = parseNoiseModelName(noise);
+    const double sd = optionalNumber(forceSd);
+    if (io.noise == NoiseModel::Relative) io.relativeForceSd = sd;
+    else io.forceSd = sd;
+    io.starts = multistart;
+    io.seed = seed;
+    io.maxIterations = maxIterations;
+    io.forceTolerance = tolerance;
+
+    ForwardModelChoice choice;
+    choice.model = forward;
+    choice.estimate = parseForceEstimateName(estimate);
+    choice.holdDuration = hold;
+    choice.sampleRate = rate;
+    choice.warmStart = warmStart;
+    choice.jobs = jobs;
+    IdentificationReport r;
+    {
+        py::gil_scoped_release release;
+        r = identifyAndRecheck(pr, io, m.setup.arm, choice);
+    }
+    py::dict d = toPython(r);
+    if (!out.empty()) {
+        std::filesystem::create_directories(out);
+        d["files"] = writeReportFiles(r, out);
+    }
+    return d;
+}
+
+py::list identifyTorquePy(const py::object& data, const py::object& population, const py::object& noiseLevel,
+                          const py::object& activation, double activationSd) {
+    const std::vector<TorqueObservation> obs = toTorqueData(data);
+    const Population prior = toPopulation(population);
+    TorqueIdentificationOptions o;
+    o.noiseLevel = optionalNumber(noiseLevel);
+    o.activation = optionalNumber(activation);
+    o.activationSd = activationSd;
+    std::vector<BicepsEstimate> estimates;
+    {
+        py::gil_scoped_release release;
+        estimates = identifyTorqueData(prior, obs, o);
+    }
+    const double noise = std::isfinite(o.noiseLevel) ? o.noiseLevel : estimates.back().noiseLevel;
+    py::list l;
+    for (const BicepsEstimate& e : estimates) {
+        py::dict d = toDict(e);
+        const TorqueResidualCheck c = checkTorqueResiduals(obs, e, noise);
+        py::dict check;
+        check["noise_level"] = noise;
+        check["rms"] = c.rms;
+        check["chi_square"] = c.chiSquare;
+        check["degrees_of_freedom"] = c.dof;
+        check["p_value"] = c.p;
+        check["consistent_with_noise"] = c.p >= 0.05;
+        d["residual_check"] = check;
+        l.append(d);
+    }
+    return l;
+}
+
+py::dict validatePy(const Model& m, int seeds, unsigned seed, const std::vector<double>& noise,
+                    const std::vector<std::string>& methods, const std::string& forward, const std::string& estimate,
+                    int jobs) {
+    ValidationSettings s;
+    s.seeds = seeds;
+    s.seed = seed;
+    s.noiseLevels = noise;
+    for (const std::string& name : methods) s.methods.push_back(parseMethodName(name));
+    s.model = parseValidationModelName(forward);
+    s.estimate = parseForceEstimateName(estimate);
+    s.jobs = jobs;
+    s.validate(m.setup.arm);
+    std::vector<ValidationRow> rows;
+    {
+        py::gil_scoped_release release;
+        rows = runValidation(m.setup.arm, m.setup.calcBicepsParameters(), s);
+    }
+    Columns c;
+    for (const ValidationRow& r : rows) {
+        c.add("truth", r.truth);
+        c.add("noise", r.noise);
+        c.add("method", r.method);
+        c.add("true_mass", r.trueMass);
+        c.add("true_tendon_length", r.trueTendonLength);
+        c.add("mass", r.mass);
+        c.add("tendon_length", r.tendonLength);
+        c.add("mass_error", r.massError);
+        c.add("tendon_length_error", r.tendonLengthError);
+        c.add("mass_covered", r.massCovered);
+        c.add("tendon_length_covered", r.tendonLengthCovered);
+        c.add("stop_reason", r.stopReason);
+        c.add("iterations", r.iterations);
+        c.add("evaluations", r.evaluations);
+        c.add("wall_time", r.wallTime);
+    }
+    return c.finish();
+}
+
+py::tuple validateElbowPy(const py::object& population, int subjects, unsigned seed, const py::object& noise,
+                          double activationSd, const py::object& angles, int repetitions, const py::object& protocol,
+                          bool freeSlowFraction, int jobs) {
+    const Population pop = toPopulation(population);
+    ElbowValidationSettings s;
+    s.subjects = subjects;
+    s.seed = seed;
+    s.noiseLevels = toNumbers(noise);
+    s.activationSd = activationSd;
+    s.freeSlowFraction = freeSlowFraction;
+    s.jobs = jobs;
+    checkField("subjects", subjects, Bound::closed(1, 1e6));
+    checkField("activation_sd", activationSd, Bound::closed(0, 0.5));
+    checkField("jobs", jobs, Bound::closed(1, 64));
+    if (!protocol.is_none()) {
+        if (!angles.is_none()) throw InputError("protocol replaces angles and repetitions: give one or the other");
+        s.protocol = readTorqueProtocol(findFile(pathOf(protocol)));
+    } else {
+        const std::vector<double> a = angles.is_none() ? std::vector<double>{135, 120, 90, 60, 30} : toNumbers(angles);
+        s.protocol.conditions = TorqueProtocol::makeFlexionMvcs(a, repetitions);
+        s.protocol.validate();
+    }
+    std::vector<ElbowValidationRow> rows;
+    {
+        py::gil_scoped_release release;
+        rows = runElbowValidation(pop, s);
+    }
+    Columns c;
+    for (const ElbowValidationRow& r : rows) {
+        c.add("subject", r.subject);
+        c.add("noise", r.noise);
+        c.add("method", r.method);
+        c.add("true_mass", r.trueMass);
+        c.add("true_tendon_length", r.trueTendonLength);
+        c.add("mass", r.estimate.mass);
+        c.add("tendon_length", r.estimate.tendonLength);
+        c.add("mass_lower", r.estimate.massLower);
+        c.add("mass_upper", r.estimate.massUpper);
+        c.add("tendon_lower", r.estimate.tendonLower);
+        c.add("tendon_upper", r.estimate.tendonUpper);
+        c.add("converged", r.estimate.converged);
+        c.add("mass_error", r.massError);
+        c.add("tendon_error", r.tendonError);
+        c.add("mass_covered", r.massCovered);
+        c.add("tendon_covered", r.tendonCovered);
+        c.add("voluntary_activation", r.voluntaryActivation);
+        c.add("co_contraction", r.coContraction);
+        c.add("strength_level", r.strengthLevel);
+        c.add("biceps_short_scale", r.bicepsShortScale);
+        c.add("synergist_scale", r.synergistScale);
+    }
+    py::list summary;
+    for (const ElbowValidationSummary& x : summarizeElbowValidation(rows)) {
+        py::dict d;
+        d["method"] = x.method;
+        d["noise"] = x.noise;
+        d["subjects"] = x.subjects;
+        d["converged"] = x.converged;
+        d["mass_bias"] = x.massBias;
+        d["mass_rmse"] = x.massRmse;
+        d["tendon_bias"] = x.tendonBias;
+        d["tendon_rmse"] = x.tendonRmse;
+        d["mass_coverage"] = x.massCoverage;
+        d["tendon_coverage"] = x.tendonCoverage;
+        d["mass_interval_width"] = x.massIntervalWidth;
+        d["tendon_interval_width"] = x.tendonIntervalWidth;
+        summary.append(d);
+    }
+    return py::make_tuple(c.finish(), summary);
+}
+
+py::dict designPy(const py::object& population, const std::vector<double>& angles, const py::object& levels,
+                  bool extension, int trials, int repetitions, int draws, unsigned seed, double activationSd,
+                  bool freeSlowFraction, int jobs) {
+    const Population pop = toPopulation(population);
+    DesignSettings s;
+    s.flexionDeg = angles;
+    s.levels = toNumbers(levels);
+    s.extension = extension;
+    s.trials = trials;
+    s.repetitions = repetitions;
+    s.draws = draws;
+    s.seed = seed;
+    s.activationSd = activationSd;
+    s.freeSlowFraction = freeSlowFraction;
+    s.jobs = jobs;
+    s.validate();
+    TorqueProtocol thesis;
+    thesis.name = "thesis";
+    DesignResult r;
+    {
+        py::gil_scoped_release release;
+        r = designProtocol(pop, s, thesis);
+    }
+    py::dict d;
+    py::list conditions, steps;
+    for (const TorqueCondition& c : r.protocol.conditions) conditions.append(toDict(c));
+    for (const DesignStep& st : r.steps) {
+        py::dict x = toDict(st.condition);
+        x["criterion"] = st.criterion;
+        steps.append(x);
+    }
+    d["conditions"] = conditions;
+    d["protocol_yaml"] = formatTorqueProtocol(r.protocol);
+    d["predicted"] = toDict(r.predicted);
+    d["reference"] = toDict(r.reference);
+    d["steps"] = steps;
+    return d;
+}
+
+py::dict runProtocolPy(const py::object& file, const std::string& out, int jobs) {
+    const std::string path = findFile(pathOf(file));
+    checkField("jobs", jobs, Bound::closed(1, 64));
+    py::dict d;
+    if (isTorqueProtocolFile(path)) {
+        const TorqueProtocol protocol = readTorqueProtocol(path);
+        std::vector<TorqueObservation> data;
+        {
+            py::gil_scoped_release release;
+            data = synthesizeTorqueData(loadTorqueProtocolSubject(protocol), protocol, protocol.seed, jobs);
+        }
+        d["name"] = protocol.name;
+        d["kind"] = "torque";
+        d["data"] = toDict(data);
+        d["files"] = out.empty() ? std::vector<std::string>{} : writeTorqueProtocolRun(out, protocol, data);
+        return d;
+    }
+    const Protocol protocol = readProtocol(path);
+    const ArmSetup subject = loadProtocolSubject(protocol);
+    ProtocolResult r;
+    {
+        py::gil_scoped_release release;
+        r = runProtocol(protocol, subject, {out, jobs, {}});
+    }
+    d["name"] = protocol.name;
+    d["kind"] = getProtocolKindName(protocol.kind);
+    d["trials"] = toDict(std::move(r.trials));
+    d["trial_ids"] = r.trialIds;
+    d["summary"] = toDict(std::move(r.summary));
+    py::dict fits;
+    for (const auto& [key, q] : r.quadraticFits) fits[py::str(key)] = toDict(q);
+    d["fits"] = fits;
+    if (r.emgToActivation) {
+        py::dict e;
+        e["coefficients"] = toArray(r.emgToActivation->coefficients);
+        e["r_squared"] = r.emgToActivation->rSquared;
+        d["emg_to_activation"] = e;
+    } else {
+        d["emg_to_activation"] = py::none();
+    }
+    d["muscle_sweep"] = toDict(std::move(r.muscleSweep));
+    d["composition"] = toDict(std::move(r.composition));
+    d["files"] = r.files;
+    return d;
+}
+
+}  // namespace
+
+void addIdentificationBindings(py::module_& mod) {
+    using namespace pybind11::literals;
+    mod.def("identify", &identifyPy, "model"_a, "data"_a, "method"_a = "lm",
+            "free"_a = std::vector<std::string>{"mass", "optimal_tendon_length"}, "bounds"_a = py::none(),
+            "start"_a = py::none(), "forward"_a = "steady", "estimate"_a = "moment-arm", "hold"_a = 3.0,
+            "rate"_a = 200.0, "warm_start"_a = true, "jobs"_a = 2, "force_sd"_a = py::none(), "noise"_a = "absolute",
+            "multistart"_a = 1, "seed"_a = 1u, "max_iterations"_a = 200, "tolerance"_a = 0.1, "subject"_a = -1,
+            "out"_a = "",
+            R"(Identifies the primary muscle's parameters from isometric forces, as `armsim identify`.
+
+data: a CSV path, or a dict of columns with the file's names: force_N [N] and one of path_m,
+  path_cm, angle_deg (included elbow angle, 180 = extended, converted with the model's geometry);
+  optional activation (default 1), trial, subject (keep one with subject=).
+method: lm | false-position | ilc-standard | ilc-constant | ilc-secant | ilc-bounded-secant |
+  ilc-sign-search.  free: unknowns (mass, optimal_tendon_length, optimal_fascicle_length,
+  slow_fraction, max_path_length).  bounds: {name: (lower, upper)}, start: {name: value}, SI units.
+forward: steady | faithful (Simbody arm trials in the loop, at hold [s] and rate [Hz]; warm-started
+  from the steady estimate unless warm_start=False) | corrected (steady iterations corrected by the
+  faithful model).  estimate: the force the simulated experimenter reports: moment-arm |
+  fixed-ratio | true.  lm only: force_sd (known sd: N, or a fraction with noise='relative'),
+  noise (absolute | relative), multistart and seed.  out: also write the report files there.
+
+Returns the report as a dict with the keys of the command's JSON report (method, stop_reason,
+converged, message, parameters with intervals, uncertainty with covariance and correlation arrays,
+model_checks: the estimate re-checked by the steady model and the faithful model at 1000 Hz), plus
+estimate {name: value}, observations and history as dicts of float64 arrays. Releases the GIL.)");
+
+    mod.def("identify_torque", &identifyTorquePy, "data"_a, "population"_a = py::none(), "noise_level"_a = py::none(),
+            "activation"_a = py::none(), "activation_sd"_a = 0.02,
+            R"(Identifies the biceps long head's mass and tendon length from tared elbow torque data with
+every elbow method, as `armsim identify-torque`: 'thesis' (flexion MVCs at >= 2 angles),
+'synergist' (MAP over the whole elbow, the population as prior) and, given a measured voluntary
+activation, 'synergist-va'.
+
+data: a torque CSV path or a dict of columns (flexion_deg [deg, 0 = extended], torque_Nm, optional
+effort 1/-1, level, repetition; e.g. run_protocol(...)['data']).  population: prior population file
+(default assets/subjects/default_population.yaml).  noise_level: relative sd of one trial's torque
+(default: estimated from the repetitions).  Returns one dict per method: mass [kg], tendon_length
+[m], 95 % mass_interval and tendon_interval, nuisance estimates, predicted_torque, and
+residual_check (chi-square against the noise level). Releases the GIL.)");
+
+    mod.def(
+        "read_torque_data", [](const py::object& path) { return toDict(readTorqueData(findFile(pathOf(path)))); },
+        "path"_a,
+        R"(Reads a torque data file (a path or a name under assets/) with the strict reader the command
+uses: columns flexion_deg [deg, 0 = extended], torque_Nm (tared, + = flexion) and optionally effort
+(1 flexion, -1 extension), level (fraction of MVC), repetition. Returns a dict of float64 arrays
+with the columns of run_protocol's torque data (activation and clean_torque_Nm, the truth of
+synthetic data, are NaN: the reader ignores them): pass it to identify_torque. ValueError names the file, line, column and value.)");
+
+    mod.def("validate", &validatePy, "model"_a, "seeds"_a = 1, "seed"_a = 1u,
+            "noise"_a = std::vector<double>{0, 0.01, 0.02, 0.05}, "methods"_a = std::vector<std::string>{},
+            "forward"_a = "corrected", "estimate"_a = "moment-arm", "jobs"_a = 2,
+            R"(The identifiers against ground truth on synthetic MVC data of the model's biceps (as
+`armsim validate --truth thesis`): the thesis's truth and `seeds` random ones, each at every noise
+level (relative force sd, a fraction: 0.02 = 2 %), identified by every method (default lm and the
+two-output learning family) with the `forward` model (corrected | faithful | steady).
+Returns the rows as columns: truth, noise, method, true_mass, mass, mass_error, ..., stop_reason.)");
+
+    mod.def("validate_elbow", &validateElbowPy, "population"_a = py::none(), "subjects"_a = 200, "seed"_a = 1u,
+            "noise"_a = py::none(), "activation_sd"_a = 0.02, "angles"_a = py::none(), "repetitions"_a = 3,
+            "protocol"_a = py::none(), "free_slow_fraction"_a = false, "jobs"_a = 2,
+            R"(Validation on virtual subjects of the seven-muscle elbow (as `armsim validate --truth elbow`):
+`subjects` people drawn from the population (default assets/subjects/default_population.yaml),
+MVC torque data synthesized per noise level (fractions; default the population's), identified by
+the thesis, synergist and (activation_sd > 0) synergist-va methods. The protocol: flexion MVCs at
+`angles` [deg flexion, default 135, 120, 90, 60, 30] x repetitions, or a torque protocol file.
+Returns (rows, summary): rows as columns (subject, method, true_mass, mass, mass_lower, mass_upper,
+mass_error, coverage, nuisance truths, ...); summary one dict per method and noise (bias, RMSE,
+coverage, interval widths). Releases the GIL.)");
+
+    mod.def("design_protocol", &designPy, "population"_a = py::none(),
+            "angles"_a = std::vector<double>{15, 30, 45, 60, 75, 90, 105, 120, 135}, "levels"_a = py::none(),
+            "extension"_a = true, "trials"_a = 15, "repetitions"_a = 3, "draws"_a = 32, "seed"_a = 1u,
+            "activation_sd"_a = 0.02, "free_slow_fraction"_a = false, "jobs"_a = 2,
+            R"(The torque protocol that minimises the synergist-aware identifier's expected uncertainty of
+the biceps mass and tendon length over the population (as `armsim design`): greedy picks of blocks
+of `repetitions` trials among flexion MVCs at `angles` [deg], extension MVCs (extension=True) and
+submaximal `levels` (fractions of MVC), within `trials`. Returns conditions, protocol_yaml (a torque
+protocol file's text: write it and pass it to run_protocol or validate_elbow), predicted and
+reference (the thesis's five angles) uncertainty, and the greedy steps. Releases the GIL.)");
+
+    mod.def("run_protocol", &runProtocolPy, "file"_a, "out"_a = "", "jobs"_a = 2,
+            R"(Runs an experiment protocol file (a path or a name under assets/, e.g.
+'protocols/mvc_force_angle.yaml'), as `armsim protocol`. out: the run directory to write (replaced
+as a whole); '' computes only.
+Arm protocols (mvc, submaximal, force_length, composition) return trials and summary (dicts of
+float64 arrays: per trial and per condition), fits (quadratic force-angle fits), emg_to_activation,
+muscle_sweep, composition, files. Torque protocols (kind: torque) return data: the tared torque per
+trial with the torque data file's columns, ready for identify_torque. Releases the GIL.)");
+}
+
+}  // namespace armsim::python

@@ -1,0 +1,77 @@
+#include "python/module_support.h"
+
+#include "muscles/muscle_file.h"
+#include "muscles/param_file.h"
+
+namespace armsim::python {
+
+py::dict toDict(const Table& t) { return toDict(Table(t)); }
+
+py::dict toDict(Table&& t) {
+    const py::ssize_t n = t.getNumRows(), m = t.getNumColumns();
+    const std::vector<std::string> names = t.getColumnNames();
+    auto* values = new std::vector<double>(t.releaseData());
+    const py::capsule owner(values, [](void* p) { delete static_cast<std::vector<double>*>(p); });
+    py::dict d;
+    for (py::ssize_t c = 0; c < m; ++c)
+        d[py::str(names[c])] = py::array_t<double>({n}, {py::ssize_t(sizeof(double)) * m}, values->data() + c, owner);
+    return d;
+}
+
+Table toTable(const py::dict& columns, const std::string& what) {
+    std::vector<std::string> names;
+    std::vector<py::array_t<double>> arrays;
+    py::ssize_t rows = -1;
+    for (auto item : columns) {
+        const std::string name = py::str(item.first);
+        py::array_t<double> a;
+        try {
+            a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(item.second);
+        } catch (const py::error_already_set&) {
+        }
+        if (!a || a.ndim() != 1)
+            throw InputError(what + ": column '" + name + "': expected a 1-D sequence of numbers");
+        if (rows >= 0 && a.shape(0) != rows)
+            throw InputError(what + ": column '" + name + "' has " + std::to_string(a.shape(0)) + " values: expected " +
+                             std::to_string(rows) + " like column '" + names[0] + "'");
+        rows = a.shape(0);
+        names.push_back(name);
+        arrays.push_back(a);
+    }
+    Table t(names);
+    std::vector<double> row(names.size());
+    for (py::ssize_t r = 0; r < std::max<py::ssize_t>(rows, 0); ++r) {
+        for (std::size_t c = 0; c < arrays.size(); ++c) row[c] = arrays[c].at(r);
+        t.appendRow(row);
+    }
+    return t;
+}
+
+py::array_t<double> toArray(const std::vector<double>& v) {
+    return py::array_t<double>(py::ssize_t(v.size()), v.data());
+}
+
+py::array_t<double> toArray(const std::vector<std::vector<double>>& rows) {
+    const std::size_t n = rows.size(), m = rows.empty() ? 0 : rows[0].size();
+    py::array_t<double> a({n, m});
+    auto w = a.mutable_unchecked<2>();
+    for (std::size_t i = 0; i < n; ++i)
+        for (std::size_t j = 0; j < m; ++j) w(i, j) = rows[i][j];
+    return a;
+}
+
+void throwFileNotFound(const std::string& path, const char* what) {
+    PyErr_SetString(PyExc_FileNotFoundError, (path + ": cannot open " + what + " (no such file)").c_str());
+    throw py::error_already_set();
+}
+
+std::string findFile(const std::string& name) {
+    try {
+        return findAsset(name);
+    } catch (const InputError& e) {
+        PyErr_SetString(PyExc_FileNotFoundError, e.what());
+        throw py::error_already_set();
+    }
+}
+
+}  // namespace armsim::python

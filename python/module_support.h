@@ -1,0 +1,48 @@
+// What the Python module's source files share: the Model handle (one definition, so the _render
+// extension accepts the Models that _armsim makes), conversions to numpy and dicts, and the
+// FileNotFoundError of the command line's wording.
+#pragma once
+
+#include "model/model_file.h"
+#include "muscles/table.h"
+
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <string>
+#include <vector>
+
+namespace armsim::python {
+
+namespace py = pybind11;
+
+/// The Python face of an ArmSetup (armsim.Model): immutable; with_muscle returns a changed copy.
+struct Model {
+    ArmSetup setup;
+};
+
+/// A table's columns as a dict of float64 arrays, in column order. The arrays are views (stride: one
+/// table row) of one buffer taken from the table without a copy, which they keep alive.
+py::dict toDict(Table&& table);
+/// The same for a table that stays with its owner (copied first).
+py::dict toDict(const Table& table);
+/// A dict of equal-length 1-D arrays (e.g. a trial series) as a Table, in the dict's order.
+/// ValueError naming `what` and the column for a non-numeric, non-1-D or short column.
+Table toTable(const py::dict& columns, const std::string& what);
+/// A float64 array of the values.
+py::array_t<double> toArray(const std::vector<double>& values);
+/// Rows (equal lengths) as an (n, m) float64 array.
+py::array_t<double> toArray(const std::vector<std::vector<double>>& rows);
+
+/// Raises FileNotFoundError "<path>: cannot open <what> (no such file)".
+[[noreturn]] void throwFileNotFound(const std::string& path, const char* what);
+/// findAsset(name) (a path, or a name under the asset folder), FileNotFoundError with its message
+/// when neither exists.
+std::string findFile(const std::string& name);
+
+/// Adds identify, identify_torque, validate, validate_elbow, design_protocol, run_protocol,
+/// synthesize_torque (python/identification_bindings.cpp).
+void addIdentificationBindings(py::module_& module);
+
+}  // namespace armsim::python

@@ -1,0 +1,207 @@
+"""The module's identification, validation, design, protocol and render functions (issue 12): results
+equal the C++ API's (tests/python/reference.cpp) to 1e-12 relative, the report has the command's
+keys with numpy arrays, bad arguments raise with the message, files are written where asked."""
+import os
+
+import numpy as np
+import pytest
+
+import armsim
+
+from conftest import REL_TOL
+
+THESIS_START = {"mass": 0.330, "optimal_tendon_length": 0.22}
+
+
+@pytest.fixture(scope="module")
+def report(thesis, reference):
+    data = {"angle_deg": reference["identify_angles_deg"], "force_N": reference["identify_forces"]}
+    return armsim.identify(thesis, data, start=THESIS_START)
+
+
+def test_identify_estimate_intervals_and_correlation_equal_the_cpp_api(report, reference):
+    assert report["converged"] and report["stop_reason"] == "converged"
+    est = [report["estimate"]["mass"], report["estimate"]["optimal_tendon_length"]]
+    np.testing.assert_allclose(est, reference["identify_estimate"], rtol=REL_TOL, atol=0)
+    p = report["parameters"]
+    intervals = [p[0]["interval"][0], p[0]["interval"][1], p[1]["interval"][0], p[1]["interval"][1]]
+    np.testing.assert_allclose(intervals, reference["identify_interval"], rtol=REL_TOL, atol=0)
+    corr = report["uncertainty"]["correlation"]
+    assert corr.shape == (2, 2) and corr.dtype == np.float64
+    assert corr[0, 1] == pytest.approx(reference["identify_correlation"], rel=REL_TOL)
+    assert report["model_checks"][1]["rms_residual_N"] == pytest.approx(reference["identify_faithful_check_rms"],
+                                                                        rel=REL_TOL)
+
+
+def test_identify_report_has_the_json_reports_keys_and_arrays(report, reference):
+    for key in ("method", "force_model", "stop_reason", "message", "parameters", "uncertainty", "model_checks",
+                "iterations", "forward_evaluations", "rms_residual_N", "start_costs_N2"):
+        assert key in report
+    history = report["history"]
+    assert len(history["iteration"]) == reference["identify_history_length"]
+    assert {"mass_kg", "optimal_tendon_length_m", "cost_N2"} <= set(history)
+    # the history's last row is the estimate; its cost falls from the start
+    assert history["mass_kg"][-1] == report["estimate"]["mass"]
+    assert history["cost_N2"][-1] < history["cost_N2"][0]
+    obs = report["observations"]
+    assert obs["residual_N"].shape == (5,)
+    np.testing.assert_allclose(obs["model_N"] - obs["measured_N"], obs["residual_N"], rtol=0, atol=1e-9)
+
+
+def test_identify_reads_a_csv_and_writes_the_commands_report_files(thesis, tmp_path):
+    r = armsim.identify(thesis, "measured/thesis_measured.csv", method="ilc-sign-search", out=str(tmp_path))
+    assert r["converged"] and r["data_source"].endswith("thesis_measured.csv")
+    assert sorted(os.path.basename(f) for f in r["files"]) == ["identification.json", "identification_convergence.png",
+                                                               "identification_history.csv"]
+    assert all(os.path.getsize(f) > 0 for f in r["files"])
+    # the two measured forces are reproduced within the method's 0.1 N tolerance
+    assert np.all(np.abs(r["observations"]["residual_N"]) <= 0.1)
+
+
+def test_identify_torque_runs_every_method_and_equals_the_cpp_api(reference):
+    estimates = armsim.identify_torque("measured/thesis_mvc_torque.csv", activation=0.95)
+    assert [e["method"] for e in estimates] == ["thesis", "synergist", "synergist-va"]
+    np.testing.assert_allclose([e["mass"] for e in estimates], reference["identify_torque_masses"], rtol=REL_TOL)
+    for e in estimates:
+        lo, hi = e["mass_interval"]
+        assert lo <= e["mass"] <= hi
+        assert 0 <= e["residual_check"]["p_value"] <= 1
+    assert "activation" in " ".join(estimates[1]["nuisance"])
+
+
+def test_validate_elbow_equals_the_cpp_api(reference):
+    rows, summary = armsim.validate_elbow(subjects=2, noise=[0.02])
+    np.testing.assert_allclose(rows["mass"], reference["validate_elbow_masses"], rtol=REL_TOL)
+    assert rows["method"][:3] == ["thesis", "synergist", "synergist-va"]
+    assert rows["true_mass"].dtype == np.float64 and rows["true_mass"].shape == (6,)
+    assert {s["method"] for s in summary} == {"thesis", "synergist", "synergist-va"}
+
+
+def test_validate_thesis_truth_recovers_the_truth_without_noise(thesis):
+    rows = armsim.validate(thesis, seeds=0, noise=[0.0], methods=["lm"], forward="steady")
+    assert rows["method"] == ["lm"] and rows["truth"] == ["thesis"]
+    # steady model on the faithful model's tared data: the known bias of a few percent, not zero
+    assert abs(rows["mass_error"][0]) < 0.1 and rows["stop_reason"] == ["converged"]
+
+
+def test_design_protocol_equals_the_cpp_api_and_writes_a_readable_protocol(reference, tmp_path):
+    d = armsim.design_protocol(draws=4, trials=6)
+    assert d["predicted"]["mass_sd"] == pytest.approx(reference["design_mass_sd"], rel=REL_TOL)
+    assert d["reference"]["mass_sd"] == pytest.approx(reference["design_reference_mass_sd"], rel=REL_TOL)
+    assert sum(c["repetitions"] for c in d["conditions"]) == 6
+    path = tmp_path / "designed.yaml"
+    path.write_text(d["protocol_yaml"])
+    run = armsim.run_protocol(str(path))
+    assert run["kind"] == "torque" and len(run["data"]["torque_Nm"]) == 6
+
+
+def test_run_protocol_torque_equals_the_cpp_api_and_feeds_identify_torque(reference, tmp_path):
+    run = armsim.run_protocol("protocols/designed_emg_torque.yaml", out=str(tmp_path / "run"))
+    np.testing.assert_allclose(run["data"]["torque_Nm"], reference["torque_protocol_torque"], rtol=REL_TOL)
+    assert sorted(os.path.basename(f) for f in run["files"]) == ["protocol.yaml", "torque_angle.png", "torque_data.csv"]
+    from_dict = armsim.identify_torque(run["data"])
+    from_file = armsim.identify_torque(str(tmp_path / "run" / "torque_data.csv"))
+    # the file holds the same numbers to 17 digits: the same estimates
+    assert [e["mass"] for e in from_dict] == pytest.approx([e["mass"] for e in from_file], rel=1e-12)
+
+
+def test_run_protocol_mvc_then_identify_recovers_the_subject(thesis):
+    run = armsim.run_protocol("protocols/mvc_force_angle.yaml")
+    t = run["trials"]
+    assert run["kind"] == "mvc" and len(t["trial"]) == 15 and run["files"] == []
+    assert set(run["fits"]) >= {"muscle_force", "force_measured"}
+    data = {"angle_deg": t["elbow_angle_deg"], "force_N": t["force_measured_N"], "trial": t["repetition"]}
+    r = armsim.identify(thesis, data, forward="corrected")
+    truth = thesis.parameters()
+    assert r["estimate"]["mass"] == pytest.approx(truth["mass"], rel=0.01)
+    assert r["estimate"]["optimal_tendon_length"] == pytest.approx(truth["optimal_tendon_length"], rel=0.01)
+
+
+def test_render_frame_is_the_cpp_frame_in_rgb(elbow, reference):
+    if not reference["frame_rgb_sums"]:
+        pytest.skip("built without the renderer")
+    series, _ = armsim.arm_trial(elbow, angle_deg=100, activation=0.7, antagonist_activation=0.05, hold=1.0, rate=200)
+    frame = armsim.render_frame(elbow, series, 1.0, width=160, height=90)
+    assert frame.shape == (90, 160, 3) and frame.dtype == np.uint8
+    np.testing.assert_array_equal(frame.reshape(-1, 3).sum(axis=0, dtype=np.int64), reference["frame_rgb_sums"])
+
+
+def test_render_video_writes_an_mp4_of_the_trials_frames(elbow, reference, tmp_path):
+    if not reference["frame_rgb_sums"]:
+        pytest.skip("built without the renderer")
+    series, _ = armsim.arm_trial(elbow, hold=1.0, rate=200)
+    out = tmp_path / "trial.mp4"
+    r = armsim.render_video(elbow, series, str(out), fps=10, width=160, height=90)
+    duration = series["time_s"][-1] - series["time_s"][0]
+    assert r["frames"] == int(np.floor(duration * 10 + 1e-9)) + 1
+    assert out.read_bytes()[4:8] == b"ftyp"  # an MP4 container
+
+
+@pytest.mark.parametrize("call, error, message", [
+    (lambda m: armsim.identify(m, {"angle_deg": [90.0]}), ValueError, "data: missing column 'force_N'"),
+    (lambda m: armsim.identify(m, {"angle_deg": [90.0], "force_N": [1.0], "emg": [0.0]}), ValueError,
+     "unknown column 'emg'"),
+    (lambda m: armsim.identify(m, {"angle_deg": [90.0, 60.0], "force_N": [1.0]}), ValueError,
+     "column 'force_N' has 1 values: expected 2"),
+    (lambda m: armsim.identify(m, {"angle_deg": [90.0, 200.0], "force_N": [300.0, 400.0]}), ValueError,
+     "data row 2: column 'angle_deg' = 200"),
+    (lambda m: armsim.identify(m, "/no/such/data.csv"), FileNotFoundError, "/no/such/data.csv"),
+    (lambda m: armsim.identify(m, "measured/thesis_measured.csv", method="newton"), ValueError, "newton"),
+    (lambda m: armsim.identify(m, "measured/thesis_measured.csv", bounds={"slow_fraction": (0, 1)}), ValueError,
+     "bounds 'slow_fraction': not a free parameter"),
+    (lambda m: armsim.identify(m, "measured/thesis_measured.csv", forward="exact"), ValueError,
+     "forward model 'exact': expected steady, faithful or corrected"),
+    (lambda m: armsim.identify(m, "measured/thesis_measured.csv", forward="faithful", hold=-1), ValueError, "hold"),
+    (lambda m: armsim.identify_torque("measured/thesis_mvc_torque.csv", noise_level=2.0), ValueError,
+     "field 'noise_level' = 2"),
+    (lambda m: armsim.identify_torque({"flexion_deg": [90.0]}), ValueError, "missing column 'torque_Nm'"),
+    (lambda m: armsim.validate_elbow(subjects=0), ValueError, "field 'subjects' = 0"),
+    (lambda m: armsim.validate_elbow(population="/no/such/population.yaml"), FileNotFoundError, "population.yaml"),
+    (lambda m: armsim.design_protocol(trials=0), ValueError, "trials"),
+    (lambda m: armsim.run_protocol("/no/such/protocol.yaml"), FileNotFoundError, "/no/such/protocol.yaml"),
+    (lambda m: armsim.render_frame(m, {"time_s": [0.0]}, 0.0), ValueError, "series"),
+    (lambda m: armsim.render_video(m, armsim.arm_trial(m, hold=0.2, rate=100, averaging_window=0.1)[0], "/tmp/x.mp4", codec="vp9"),
+     ValueError, "vp9"),
+])
+def test_bad_arguments_raise_with_the_message(thesis, call, error, message):
+    with pytest.raises(error) as e:
+        call(thesis)
+    assert message in str(e.value)
+
+
+def test_every_public_function_has_a_useful_docstring():
+    for name in armsim.__all__:
+        doc = getattr(armsim, name).__doc__
+        assert doc and len(doc) > 150, name
+    assert "mass_interval" in armsim.identify_torque.__doc__ and "forward" in armsim.identify.__doc__
+
+
+def _stub_functions():
+    import ast
+    package = os.path.dirname(armsim.__file__)
+    funcs = {}
+    for stub in ("_armsim.pyi", "__init__.pyi"):
+        with open(os.path.join(package, stub)) as f:
+            for node in ast.parse(f.read()).body:
+                if isinstance(node, ast.FunctionDef):
+                    funcs[node.name] = [a.arg for a in node.args.args]
+    return funcs
+
+
+def test_type_stubs_name_every_public_function_with_its_arguments():
+    """The stubs editors complete from (_armsim.pyi, __init__.pyi) list every public function with the
+    argument names the functions take (pybind11's signature line, or the Python signature)."""
+    import inspect
+    import re
+    stubs = _stub_functions()
+    for name in armsim.__all__:
+        if name == "Model":
+            continue
+        f = getattr(armsim, name)
+        assert name in stubs, name
+        if inspect.isfunction(f):
+            names = list(inspect.signature(f).parameters)
+        else:
+            signature = f.__doc__.splitlines()[0]
+            names = re.findall(r"(\w+): ", signature[signature.index("(") + 1:signature.rindex(")")])
+        assert stubs[name] == names, (name, stubs[name], names)
