@@ -1,6 +1,7 @@
 // armsim protocol: runs an experiment protocol file (assets/protocols/*.yaml); and the thesis MVC
 // protocol as a main-job step.
 #include "cli/commands.h"
+#include "cli/plugins.h"
 #include "experiments/protocol.h"
 #include "experiments/torque_protocol.h"
 #include "muscles/muscle_file.h"
@@ -9,7 +10,7 @@
 #include "muscles/table.h"
 
 #ifdef ARMSIM_WITH_RENDER
-#include "render/trial_video.h"
+#include "render/render_plugin.h"
 #endif
 
 #include <cmath>
@@ -39,6 +40,7 @@ void renderProtocolVideos(const ProtocolOptions& o, const ArmSetup& subject, con
         std::printf("  --video: this protocol has no arm trials to render\n");
         return;
     }
+    const RenderPlugin& render = getRenderPlugin("--video");
     std::filesystem::create_directories(out + "/videos");
     runParallel(
         n, o.jobs,
@@ -50,7 +52,7 @@ void renderProtocolVideos(const ProtocolOptions& o, const ArmSetup& subject, con
             v.fps = o.videoFps;
             v.render.width = o.videoWidth;
             v.render.height = o.videoHeight;
-            renderTrialVideo(subject, Table::readCsv(csv), v);
+            render.renderTrialVideo(subject, Table::readCsv(csv), v, {});
         },
         [](int d, int total) { printProgress("trial videos", d, total); });
     std::printf("  wrote %d videos to %s/videos/\n", n, out.c_str());
@@ -135,9 +137,7 @@ void runTorqueProtocolCommand(const ProtocolOptions& o, const std::string& file)
 }
 
 void runProtocolCommand(const ProtocolOptions& o) {
-#ifndef ARMSIM_WITH_RENDER
-    if (o.video) throw InputError("--video: this armsim was built without the renderer (-DARMSIM_RENDER=OFF)");
-#endif
+    if (o.video) getRenderPlugin("--video");  // before the run: a missing renderer fails first
     const std::string file = findAsset(o.file);
     if (isTorqueProtocolFile(file)) return runTorqueProtocolCommand(o, file);
     const Protocol protocol = readProtocol(file);

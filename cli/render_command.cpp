@@ -1,13 +1,14 @@
 // armsim render: a video and/or PNG still of a recorded trial (replayed from its table); and the
 // main-job step that leaves an MVC video, a free-movement video and a still in the output directory.
 #include "cli/commands.h"
+#include "cli/plugins.h"
 #include "model/geometry.h"
 #include "model/trial.h"
 #include "muscles/muscle_file.h"
 #include "muscles/param_file.h"
 
 #ifdef ARMSIM_WITH_RENDER
-#include "render/trial_video.h"
+#include "render/render_plugin.h"
 
 #include <cstdio>
 #include <future>
@@ -37,7 +38,7 @@ void runRenderCommand(const RenderOptions& o) {
     if (!o.renderSettingsFile.empty()) {
         const ParamNode node = ParamNode::loadFile(o.renderSettingsFile);
         v.autoCamera = !node.has("camera");
-        v.render = readRenderSettings(node);
+        v.render = getRenderPlugin("--render-settings").readRenderSettings(node);
     }
     if (o.renderSettingsFile.empty() || o.widthOption->count()) v.render.width = o.width;
     if (o.renderSettingsFile.empty() || o.heightOption->count()) v.render.height = o.height;
@@ -61,12 +62,12 @@ void runRenderCommand(const RenderOptions& o) {
     v.tableName = o.table;
     if (v.videoPath.empty() && !v.stillTime)
         throw InputError("armsim render: nothing to write: expected --out VIDEO and/or --still-at T --still FILE.png");
-    v.validate();  // before the table is read
+    getRenderPlugin("render").validate(v);  // before the table is read
 
     const ArmSetup setup = o.muscle.loadSetup();
     const Table table = Table::readCsv(o.table);
     const TrialVideoResult r =
-        renderTrialVideo(setup, table, v, [](int d, int n) { printProgress("rendering", d, n); });
+        getRenderPlugin("render").renderTrialVideo(setup, table, v, [](int d, int n) { printProgress("rendering", d, n); });
     if (!r.stillPath.empty()) std::printf("wrote %s (still at t = %.3f s)\n", r.stillPath.c_str(), *v.stillTime);
     if (!r.videoPath.empty())
         std::printf("wrote %s (%d frames, %dx%d, %g fps, %s)\n", r.videoPath.c_str(), r.frames, v.render.width,
@@ -129,14 +130,15 @@ void runTrialVideos(const MainJobContext& ctx) {
     v.stillTime = iso.restDuration + iso.holdDuration - 0.5;
     v.stillPath = ctx.outDir + "/still_mvc_90deg.png";
     v.tableName = "trial_mvc_90deg.csv";
-    TrialVideoResult r = renderTrialVideo(elbow, mvc, v, [](int d, int n) { printProgress("MVC video", d, n); });
+    const RenderPlugin& render = getRenderPlugin("videos");
+    TrialVideoResult r = render.renderTrialVideo(elbow, mvc, v, [](int d, int n) { printProgress("MVC video", d, n); });
     std::printf("  wrote %s (%d frames) and %s\n", r.videoPath.c_str(), r.frames, r.stillPath.c_str());
 
     v.videoPath = ctx.outDir + "/video_free_movement.mp4";
     v.stillTime.reset();
     v.stillPath.clear();
     v.tableName = "trial_free_movement.csv";
-    r = renderTrialVideo(setup, movement, v, [](int d, int n) { printProgress("free-movement video", d, n); });
+    r = render.renderTrialVideo(setup, movement, v, [](int d, int n) { printProgress("free-movement video", d, n); });
     std::printf("  wrote %s (%d frames)\n", r.videoPath.c_str(), r.frames);
 }
 

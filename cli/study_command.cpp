@@ -1,5 +1,6 @@
 // armsim study STUDY.yaml: a population study on threads, or over MPI ranks under mpirun.
 #include "cli/commands.h"
+#include "cli/plugins.h"
 #include "identification/study.h"
 #include "identification/study_mpi.h"
 #include "muscles/param_file.h"
@@ -50,7 +51,7 @@ void runStudyCommand(const StudyOptions& o) {
 
     std::optional<std::pair<Study, StudyOutcome>> done;
     if (isLaunchedByMpi()) {
-        done = runStudyOnMpi(o.file, run);  // every rank reads the study after MPI starts
+        done = getStudyMpiPlugin().runStudyOnMpi(o.file, run);  // every rank reads the study after MPI starts
         if (!done) return;                  // a worker rank: rank 0 reports
     } else {
         const Study study = readStudy(o.file);

@@ -1,12 +1,13 @@
 // armsim trial: one isometric or free-movement trial of the arm; and the MVC-per-angle main-job step.
 #include "cli/commands.h"
+#include "cli/plugins.h"
 #include "experiments/plot.h"
 #include "model/geometry.h"
 #include "model/trial.h"
 #include "muscles/muscle_file.h"
 #include "muscles/param_file.h"
 #ifdef ARMSIM_WITH_RENDER
-#include "render/trial_video.h"
+#include "render/render_plugin.h"
 #endif
 
 #include <algorithm>
@@ -34,15 +35,13 @@ void renderVideo(const TrialOptions& o, const ArmSetup& setup, const Table& tabl
     v.videoPath = o.video;
     v.tableName = o.out;
     v.scene.handLoad = handLoad;
-    const TrialVideoResult r = renderTrialVideo(setup, table, v, [](int d, int n) { printProgress("video", d, n); });
+    const TrialVideoResult r = getRenderPlugin("--video").renderTrialVideo(setup, table, v, [](int d, int n) { printProgress("video", d, n); });
     std::printf("wrote %s (%d frames)\n", r.videoPath.c_str(), r.frames);
 #endif
 }
 
 void runTrialCommand(const TrialOptions& o) {
-#ifndef ARMSIM_WITH_RENDER
-    if (!o.video.empty()) throw InputError("--video: this armsim was built without the renderer (-DARMSIM_RENDER=OFF)");
-#endif
+    if (!o.video.empty()) getRenderPlugin("--video");  // before the trial: a missing renderer fails first
     const ArmSetup setup = o.muscle.loadSetup();
     std::string type = o.type;
     IsometricTrialSettings iso;

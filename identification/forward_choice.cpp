@@ -16,9 +16,7 @@ void ForwardModelChoice::validate() const {
     const auto& names = getForwardModelNames();
     if (std::find(names.begin(), names.end(), model) == names.end())
         throw InputError("forward model '" + model + "': expected steady, faithful or corrected");
-    checkField("hold", holdDuration, Bound::open(0, 600, "s"));
-    checkField("rate", sampleRate, Bound::closed(1, 1e5, "Hz"));
-    checkField("jobs", jobs, Bound::closed(1, 64));
+    checkField("jobs", jobs, Bound::closed(1, 64));  // hold and rate: FaithfulProtocol::validate
 }
 
 FaithfulModelOptions ForwardModelChoice::makeIterationOptions() const {

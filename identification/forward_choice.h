@@ -23,7 +23,8 @@ struct ForwardModelChoice {
     bool warmStart = true;       ///< faithful: start from the steady lm estimate
     int jobs = 2;                ///< faithful: trials run in parallel
 
-    /// InputError naming the field (model, hold, rate, jobs) and the expected values.
+    /// InputError naming the field (model, jobs) and the expected values; hold and rate are checked
+    /// by the faithful model (FaithfulProtocol::validate, fields protocol.hold, protocol.sample_rate).
     void validate() const;
     /// The faithful model's options in the iterations.
     FaithfulModelOptions makeIterationOptions() const;

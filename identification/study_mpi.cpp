@@ -77,8 +77,6 @@ int getEnvInt(const char* name, int fallback) {
 
 }  // namespace
 
-bool hasMpi() { return true; }
-
 std::optional<std::pair<Study, StudyOutcome>> runStudyOnMpi(const std::string& studyFile, const StudyRunOptions& options) {
     // Shared-memory transfers through CMA need ptrace rights that containers often lack; copy-in/out
     // costs nothing at these message sizes. A user's own setting wins.
@@ -117,3 +115,8 @@ std::optional<std::pair<Study, StudyOutcome>> runStudyOnMpi(const std::string& s
 }
 
 }  // namespace armsim
+
+extern "C" __attribute__((visibility("default"))) const armsim::StudyMpiPlugin* armsim_get_study_mpi_plugin() {
+    static const armsim::StudyMpiPlugin plugin{armsim::kStudyMpiPluginAbi, &armsim::runStudyOnMpi};
+    return &plugin;
+}

@@ -182,7 +182,8 @@ PYBIND11_MODULE(_armsim, mod) {
         "An isometric trial of one muscle at a fixed path length (as `armsim muscle trial`): activation 0\n"
         "until onset [s], then a ramp of `rise` [s] (0: a step) to `activation`. Returns a dict of float64\n"
         "arrays: time_s, activation, force_N, fce_N, fascicle_length_m, fascicle_velocity_mps,\n"
-        "tendon_length_m, active_fraction, and the states. Releases the GIL.");
+        "tendon_length_m, active_fraction, and the states (views of one buffer, strided: np.ascontiguousarray\n"
+        "copies one column out). Releases the GIL.");
 
     mod.def(
         "arm_trial",

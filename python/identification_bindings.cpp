@@ -14,6 +14,8 @@
 
 #include <cmath>
 #include <filesystem>
+#include <map>
+#include <optional>
 
 namespace armsim::python {
 
@@ -85,32 +87,45 @@ py::dict toPython(const IdentificationReport& r) {
     return d;
 }
 
-std::string pathOf(const py::object& o) {
+bool isPath(const py::object& o) {
+    return py::isinstance<py::str>(o) || py::hasattr(o, "__fspath__");
+}
+
+/// A str or os.PathLike argument as a path; InputError naming the argument otherwise.
+std::string pathOf(const py::object& o, const char* argument) {
+    if (!isPath(o))
+        throw InputError(std::string(argument) + ": expected a file path (str or os.PathLike), got " +
+                         py::str(py::type::of(o).attr("__name__")).cast<std::string>());
     return py::str(py::module_::import("os").attr("fspath")(o));
 }
 
-bool isPath(const py::object& o) {
-    return py::isinstance<py::str>(o) || py::hasattr(o, "__fspath__");
+/// A mapping of columns (a dict, or anything with keys()) as a dict; nullopt for something else.
+std::optional<py::dict> asColumns(const py::object& o) {
+    if (py::isinstance<py::dict>(o)) return o.cast<py::dict>();
+    if (py::hasattr(o, "keys") && py::hasattr(o, "__getitem__")) return py::dict(o);
+    return std::nullopt;
 }
 
 /// Identification data: a CSV path (as `armsim identify DATA.csv`) or a dict of columns with the
 /// file's names (force_N and one of path_m, path_cm, angle_deg; optional activation, trial, subject).
 ObservationSet toObservations(const py::object& data, const ArmSetup& setup, int subject) {
-    if (isPath(data)) return readArmObservations(findFile(pathOf(data)), setup.arm, subject);
-    if (!py::isinstance<py::dict>(data))
+    if (isPath(data)) return readArmObservations(findFile(pathOf(data, "data")), setup.arm, subject);
+    const std::optional<py::dict> columns = asColumns(data);
+    if (!columns)
         throw InputError("data: expected a CSV path or a dict of columns (force_N and one of path_m, path_cm, angle_deg)");
     ObservationOptions oo;
     oo.pathFromAngle = makeArmPathFromAngle(setup.arm);
     oo.subject = subject;
-    return makeObservations(toTable(data.cast<py::dict>(), "data"), "data", oo);
+    return makeObservations(toTable(*columns, "data"), "data", oo);
 }
 
 std::vector<TorqueObservation> toTorqueData(const py::object& data) {
-    if (isPath(data)) return readTorqueData(findFile(pathOf(data)));
-    if (!py::isinstance<py::dict>(data))
+    if (isPath(data)) return readTorqueData(findFile(pathOf(data, "data")));
+    const std::optional<py::dict> columns = asColumns(data);
+    if (!columns)
         throw InputError("data: expected a torque CSV path or a dict of columns (flexion_deg, torque_Nm, and "
                          "optionally effort, level, repetition)");
-    return makeTorqueData(toTable(data.cast<py::dict>(), "data"), "data");
+    return makeTorqueData(toTable(*columns, "data"), "data");
 }
 
 /// Torque data as columns with the torque data file's names (formatTorqueData with the truth).
@@ -161,13 +176,14 @@ py::dict toDict(const BicepsEstimate& e) {
 
 Population toPopulation(const py::object& population) {
     if (population.is_none()) return loadDefaultPopulation();
-    return loadPopulation(findFile(pathOf(population)));
+    return loadPopulation(findFile(pathOf(population, "population")));
 }
 
-double optionalNumber(const py::object& o) { return o.is_none() ? NAN : o.cast<double>(); }
-
-std::vector<double> toNumbers(const py::object& o) {
-    return o.is_none() ? std::vector<double>{} : o.cast<std::vector<double>>();
+/// An optional number: NaN when not given; a given NaN or infinity is an error naming the argument.
+double optionalNumber(const std::optional<double>& v, const char* argument) {
+    if (!v) return NAN;
+    if (!std::isfinite(*v)) throw InputError(std::string(argument) + " = " + formatNumber(*v) + ": expected a finite number or None");
+    return *v;
 }
 
 /// A list of rows as columns: numbers become float64 arrays, strings lists.
@@ -231,10 +247,11 @@ py::dict toDict(const QuadraticFit& q) {
 // ---- the functions -------------------------------------------------------------------------------
 
 py::dict identifyPy(const Model& m, const py::object& data, const std::string& method, const std::vector<std::string>& free,
-                    const py::object& bounds, const py::object& start, const std::string& forward,
+                    const std::optional<std::map<std::string, std::pair<double, double>>>& bounds,
+                    const std::optional<std::map<std::string, double>>& start, const std::string& forward,
                     const std::string& estimate, double hold, double rate, bool warmStart, int jobs,
-                    const py::object& forceSd, const std::string& noise, int multistart, unsigned seed,
-                    int maxIterations, double tolerance, int subject, const std::string& out) {
+                    const std::optional<double>& forceSd, const std::string& noise, int multistart, unsigned seed,
+                    int maxIterations, double tolerance, int subject, const py::object& out) {
     IdentificationProblem pr;
     pr.base = m.setup.calcBicepsParameters();
     pr.data = toObservations(data, m.setup, subject);
@@ -247,22 +264,19 @@ py::dict identifyPy(const Model& m, const py::object& data, const std::string& m
             if (u.id == id) return u;
         throw InputError(what + " '" + name + "': not a free parameter (free: " + py::str(py::cast(free)).cast<std::string>() + ")");
     };
-    if (!bounds.is_none())
-        for (auto item : bounds.cast<py::dict>()) {
-            const std::string name = py::str(item.first);
-            const auto lohi = item.second.cast<std::pair<double, double>>();
+    if (bounds)
+        for (const auto& [name, lohi] : *bounds) {
             Unknown& u = findUnknown("bounds", name);
             u.lower = lohi.first;
             u.upper = lohi.second;
         }
-    if (!start.is_none())
-        for (auto item : start.cast<py::dict>())
-            findUnknown("start", py::str(item.first)).start = item.second.cast<double>();
+    if (start)
+        for (const auto& [name, value] : *start) findUnknown("start", name).start = value;
 
     IdentificationOptions io;
     io.method = parseMethodName(method);
     io.noise = parseNoiseModelName(noise);
-    const double sd = optionalNumber(forceSd);
+    const double sd = optionalNumber(forceSd, "force_sd");
     if (io.noise == NoiseModel::Relative) io.relativeForceSd = sd;
     else io.forceSd = sd;
     io.starts = multistart;
@@ -283,26 +297,29 @@ py::dict identifyPy(const Model& m, const py::object& data, const std::string& m
         r = identifyAndRecheck(pr, io, m.setup.arm, choice);
     }
     py::dict d = toPython(r);
-    if (!out.empty()) {
-        std::filesystem::create_directories(out);
-        d["files"] = writeReportFiles(r, out);
+    if (!out.is_none()) {
+        const std::string dir = pathOf(out, "out");
+        std::filesystem::create_directories(dir);
+        d["files"] = writeReportFiles(r, dir);
     }
     return d;
 }
 
-py::list identifyTorquePy(const py::object& data, const py::object& population, const py::object& noiseLevel,
-                          const py::object& activation, double activationSd) {
+py::list identifyTorquePy(const py::object& data, const py::object& population, const std::optional<double>& noiseLevel,
+                          const std::optional<double>& activation, double activationSd) {
     const std::vector<TorqueObservation> obs = toTorqueData(data);
     const Population prior = toPopulation(population);
     TorqueIdentificationOptions o;
-    o.noiseLevel = optionalNumber(noiseLevel);
-    o.activation = optionalNumber(activation);
+    o.noiseLevel = optionalNumber(noiseLevel, "noise_level");
+    o.activation = optionalNumber(activation, "activation");
     o.activationSd = activationSd;
     std::vector<BicepsEstimate> estimates;
+    std::string skipped;
     {
         py::gil_scoped_release release;
-        estimates = identifyTorqueData(prior, obs, o);
+        estimates = identifyTorqueData(prior, obs, o, &skipped);
     }
+    if (!skipped.empty() && PyErr_WarnEx(PyExc_UserWarning, skipped.c_str(), 1) != 0) throw py::error_already_set();
     const double noise = std::isfinite(o.noiseLevel) ? o.noiseLevel : estimates.back().noiseLevel;
     py::list l;
     for (const BicepsEstimate& e : estimates) {
@@ -359,14 +376,16 @@ py::dict validatePy(const Model& m, int seeds, unsigned seed, const std::vector<
     return c.finish();
 }
 
-py::tuple validateElbowPy(const py::object& population, int subjects, unsigned seed, const py::object& noise,
-                          double activationSd, const py::object& angles, int repetitions, const py::object& protocol,
+py::tuple validateElbowPy(const py::object& population, int subjects, unsigned seed,
+                          const std::optional<std::vector<double>>& noise, double activationSd,
+                          const std::optional<std::vector<double>>& angles, const std::optional<int>& repetitions,
+                          const py::object& protocol,
                           bool freeSlowFraction, int jobs) {
     const Population pop = toPopulation(population);
     ElbowValidationSettings s;
     s.subjects = subjects;
     s.seed = seed;
-    s.noiseLevels = toNumbers(noise);
+    s.noiseLevels = noise.value_or(std::vector<double>{});
     s.activationSd = activationSd;
     s.freeSlowFraction = freeSlowFraction;
     s.jobs = jobs;
@@ -374,11 +393,12 @@ py::tuple validateElbowPy(const py::object& population, int subjects, unsigned s
     checkField("activation_sd", activationSd, Bound::closed(0, 0.5));
     checkField("jobs", jobs, Bound::closed(1, 64));
     if (!protocol.is_none()) {
-        if (!angles.is_none()) throw InputError("protocol replaces angles and repetitions: give one or the other");
-        s.protocol = readTorqueProtocol(findFile(pathOf(protocol)));
+        if (angles || repetitions) throw InputError("protocol replaces angles and repetitions: give one or the other");
+        s.protocol = readTorqueProtocol(findFile(pathOf(protocol, "protocol")));
     } else {
-        const std::vector<double> a = angles.is_none() ? std::vector<double>{135, 120, 90, 60, 30} : toNumbers(angles);
-        s.protocol.conditions = TorqueProtocol::makeFlexionMvcs(a, repetitions);
+        checkField("repetitions", repetitions.value_or(3), Bound::closed(1, 100));
+        s.protocol.conditions =
+            TorqueProtocol::makeFlexionMvcs(angles.value_or(std::vector<double>{135, 120, 90, 60, 30}), repetitions.value_or(3));
         s.protocol.validate();
     }
     std::vector<ElbowValidationRow> rows;
@@ -430,13 +450,14 @@ py::tuple validateElbowPy(const py::object& population, int subjects, unsigned s
     return py::make_tuple(c.finish(), summary);
 }
 
-py::dict designPy(const py::object& population, const std::vector<double>& angles, const py::object& levels,
+py::dict designPy(const py::object& population, const std::vector<double>& angles,
+                  const std::optional<std::vector<double>>& levels,
                   bool extension, int trials, int repetitions, int draws, unsigned seed, double activationSd,
                   bool freeSlowFraction, int jobs) {
     const Population pop = toPopulation(population);
     DesignSettings s;
     s.flexionDeg = angles;
-    s.levels = toNumbers(levels);
+    s.levels = levels.value_or(std::vector<double>{});
     s.extension = extension;
     s.trials = trials;
     s.repetitions = repetitions;
@@ -469,21 +490,24 @@ py::dict designPy(const py::object& population, const std::vector<double>& angle
     return d;
 }
 
-py::dict runProtocolPy(const py::object& file, const std::string& out, int jobs) {
-    const std::string path = findFile(pathOf(file));
+py::dict runProtocolPy(const py::object& file, const py::object& outArgument, int jobs) {
+    const std::string path = findFile(pathOf(file, "file"));
+    const std::string out = outArgument.is_none() ? std::string() : pathOf(outArgument, "out");
     checkField("jobs", jobs, Bound::closed(1, 64));
     py::dict d;
     if (isTorqueProtocolFile(path)) {
         const TorqueProtocol protocol = readTorqueProtocol(path);
         std::vector<TorqueObservation> data;
+        std::vector<std::string> files;
         {
             py::gil_scoped_release release;
             data = synthesizeTorqueData(loadTorqueProtocolSubject(protocol), protocol, protocol.seed, jobs);
+            if (!out.empty()) files = writeTorqueProtocolRun(out, protocol, data);
         }
         d["name"] = protocol.name;
         d["kind"] = "torque";
         d["data"] = toDict(data);
-        d["files"] = out.empty() ? std::vector<std::string>{} : writeTorqueProtocolRun(out, protocol, data);
+        d["files"] = files;
         return d;
     }
     const Protocol protocol = readProtocol(path);
@@ -524,7 +548,7 @@ void addIdentificationBindings(py::module_& mod) {
             "start"_a = py::none(), "forward"_a = "steady", "estimate"_a = "moment-arm", "hold"_a = 3.0,
             "rate"_a = 200.0, "warm_start"_a = true, "jobs"_a = 2, "force_sd"_a = py::none(), "noise"_a = "absolute",
             "multistart"_a = 1, "seed"_a = 1u, "max_iterations"_a = 200, "tolerance"_a = 0.1, "subject"_a = -1,
-            "out"_a = "",
+            "out"_a = py::none(),
             R"(Identifies the primary muscle's parameters from isometric forces, as `armsim identify`.
 
 data: a CSV path, or a dict of columns with the file's names: force_N [N] and one of path_m,
@@ -556,10 +580,12 @@ effort 1/-1, level, repetition; e.g. run_protocol(...)['data']).  population: pr
 (default assets/subjects/default_population.yaml).  noise_level: relative sd of one trial's torque
 (default: estimated from the repetitions).  Returns one dict per method: mass [kg], tendon_length
 [m], 95 % mass_interval and tendon_interval, nuisance estimates, predicted_torque, and
-residual_check (chi-square against the noise level). Releases the GIL.)");
+residual_check (chi-square against the noise level). A method that cannot run on these data (the
+thesis method without flexion MVCs at two angles) is left out with a UserWarning saying why.
+Releases the GIL.)");
 
     mod.def(
-        "read_torque_data", [](const py::object& path) { return toDict(readTorqueData(findFile(pathOf(path)))); },
+        "read_torque_data", [](const py::object& path) { return toDict(readTorqueData(findFile(pathOf(path, "path")))); },
         "path"_a,
         R"(Reads a torque data file (a path or a name under assets/) with the strict reader the command
 uses: columns flexion_deg [deg, 0 = extended], torque_Nm (tared, + = flexion) and optionally effort
@@ -574,19 +600,23 @@ synthetic data, are NaN: the reader ignores them): pass it to identify_torque. V
 `armsim validate --truth thesis`): the thesis's truth and `seeds` random ones, each at every noise
 level (relative force sd, a fraction: 0.02 = 2 %), identified by every method (default lm and the
 two-output learning family) with the `forward` model (corrected | faithful | steady).
-Returns the rows as columns: truth, noise, method, true_mass, mass, mass_error, ..., stop_reason.)");
+Returns the rows as columns: truth, noise, method, true_mass, true_tendon_length, mass, tendon_length,
+mass_error, tendon_length_error, mass_covered, tendon_length_covered (1/0, -1 without an interval),
+stop_reason, iterations, evaluations, wall_time [s].)");
 
     mod.def("validate_elbow", &validateElbowPy, "population"_a = py::none(), "subjects"_a = 200, "seed"_a = 1u,
-            "noise"_a = py::none(), "activation_sd"_a = 0.02, "angles"_a = py::none(), "repetitions"_a = 3,
+            "noise"_a = py::none(), "activation_sd"_a = 0.02, "angles"_a = py::none(), "repetitions"_a = py::none(),
             "protocol"_a = py::none(), "free_slow_fraction"_a = false, "jobs"_a = 2,
             R"(Validation on virtual subjects of the seven-muscle elbow (as `armsim validate --truth elbow`):
 `subjects` people drawn from the population (default assets/subjects/default_population.yaml),
 MVC torque data synthesized per noise level (fractions; default the population's), identified by
 the thesis, synergist and (activation_sd > 0) synergist-va methods. The protocol: flexion MVCs at
 `angles` [deg flexion, default 135, 120, 90, 60, 30] x repetitions, or a torque protocol file.
-Returns (rows, summary): rows as columns (subject, method, true_mass, mass, mass_lower, mass_upper,
-mass_error, coverage, nuisance truths, ...); summary one dict per method and noise (bias, RMSE,
-coverage, interval widths). Releases the GIL.)");
+Returns (rows, summary): rows as columns (subject, noise, method, true_mass, true_tendon_length,
+mass, tendon_length, mass_lower, mass_upper, tendon_lower, tendon_upper, converged, mass_error,
+tendon_error, mass_covered, tendon_covered, and the nuisance truths voluntary_activation,
+co_contraction, strength_level, biceps_short_scale, synergist_scale); summary one dict per method
+and noise (bias, RMSE, coverage, interval widths). Releases the GIL.)");
 
     mod.def("design_protocol", &designPy, "population"_a = py::none(),
             "angles"_a = std::vector<double>{15, 30, 45, 60, 75, 90, 105, 120, 135}, "levels"_a = py::none(),
@@ -599,10 +629,11 @@ submaximal `levels` (fractions of MVC), within `trials`. Returns conditions, pro
 protocol file's text: write it and pass it to run_protocol or validate_elbow), predicted and
 reference (the thesis's five angles) uncertainty, and the greedy steps. Releases the GIL.)");
 
-    mod.def("run_protocol", &runProtocolPy, "file"_a, "out"_a = "", "jobs"_a = 2,
+    mod.def("run_protocol", &runProtocolPy, "file"_a, "out"_a = py::none(), "jobs"_a = 2,
             R"(Runs an experiment protocol file (a path or a name under assets/, e.g.
-'protocols/mvc_force_angle.yaml'), as `armsim protocol`. out: the run directory to write (replaced
-as a whole); '' computes only.
+'protocols/mvc_force_angle.yaml'), as `armsim protocol`. out: the run directory to write (arm
+protocols: written whole and replacing an earlier run; torque protocols: torque_data.csv,
+protocol.yaml and torque_angle.png written into it); None computes only.
 Arm protocols (mvc, submaximal, force_length, composition) return trials and summary (dicts of
 float64 arrays: per trial and per condition), fits (quadratic force-angle fits), emg_to_activation,
 muscle_sweep, composition, files. Torque protocols (kind: torque) return data: the tared torque per

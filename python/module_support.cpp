@@ -10,6 +10,11 @@ py::dict toDict(const Table& t) { return toDict(Table(t)); }
 py::dict toDict(Table&& t) {
     const py::ssize_t n = t.getNumRows(), m = t.getNumColumns();
     const std::vector<std::string> names = t.getColumnNames();
+    if (n == 0) {
+        py::dict d;
+        for (const std::string& name : names) d[py::str(name)] = py::array_t<double>(0);
+        return d;
+    }
     auto* values = new std::vector<double>(t.releaseData());
     const py::capsule owner(values, [](void* p) { delete static_cast<std::vector<double>*>(p); });
     py::dict d;
@@ -24,12 +29,10 @@ Table toTable(const py::dict& columns, const std::string& what) {
     py::ssize_t rows = -1;
     for (auto item : columns) {
         const std::string name = py::str(item.first);
-        py::array_t<double> a;
-        try {
-            a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(item.second);
-        } catch (const py::error_already_set&) {
-        }
-        if (!a || a.ndim() != 1)
+        const py::array raw = py::array::ensure(item.second);
+        const char kind = raw ? raw.dtype().kind() : 'O';
+        const auto a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(item.second);
+        if (!a || a.ndim() != 1 || (kind != 'f' && kind != 'i' && kind != 'u' && kind != 'b'))
             throw InputError(what + ": column '" + name + "': expected a 1-D sequence of numbers");
         if (rows >= 0 && a.shape(0) != rows)
             throw InputError(what + ": column '" + name + "' has " + std::to_string(a.shape(0)) + " values: expected " +

@@ -23,7 +23,8 @@ struct Model {
 };
 
 /// A table's columns as a dict of float64 arrays, in column order. The arrays are views (stride: one
-/// table row) of one buffer taken from the table without a copy, which they keep alive.
+/// table row) of one buffer taken from the table without a copy, which they keep alive (a copy of
+/// a 3.5 s trial's table costs about 5 % of the trial: docs/benchmarks.md).
 py::dict toDict(Table&& table);
 /// The same for a table that stays with its owner (copied first).
 py::dict toDict(const Table& table);
@@ -41,8 +42,8 @@ py::array_t<double> toArray(const std::vector<std::vector<double>>& rows);
 /// when neither exists.
 std::string findFile(const std::string& name);
 
-/// Adds identify, identify_torque, validate, validate_elbow, design_protocol, run_protocol,
-/// synthesize_torque (python/identification_bindings.cpp).
+/// Adds identify, identify_torque, read_torque_data, validate, validate_elbow, design_protocol and
+/// run_protocol (python/identification_bindings.cpp).
 void addIdentificationBindings(py::module_& module);
 
 }  // namespace armsim::python

@@ -67,9 +67,11 @@ forces and live plots. Written whole or not at all. Returns {'path', 'frames'}. 
         "render_frame",
         [](const Model& m, const py::dict& series, double time, int width, int height, bool overlay, int supersample,
            const std::string& colorBy) {
-            checkField("time", time, Bound::any("s"));
             const TrialVideoSettings v = makeSettings(width, height, supersample, overlay, colorBy);
             const Table table = toTable(series, "series");
+            if (table.hasColumn("time_s") && table.getNumRows() > 0)  // the renderer checks the rest of the table
+                checkField("time", time, Bound::closed(table.get(0, "time_s"), table.get(table.getNumRows() - 1, "time_s"),
+                                                       "s, within the trial"));
             cv::Mat rgb;
             {
                 py::gil_scoped_release release;

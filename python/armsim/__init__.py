@@ -2,7 +2,8 @@
 
 Models, steady states, muscle and arm trials, protocols, identification with its reports,
 validation, experiment design, population studies and rendering on the C++ core, with numpy arrays
-out. Units are SI; keyword names are those of the YAML files and the command's options. Errors carry
+out. Units are SI; keyword names are those of the YAML files, and for the command's options their long
+names with underscores (--max-iterations: max_iterations; --speed is playback_speed). Errors carry
 the command line's messages: ValueError for bad input, FileNotFoundError for a missing file,
 RuntimeError for a simulation that cannot go on. Long calls release the GIL, so threads can run
 trials in parallel.

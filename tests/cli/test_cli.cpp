@@ -2,6 +2,7 @@
 #include "muscles/table.h"
 
 #include "tests/support/run_armsim.h"
+#include "tests/support/temp_files.h"
 
 #include <gtest/gtest.h>
 
@@ -190,4 +191,28 @@ TEST(Cli, MainJobRunsTheThesisArmAndTheElbowSubject) {
         EXPECT_NEAR(t.get(i, "biceps_both_heads_N"), t.get(i, "force_BIClong_N") + t.get(i, "force_BICshort_N"), 1e-6);
     }
     EXPECT_NE(r.output.find("Elbow model (seven muscles)"), std::string::npos) << r.output;
+}
+
+// Issue 14: a command that neither renders nor runs under mpirun starts without the render stack and
+// MPI: they are plugins loaded on demand (cli/plugins.h), so the executable must not need them.
+TEST(Cli, TheCommandDoesNotLoadTheRendererOrMpiUntilAskedTo) {
+    const armsim::testing::CommandResult deps = armsim::testing::runCommand(std::string("ldd ") + ARMSIM_EXE);
+    ASSERT_EQ(deps.exitCode, 0) << deps.output;
+    for (const char* library : {"libOSMesa", "libopencv", "libLLVM", "libavcodec", "libmpi"})
+        EXPECT_EQ(deps.output.find(library), std::string::npos) << library << " is linked:\n" << deps.output;
+    // and the plugins load where they are needed: a still rendered, and the command still exits 2 with
+    // the plugin's field error (an exception from the plugin caught by the command)
+    if (!ARMSIM_RENDER_BUILT) GTEST_SKIP() << "built without the renderer";
+    const std::filesystem::path d = armsim::testing::makeFreshDir("cli", "plugins");
+    const armsim::testing::CommandResult trial =
+        runArmsim("trial --angle 90 --hold 0.2 --rate 100 --out " + (d / "t.csv").string());
+    ASSERT_EQ(trial.exitCode, 0) << trial.output;
+    const armsim::testing::CommandResult still = runArmsim("render " + (d / "t.csv").string() + " --still-at 0.5 --still " +
+                                                           (d / "s.png").string() + " --width 64 --height 48");
+    EXPECT_EQ(still.exitCode, 0) << still.output;
+    EXPECT_GT(std::filesystem::file_size(d / "s.png"), 100u);
+    const armsim::testing::CommandResult bad =
+        runArmsim("render " + (d / "t.csv").string() + " --out " + (d / "v.mp4").string() + " --codec vp9");
+    EXPECT_EQ(bad.exitCode, 2) << bad.output;
+    EXPECT_NE(bad.output.find("field 'codec' = 'vp9'"), std::string::npos) << bad.output;
 }

@@ -53,6 +53,7 @@ TEST(ForwardChoice, SteadyChoiceIsIdentifyPlusTwoRechecks) {
     ASSERT_EQ(r.checks.size(), 2u);
     EXPECT_EQ(r.checks[0].model, "steady");
     EXPECT_EQ(r.checks[1].model, "faithful");
+    EXPECT_NE(r.checks[1].note.find("1000 Hz"), std::string::npos) << r.checks[1].note;  // the reference protocol
     // the steady re-check at the estimate reproduces the run's own residuals
     for (std::size_t k = 0; k < r.residuals.size(); ++k) EXPECT_NEAR(r.checks[0].residuals[k], r.residuals[k], 1e-9);
 }
@@ -72,7 +73,25 @@ TEST(ForwardChoice, FaithfulChoiceNamesItsIterationModelAndBadChoicesAreRefused)
     EXPECT_THROW(c.validate(), InputError);
     c.model = "faithful";
     c.holdDuration = -1;
-    EXPECT_THROW(c.validate(), InputError);
+    EXPECT_THROW(identifyAndRecheck(makeFiveAngleProblem(setup), {}, setup.arm, c), InputError);
+}
+
+TEST(ForwardChoice, FaithfulIsWarmStartedFromTheSteadyEstimateUnlessAskedNotTo) {
+    const ArmSetup setup = loadModel("thesis");
+    const IdentificationProblem pr = makeFiveAngleProblem(setup);
+    ForwardModelChoice c;
+    c.model = "faithful";
+    c.holdDuration = 1.5;
+    const IdentificationReport warm = identifyAndRecheck(pr, {}, setup.arm, c);
+    c.warmStart = false;
+    const IdentificationReport cold = identifyAndRecheck(pr, {}, setup.arm, c);
+    EXPECT_NE(warm.message.find("started from the steady-model lm estimate"), std::string::npos) << warm.message;
+    EXPECT_EQ(cold.message.find("steady-model"), std::string::npos) << cold.message;
+    ASSERT_TRUE(warm.isConverged() && cold.isConverged()) << warm.message << " / " << cold.message;
+    // both reach the faithful model's least-squares point, within its parameter tolerance (1e-5 scaled)
+    for (int j = 0; j < 2; ++j)
+        EXPECT_NEAR(warm.parameters[j].value, cold.parameters[j].value, 1e-3 * warm.parameters[j].value) << j;
+    EXPECT_LT(warm.forwardEvaluations, cold.forwardEvaluations);  // the point of the warm start
 }
 
 TEST(TablesInMemory, RowsAreNamedByNumberWhenTheyHaveNoLine) {
@@ -120,7 +139,7 @@ TEST(TorqueIdentification, RunsThesisOnlyWithMvcsAtTwoAnglesAndChecksResidualsIn
     EXPECT_EQ(c.n, n);
     EXPECT_EQ(c.dof, n - all[0].numParameters);
     EXPECT_NEAR(c.chiSquare, chi, kChiTol * chi);
-    EXPECT_EQ(c.p, calcChiSquareSurvival(chi, c.dof));
+    EXPECT_EQ(c.p, calcChiSquareSurvival(c.chiSquare, c.dof));
     EXPECT_EQ(checkTorqueResiduals(data, all[1], noise).dof, int(data.size()));  // MAP fits: no subtraction
 
     // one angle only: the thesis method is skipped and says why

@@ -16,9 +16,9 @@ struct CommandResult {
     std::string output;  ///< stdout and stderr, interleaved
 };
 
-/// Runs `armsim <args>` through the shell and waits for it.
-inline CommandResult runArmsim(const std::string& args) {
-    const std::string cmd = std::string(ARMSIM_EXE) + " " + args + " 2>&1";
+/// Runs a shell command and waits for it.
+inline CommandResult runCommand(const std::string& command) {
+    const std::string cmd = command + " 2>&1";
     std::unique_ptr<FILE, int (*)(FILE*)> pipe(popen(cmd.c_str(), "r"), pclose);
     std::string out;
     std::array<char, 4096> buf;
@@ -26,5 +26,8 @@ inline CommandResult runArmsim(const std::string& args) {
     const int status = pclose(pipe.release());
     return {WEXITSTATUS(status), out};
 }
+
+/// Runs `armsim <args>` through the shell and waits for it.
+inline CommandResult runArmsim(const std::string& args) { return runCommand(std::string(ARMSIM_EXE) + " " + args); }
 
 }  // namespace armsim::testing

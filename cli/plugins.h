@@ -1,0 +1,22 @@
+// Plugins of the armsim command: libraries loaded with dlopen only by the commands that need them
+// (the renderer, MPI), so that every other command starts without their shared libraries.
+#pragma once
+
+#include <string>
+
+namespace armsim {
+struct RenderPlugin;
+struct StudyMpiPlugin;
+}
+
+namespace armsim::cli {
+
+/// The renderer (render/render_plugin.h). InputError naming `option` when it cannot be loaded (built
+/// with -DARMSIM_RENDER=OFF, or the plugin file missing beside the executable).
+const RenderPlugin& getRenderPlugin(const std::string& option);
+
+/// Studies over MPI ranks (identification/study_mpi.h). InputError saying how to get MPI when the
+/// plugin is missing (built without libopenmpi-dev).
+const StudyMpiPlugin& getStudyMpiPlugin();
+
+}  // namespace armsim::cli
