@@ -1,15 +1,12 @@
 """The Python module (issue 12): every bound function called, results equal to the C++ API's
 (tests/python/reference.cpp, 17 digits) to 1e-12 relative, numpy dtypes and shapes, errors with the
 command line's messages, and the GIL released during long calls."""
-import threading
-import time
-
 import numpy as np
 import pytest
 
 import armsim
 
-from conftest import REL_TOL
+from conftest import REL_TOL, measure_longest_stall
 
 
 def test_model_lists_muscles_and_parameters_with_the_files_names(thesis, elbow):
@@ -96,25 +93,8 @@ def test_a_trial_releases_the_gil(elbow):
     end, the longest stretch without an iteration of this loop stays well below the call's duration.
     With the GIL held through the call, no iteration falls inside it (checked by building without the
     release: the stretch is then the whole call)."""
-    done = threading.Event()
-    span = {}
-
-    def work():
-        span["start"] = time.perf_counter()
-        armsim.arm_trial(elbow, hold=10.0)
-        span["end"] = time.perf_counter()
-        done.set()
-
-    ticks = []
-    worker = threading.Thread(target=work)
-    worker.start()
-    while not done.is_set():
-        ticks.append(time.perf_counter())
-        time.sleep(0)
-    worker.join()
-    inside = [span["start"]] + [t for t in ticks if span["start"] < t < span["end"]] + [span["end"]]
-    longest = max(b - a for a, b in zip(inside, inside[1:]))
-    assert longest < 0.5 * (span["end"] - span["start"]), (longest, span["end"] - span["start"])
+    longest, duration = measure_longest_stall(lambda: armsim.arm_trial(elbow, hold=10.0))
+    assert longest < 0.5 * duration, (longest, duration)
 
 
 def test_docstrings_name_units_and_arguments():

@@ -8,7 +8,7 @@ import pytest
 
 import armsim
 
-from conftest import REL_TOL
+from conftest import REL_TOL, measure_longest_stall
 
 THESIS_START = {"mass": 0.330, "optimal_tendon_length": 0.22}
 
@@ -206,27 +206,8 @@ def test_any_mapping_of_columns_is_data_and_a_skipped_method_warns(thesis, refer
 ])
 def test_long_calls_release_the_gil(thesis, name, call):
     """As test_a_trial_releases_the_gil: a Python loop keeps running while the call works in a thread."""
-    import threading
-    import time
-    done = threading.Event()
-    span = {}
-
-    def work():
-        span["start"] = time.perf_counter()
-        call(thesis)
-        span["end"] = time.perf_counter()
-        done.set()
-
-    ticks = []
-    worker = threading.Thread(target=work)
-    worker.start()
-    while not done.is_set():
-        ticks.append(time.perf_counter())
-        time.sleep(0)
-    worker.join()
-    inside = [span["start"]] + [t for t in ticks if span["start"] < t < span["end"]] + [span["end"]]
-    longest = max(b - a for a, b in zip(inside, inside[1:]))
-    assert longest < 0.5 * (span["end"] - span["start"]), (name, longest, span["end"] - span["start"])
+    longest, duration = measure_longest_stall(lambda: call(thesis))
+    assert longest < 0.5 * duration, (name, longest, duration)
 
 
 def test_every_public_function_has_a_useful_docstring():
