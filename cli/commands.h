@@ -63,6 +63,11 @@ std::vector<std::string> splitList(const std::string& text);
 /// A comma-separated list of finite numbers given to `option` (each checked by parseNumber).
 std::vector<double> parseNumberList(const std::string& option, const std::string& text);
 
+/// Checks, before any work and without creating anything, that the output folder given to `option`
+/// can be created or written (it, or its nearest existing ancestor, is a writable folder): InputError
+/// naming the option, the path and the reason.
+void checkOutputFolder(const std::string& option, const std::string& dir);
+
 /// Prints a one-line progress bar to stderr ("label [#####     ] 5/10").
 void printProgress(const std::string& label, int done, int total);
 

@@ -43,6 +43,7 @@ void printPrediction(const ProtocolPrediction& p) {
 }
 
 void runDesign(const DesignOptions& o) {
+    checkOutputFolder("--out", o.out);
     const Population population = o.population.empty() ? loadDefaultPopulation() : loadPopulation(o.population);
     DesignSettings s;
     s.flexionDeg = parseNumberList("--angles", o.angles);

@@ -127,6 +127,7 @@ void printThesisCases(const MuscleParameters& base, const ForceModel& model, con
 }
 
 void runIdentify(const IdentifyOptions& o) {
+    checkOutputFolder("--out", o.out);
     const ArmSetup setup = o.muscle.loadSetup();
     const MuscleParameters base = setup.calcBicepsParameters();
     if (o.thesisCases) {
@@ -321,6 +322,7 @@ void runElbowValidate(const ValidateOptions& o) {
 }
 
 void runValidate(const ValidateOptions& o) {
+    checkOutputFolder("--out", o.out);
     if (o.truth == "elbow") return runElbowValidate(o);
     const ArmSetup setup = o.muscle.loadSetup();
     ValidationSettings s;

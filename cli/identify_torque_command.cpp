@@ -25,6 +25,7 @@ struct IdentifyTorqueOptions {
 };
 
 void runIdentifyTorque(const IdentifyTorqueOptions& o) {
+    checkOutputFolder("--out", o.out);
     const std::string file = findAsset(o.data);
     const std::vector<TorqueObservation> data = readTorqueData(file);
     const Population prior = o.population.empty() ? loadDefaultPopulation() : loadPopulation(o.population);

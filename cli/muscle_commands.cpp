@@ -122,6 +122,10 @@ void addMuscleCommands(CLI::App& app) {
         c->callback([=] {
             checkActivation(*U);
             checkField("--step", *step, Bound::positive("m"));
+            if ((*to - *from) / *step > 1e6)
+                throw InputError("--step " + formatNumber(*step) + " m over " + formatNumber(*from) + ".." +
+                                 formatNumber(*to) + " m gives " + formatNumber(std::floor((*to - *from) / *step) + 1) +
+                                 " path lengths: expected at most 1000001");
             if (!(*to >= *from)) throw InputError("--to must not be below --from");
             const VirtualMuscle m = opts->build();
             m.checkPathLength(*from);

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <sstream>
 #include <cstdio>
+#include <filesystem>
 #include <memory>
 #include <unistd.h>
 #include <vector>
@@ -69,6 +70,19 @@ std::vector<double> parseNumberList(const std::string& option, const std::string
     std::vector<double> v;
     for (const std::string& item : splitList(text)) v.push_back(parseNumber(option, item));
     return v;
+}
+
+void checkOutputFolder(const std::string& option, const std::string& dir) {
+    namespace fs = std::filesystem;
+    std::error_code ec;
+    fs::path p = fs::absolute(dir.empty() ? "." : dir, ec);
+    const fs::path given = p;
+    while (!fs::exists(p, ec) && p.has_parent_path() && p != p.parent_path()) p = p.parent_path();
+    if (!fs::is_directory(p, ec))
+        throw InputError(option + " '" + dir + "': cannot create the folder (" + p.string() + " is not a folder)");
+    if (::access(p.c_str(), W_OK | X_OK) != 0)
+        throw InputError(option + " '" + dir + "': cannot write in " + p.string() + " (" + (p == given ? "the folder" : "its parent") +
+                         " is not writable)");
 }
 
 void printProgress(const std::string& label, int done, int total) {

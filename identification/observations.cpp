@@ -48,7 +48,8 @@ void validateObservations(const ObservationSet& set) {
         auto fail = [&](const std::string& field, double v, const std::string& expected) {
             throw InputError(at + ": " + field + " = " + fmt(v) + ": expected " + expected);
         };
-        if (!std::isfinite(o.force)) fail("force_N", o.force, "a finite number");
+        if (!std::isfinite(o.force) || o.force > 1e5)
+            fail("force_N", o.force, "a finite force of at most 1e5 N (100 kN, beyond any muscle)");
         if (o.force < 0) fail("force_N", o.force, ">= 0 (a measured muscle force cannot be negative)");
         if (!std::isfinite(o.pathLength) || !(o.pathLength > 0))
             fail("path length [m]", o.pathLength, "a finite value > 0");
@@ -104,7 +105,8 @@ ObservationSet makeObservations(const Table& t, const std::string& path, const O
         o.subject = integer("subject");
         if (options.subject >= 0 && o.subject != options.subject) continue;
         o.force = t.get(r, "force_N");
-        if (!std::isfinite(o.force)) fail("force_N", o.force, "a finite number");
+        if (!std::isfinite(o.force) || o.force > 1e5)
+            fail("force_N", o.force, "a finite force of at most 1e5 N (100 kN, beyond any muscle)");
         if (o.force < 0) fail("force_N", o.force, ">= 0 (a measured muscle force cannot be negative)");
         if (t.hasColumn("activation")) {
             o.activation = t.get(r, "activation");

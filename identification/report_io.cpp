@@ -137,11 +137,16 @@ void writeConvergencePlot(const std::string& path, const IdentificationReport& r
 std::vector<std::string> writeReportFiles(const IdentificationReport& report, const std::string& dir,
                                           const std::string& stem) {
     const std::filesystem::path d(dir);
-    const std::vector<std::string> paths = {(d / (stem + ".json")).string(), (d / (stem + "_history.csv")).string(),
-                                            (d / (stem + "_convergence.png")).string()};
+    std::vector<std::string> paths = {(d / (stem + ".json")).string(), (d / (stem + "_history.csv")).string()};
     writeReportJson(paths[0], report);
     writeHistoryCsv(paths[1], report);
-    writeConvergencePlot(paths[2], report);
+    // A run whose forward model failed from the start has no finite cost to plot: no plot, the report says why.
+    bool finite = false;
+    for (const IterationRecord& h : report.history) finite = finite || std::isfinite(h.cost);
+    if (finite) {
+        paths.push_back((d / (stem + "_convergence.png")).string());
+        writeConvergencePlot(paths.back(), report);
+    }
     return paths;
 }
 

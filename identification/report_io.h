@@ -24,6 +24,7 @@ void writeHistoryCsv(const std::string& path, const IdentificationReport& report
 /// PNG of the residual norm ||r|| [N] against the iteration, log y (zeros drawn at 1e-12 N).
 void writeConvergencePlot(const std::string& path, const IdentificationReport& report);
 /// Writes <dir>/<stem>.json, <dir>/<stem>_history.csv and <dir>/<stem>_convergence.png; returns the paths.
+/// (The convergence plot is left out when no iteration has a finite cost.)
 std::vector<std::string> writeReportFiles(const IdentificationReport& report, const std::string& dir,
                                           const std::string& stem = "identification");
 /// A few lines for a terminal: stop reason, estimate with intervals, residuals, cost, counts (SI).

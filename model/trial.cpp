@@ -81,6 +81,10 @@ std::vector<ActivationProfile> readActivationProfiles(const ArmSetup& setup, con
 
 void IsometricTrialSettings::validate(const ArmParameters& arm) const {
     checkElbowAngle("elbow_angle_deg", elbowAngle, arm);
+    if (radToDeg(elbowAngle) >= 180 - 1e-9)  // the straight-line biceps passes through the joint there
+        throw FieldError("elbow_angle_deg", "= " + formatNumber(radToDeg(elbowAngle)) +
+                                                ": an isometric trial reads the biceps force as torque / moment arm, and the "
+                                                "moment arm vanishes at full extension: expected an angle below 180 deg");
     checkField("activation", activation, Bound::closed(0, 1));
     checkField("antagonist_activation", antagonistActivation, Bound::closed(0, 1));
     checkField("rest", restDuration, Bound::positive("s"));
@@ -88,6 +92,7 @@ void IsometricTrialSettings::validate(const ArmParameters& arm) const {
     checkField("hold", holdDuration, Bound::positive("s"));
     checkField("sample_rate", sampleRate, Bound::positive("Hz"));
     checkField("averaging_window", averagingWindow, {0, holdDuration, true, false, "s, within the hold"});
+    calcNumSamples(getDuration(), sampleRate);
     integration.validate();
 }
 
@@ -256,6 +261,7 @@ void FreeMovementSettings::validate(const ArmParameters& arm) const {
     checkField("duration", duration, Bound::positive("s"));
     checkField("hand_load", handLoad, Bound::closed(0, 50, "kg"));
     checkField("sample_rate", sampleRate, Bound::positive("Hz"));
+    calcNumSamples(duration, sampleRate);
     integration.validate();
 }
 

@@ -123,6 +123,7 @@ void MuscleIsometricSettings::validate(const VirtualMuscle& muscle) const {
     muscle.checkPathLength(pathLength);
     checkField("duration", duration, Bound::positive("s"));
     checkField("sample_rate", sampleRate, Bound::positive("Hz"));
+    calcNumSamples(duration, sampleRate);
     integration.validate();
 }
 

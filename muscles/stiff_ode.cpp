@@ -21,12 +21,21 @@ void IntegrationSettings::validate() const {
         checkField("max_step", maxStepSize, Bound{kMinStepSize, 1e300, false, false, "s, 0 or at least the 1e-12 s minimum step"});
 }
 
+long calcNumSamples(double duration, double sampleRate) {
+    const double n = std::round(duration * sampleRate) + 1;
+    if (!(n <= kMaxSamples))
+        throw InputError("duration " + formatNumber(duration) + " s x sample_rate " + formatNumber(sampleRate) +
+                         " Hz = " + formatNumber(n) + " samples: expected at most " + formatNumber(kMaxSamples) +
+                         " (lower the sample rate or the duration)");
+    return long(n);
+}
+
 namespace detail {
 
 SampledRun::SampledRun(double t0, double duration, double sampleRate, const std::vector<double>& breakpoints,
                        int size)
     : t0_(t0), tEnd_(t0 + duration), rate_(sampleRate), eps_(1e-9 / sampleRate),
-      numSamples_(std::lround(duration * sampleRate) + 1), ya_(size), yda_(size), y_(size) {
+      numSamples_(calcNumSamples(duration, sampleRate)), ya_(size), yda_(size), y_(size) {
     for (double b : breakpoints)
         if (b > t0 + eps_ && b < tEnd_ - eps_) cuts_.push_back(b);
     std::sort(cuts_.begin(), cuts_.end());

@@ -26,6 +26,14 @@ struct IntegrationSettings {
     void validate() const;
 };
 
+/// Most samples one sampled run records (10 million rows; a 33-column arm trial table is then 2.6 GB).
+constexpr double kMaxSamples = 1e7;
+
+/// Samples of a sampled run of `duration` at `sampleRate`: round(duration x rate) + 1. InputError
+/// naming both values and the count when it exceeds kMaxSamples (a typo like --rate 1e12 would
+/// otherwise exhaust memory or run for days).
+long calcNumSamples(double duration, double sampleRate);
+
 /// What an integration cost.
 struct IntegrationStats {
     int steps = 0;              ///< internal steps taken

@@ -1,0 +1,177 @@
+// The bad-input catalogue (issue 15): every command and file kind fed missing, empty, binary, mistyped,
+// out-of-range, huge and unknown input. Each case asserts exit code 2 (bad input), a message naming the
+// option, file, field or line together with the value and what was expected, and that nothing was
+// written: the case's output folder does not exist afterwards.
+#include "tests/support/run_armsim.h"
+#include "tests/support/temp_files.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace {
+
+namespace fs = std::filesystem;
+using armsim::testing::CommandResult;
+using armsim::testing::runArmsim;
+
+struct BadInput {
+    std::string name;                           ///< test case name
+    std::map<std::string, std::string> files;   ///< input files (name -> text) written into IN
+    std::string args;                           ///< IN and OUT are replaced by the case's folders
+    std::vector<std::string> expected;          ///< fragments the message must contain
+};
+
+void PrintTo(const BadInput& c, std::ostream* os) { *os << c.name << ": armsim " << c.args; }
+
+std::string replaceAll(std::string s, const std::string& from, const std::string& to) {
+    for (std::size_t at = s.find(from); at != std::string::npos; at = s.find(from, at + to.size())) s.replace(at, from.size(), to);
+    return s;
+}
+
+const std::string kProtocolHead =
+    "name: bad\nkind: mvc\nseed: 1\nsubject:\n  arm: arm/default_male.yaml\n  muscle: muscles/biceps_long_head.yaml\n";
+const std::string kTrial = "trial:\n  rest: 0.5\n  hold: 1.0\n  averaging_window: 0.5\n";
+const std::string kAngles = "conditions:\n  elbow_angles_deg: [90]\n";
+const std::string kTorqueHead = "kind: torque\nname: bad\n";
+const std::string kStudyHead = "kind: study\nname: bad\nsubjects: 1\nprotocols: [thesis]\nnoise_levels: [0.02]\n";
+
+std::vector<BadInput> makeCatalogue() {
+    const std::string binary("\x7f" "ELF\x02\x01\x01\0\0\0\xff\xfe", 12);
+    return {
+        // ---- command line -----------------------------------------------------------------------
+        {"UnknownCommand", {}, "nosuch", {"unknown command 'nosuch'", "expected one of", "muscle"}},
+        {"UnknownOption", {}, "muscle steady --foo 1", {"--foo"}},
+        {"NotANumber", {}, "muscle steady --path abc", {"--path", "abc"}},
+        {"MissingOptionValue", {}, "muscle steady --path", {"--path"}},
+        {"ActivationAboveOne", {}, "muscle steady --activation 1.5", {"activation", "1.5", "[0, 1]"}},
+        {"ActivationNan", {}, "muscle steady --activation nan", {"activation", "nan"}},
+        {"NegativePath", {}, "muscle steady --path -1", {"-1"}},
+        {"ZeroMass", {}, "muscle steady --mass 0", {"--mass", "= 0", "(0, 100] (kg)"}},
+        {"HugeMass", {}, "muscle steady --mass 1e300", {"--mass", "1e+300", "(0, 100] (kg)"}},
+        {"NegativeSlowUnits", {}, "muscle steady --slow-units -1", {"--slow-units", "-1", "[0, 1000]"}},
+        {"TendonTooLong", {}, "muscle steady --tendon-length 5", {"--tendon-length", "= 5", "(0, 2] (m)"}},
+        {"UnknownModel", {}, "muscle steady --model no_such_model", {"no_such_model"}},
+        // ---- muscle files ----------------------------------------------------------------------
+        {"MuscleFileMissing", {}, "muscle steady --muscle IN/missing.yaml", {"missing.yaml"}},
+        {"MuscleFileEmpty", {{"m.yaml", ""}}, "muscle steady --muscle IN/m.yaml", {"m.yaml"}},
+        {"MuscleFileBinary", {{"m.yaml", binary}}, "muscle steady --muscle IN/m.yaml", {"m.yaml"}},
+        {"MuscleFileNotYaml", {{"m.yaml", "mass: [1, 2\n"}}, "muscle steady --muscle IN/m.yaml", {"m.yaml:2", "invalid YAML"}},
+        // ---- trials and their sizes ------------------------------------------------------------
+        {"TrialRateHuge", {}, "muscle trial --rate 1e12 --out OUT/t.csv", {"sample_rate 1e+12 Hz", "samples", "at most 1e+07"}},
+        {"TrialDurationHuge", {}, "muscle trial --duration 1e9 --out OUT/t.csv", {"duration 1e+09 s", "at most 1e+07"}},
+        {"TrialDurationNegative", {}, "muscle trial --duration -1 --out OUT/t.csv", {"duration", "-1"}},
+        {"TrialActivationBad", {}, "muscle trial --activation 2 --out OUT/t.csv", {"activation", "= 2"}},
+        {"TrialOutUnwritable", {}, "muscle trial --duration 0.1 --out /proc/armsim/t.csv", {"/proc/armsim/t.csv", "cannot write"}},
+        {"SweepStepTiny", {}, "muscle sweep --step 1e-9 --out OUT/s.csv", {"--step 1e-09", "at most 1000001"}},
+        {"SweepStepZero", {}, "muscle sweep --step 0 --out OUT/s.csv", {"--step", "= 0"}},
+        {"ArmAngleFullExtension", {}, "trial --angle 180 --out OUT/t.csv", {"elbow_angle_deg", "= 180", "below 180"}},
+        {"ArmAngleOutsideRange", {}, "trial --angle 10 --out OUT/t.csv", {"elbow_angle_deg", "= 10"}},
+        {"ArmActivationNegative", {}, "trial --activation -0.1 --out OUT/t.csv", {"activation", "-0.1", "[0, 1]"}},
+        {"ArmHoldZero", {}, "trial --hold 0 --out OUT/t.csv", {"hold", "= 0"}},
+        {"ArmRateHuge", {}, "trial --rate 1e12 --out OUT/t.csv", {"sample_rate 1e+12 Hz", "at most 1e+07"}},
+        {"ArmTypeUnknown", {}, "trial --type sideways --out OUT/t.csv", {"--type", "sideways"}},
+        {"TrialSettingsMissing", {}, "trial --settings IN/none.yaml --out OUT/t.csv", {"none.yaml"}},
+        {"TrialSettingsUnknownKey", {{"s.yaml", "type: isometric\nweather: sunny\n"}},
+         "trial --settings IN/s.yaml --out OUT/t.csv", {"s.yaml:2", "unknown field 'weather'"}},
+        // ---- protocol files --------------------------------------------------------------------
+        {"ProtocolMissing", {}, "protocol IN/none.yaml --out OUT/run", {"none.yaml"}},
+        {"ProtocolEmpty", {{"p.yaml", ""}}, "protocol IN/p.yaml --out OUT/run", {"p.yaml"}},
+        {"ProtocolBinary", {{"p.yaml", binary}}, "protocol IN/p.yaml --out OUT/run", {"p.yaml"}},
+        {"ProtocolUnknownKey", {{"p.yaml", kProtocolHead + kTrial + kAngles + "colour: blue\n"}},
+         "protocol IN/p.yaml --out OUT/run", {"p.yaml", "colour"}},
+        {"ProtocolHoldNegative", {{"p.yaml", kProtocolHead + "trial:\n  hold: -3\n" + kAngles}},
+         "protocol IN/p.yaml --out OUT/run", {"p.yaml", "hold", "-3"}},
+        {"ProtocolHoldHuge", {{"p.yaml", kProtocolHead + "trial:\n  hold: 1.0e9\n" + kAngles}},
+         "protocol IN/p.yaml --out OUT/run", {"samples", "at most 1e+07"}},
+        {"ProtocolAngleOutOfRange", {{"p.yaml", kProtocolHead + kTrial + "conditions:\n  elbow_angles_deg: [200]\n"}},
+         "protocol IN/p.yaml --out OUT/run", {"p.yaml", "200"}},
+        {"ProtocolWrongType", {{"p.yaml", kProtocolHead + "trial:\n  hold: long\n" + kAngles}},
+         "protocol IN/p.yaml --out OUT/run", {"p.yaml", "hold", "long"}},
+        {"TorqueProtocolLevelAboveOne",
+         {{"p.yaml", kTorqueHead + "conditions:\n  - {flexion_deg: 90, effort: flexion, level: 1.5, repetitions: 3}\n"}},
+         "protocol IN/p.yaml --out OUT/run", {"p.yaml", "level", "1.5"}},
+        // ---- force data (identify) -------------------------------------------------------------
+        {"ForceDataMissing", {}, "identify IN/none.csv --out OUT/id", {"none.csv", "no such file"}},
+        {"ForceDataEmpty", {{"d.csv", ""}}, "identify IN/d.csv --out OUT/id", {"d.csv"}},
+        {"ForceDataBinary", {{"d.csv", binary}}, "identify IN/d.csv --out OUT/id", {"d.csv"}},
+        {"ForceDataUnknownColumn", {{"d.csv", "path_cm,force_N,emg\n41,600,1\n"}}, "identify IN/d.csv --out OUT/id",
+         {"d.csv", "unknown column 'emg'"}},
+        {"ForceDataTruncatedRow", {{"d.csv", "path_cm,force_N\n41,600\n37.5\n"}}, "identify IN/d.csv --out OUT/id",
+         {"d.csv:3"}},
+        {"ForceDataNan", {{"d.csv", "path_cm,force_N\n41,nan\n37.5,458\n"}}, "identify IN/d.csv --out OUT/id",
+         {"d.csv:2", "force_N"}},
+        {"ForceDataHuge", {{"d.csv", "path_cm,force_N\n41,1e308\n37.5,458\n"}}, "identify IN/d.csv --out OUT/id",
+         {"d.csv:2", "force_N", "1e+308", "at most 1e5 N"}},
+        {"ForceDataNegative", {{"d.csv", "path_cm,force_N\n41,-600\n37.5,458\n"}}, "identify IN/d.csv --out OUT/id",
+         {"d.csv:2", "force_N", "-600", ">= 0"}},
+        {"ForceDataAngleOutOfRange", {{"d.csv", "angle_deg,force_N\n200,600\n90,458\n"}}, "identify IN/d.csv --out OUT/id",
+         {"d.csv:2", "angle_deg", "200", "(0, 180]"}},
+        {"IdentifyMethodUnknown", {}, "identify measured/thesis_measured.csv --method newton --out OUT/id", {"--method", "newton"}},
+        {"IdentifyBoundsNotANumber", {}, "identify measured/thesis_measured.csv --bounds mass=abc:1 --out OUT/id",
+         {"--bounds mass lower", "abc"}},
+        {"IdentifyOutIsAFile", {{"afile", "x"}}, "identify measured/thesis_measured.csv --out IN/afile/id",
+         {"--out", "afile", "not a folder"}},
+        // ---- torque data, validation, design, studies ------------------------------------------
+        {"TorqueDataMissing", {}, "identify-torque IN/none.csv --out OUT/it", {"none.csv"}},
+        {"TorqueDataWrongSign", {{"t.csv", "flexion_deg,torque_Nm\n90,-40\n"}}, "identify-torque IN/t.csv --out OUT/it",
+         {"t.csv:2", "torque_Nm", "-40"}},
+        {"TorqueNoiseLevelOutOfRange", {}, "identify-torque measured/thesis_mvc_torque.csv --noise-level 2 --out OUT/it",
+         {"--noise-level", "2"}},
+        {"ValidateNoiseNotANumber", {}, "validate --noise abc --out OUT/v", {"--noise", "abc"}},
+        {"ValidateSubjectsZero", {}, "validate --truth elbow --subjects 0 --out OUT/v", {"--subjects", "0"}},
+        {"ValidateOutIsAFile", {{"afile", "x"}}, "validate --seeds 0 --noise 0 --out IN/afile", {"--out", "not a folder"}},
+        {"DesignTrialsZero", {}, "design --trials 0 --out OUT/d", {"--trials", "0"}},
+        {"DesignAnglesNotNumbers", {}, "design --angles 30,abc --out OUT/d", {"--angles", "abc"}},
+        {"StudyMissing", {}, "study IN/none.yaml --out OUT/s", {"none.yaml"}},
+        {"StudyUnknownKey", {{"s.yaml", kStudyHead + "methods:\n  - {method: thesis}\nweather: rain\n"}},
+         "study IN/s.yaml --out OUT/s", {"s.yaml", "weather"}},
+        {"StudyNoiseOutOfRange", {{"s.yaml", "kind: study\nname: bad\nsubjects: 1\nprotocols: [thesis]\nnoise_levels: [3]\n"
+                                            "methods:\n  - {method: thesis}\n"}},
+         "study IN/s.yaml --out OUT/s", {"s.yaml", "noise_levels", "3"}},
+        // ---- render and model ------------------------------------------------------------------
+        {"RenderTableMissing", {}, "render IN/none.csv --out OUT/v.mp4", {"none.csv"}},
+        {"RenderTableWithoutStates", {{"t.csv", "time_s,activation\n0,0\n0.1,1\n"}}, "render IN/t.csv --out OUT/v.mp4",
+         {"t.csv", "column"}},
+        {"RenderCodecUnknown", {{"t.csv", "time_s\n0\n"}}, "render IN/t.csv --out OUT/v.mp4 --codec vp9",
+         {"field 'codec' = 'vp9'", "expected one of"}},
+        {"ModelShowUnknown", {}, "model show no_such_model --out OUT/m", {"no_such_model"}},
+    };
+}
+
+class BadInputCatalogue : public ::testing::TestWithParam<BadInput> {};
+
+TEST_P(BadInputCatalogue, ExitsTwoNamesTheInputAndWritesNothing) {
+    const BadInput& c = GetParam();
+    const fs::path d = armsim::testing::makeFreshDir("bad_input", c.name);
+    fs::create_directories(d / "in");
+    for (const auto& [file, text] : c.files) std::ofstream(d / "in" / file, std::ios::binary) << text;
+    const std::string args = replaceAll(replaceAll(c.args, "IN", (d / "in").string()), "OUT", (d / "out").string());
+    const CommandResult r = runArmsim(args);
+    EXPECT_EQ(r.exitCode, 2) << args << "\n" << r.output;
+    for (const std::string& fragment : c.expected)
+        EXPECT_NE(r.output.find(fragment), std::string::npos) << "missing '" << fragment << "' for: " << args << "\n" << r.output;
+    EXPECT_FALSE(fs::exists(d / "out")) << "output left behind by: " << args;
+    EXPECT_EQ(r.output.find("internal error"), std::string::npos) << r.output;
+    fs::remove_all(d);
+}
+
+INSTANTIATE_TEST_SUITE_P(Cases, BadInputCatalogue, ::testing::ValuesIn(makeCatalogue()),
+                         [](const ::testing::TestParamInfo<BadInput>& info) { return info.param.name; });
+
+TEST(BadInputCatalogue, HasAtLeastFiftyCasesOverEveryCommand) {
+    const std::vector<BadInput> all = makeCatalogue();
+    EXPECT_GE(all.size(), 50u);
+    for (const char* command : {"muscle steady", "muscle trial", "muscle sweep", "trial", "protocol", "identify ",
+                                "identify-torque", "validate", "design", "study", "render", "model show"}) {
+        bool found = false;
+        for (const BadInput& c : all) found = found || c.args.rfind(command, 0) == 0;
+        EXPECT_TRUE(found) << command;
+    }
+}
+
+}  // namespace
