@@ -1,13 +1,44 @@
 // armsim: musculoskeletal arm simulation with a Virtual Muscle biceps.
 // Exit codes: 0 done, 2 bad input (options, files; the message names the option or file, the value and
-// what was expected), 3 a simulation that cannot go on, 4 an internal error.
+// what was expected), 3 a simulation that cannot go on, 4 an internal error, 128 + signal when stopped
+// by SIGINT or SIGTERM (after removing the partial output of the run in progress).
 #include "cli/commands.h"
 #include "muscles/param_file.h"
 
+#include <pthread.h>
+
+#include <csignal>
+#include <cstdio>
+#include <ctime>
 #include <filesystem>
 #include <iostream>
+#include <thread>
 
 namespace {
+
+/// SIGINT and SIGTERM are taken by a thread of their own (they are blocked in every other thread): the
+/// first asks the run to stop at its next task boundary (checkInterruption), whose writers then remove
+/// their partial output; a second signal, or a run that has not stopped after 10 s, ends the process
+/// at once (a protocol run's leftover temporary folder is removed by the next run).
+void startSignalThread() {
+    sigset_t set;
+    sigemptyset(&set);
+    sigaddset(&set, SIGINT);
+    sigaddset(&set, SIGTERM);
+    pthread_sigmask(SIG_BLOCK, &set, nullptr);
+    std::thread([set] {
+        int sig = 0;
+        if (sigwait(&set, &sig) != 0) return;
+        armsim::requestInterruption(sig);
+        std::fprintf(stderr, "\narmsim: interrupted: stopping after the current task (again to stop at once)\n");
+        const timespec wait{10, 0};
+        siginfo_t info;
+        sigtimedwait(&set, &info, &wait);
+        std::signal(sig, SIG_DFL);
+        pthread_sigmask(SIG_UNBLOCK, &set, nullptr);
+        std::raise(sig);
+    }).detach();
+}
 
 /// "unknown command 'x': expected one of ..." when the first argument that is not an option names no
 /// subcommand (CLI11 would say only that a subcommand is required).
@@ -28,6 +59,7 @@ std::string findUnknownCommand(const CLI::App& app, int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
+    startSignalThread();
     CLI::App app{"armsim: a Simbody elbow with a Virtual Muscle biceps (simulate, identify, render)"};
     app.require_subcommand(1);
     app.set_version_flag("--version", std::string("armsim ") + ARMSIM_VERSION);
@@ -51,6 +83,9 @@ int main(int argc, char** argv) {
     } catch (const std::filesystem::filesystem_error& e) {
         std::cerr << "armsim: error: cannot use '" << e.path1().string() << "': " << e.code().message() << "\n";
         return 2;
+    } catch (const armsim::InterruptedError& e) {
+        std::cerr << "armsim: " << e.what() << "; the run's partial output was removed\n";
+        return 128 + armsim::getInterruption();
     } catch (const armsim::SimulationError& e) {
         std::cerr << "armsim: simulation failed: " << e.what() << "\n";
         return 3;

@@ -8,14 +8,17 @@
 
 #include <nlohmann/json.hpp>
 
+#include <signal.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <mutex>
 #include <set>
-#include <unistd.h>
 
 #ifndef ARMSIM_VERSION
 #define ARMSIM_VERSION "unknown"
@@ -127,6 +130,7 @@ public:
         std::error_code ec;
         fs::create_directories(parent, ec);
         const std::string stem = "." + target_.filename().string();
+        removeStaleLeftovers(parent, stem);
         temp_ = parent / (stem + ".partial." + std::to_string(::getpid()));
         old_ = parent / (stem + ".old." + std::to_string(::getpid()));
         fs::remove_all(temp_, ec);
@@ -177,6 +181,30 @@ public:
     }
 
 private:
+    /// What a run killed before its cleanup (SIGKILL, a second Ctrl-C) left beside the target:
+    /// <stem>.partial.<pid> folders of processes that no longer exist are removed; a <stem>.old.<pid>
+    /// folder holds the earlier run, moved aside just before the kill: moved back when the target is
+    /// missing, removed otherwise.
+    void removeStaleLeftovers(const fs::path& parent, const std::string& stem) const {
+        std::error_code ec;
+        std::vector<fs::path> entries;
+        for (const fs::directory_entry& e : fs::directory_iterator(parent, ec)) entries.push_back(e.path());
+        for (const fs::path& p : entries) {
+            const std::string name = p.filename().string();
+            for (const std::string kind : {".partial.", ".old."}) {
+                const std::string prefix = stem + kind;
+                if (name.rfind(prefix, 0) != 0) continue;
+                const std::string digits = name.substr(prefix.size());
+                if (digits.empty() || digits.size() > 9 || digits.find_first_not_of("0123456789") != std::string::npos)
+                    continue;
+                const pid_t pid = pid_t(std::stol(digits));
+                if (pid == ::getpid() || ::kill(pid, 0) == 0 || errno == EPERM) continue;  // its process still runs
+                if (kind == ".old." && !fs::exists(target_, ec)) fs::rename(p, target_, ec);
+                else fs::remove_all(p, ec);
+            }
+        }
+    }
+
     void checkReplaceable() const {
         std::error_code ec;
         if (!fs::exists(target_, ec)) return;

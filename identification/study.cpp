@@ -217,6 +217,7 @@ StudyTask getStudyTask(const Study& s, long index) {
 }
 
 std::vector<StudyResult> runStudyGroup(const Study& study, long group, const std::vector<long>& tasks, int rank) {
+    checkInterruption();
     using Clock = std::chrono::steady_clock;
     const int P = int(study.protocols.size());
     const int subject = int(group / P), protocol = int(group % P);
@@ -228,6 +229,8 @@ std::vector<StudyResult> runStudyGroup(const Study& study, long group, const std
     try {
         v = drawSubject(study.population, study.seed, subject);
         clean = synthesizeTorqueData(v, pr, study.seed, 1);
+    } catch (const InterruptedError&) {
+        throw;  // not a failed task: the study stops and resumes later
     } catch (const std::exception& e) {
         synthesisError = std::string("synthesis: ") + e.what();
     }
@@ -249,6 +252,8 @@ std::vector<StudyResult> runStudyGroup(const Study& study, long group, const std
                 auto it = noisy.find(t.noise);
                 if (it == noisy.end()) it = noisy.emplace(t.noise, setTransducerNoise(clean, level)).first;
                 e = identifyElbowMethod(m, study.population, it->second, study.seed, subject);
+            } catch (const InterruptedError&) {
+                throw;
             } catch (const std::exception& x) {
                 error = x.what();
             }

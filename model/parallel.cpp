@@ -1,5 +1,7 @@
 #include "model/parallel.h"
 
+#include "muscles/param_file.h"
+
 #include <algorithm>
 #include <atomic>
 #include <condition_variable>
@@ -28,6 +30,7 @@ void runParallel(int n, int jobs, const std::function<void(int)>& task,
         for (int i = next++; i < n; i = next++) {
             if (!stop) {
                 try {
+                    checkInterruption();
                     task(i);
                 } catch (...) {
                     fail();

@@ -2,6 +2,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <atomic>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
@@ -11,6 +12,17 @@
 #include <unistd.h>
 
 namespace armsim {
+
+namespace {
+std::atomic<int> interruption{0};
+}
+
+void requestInterruption(int sig) { interruption.store(sig); }
+int getInterruption() { return interruption.load(); }
+void checkInterruption() {
+    if (const int sig = interruption.load())
+        throw InterruptedError("interrupted by signal " + std::to_string(sig));
+}
 
 std::string formatNumber(double v) {
     char buf[32];

@@ -33,6 +33,21 @@ public:
     using std::runtime_error::runtime_error;
 };
 
+/// A run stopped because the user asked (SIGINT or SIGTERM, see requestInterruption); the work in
+/// progress was abandoned and its partial output removed by the writers' destructors.
+class InterruptedError : public std::runtime_error {
+public:
+    using std::runtime_error::runtime_error;
+};
+
+/// Records that signal `sig` asked the process to stop (async-signal-safe: sets an atomic).
+void requestInterruption(int sig);
+/// The signal that asked to stop, 0 if none.
+int getInterruption();
+/// Throws InterruptedError when an interruption was requested; long loops call it between tasks
+/// (runParallel does before every task).
+void checkInterruption();
+
 /// A value that violates a documented bound. field is the dotted parameter name ("slow.Tf1"), so a
 /// loader can add the file and line where that field was written.
 class FieldError : public InputError {

@@ -6,12 +6,17 @@
 
 #include <gtest/gtest.h>
 
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <array>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <sstream>
 #include <string>
+#include <vector>
 
 namespace fs = std::filesystem;
 
@@ -215,4 +220,101 @@ TEST(Cli, TheCommandDoesNotLoadTheRendererOrMpiUntilAskedTo) {
         runArmsim("render " + (d / "t.csv").string() + " --out " + (d / "v.mp4").string() + " --codec vp9");
     EXPECT_EQ(bad.exitCode, 2) << bad.output;
     EXPECT_NE(bad.output.find("field 'codec' = 'vp9'"), std::string::npos) << bad.output;
+}
+
+// Issue 15: Ctrl-C (SIGINT) stops a protocol run at its next trial, removes its temporary folder and
+// exits 130; a temporary folder left by a process that died without its cleanup (SIGKILL) is removed
+// by the next run in that place, and an earlier run that process had moved aside is not lost.
+TEST(Cli, AnInterruptedProtocolLeavesNothingAndTheNextRunCleansUpAfterAKilledOne) {
+    namespace fs = std::filesystem;
+    const fs::path d = armsim::testing::makeFreshDir("cli", "interrupt");
+    std::ofstream(d / "long.yaml") << "name: long\nkind: mvc\nseed: 1\nrepetitions: 100\nsubject:\n"
+                                      "  arm: arm/default_male.yaml\n  muscle: muscles/biceps_long_head.yaml\n"
+                                      "trial:\n  rest: 0.5\n  hold: 10.0\n  averaging_window: 1.0\n"
+                                      "conditions:\n  elbow_angles_deg: [45, 60, 90, 120, 150]\n";
+    const std::string run = std::string(ARMSIM_EXE) + " protocol " + (d / "long.yaml").string() + " --out " +
+                            (d / "run").string() + " --jobs 2";
+    const armsim::testing::CommandResult r =
+        armsim::testing::runCommand("sh -c '" + run + " & pid=$!; sleep 1; kill -INT $pid; wait $pid; echo rc=$?'");
+    EXPECT_NE(r.output.find("rc=130"), std::string::npos) << r.output;  // 128 + SIGINT: stopped, not finished
+    EXPECT_NE(r.output.find("interrupted by signal 2"), std::string::npos) << r.output;
+    std::vector<std::string> left;
+    for (const auto& e : fs::directory_iterator(d)) left.push_back(e.path().filename().string());
+    EXPECT_EQ(left, std::vector<std::string>{"long.yaml"}) << "left behind: " << left.size() << " entries";
+
+    // Leftovers of a process that no longer exists (a pid that has just exited).
+    const pid_t dead = fork();
+    if (dead == 0) _exit(0);
+    waitpid(dead, nullptr, 0);
+    const std::string tag = std::to_string(dead);
+    fs::create_directories(d / (".quick.partial." + tag) / "trials");
+    fs::create_directories(d / (".quick.old." + tag));
+    std::ofstream(d / (".quick.old." + tag) / "manifest.json") << "{}";  // an earlier run, moved aside
+    const armsim::testing::CommandResult q =
+        runArmsim("protocol protocols/mvc_force_angle.yaml --jobs 2 --out " + (d / "quick").string());
+    ASSERT_EQ(q.exitCode, 0) << q.output;
+    EXPECT_FALSE(fs::exists(d / (".quick.partial." + tag)));
+    EXPECT_FALSE(fs::exists(d / (".quick.old." + tag)));
+    EXPECT_TRUE(fs::exists(d / "quick" / "summary.csv"));
+    fs::remove_all(d);
+}
+
+namespace {
+
+std::string readWhole(const std::filesystem::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+/// The CSV text without one column (a wall time), for comparing runs that differ only in it.
+std::string dropColumn(const std::string& csv, const std::string& column) {
+    std::istringstream in(csv);
+    std::string line, out;
+    int drop = -1;
+    while (std::getline(in, line)) {
+        std::vector<std::string> cells;
+        std::stringstream s(line);
+        for (std::string c; std::getline(s, c, ',');) cells.push_back(c);
+        if (drop < 0)
+            for (std::size_t i = 0; i < cells.size(); ++i)
+                if (cells[i] == column) drop = int(i);
+        for (std::size_t i = 0; i < cells.size(); ++i)
+            if (int(i) != drop) out += cells[i] + ",";
+        out += "\n";
+    }
+    return out;
+}
+
+}  // namespace
+
+// Issue 15: a seeded command run twice (with a different thread count) writes the same bytes: every
+// file of a protocol run (CSVs, .sto, JSON, PNG plots); validation.csv apart from its wall-time column.
+TEST(Cli, SeededCommandsWriteTheSameFilesTwice) {
+    namespace fs = std::filesystem;
+    const fs::path d = armsim::testing::makeFreshDir("cli", "determinism");
+    for (const char* jobs : {"1", "2"}) {
+        const armsim::testing::CommandResult r = runArmsim("protocol protocols/submaximal_emg.yaml --jobs " + std::string(jobs) +
+                                                           " --out " + (d / ("p" + std::string(jobs))).string());
+        ASSERT_EQ(r.exitCode, 0) << r.output;
+    }
+    int files = 0;
+    for (const auto& e : fs::recursive_directory_iterator(d / "p1")) {
+        if (!e.is_regular_file()) continue;
+        const fs::path twin = d / "p2" / fs::relative(e.path(), d / "p1");
+        ASSERT_TRUE(fs::exists(twin)) << twin;
+        EXPECT_TRUE(readWhole(e.path()) == readWhole(twin)) << "differs: " << fs::relative(e.path(), d / "p1");
+        ++files;
+    }
+    EXPECT_GT(files, 20);
+
+    for (const char* jobs : {"1", "2"}) {
+        const armsim::testing::CommandResult r =
+            runArmsim("validate --seeds 1 --noise 0,2 --methods lm,ilc-sign-search --forward steady --jobs " +
+                      std::string(jobs) + " --out " + (d / ("v" + std::string(jobs))).string());
+        ASSERT_EQ(r.exitCode, 0) << r.output;
+    }
+    const std::string v1 = readWhole(d / "v1" / "validation.csv"), v2 = readWhole(d / "v2" / "validation.csv");
+    EXPECT_EQ(dropColumn(v1, "wall_time_s"), dropColumn(v2, "wall_time_s"));
+    EXPECT_NE(dropColumn(v1, "wall_time_s"), dropColumn(v1, "nothing"));  // the column was there and dropped
+    fs::remove_all(d);
 }
