@@ -3,10 +3,13 @@
 // what was expected), 3 a simulation that cannot go on, 4 an internal error, 128 + signal when stopped
 // by SIGINT or SIGTERM (after removing the partial output of the run in progress).
 #include "cli/commands.h"
+#include "cli/plugins.h"
 #include "muscles/param_file.h"
 
 #include <pthread.h>
 
+#include <cerrno>
+#include <chrono>
 #include <csignal>
 #include <cstdio>
 #include <ctime>
@@ -23,17 +26,26 @@ namespace {
 void startSignalThread() {
     sigset_t set;
     sigemptyset(&set);
-    sigaddset(&set, SIGINT);
-    sigaddset(&set, SIGTERM);
+    for (int sig : {SIGINT, SIGTERM}) {
+        struct sigaction old {};
+        sigaction(sig, nullptr, &old);
+        if (old.sa_handler != SIG_IGN) sigaddset(&set, sig);  // ignored (a script's background job): keep it so
+    }
     pthread_sigmask(SIG_BLOCK, &set, nullptr);
     std::thread([set] {
         int sig = 0;
         if (sigwait(&set, &sig) != 0) return;
         armsim::requestInterruption(sig);
-        std::fprintf(stderr, "\narmsim: interrupted: stopping after the current task (again to stop at once)\n");
-        const timespec wait{10, 0};
+        armsim::cli::forwardInterruption(sig);
+        std::fprintf(stderr, "\narmsim: interrupted: stopping at the next step (again to stop at once)\n");
+        timespec wait{10, 0};
         siginfo_t info;
-        sigtimedwait(&set, &info, &wait);
+        const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+        while (sigtimedwait(&set, &info, &wait) < 0 && errno == EINTR) {
+            const auto left = std::chrono::duration<double>(end - std::chrono::steady_clock::now()).count();
+            if (left <= 0) break;
+            wait = timespec{time_t(left), long((left - double(time_t(left))) * 1e9)};
+        }
         std::signal(sig, SIG_DFL);
         pthread_sigmask(SIG_UNBLOCK, &set, nullptr);
         std::raise(sig);
@@ -66,6 +78,7 @@ int main(int argc, char** argv) {
     armsim::cli::addRegisteredCommands(app);
     try {
         app.parse(argc, argv);
+        armsim::checkInterruption();  // a command that finished its work after Ctrl-C still reports the stop
     } catch (const CLI::CallForHelp& e) {
         return app.exit(e);
     } catch (const CLI::CallForAllHelp& e) {
@@ -84,7 +97,7 @@ int main(int argc, char** argv) {
         std::cerr << "armsim: error: cannot use '" << e.path1().string() << "': " << e.code().message() << "\n";
         return 2;
     } catch (const armsim::InterruptedError& e) {
-        std::cerr << "armsim: " << e.what() << "; the run's partial output was removed\n";
+        std::cerr << "armsim: " << e.what() << ": stopped (unfinished output removed; a study resumes from its journal)\n";
         return 128 + armsim::getInterruption();
     } catch (const armsim::SimulationError& e) {
         std::cerr << "armsim: simulation failed: " << e.what() << "\n";

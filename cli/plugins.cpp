@@ -11,16 +11,29 @@
 
 #include <filesystem>
 #include <mutex>
+#include <vector>
 
 namespace armsim::cli {
 
 namespace {
 
-/// The folder of the running executable (plugins are built beside it).
+std::mutex gMutex;
+std::vector<void (*)(int)> gInterruptionSinks;  // the loaded plugins' requestInterruption
+int gForwarded = 0;
+
+/// The folder of the running executable (plugins are built beside it); empty when unknown (then no
+/// plugin is loaded: never from the current folder).
 std::string findExecutableFolder() {
     std::error_code ec;
     const std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", ec);
-    return ec ? std::string(".") : exe.parent_path().string();
+    return ec ? std::string() : exe.parent_path().string();
+}
+
+void addInterruptionSink(void (*sink)(int)) {
+    if (!sink) return;
+    const std::lock_guard<std::mutex> lock(gMutex);
+    gInterruptionSinks.push_back(sink);
+    if (gForwarded) sink(gForwarded);
 }
 
 /// dlopen(file beside the executable, else ARMSIM_PLUGIN_DIR/file) and dlsym(symbol); the entry
@@ -28,10 +41,12 @@ std::string findExecutableFolder() {
 const void* loadPluginApi(const char* file, const char* symbol, std::string& why) {
     static std::mutex mutex;
     const std::lock_guard<std::mutex> lock(mutex);
-    std::vector<std::string> candidates = {findExecutableFolder() + "/" + file};
-#ifdef ARMSIM_PLUGIN_DIR
-    candidates.push_back(std::string(ARMSIM_PLUGIN_DIR) + "/" + file);
-#endif
+    const std::string folder = findExecutableFolder();
+    if (folder.empty()) {
+        why = "the executable's folder is unknown (/proc/self/exe unreadable)";
+        return nullptr;
+    }
+    const std::vector<std::string> candidates = {folder + "/" + file};
     for (const std::string& path : candidates) {
         if (!std::filesystem::exists(path)) continue;
         void* handle = dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);
@@ -53,6 +68,12 @@ const void* loadPluginApi(const char* file, const char* symbol, std::string& why
 
 }  // namespace
 
+void forwardInterruption(int sig) {
+    const std::lock_guard<std::mutex> lock(gMutex);
+    gForwarded = sig;
+    for (void (*sink)(int) : gInterruptionSinks) sink(sig);
+}
+
 const RenderPlugin& getRenderPlugin(const std::string& option) {
 #ifdef ARMSIM_WITH_RENDER
     std::string why;
@@ -61,6 +82,8 @@ const RenderPlugin& getRenderPlugin(const std::string& option) {
     if (p->abiVersion != kRenderPluginAbi)
         throw InputError(option + ": the renderer plugin is from another build (interface " +
                          std::to_string(p->abiVersion) + ", expected " + std::to_string(kRenderPluginAbi) + "): rebuild");
+    static std::once_flag once;
+    std::call_once(once, [p] { addInterruptionSink(p->requestInterruption); });
     return *p;
 #else
     throw InputError(option + ": this armsim was built without the renderer (-DARMSIM_RENDER=OFF)");
@@ -74,6 +97,8 @@ const StudyMpiPlugin& getStudyMpiPlugin() {
         throw InputError("this armsim has no MPI (" + why + "; install libopenmpi-dev and rebuild); run the study "
                          "without mpirun to use threads");
     if (p->abiVersion != kStudyMpiPluginAbi) throw InputError("the MPI plugin is from another build: rebuild");
+    static std::once_flag once;
+    std::call_once(once, [p] { addInterruptionSink(p->requestInterruption); });
     return *p;
 }
 

@@ -15,6 +15,10 @@ namespace armsim::cli {
 /// with -DARMSIM_RENDER=OFF, or the plugin file missing beside the executable).
 const RenderPlugin& getRenderPlugin(const std::string& option);
 
+/// Passes an interruption (SIGINT/SIGTERM) on to every plugin loaded now or later: each holds its own
+/// copy of the interruption flag.
+void forwardInterruption(int sig);
+
 /// Studies over MPI ranks (identification/study_mpi.h). InputError saying how to get MPI when the
 /// plugin is missing (built without libopenmpi-dev).
 const StudyMpiPlugin& getStudyMpiPlugin();

@@ -74,8 +74,9 @@ std::vector<double> parseNumberList(const std::string& option, const std::string
 
 void checkOutputFolder(const std::string& option, const std::string& dir) {
     namespace fs = std::filesystem;
+    if (dir.empty()) throw InputError(option + " is empty: expected a folder path");
     std::error_code ec;
-    fs::path p = fs::absolute(dir.empty() ? "." : dir, ec);
+    fs::path p = fs::absolute(dir, ec);
     const fs::path given = p;
     while (!fs::exists(p, ec) && p.has_parent_path() && p != p.parent_path()) p = p.parent_path();
     if (!fs::is_directory(p, ec))

@@ -21,6 +21,7 @@ std::string formatStorage(const Table& t, const std::string& name, bool inDegree
 }
 
 Table readStorage(const std::string& path, StorageHeader* header) {
+    checkInputFile(path, std::uintmax_t(4) << 30);
     std::ifstream in(path);
     if (!in) throw InputError(path + ": cannot open file (does it exist and is it readable?)");
     StorageHeader h;

@@ -26,7 +26,7 @@ const FibreType& fibreTypeOf(const VirtualMuscle& muscle, int unit) {
 
 void SurfaceEmgSettings::validate() const {
     acquisition.validate();
-    checkField("internal_rate", internalRate, Bound::positive("Hz"));
+    checkField("internal_rate", internalRate, Bound::closed(1, 1e6, "Hz"));
     const double ratio = internalRate / acquisition.outputRate;
     if (std::round(ratio) < 1 || std::abs(ratio - std::round(ratio)) > 1e-9 * ratio)
         throw FieldError("internal_rate", "= " + std::to_string(internalRate) +

@@ -198,7 +198,8 @@ private:
                 if (digits.empty() || digits.size() > 9 || digits.find_first_not_of("0123456789") != std::string::npos)
                     continue;
                 const pid_t pid = pid_t(std::stol(digits));
-                if (pid == ::getpid() || ::kill(pid, 0) == 0 || errno == EPERM) continue;  // its process still runs
+                // Ours are stale too: this run has not made its folders yet (pids repeat in containers).
+                if (pid != ::getpid() && (::kill(pid, 0) == 0 || errno == EPERM)) continue;  // its process still runs
                 if (kind == ".old." && !fs::exists(target_, ec)) fs::rename(p, target_, ec);
                 else fs::remove_all(p, ec);
             }

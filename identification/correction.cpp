@@ -65,6 +65,10 @@ IdentificationReport identifyCorrected(const IdentificationProblem& problem, con
         ++fineEvaluations;
         try {
             fineForces = fine.calcForces(report.muscle, obs);
+        } catch (const InterruptedError&) {
+            throw;
+        } catch (const InputError&) {
+            throw;
         } catch (const std::exception& e) {
             failure = std::string("the ") + fine.getName() + " model failed at correction " + std::to_string(j + 1) +
                       ": " + e.what();

@@ -134,6 +134,10 @@ bool SolverContext::calcResiduals(const std::vector<double>& x, std::vector<doub
                                 fmt(observations[k].activation) + " for " + describe(x);
             }
         }
+    } catch (const InterruptedError&) {
+        throw;  // the user stopped the run: not a model failure
+    } catch (const InputError&) {
+        throw;  // bad input (a protocol beyond the sample limit, an angle the arm cannot take): not a model failure
     } catch (const std::exception& e) {
         entry.ok = false;
         entry.failure = std::string("the ") + model.getName() + " model failed for " + describe(x) + ": " + e.what();
@@ -364,6 +368,10 @@ void addModelCheck(IdentificationReport& report, const ForceModel& model, const 
         }
         c.rmsResidual = std::sqrt(ssr / double(n));
         if (!std::isfinite(c.rmsResidual)) c.failure = "no solution at some observation (NaN force)";
+    } catch (const InterruptedError&) {
+        throw;
+    } catch (const InputError&) {
+        throw;
     } catch (const std::exception& e) {
         c.failure = e.what();
     }

@@ -1,5 +1,7 @@
 #include "identification/study_mpi.h"
 
+#include "muscles/param_file.h"
+
 #include <mpi.h>
 
 #include <chrono>
@@ -105,6 +107,10 @@ std::optional<std::pair<Study, StudyOutcome>> runStudyOnMpi(const std::string& s
             Worker link(rank);
             runStudyWorker(study, o.threads, link);
         }
+    } catch (const InterruptedError& e) {
+        std::fprintf(stderr, "rank %d: %s; the journal keeps every finished group\n", rank, e.what());
+        std::fflush(stderr);
+        MPI_Abort(MPI_COMM_WORLD, 128 + getInterruption());
     } catch (const std::exception& e) {
         std::fprintf(stderr, "error (rank %d): %s\n", rank, e.what());
         std::fflush(stderr);
@@ -117,6 +123,7 @@ std::optional<std::pair<Study, StudyOutcome>> runStudyOnMpi(const std::string& s
 }  // namespace armsim
 
 extern "C" __attribute__((visibility("default"))) const armsim::StudyMpiPlugin* armsim_get_study_mpi_plugin() {
-    static const armsim::StudyMpiPlugin plugin{armsim::kStudyMpiPluginAbi, &armsim::runStudyOnMpi};
+    static const armsim::StudyMpiPlugin plugin{armsim::kStudyMpiPluginAbi, &armsim::runStudyOnMpi,
+                                               &armsim::requestInterruption};
     return &plugin;
 }

@@ -24,9 +24,11 @@ struct StudyMpiPlugin {
     int abiVersion = 0;  ///< kStudyMpiPluginAbi of the plugin's build
     std::optional<std::pair<Study, StudyOutcome>> (*runStudyOnMpi)(const std::string& studyFile,
                                                                    const StudyRunOptions& options) = nullptr;
+    /// The plugin's own copy of requestInterruption (it links its own ground-floor code).
+    void (*requestInterruption)(int sig) = nullptr;
 };
 
-constexpr int kStudyMpiPluginAbi = 1;
+constexpr int kStudyMpiPluginAbi = 2;
 constexpr const char* kStudyMpiPluginFile = "libarmsim_study_mpi.so";
 constexpr const char* kStudyMpiPluginSymbol = "armsim_get_study_mpi_plugin";
 

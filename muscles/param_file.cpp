@@ -17,6 +17,16 @@ namespace {
 std::atomic<int> interruption{0};
 }
 
+void checkInputFile(const std::string& path, std::uintmax_t maxBytes) {
+    std::error_code ec;
+    if (std::filesystem::exists(path, ec) && !std::filesystem::is_regular_file(path, ec))
+        throw InputError(path + ": not a regular file (a folder, device or pipe): expected a file");
+    const std::uintmax_t size = std::filesystem::file_size(path, ec);
+    if (!ec && size > maxBytes)
+        throw InputError(path + ": " + std::to_string(size) + " bytes: expected at most " + std::to_string(maxBytes) +
+                         " for this kind of file");
+}
+
 void requestInterruption(int sig) { interruption.store(sig); }
 int getInterruption() { return interruption.load(); }
 void checkInterruption() {
@@ -87,6 +97,7 @@ ParamNode ParamNode::loadString(const std::string& text, const std::string& sour
 }
 
 std::string readFileText(const std::string& path) {
+    checkInputFile(path, 64 << 20);
     std::ifstream in(path, std::ios::binary);
     if (!in) throw InputError(path + ": cannot open file (does it exist and is it readable?)");
     std::stringstream buf;

@@ -84,6 +84,7 @@ IntegrationStats simulateSampled(const MultibodySystem& system, State& state, do
         yda = a.getYDot();
         run.restart(a.getTime(), &ya[0], &yda[0]);
         while (integ.getTime() < segmentEnd - run.getEpsilon()) {
+            checkInterruption();
             Integrator::SuccessfulStepStatus status;
             try {
                 status = integ.stepTo(segmentEnd, segmentEnd);

@@ -165,6 +165,7 @@ IntegrationStats integrateSampled(const OdeRhs& f, double t0, std::vector<double
         if (settings.maxStepSize > 0) cpodes.setMaxStep(settings.maxStepSize);
         ++stats.restarts;
         while (t < segmentEnd - run.getEpsilon()) {
+            checkInterruption();  // a long trial stops within a step of Ctrl-C
             Real tret = t;
             system.clearLastError();  // report only this step's model errors
             int res = cpodes.step(segmentEnd, &tret, yout, ypout, CPodes::OneStep);

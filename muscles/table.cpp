@@ -88,6 +88,7 @@ std::string Table::toCsv(int digits) const {
 void Table::writeCsv(const std::string& path, int digits) const { writeFileAtomically(path, toCsv(digits)); }
 
 Table Table::readCsv(const std::string& path) {
+    checkInputFile(path, std::uintmax_t(4) << 30);
     std::ifstream in(path);
     if (!in) throw InputError(path + ": cannot open file (does it exist and is it readable?)");
     auto split = [](const std::string& line) {

@@ -1,5 +1,7 @@
 #include "render/render_plugin.h"
 
+#include "muscles/param_file.h"
+
 extern "C" __attribute__((visibility("default"))) const armsim::RenderPlugin* armsim_get_render_plugin() {
     static const armsim::RenderPlugin plugin = [] {
         armsim::RenderPlugin p;
@@ -10,6 +12,7 @@ extern "C" __attribute__((visibility("default"))) const armsim::RenderPlugin* ar
         };
         p.readRenderSettings = &armsim::readRenderSettings;
         p.validate = [](const armsim::TrialVideoSettings& s) { s.validate(); };
+        p.requestInterruption = &armsim::requestInterruption;
         return p;
     }();
     return &plugin;

@@ -18,9 +18,11 @@ struct RenderPlugin {
                                          const std::function<void(int, int)>& progress) = nullptr;
     RenderSettings (*readRenderSettings)(const ParamNode& node) = nullptr;
     void (*validate)(const TrialVideoSettings& settings) = nullptr;  ///< TrialVideoSettings::validate
+    /// The plugin's own copy of requestInterruption (it links its own ground-floor code).
+    void (*requestInterruption)(int sig) = nullptr;
 };
 
-constexpr int kRenderPluginAbi = 1;                          ///< raised when RenderPlugin changes
+constexpr int kRenderPluginAbi = 2;                          ///< raised when RenderPlugin changes
 constexpr const char* kRenderPluginFile = "libarmsim_render_plugin.so";
 constexpr const char* kRenderPluginSymbol = "armsim_get_render_plugin";
 

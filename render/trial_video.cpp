@@ -176,6 +176,11 @@ struct TrialRenderer::Impl {
         settings.validate();
         name = settings.tableName.empty() ? "trial table" : "trial table '" + settings.tableName + "'";
         checkTable();
+        const double frames = (time.back() - time.front()) * settings.fps / settings.playbackSpeed;
+        if (!settings.videoPath.empty() && !(frames <= 1e6))
+            throw FieldError("playback_speed", "= " + format("%g", settings.playbackSpeed) + ": the " + name + " would give " +
+                                                   format("%g", frames) + " frames at " + format("%g", settings.fps) +
+                                                   " fps: expected at most 1e6 (a faster playback or a lower rate)");
         isometric = table.hasColumn("strap_force_N");
         if (isometric) {
             strap = table.getColumn("strap_force_N");

@@ -10,6 +10,7 @@ packages=(
   libplplot-dev plplot-driver-cairo libfftw3-dev
   libopenmpi-dev openmpi-bin
   pybind11-dev python3-dev python3-numpy python3-pytest python3-matplotlib
+  clang libclang-rt-14-dev
 )
 
 missing=()

@@ -88,6 +88,10 @@ std::vector<BadInput> makeCatalogue() {
          "protocol IN/p.yaml --out OUT/run", {"p.yaml", "hold", "-3"}},
         {"ProtocolHoldHuge", {{"p.yaml", kProtocolHead + "trial:\n  hold: 1.0e9\n" + kAngles}},
          "protocol IN/p.yaml --out OUT/run", {"samples", "at most 1e+07"}},
+        {"ProtocolFromADevice", {}, "protocol /dev/zero --out OUT/run", {"/dev/zero", "not a regular file"}},
+        {"ProtocolRunTooLarge", {{"p.yaml", kProtocolHead + "repetitions: 1000\ntrial:\n  hold: 9000\n" +
+                                             "conditions:\n  elbow_angles_deg: [45, 60, 90, 120, 150]\n"}},
+         "protocol IN/p.yaml --out OUT/run", {"p.yaml", "5000 trials", "samples in the run", "at most 1e+08"}},
         {"ProtocolAngleOutOfRange", {{"p.yaml", kProtocolHead + kTrial + "conditions:\n  elbow_angles_deg: [200]\n"}},
          "protocol IN/p.yaml --out OUT/run", {"p.yaml", "200"}},
         {"ProtocolWrongType", {{"p.yaml", kProtocolHead + "trial:\n  hold: long\n" + kAngles}},
@@ -139,7 +143,15 @@ std::vector<BadInput> makeCatalogue() {
          {"t.csv", "column"}},
         {"RenderCodecUnknown", {{"t.csv", "time_s\n0\n"}}, "render IN/t.csv --out OUT/v.mp4 --codec vp9",
          {"field 'codec' = 'vp9'", "expected one of"}},
-        {"ModelShowUnknown", {}, "model show no_such_model --out OUT/m", {"no_such_model"}},
+        {"ModelShowUnknown", {}, "model show --model no_such_model --out OUT/m", {"no_such_model"}},
+        {"OutEmpty", {}, "identify-torque measured/thesis_mvc_torque.csv --out ''", {"--out is empty", "expected a folder path"}},
+        {"IdentifyFaithfulHoldHuge", {}, "identify measured/thesis_measured.csv --forward faithful --hold 1e9 --out OUT/id",
+         {"samples", "at most 1e+07"}},
+        {"EmgInternalRateHuge", {{"p.yaml", "name: bad\nkind: submaximal\nseed: 1\nsubject:\n  arm: arm/default_male.yaml\n"
+                                            "  muscle: muscles/biceps_long_head.yaml\n" + std::string("trial:\n  hold: 1.0\n"
+                                            "  averaging_window: 0.5\nconditions:\n  elbow_angles_deg: [90]\n"
+                                            "  levels_pct_mvc: [50, 100]\nsensors:\n  emg:\n    internal_rate: 1.0e12\n")}},
+         "protocol IN/p.yaml --out OUT/run", {"p.yaml", "internal_rate", "1e+12"}},
     };
 }
 

@@ -234,10 +234,13 @@ TEST(Cli, AnInterruptedProtocolLeavesNothingAndTheNextRunCleansUpAfterAKilledOne
                                       "conditions:\n  elbow_angles_deg: [45, 60, 90, 120, 150]\n";
     const std::string run = std::string(ARMSIM_EXE) + " protocol " + (d / "long.yaml").string() + " --out " +
                             (d / "run").string() + " --jobs 2";
-    const armsim::testing::CommandResult r =
-        armsim::testing::runCommand("sh -c '" + run + " & pid=$!; sleep 1; kill -INT $pid; wait $pid; echo rc=$?'");
-    EXPECT_NE(r.output.find("rc=130"), std::string::npos) << r.output;  // 128 + SIGINT: stopped, not finished
-    EXPECT_NE(r.output.find("interrupted by signal 2"), std::string::npos) << r.output;
+    // SIGTERM (a script's background job ignores SIGINT, and armsim keeps it so), once the run's
+    // temporary folder exists.
+    const armsim::testing::CommandResult r = armsim::testing::runCommand(
+        "sh -c '" + run + " & pid=$!; for i in $(seq 200); do ls -a " + d.string() +
+        " | grep -q partial && break; sleep 0.05; done; sleep 0.3; kill -TERM $pid; wait $pid; echo rc=$?'");
+    EXPECT_NE(r.output.find("rc=143"), std::string::npos) << r.output;  // 128 + SIGTERM: stopped, not finished
+    EXPECT_NE(r.output.find("interrupted by signal 15"), std::string::npos) << r.output;
     std::vector<std::string> left;
     for (const auto& e : fs::directory_iterator(d)) left.push_back(e.path().filename().string());
     EXPECT_EQ(left, std::vector<std::string>{"long.yaml"}) << "left behind: " << left.size() << " entries";
@@ -317,4 +320,10 @@ TEST(Cli, SeededCommandsWriteTheSameFilesTwice) {
     EXPECT_EQ(dropColumn(v1, "wall_time_s"), dropColumn(v2, "wall_time_s"));
     EXPECT_NE(dropColumn(v1, "wall_time_s"), dropColumn(v1, "nothing"));  // the column was there and dropped
     fs::remove_all(d);
+}
+
+TEST(Cli, VersionPrintsTheProjectVersion) {
+    const armsim::testing::CommandResult r = runArmsim("--version");
+    EXPECT_EQ(r.exitCode, 0) << r.output;
+    EXPECT_EQ(r.output, std::string("armsim ") + ARMSIM_VERSION + "\n");
 }

@@ -54,6 +54,22 @@ TEST(ReportIo, WritesJsonHistoryAndPlotThatMatchTheReport) {
     fs::remove_all(dir);
 }
 
+// A run whose forward model never produced a finite cost has nothing to plot: the report and the
+// history are written, the plot is left out (it used to end the command with an internal error).
+TEST(ReportIo, ARunWithoutAFiniteCostIsWrittenWithoutAPlot) {
+    const ObservationSet data = makeSyntheticData(makeTruth(), thesisAnglePaths());
+    IdentificationReport r = identify(makeProblem(data), SteadyForceModel());
+    for (IterationRecord& h : r.history) h.cost = NAN;
+    const fs::path dir = tempPath("report_nan");
+    const std::vector<std::string> files = writeReportFiles(r, dir.string(), "run");
+    ASSERT_EQ(files.size(), 2u);
+    EXPECT_TRUE(fs::exists(files[0]) && fs::exists(files[1]));
+    EXPECT_FALSE(fs::exists(dir / "run_convergence.png"));
+    r.history.back().cost = 1.0;  // one finite cost: the plot is back
+    EXPECT_EQ(writeReportFiles(r, dir.string(), "run").size(), 3u);
+    fs::remove_all(dir);
+}
+
 TEST(ReportIo, UnwritablePathsFailAndLeaveNoFile) {
     const ObservationSet data = makeSyntheticData(makeTruth(), {0.375, 0.40});
     const IdentificationReport r = identify(makeProblem(data), SteadyForceModel());
