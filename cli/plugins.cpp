@@ -46,7 +46,8 @@ const void* loadPluginApi(const char* file, const char* symbol, std::string& why
         why = "the executable's folder is unknown (/proc/self/exe unreadable)";
         return nullptr;
     }
-    const std::vector<std::string> candidates = {folder + "/" + file};
+    // Beside the executable (the build tree), or <prefix>/lib/armsim/ for <prefix>/bin/armsim (installed).
+    const std::vector<std::string> candidates = {folder + "/" + file, folder + "/../lib/armsim/" + file};
     for (const std::string& path : candidates) {
         if (!std::filesystem::exists(path)) continue;
         void* handle = dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);

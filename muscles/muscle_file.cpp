@@ -14,7 +14,14 @@ namespace armsim {
 
 std::string getAssetDirectory() {
     const char* env = std::getenv("ARMSIM_ASSETS");
-    return env && *env ? env : ARMSIM_ASSET_DIR;
+    if (env && *env) return env;
+    std::error_code ec;
+    if (std::filesystem::is_directory(ARMSIM_ASSET_DIR, ec)) return ARMSIM_ASSET_DIR;  // the source tree
+    // An installed armsim (cmake --install): <prefix>/bin/armsim with <prefix>/share/armsim/assets.
+    const std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", ec);
+    const std::filesystem::path installed = exe.parent_path().parent_path() / "share" / "armsim" / "assets";
+    if (!ec && std::filesystem::is_directory(installed, ec)) return installed.string();
+    return ARMSIM_ASSET_DIR;
 }
 
 std::string findAsset(const std::string& name) {

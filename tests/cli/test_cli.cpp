@@ -327,3 +327,30 @@ TEST(Cli, VersionPrintsTheProjectVersion) {
     EXPECT_EQ(r.exitCode, 0) << r.output;
     EXPECT_EQ(r.output, std::string("armsim ") + ARMSIM_VERSION + "\n");
 }
+
+// Issue 15: `cmake --install` puts the command, its plugins and the assets under a prefix, and the
+// installed command finds its plugins there (a still rendered through <prefix>/lib/armsim/).
+TEST(Cli, TheInstalledCommandRunsAndFindsItsPlugins) {
+    namespace fs = std::filesystem;
+    const fs::path d = armsim::testing::makeFreshDir("cli", "install");
+    const armsim::testing::CommandResult install = armsim::testing::runCommand(
+        "DESTDIR=" + d.string() + " " + ARMSIM_CMAKE + " --install " + ARMSIM_BUILD_DIR + " --prefix /usr/local");
+    ASSERT_EQ(install.exitCode, 0) << install.output;
+    const fs::path prefix = d / "usr" / "local", exe = prefix / "bin" / "armsim";
+    ASSERT_TRUE(fs::exists(exe));
+    EXPECT_TRUE(fs::exists(prefix / "share" / "armsim" / "assets" / "models" / "thesis.yaml"));
+    const armsim::testing::CommandResult version = armsim::testing::runCommand(exe.string() + " --version");
+    EXPECT_EQ(version.output, std::string("armsim ") + ARMSIM_VERSION + "\n");
+    if (ARMSIM_RENDER_BUILT) {
+        EXPECT_TRUE(fs::exists(prefix / "lib" / "armsim" / "libarmsim_render_plugin.so"));
+        const armsim::testing::CommandResult trial = armsim::testing::runCommand(
+            exe.string() + " trial --angle 90 --hold 0.2 --rate 100 --out " + (d / "t.csv").string());
+        ASSERT_EQ(trial.exitCode, 0) << trial.output;
+        const armsim::testing::CommandResult still = armsim::testing::runCommand(
+            exe.string() + " render " + (d / "t.csv").string() + " --still-at 0.5 --still " + (d / "s.png").string() +
+            " --width 64 --height 48");
+        EXPECT_EQ(still.exitCode, 0) << still.output;
+        EXPECT_TRUE(fs::exists(d / "s.png"));
+    }
+    fs::remove_all(d);
+}
