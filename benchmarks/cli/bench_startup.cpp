@@ -36,6 +36,12 @@ void BM_StartupMuscleSteady(benchmark::State& state) {
 }
 BENCHMARK(BM_StartupMuscleSteady)->Unit(benchmark::kMillisecond)->UseRealTime();
 
+// The floor of any process start on this machine: spawning /bin/true.
+void BM_SpawnTrue(benchmark::State& state) {
+    for (auto _ : state) runQuietly({"/bin/true"});
+}
+BENCHMARK(BM_SpawnTrue)->Unit(benchmark::kMillisecond)->UseRealTime();
+
 void BM_StartupHelp(benchmark::State& state) {
     for (auto _ : state) runQuietly({ARMSIM_EXE, "--help"});
 }

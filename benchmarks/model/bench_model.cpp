@@ -30,9 +30,10 @@ const ArmSetup& elbow() {
 // One isometric trial per iteration; arg = sample rate.
 void measureIsometricTrial(benchmark::State& state, const ArmSetup& setup, IsometricTrialSettings s) {
     s.sampleRate = double(state.range(0));
-    int steps = 0;
-    for (auto _ : state) steps = runIsometricTrial(setup, s).summary.stats.steps;
-    state.counters["steps"] = steps;
+    IntegrationStats stats;
+    for (auto _ : state) stats = runIsometricTrial(setup, s).summary.stats;
+    state.counters["steps"] = stats.steps;
+    state.counters["rhs"] = stats.realizations;  // right-hand sides, finite-difference Jacobians included
 }
 
 void BM_IsometricMvcTrial(benchmark::State& state) {
@@ -65,6 +66,28 @@ void BM_ElbowMvcTrial(benchmark::State& state) {
     measureIsometricTrial(state, elbow(), s);
 }
 BENCHMARK(BM_ElbowMvcTrial)->Arg(1000)->Arg(100)->Unit(benchmark::kMillisecond);
+
+// Issue 14's floor: one right-hand side of the locked elbow is every muscle's state derivative at its
+// fixed path (90 deg flexion; agonists 0.95, antagonists 0.10); arg 0 = thesis arm, 1 = elbow.
+void BM_LockedArmDerivative(benchmark::State& state) {
+    const ArmSetup& setup = state.range(0) ? elbow() : subject();
+    const MvcGeometry g = calcMvcGeometry(setup, {90});
+    std::vector<VirtualMuscle> muscles;
+    std::vector<std::vector<double>> y, ydot;
+    std::vector<double> U;
+    for (int i = 0; i < setup.getNumMuscles(); ++i) {
+        muscles.emplace_back(setup.calcMuscleParameters(i));
+        U.push_back(setup.muscles[i].group == MuscleGroup::Flexor ? 0.95 : 0.10);
+        y.push_back(muscles.back().calcSteadyState(g.pathLength[0][i], U.back()).states);
+        ydot.emplace_back(y.back().size());
+    }
+    for (auto _ : state)
+        for (std::size_t i = 0; i < muscles.size(); ++i) {
+            muscles[i].calcStateDerivative(g.pathLength[0][i], U[i], y[i].data(), ydot[i].data());
+            benchmark::DoNotOptimize(ydot[i].data());
+        }
+}
+BENCHMARK(BM_LockedArmDerivative)->Arg(0)->Arg(1);
 
 // Issue 10: path length and virtual-work moment arm of all seven muscles at one pose (the pose changes
 // every iteration so nothing is cached).
