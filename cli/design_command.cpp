@@ -120,7 +120,7 @@ void runDesign(const DesignOptions& o) {
         v.protocol = protocol;
         v.freeSlowFraction = o.freeSlowFraction;
         const std::vector<ElbowValidationRow> rows = runElbowValidation(
-            population, v, [&](int done, int n) { printProgress("validate " + protocol.name, done, n); });
+            population, v, [label = "validate " + protocol.name](int done, int n) { printProgress(label, done, n); });
         for (const ElbowValidationSummary& x : summarizeElbowValidation(rows)) {
             if (x.method == "thesis") continue;
             std::printf("  %-9s %-13s mass bias %+5.1f %%  RMSE %5.1f %% (predicted sd %4.1f %%)  coverage %.2f  "

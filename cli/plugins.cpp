@@ -17,7 +17,8 @@ namespace armsim::cli {
 
 namespace {
 
-std::mutex gMutex;
+std::mutex gMutex;      // the interruption sinks
+std::mutex gLoadMutex;  // dlopen and the lookup
 std::vector<void (*)(int)> gInterruptionSinks;  // the loaded plugins' requestInterruption
 int gForwarded = 0;
 
@@ -37,10 +38,11 @@ void addInterruptionSink(void (*sink)(int)) {
 }
 
 /// dlopen(file beside the executable, else ARMSIM_PLUGIN_DIR/file) and dlsym(symbol); the entry
-/// point's result, or nullptr with `why` set.
-const void* loadPluginApi(const char* file, const char* symbol, std::string& why) {
-    static std::mutex mutex;
-    const std::lock_guard<std::mutex> lock(mutex);
+/// point's result, or nullptr with `why` set. The entry point is called through its own type
+/// (`const Api* (*)()`): calling it through another function type is undefined behaviour.
+template <class Api>
+const Api* loadPluginApi(const char* file, const char* symbol, std::string& why) {
+    const std::lock_guard<std::mutex> lock(gLoadMutex);
     const std::string folder = findExecutableFolder();
     if (folder.empty()) {
         why = "the executable's folder is unknown (/proc/self/exe unreadable)";
@@ -55,7 +57,7 @@ const void* loadPluginApi(const char* file, const char* symbol, std::string& why
             why = "cannot load " + path + ": " + dlerror();
             return nullptr;
         }
-        using Entry = const void* (*)();
+        using Entry = const Api* (*)();
         const auto entry = reinterpret_cast<Entry>(dlsym(handle, symbol));
         if (!entry) {
             why = path + " has no entry point " + symbol;
@@ -78,7 +80,7 @@ void forwardInterruption(int sig) {
 const RenderPlugin& getRenderPlugin(const std::string& option) {
 #ifdef ARMSIM_WITH_RENDER
     std::string why;
-    const auto* p = static_cast<const RenderPlugin*>(loadPluginApi(kRenderPluginFile, kRenderPluginSymbol, why));
+    const RenderPlugin* p = loadPluginApi<RenderPlugin>(kRenderPluginFile, kRenderPluginSymbol, why);
     if (!p) throw InputError(option + ": the renderer plugin is missing: " + why);
     if (p->abiVersion != kRenderPluginAbi)
         throw InputError(option + ": the renderer plugin is from another build (interface " +
@@ -93,7 +95,7 @@ const RenderPlugin& getRenderPlugin(const std::string& option) {
 
 const StudyMpiPlugin& getStudyMpiPlugin() {
     std::string why;
-    const auto* p = static_cast<const StudyMpiPlugin*>(loadPluginApi(kStudyMpiPluginFile, kStudyMpiPluginSymbol, why));
+    const StudyMpiPlugin* p = loadPluginApi<StudyMpiPlugin>(kStudyMpiPluginFile, kStudyMpiPluginSymbol, why);
     if (!p)
         throw InputError("this armsim has no MPI (" + why + "; install libopenmpi-dev and rebuild); run the study "
                          "without mpirun to use threads");
