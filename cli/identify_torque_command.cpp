@@ -38,8 +38,7 @@ void runIdentifyTorque(const IdentifyTorqueOptions& o) {
     std::string skipped;
     const std::vector<BicepsEstimate> estimates = identifyTorqueData(prior, data, to, &skipped);
     if (!skipped.empty()) std::printf("%s\n", skipped.c_str());
-    // The noise the residuals are judged against: given, or the synergist fit's estimate from repeats.
-    const double noise = std::isfinite(o.noiseLevel) ? o.noiseLevel : estimates.back().noiseLevel;
+    const double noise = findJudgingNoiseLevel(to, estimates);
     const MuscleParameters& b = prior.base.biceps();
     std::printf("prior (population base) %s: M %.1f g, L0T %.1f cm; residuals judged against a relative torque sd of "
                 "%.1f %% (%s)\n",

@@ -43,6 +43,8 @@ void addInterruptionSink(void (*sink)(int)) {
 template <class Api>
 const Api* loadPluginApi(const char* file, const char* symbol, std::string& why) {
     const std::lock_guard<std::mutex> lock(gLoadMutex);
+    static const Api* loaded = nullptr;  // one load per process; later calls reuse it
+    if (loaded) return loaded;
     const std::string folder = findExecutableFolder();
     if (folder.empty()) {
         why = "the executable's folder is unknown (/proc/self/exe unreadable)";
@@ -63,7 +65,7 @@ const Api* loadPluginApi(const char* file, const char* symbol, std::string& why)
             why = path + " has no entry point " + symbol;
             return nullptr;
         }
-        return entry();  // the handle stays open for the process's life
+        return loaded = entry();  // the handle stays open for the process's life
     }
     why = std::string(file) + " not found beside the executable (" + candidates[0] + ")";
     return nullptr;

@@ -267,11 +267,10 @@ Protocol readProtocol(const std::string& path) {
     // The whole run's size: every trial's samples (and their CSV, .sto and EMG) are kept and written.
     if (armTrials) {
         const double trials = double(p.elbowAngles.size()) * std::max<std::size_t>(1, p.levels.size()) * p.repetitions;
-        const double rows = trials * double(calcNumSamples(p.trial.getDuration(), p.trial.sampleRate));
+        const double perTrial = double(calcNumSamples(p.trial.getDuration(), p.trial.sampleRate));
+        const double rows = trials * perTrial;
         if (rows > 1e8)
-            throw InputError(path + ": " + formatNumber(trials) + " trials x " +
-                             formatNumber(double(calcNumSamples(p.trial.getDuration(), p.trial.sampleRate))) +
-                             " samples = " + formatNumber(rows) +
+            throw InputError(path + ": " + formatNumber(trials) + " trials x " + formatNumber(perTrial) + " samples = " + formatNumber(rows) +
                              " samples in the run: expected at most 1e+08 (fewer repetitions, a shorter hold or a lower "
                              "sample rate)");
     }

@@ -590,6 +590,11 @@ std::vector<BicepsEstimate> identifyTorqueData(const Population& prior, const st
     return estimates;
 }
 
+double findJudgingNoiseLevel(const TorqueIdentificationOptions& o, const std::vector<BicepsEstimate>& estimates) {
+    if (std::isfinite(o.noiseLevel) || estimates.empty()) return o.noiseLevel;
+    return estimates.back().noiseLevel;
+}
+
 TorqueResidualCheck checkTorqueResiduals(const std::vector<TorqueObservation>& data, const BicepsEstimate& e,
                                          double noise) {
     TorqueResidualCheck c;

@@ -158,6 +158,9 @@ struct TorqueResidualCheck {
 };
 TorqueResidualCheck checkTorqueResiduals(const std::vector<TorqueObservation>& data, const BicepsEstimate& estimate,
                                          double noiseLevel);
+/// The noise level residuals are judged against: the given one, or else the last (synergist) fit's
+/// estimate from the repetitions.
+double findJudgingNoiseLevel(const TorqueIdentificationOptions& options, const std::vector<BicepsEstimate>& estimates);
 
 /// A twitch-interpolation measurement of the subject's voluntary activation: the mean activation of
 /// the efforts actually produced, plus N(0, sd^2) measurement error, within [0, 1]. The default sd

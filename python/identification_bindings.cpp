@@ -320,7 +320,7 @@ py::list identifyTorquePy(const py::object& data, const py::object& population, 
         estimates = identifyTorqueData(prior, obs, o, &skipped);
     }
     if (!skipped.empty() && PyErr_WarnEx(PyExc_UserWarning, skipped.c_str(), 1) != 0) throw py::error_already_set();
-    const double noise = std::isfinite(o.noiseLevel) ? o.noiseLevel : estimates.back().noiseLevel;
+    const double noise = findJudgingNoiseLevel(o, estimates);
     py::list l;
     for (const BicepsEstimate& e : estimates) {
         py::dict d = toDict(e);
