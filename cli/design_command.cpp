@@ -1,10 +1,13 @@
 // armsim design: the torque protocol that minimises the synergist-aware identifier's expected posterior
 // uncertainty of the biceps mass and tendon length over a population (identification/experiment_design.h),
 // compared with the thesis's five-angle protocol, predicted and (with --validate-subjects) obtained.
+#include "basics/csv.h"
+#include "basics/files.h"
+#include "basics/format.h"
+#include "basics/output_folder.h"
+#include "basics/plot.h"
 #include "cli/commands.h"
-#include "experiments/plot.h"
 #include "identification/experiment_design.h"
-#include "muscles/param_file.h"
 
 #include <cmath>
 #include <cstdio>
@@ -80,18 +83,14 @@ void runDesign(const DesignOptions& o) {
     printPrediction(reference);
     printPrediction(d.predicted);
 
-    const std::string protocolPath = o.out + "/designed_protocol.yaml";
-    writeFileAtomically(protocolPath,
+    OutputFolder out(o.out, OutputFolder::Mode::AddFiles);
+    const std::string protocolPath = out.getTargetPath("designed_protocol.yaml");
+    out.write("designed_protocol.yaml",
                         "# Written by `armsim design` (identification/experiment_design.h). Run it with\n"
                         "#   armsim protocol " + protocolPath + "\n#   armsim validate --truth elbow --protocol " +
                             protocolPath + "\n" + formatTorqueProtocol(d.protocol));
-    writeFileAtomically(o.out + "/design_predictions.csv", formatPredictionsCsv({reference, d.predicted}));
-    std::string steps = "step,effort,flexion_deg,level,repetitions,criterion\n";
-    for (std::size_t k = 0; k < d.steps.size(); ++k)
-        steps += std::to_string(k + 1) + "," + getEffortName(d.steps[k].condition.effort) + "," +
-                 formatNumber(d.steps[k].condition.flexionDeg) + "," + formatNumber(d.steps[k].condition.level) + "," +
-                 std::to_string(d.steps[k].condition.repetitions) + "," + formatNumber(d.steps[k].criterion) + "\n";
-    writeFileAtomically(o.out + "/design_steps.csv", steps);
+    out.write("design_predictions.csv", formatPredictionsCsv({reference, d.predicted}));
+    out.write("design_steps.csv", formatDesignStepsCsv(d));
     PlotSpec plot;
     plot.title = "Greedy design: expected criterion after each block of trials";
     plot.xLabel = "trials";
@@ -102,15 +101,16 @@ void runDesign(const DesignOptions& o) {
         greedy.y.push_back(d.steps[k].criterion);
     }
     plot.series = {greedy, {"thesis five angles", {double(reference.trials)}, {reference.criterion}, true, 1}};
-    writePlotPng(o.out + "/design_criterion.png", plot);
+    writePlotPng(out.addFile("design_criterion.png"), plot);
+    out.commit();
     std::printf("wrote %s, %s/design_predictions.csv, design_steps.csv, design_criterion.png\n", protocolPath.c_str(),
                 o.out.c_str());
 
     if (o.validateSubjects <= 0) return;
     std::printf("validation of both protocols on %d subjects (seed %u):\n", o.validateSubjects, o.seed);
-    std::string csv = "protocol,method,subjects,converged,mass_bias_pct,mass_rmse_pct,mass_coverage,"
-                      "mass_interval_width_pct,tendon_bias_mm,tendon_rmse_mm,tendon_coverage,tendon_interval_width_mm,"
-                      "predicted_mass_sd_pct,predicted_tendon_sd_mm\n";
+    CsvText csv({"protocol", "method", "subjects", "converged", "mass_bias_pct", "mass_rmse_pct", "mass_coverage",
+                 "mass_interval_width_pct", "tendon_bias_mm", "tendon_rmse_mm", "tendon_coverage",
+                 "tendon_interval_width_mm", "predicted_mass_sd_pct", "predicted_tendon_sd_mm"});
     for (const auto& [protocol, predicted] : {std::pair{thesis, reference}, std::pair{d.protocol, d.predicted}}) {
         ElbowValidationSettings v;
         v.subjects = o.validateSubjects;
@@ -128,17 +128,18 @@ void runDesign(const DesignOptions& o) {
                         protocol.name.c_str(), x.method.c_str(), 100 * x.massBias, 100 * x.massRmse,
                         100 * predicted.massSd, x.massCoverage, 100 * x.massIntervalWidth, 1000 * x.tendonRmse,
                         1000 * predicted.tendonSd, x.tendonCoverage);
-            csv += protocol.name + "," + x.method + "," + std::to_string(x.subjects) + "," + std::to_string(x.converged) +
-                   "," + formatNumber(100 * x.massBias) + "," + formatNumber(100 * x.massRmse) + "," +
-                   formatNumber(x.massCoverage) + "," + formatNumber(100 * x.massIntervalWidth) + "," +
-                   formatNumber(1000 * x.tendonBias) + "," + formatNumber(1000 * x.tendonRmse) + "," +
-                   formatNumber(x.tendonCoverage) + "," + formatNumber(1000 * x.tendonIntervalWidth) + "," +
-                   formatNumber(100 * predicted.massSd) + "," + formatNumber(1000 * predicted.tendonSd) + "\n";
+            CsvRow row;
+            row.addText(protocol.name).addText(x.method).addInteger(x.subjects).addInteger(x.converged);
+            row.addNumber(100 * x.massBias).addNumber(100 * x.massRmse).addNumber(x.massCoverage);
+            row.addNumber(100 * x.massIntervalWidth).addNumber(1000 * x.tendonBias).addNumber(1000 * x.tendonRmse);
+            row.addNumber(x.tendonCoverage).addNumber(1000 * x.tendonIntervalWidth).addNumber(100 * predicted.massSd);
+            row.addNumber(1000 * predicted.tendonSd);
+            csv.addRow(row);
         }
     }
     std::printf("  (predicted: synergist-%s; the RMSE is the obtained counterpart of the predicted sd)\n",
                 o.activationSd > 0 ? "va" : "aware");
-    writeFileAtomically(o.out + "/design_validation.csv", csv);
+    writeFileAtomically(o.out + "/design_validation.csv", csv.getText());
     std::printf("wrote %s/design_validation.csv\n", o.out.c_str());
 }
 

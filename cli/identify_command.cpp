@@ -1,8 +1,13 @@
 // armsim identify: muscle mass and optimal tendon length (or other parameters) from measured MVC forces,
 // with the steady or the faithful forward model; armsim validate: the identifiers against ground truth
 // on synthetic MVC data; and the main-job step that identifies the thesis's and our own MVC data.
+#include "basics/errors.h"
+#include "basics/files.h"
+#include "basics/format.h"
+#include "basics/output_folder.h"
+#include "basics/plot.h"
+#include "basics/table.h"
 #include "cli/commands.h"
-#include "experiments/plot.h"
 #include "identification/elbow_identification.h"
 #include "identification/faithful_model.h"
 #include "identification/forward_choice.h"
@@ -10,24 +15,19 @@
 #include "identification/report_io.h"
 #include "identification/thesis_cases.h"
 #include "identification/validation.h"
-#include "model/muscle_arm.h"
 #include "model/geometry.h"
+#include "model/muscle_arm.h"
 #include "muscles/muscle_file.h"
-#include "muscles/param_file.h"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
-#include <sstream>
 
 namespace armsim::cli {
 
 namespace {
-
-constexpr double kThesisMeasuredMass = 0.3377;          // kg, thesis Table 7.3
-constexpr double kThesisMeasuredTendonLength = 0.244;   // m, thesis Table 7.3
 
 /// Parameter name with the short aliases of the command line (tendon_length, fascicle_length).
 ParameterId parseParameter(const std::string& option, const std::string& name) {
@@ -111,18 +111,8 @@ IdentificationReport runIdentification(const IdentificationProblem& pr, const Id
 void printThesisCases(const MuscleParameters& base, const ForceModel& model, const std::string& outDir) {
     const std::vector<ThesisCase> cases = reproduceThesisCases(base, model);
     std::printf("%s", formatThesisComparison(cases).c_str());
-    std::ostringstream csv;
-    csv << "case,quantity,unit,ours,thesis\n";
-    for (const ThesisComparisonRow& r : collectRows(cases)) {
-        char b[128];
-        std::snprintf(b, sizeof b, ",%.10g,", r.ours);
-        csv << r.caseName << "," << r.quantity << "," << r.unit << b;
-        if (std::isfinite(r.thesis)) csv << r.thesis;
-        csv << "\n";
-    }
-    std::filesystem::create_directories(outDir);
     const std::string path = outDir + "/thesis_cases_" + model.getName() + ".csv";
-    writeFileAtomically(path, csv.str());
+    writeFileAtomically(path, formatThesisCasesCsv(cases));
     std::printf("wrote %s\n", path.c_str());
 }
 
@@ -181,7 +171,6 @@ void runIdentify(const IdentifyOptions& o) {
 
     const IdentificationReport r = runIdentification(pr, io, setup.arm, o.model);
     std::printf("%s", formatReport(r).c_str());
-    std::filesystem::create_directories(o.out);
     for (const std::string& p : writeReportFiles(r, o.out)) std::printf("wrote %s\n", p.c_str());
 }
 
@@ -241,7 +230,7 @@ struct ValidateOptions {
 };
 
 // Identified vs true biceps mass per method, and the error against two nuisances.
-void writeElbowValidationPlots(const std::vector<ElbowValidationRow>& rows, const std::string& out) {
+void addElbowValidationPlots(const std::vector<ElbowValidationRow>& rows, OutputFolder& out) {
     PlotSpec vsTruth;
     vsTruth.title = "Biceps long-head mass: identified vs true (elbow model as truth)";
     vsTruth.xLabel = "true mass (g)";
@@ -273,9 +262,9 @@ void writeElbowValidationPlots(const std::vector<ElbowValidationRow>& rows, cons
         vsSynergists.series.push_back(c);
     }
     vsTruth.series.push_back({"identity", {lo, hi}, {lo, hi}, false, 7});
-    writePlotPng(out + "/mass_identified_vs_true.png", vsTruth);
-    writePlotPng(out + "/mass_error_vs_activation.png", vsActivation);
-    writePlotPng(out + "/mass_error_vs_synergists.png", vsSynergists);
+    writePlotPng(out.addFile("mass_identified_vs_true.png"), vsTruth);
+    writePlotPng(out.addFile("mass_error_vs_activation.png"), vsActivation);
+    writePlotPng(out.addFile("mass_error_vs_synergists.png"), vsSynergists);
 }
 
 void runElbowValidate(const ValidateOptions& o) {
@@ -314,9 +303,11 @@ void runElbowValidate(const ValidateOptions& o) {
                     1000 * x.tendonBias, 1000 * x.tendonRmse, x.tendonCoverage);
     std::printf("goal (issue 11, synergist-aware at 2 %% noise): |mass bias| <= 3 %%, mass RMSE <= 10 %%, "
                 "L0T RMSE <= 10 mm, coverage 0.90-0.98\n");
-    writeFileAtomically(o.out + "/elbow_validation.csv", formatElbowValidationCsv(rows));
-    writeFileAtomically(o.out + "/elbow_validation_summary.csv", formatElbowValidationSummaryCsv(summary));
-    writeElbowValidationPlots(rows, o.out);
+    OutputFolder out(o.out, OutputFolder::Mode::AddFiles);
+    out.write("elbow_validation.csv", formatElbowValidationCsv(rows));
+    out.write("elbow_validation_summary.csv", formatElbowValidationSummaryCsv(summary));
+    addElbowValidationPlots(rows, out);
+    out.commit();
     std::printf("wrote %s/elbow_validation.csv, elbow_validation_summary.csv, mass_identified_vs_true.png, "
                 "mass_error_vs_activation.png, mass_error_vs_synergists.png\n", o.out.c_str());
 }
@@ -342,10 +333,10 @@ void runValidate(const ValidateOptions& o) {
     const std::vector<ValidationRow> rows = runValidation(setup.arm, setup.calcBicepsParameters(), s,
                                                           [](int d, int n) { printProgress("identifications", d, n); });
     std::printf("%s", formatValidationTable(rows).c_str());
-    std::filesystem::create_directories(o.out);
-    const std::string path = o.out + "/validation.csv";
-    writeFileAtomically(path, formatValidationCsv(rows));
-    std::printf("wrote %s\n", path.c_str());
+    OutputFolder out(o.out, OutputFolder::Mode::AddFiles);
+    out.write("validation.csv", formatValidationCsv(rows));
+    out.commit();
+    std::printf("wrote %s\n", out.getTargetPath("validation.csv").c_str());
 }
 
 void addValidateCommand(CLI::App& app) {
@@ -432,8 +423,8 @@ void runIdentificationStep(const MainJobContext& ctx) {
         IdentificationProblem pr;
         pr.base = base;
         pr.data = data;
-        pr.unknowns[0].start = 0.330;  // thesis start (Tables 7.2, 7.3)
-        pr.unknowns[1].start = 0.22;
+        pr.unknowns[0].start = kThesisStartMass;
+        pr.unknowns[1].start = kThesisStartTendonLength;
         return pr;
     };
 
@@ -462,23 +453,21 @@ void runIdentificationStep(const MainJobContext& ctx) {
     const FaithfulModelOptions ro = faithful.makeChoice().makeReferenceOptions();
     const FaithfulForceModel reference(setup.arm, ro);
     ObservationSet angles;
-    for (double deg : {45.0, 60.0, 90.0, 120.0, 150.0}) {
+    const PathFromAngle pathFromAngle = makeArmPathFromAngle(setup.arm);
+    for (double deg : kThesisMvcAnglesDeg) {
         Observation ob;
         ob.angle = degToRad(deg);
-        ob.pathLength = calcBicepsPathLength(setup.arm.originDistance, setup.arm.insertionDistance, ob.angle);
+        ob.pathLength = pathFromAngle(ob.angle);
         angles.points.push_back(ob);
     }
     const std::vector<double> y = reference.calcForces(base, angles.points);
-    std::ostringstream csv;
-    csv << "# MVC forces of armsim's default subject (" << base.name << ", M = " << base.mass
-        << " kg, L0T = " << base.optimalTendonLength << " m): " << reference.describe() << "\nangle_deg,force_N\n";
-    for (std::size_t k = 0; k < y.size(); ++k) {
-        char b[64];
-        std::snprintf(b, sizeof b, "%.1f,%.6f\n", radToDeg(angles.points[k].angle), y[k]);
-        csv << b;
-    }
+    Table mvc({"angle_deg", "force_N"});
+    for (std::size_t k = 0; k < y.size(); ++k) mvc.appendRow({kThesisMvcAnglesDeg[k], y[k]});
+    const std::string csv = "# MVC forces of armsim's default subject (" + base.name + ", M = " +
+                            formatNumber(base.mass) + " kg, L0T = " + formatNumber(base.optimalTendonLength) +
+                            " m): " + reference.describe() + "\n" + mvc.toCsv(10);
     const std::string dataPath = dir + "/mvc_five_angles.csv";
-    writeFileAtomically(dataPath, csv.str());
+    writeFileAtomically(dataPath, csv);
     std::printf("own MVC data (%s; truth %.2f g, %.3f cm), from 330 g / 22 cm:\n", dataPath.c_str(), 1000 * base.mass,
                 100 * base.optimalTendonLength);
     const IdentificationProblem own = problemFor(readArmObservations(dataPath, setup.arm));

@@ -1,11 +1,12 @@
 // armsim identify-torque: the biceps long head's mass and tendon length from tared elbow torque data
 // (a torque data file: measured, or written by `armsim protocol` for a torque protocol) with every
 // elbow method (thesis, synergist, synergist-va), with residuals checked against the measurement noise.
+#include "basics/format.h"
+#include "basics/output_folder.h"
+#include "basics/plot.h"
 #include "cli/commands.h"
-#include "experiments/plot.h"
 #include "identification/elbow_identification.h"
 #include "muscles/muscle_file.h"
-#include "muscles/param_file.h"
 
 #include <cmath>
 #include <cstdio>
@@ -46,21 +47,12 @@ void runIdentifyTorque(const IdentifyTorqueOptions& o) {
                 std::isfinite(o.noiseLevel) ? "--noise-level" : "estimated from the repetitions");
     std::printf("%-13s %9s %21s %9s %21s %10s %12s %6s %8s\n", "method", "M (g)", "95 % interval", "L0T (cm)",
                 "95 % interval", "rms (N m)", "chi2 / dof", "p", "verdict");
-    std::string csv = "method,converged,mass_kg,mass_lower_kg,mass_upper_kg,tendon_length_m,tendon_lower_m,"
-                      "tendon_upper_m,rms_residual_Nm,chi_square,dof,p_value,noise_level\n";
-    std::string residuals = "flexion_deg,effort,level,repetition,torque_Nm";
-    for (const BicepsEstimate& e : estimates) residuals += "," + e.method + "_Nm";
-    residuals += "\n";
     for (const BicepsEstimate& e : estimates) {
         const TorqueResidualCheck c = checkTorqueResiduals(data, e, noise);
         std::printf("%-13s %9.1f   [%7.1f, %7.1f] %9.2f   [%7.2f, %7.2f] %10.2f %6.1f / %-4d %6.3f %8s%s\n",
                     e.method.c_str(), 1000 * e.mass, 1000 * e.massLower, 1000 * e.massUpper, 100 * e.tendonLength,
                     100 * e.tendonLower, 100 * e.tendonUpper, c.rms, c.chiSquare, c.dof, c.p,
                     c.p >= 0.05 ? "noise" : "misfit", e.converged ? "" : "  (not converged)");
-        csv += e.method + "," + (e.converged ? "1" : "0") + "," + formatNumber(e.mass) + "," + formatNumber(e.massLower) +
-               "," + formatNumber(e.massUpper) + "," + formatNumber(e.tendonLength) + "," + formatNumber(e.tendonLower) +
-               "," + formatNumber(e.tendonUpper) + "," + formatNumber(c.rms) + "," + formatNumber(c.chiSquare) + "," +
-               std::to_string(c.dof) + "," + formatNumber(c.p) + "," + formatNumber(noise) + "\n";
     }
     std::printf("verdict: 'noise' = residuals consistent with the measurement noise (chi-square p >= 0.05), "
                 "'misfit' = larger than the noise explains\n");
@@ -70,17 +62,14 @@ void runIdentifyTorque(const IdentifyTorqueOptions& o) {
     for (std::size_t k = 0; k < data.size(); ++k) {
         const TorqueObservation& d = data[k];
         std::printf("%-9s %6.1f %6.2f %4d %11.2f", getEffortName(d.effort), d.flexionDeg, d.level, d.repetition, d.torque);
-        residuals += formatNumber(d.flexionDeg) + "," + (d.effort == MuscleGroup::Flexor ? "1" : "-1") + "," +
-                     formatNumber(d.level) + "," + std::to_string(d.repetition) + "," + formatNumber(d.torque);
         for (const BicepsEstimate& e : estimates) {
             std::printf(" %13.2f", e.predictedTorque[k]);
-            residuals += "," + (std::isfinite(e.predictedTorque[k]) ? formatNumber(e.predictedTorque[k]) : std::string());
         }
         std::printf("\n");
-        residuals += "\n";
     }
-    writeFileAtomically(o.out + "/torque_estimates.csv", csv);
-    writeFileAtomically(o.out + "/torque_predictions.csv", residuals);
+    OutputFolder out(o.out, OutputFolder::Mode::AddFiles);
+    out.write("torque_estimates.csv", formatTorqueEstimatesCsv(data, estimates, noise));
+    out.write("torque_predictions.csv", formatTorquePredictionsCsv(data, estimates));
     PlotSpec plot;
     plot.title = "Torque data and each method's fit";
     plot.xLabel = "elbow flexion (deg, 0 = extended)";
@@ -95,7 +84,8 @@ void runIdentifyTorque(const IdentifyTorqueOptions& o) {
                 s.x.push_back(data[k].flexionDeg), s.y.push_back(estimates[m].predictedTorque[k]);
         plot.series.push_back(s);
     }
-    writePlotPng(o.out + "/torque_fit.png", plot);
+    writePlotPng(out.addFile("torque_fit.png"), plot);
+    out.commit();
     std::printf("wrote %s/torque_estimates.csv, torque_predictions.csv, torque_fit.png\n", o.out.c_str());
 }
 

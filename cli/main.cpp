@@ -2,9 +2,9 @@
 // Exit codes: 0 done, 2 bad input (options, files; the message names the option or file, the value and
 // what was expected), 3 a simulation that cannot go on, 4 an internal error, 128 + signal when stopped
 // by SIGINT or SIGTERM (after removing the partial output of the run in progress).
+#include "basics/errors.h"
 #include "cli/commands.h"
 #include "cli/plugins.h"
-#include "muscles/param_file.h"
 
 #include <pthread.h>
 

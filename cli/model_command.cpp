@@ -1,9 +1,9 @@
 // armsim model: list the shipped models, show one (muscle table, moment arms, steady MVC torque-angle
 // curves as CSV + PNG), calibrate a model's muscle strength to the elbow target curves.
+#include "basics/errors.h"
 #include "cli/commands.h"
 #include "experiments/model_report.h"
 #include "identification/strength_calibration.h"
-#include "muscles/param_file.h"
 
 #include <cstdio>
 #include <memory>

@@ -1,10 +1,10 @@
 // armsim muscle steady | sweep | trial: the muscle alone, both path ends fixed.
+#include "basics/bound.h"
+#include "basics/plot.h"
 #include "cli/commands.h"
-#include "experiments/plot.h"
 #include "model/arm_parameters.h"
 #include "model/muscle_arm.h"
 #include "muscles/muscle_file.h"
-#include "muscles/param_file.h"
 #include "muscles/simbody_isometric.h"
 
 #include <cmath>

@@ -1,8 +1,8 @@
 // armsim run: the main job on built-in defaults. Writes its results to --out (default out/).
+#include "basics/errors.h"
+#include "basics/plot.h"
 #include "cli/commands.h"
-#include "experiments/plot.h"
 #include "muscles/muscle_file.h"
-#include "muscles/param_file.h"
 #include "muscles/simbody_isometric.h"
 
 #include <cmath>

@@ -1,7 +1,7 @@
 #include "cli/plugins.h"
 
+#include "basics/errors.h"
 #include "identification/study_mpi.h"
-#include "muscles/param_file.h"
 
 #ifdef ARMSIM_WITH_RENDER
 #include "render/render_plugin.h"

@@ -1,13 +1,13 @@
 // armsim protocol: runs an experiment protocol file (assets/protocols/*.yaml); and the thesis MVC
 // protocol as a main-job step.
+#include "basics/errors.h"
+#include "basics/parallel.h"
+#include "basics/table.h"
 #include "cli/commands.h"
 #include "cli/plugins.h"
 #include "experiments/protocol.h"
 #include "experiments/torque_protocol.h"
 #include "muscles/muscle_file.h"
-#include "model/parallel.h"
-#include "muscles/param_file.h"
-#include "muscles/table.h"
 
 #ifdef ARMSIM_WITH_RENDER
 #include "render/render_plugin.h"

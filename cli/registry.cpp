@@ -1,6 +1,5 @@
+#include "basics/errors.h"
 #include "cli/commands.h"
-
-#include "muscles/param_file.h"
 
 #include <algorithm>
 #include <cmath>

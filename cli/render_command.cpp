@@ -1,11 +1,11 @@
 // armsim render: a video and/or PNG still of a recorded trial (replayed from its table); and the
 // main-job step that leaves an MVC video, a free-movement video and a still in the output directory.
+#include "basics/param_node.h"
 #include "cli/commands.h"
 #include "cli/plugins.h"
 #include "model/geometry.h"
 #include "model/trial.h"
 #include "muscles/muscle_file.h"
-#include "muscles/param_file.h"
 
 #ifdef ARMSIM_WITH_RENDER
 #include "render/render_plugin.h"

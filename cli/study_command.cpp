@@ -1,9 +1,11 @@
 // armsim study STUDY.yaml: a population study on threads, or over MPI ranks under mpirun.
+#include "basics/errors.h"
 #include "cli/commands.h"
 #include "cli/plugins.h"
 #include "identification/study.h"
 #include "identification/study_mpi.h"
-#include "muscles/param_file.h"
+
+#include <fmt/format.h>
 
 #include <cmath>
 #include <cstdio>
@@ -24,12 +26,10 @@ struct StudyOptions {
 
 std::string formatDuration(double seconds) {
     if (!std::isfinite(seconds)) return "?";
-    char buf[32];
     const long s = long(std::lround(seconds));
-    if (s >= 3600) std::snprintf(buf, sizeof buf, "%ldh%02ldm", s / 3600, s / 60 % 60);
-    else if (s >= 60) std::snprintf(buf, sizeof buf, "%ldm%02lds", s / 60, s % 60);
-    else std::snprintf(buf, sizeof buf, "%lds", s);
-    return buf;
+    if (s >= 3600) return fmt::format("{}h{:02}m", s / 3600, s / 60 % 60);
+    if (s >= 60) return fmt::format("{}m{:02}s", s / 60, s % 60);
+    return fmt::format("{}s", s);
 }
 
 // One line per report on a log; one updated line on a terminal.

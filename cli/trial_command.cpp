@@ -1,11 +1,11 @@
 // armsim trial: one isometric or free-movement trial of the arm; and the MVC-per-angle main-job step.
+#include "basics/param_node.h"
+#include "basics/plot.h"
 #include "cli/commands.h"
 #include "cli/plugins.h"
-#include "experiments/plot.h"
 #include "model/geometry.h"
 #include "model/trial.h"
 #include "muscles/muscle_file.h"
-#include "muscles/param_file.h"
 #ifdef ARMSIM_WITH_RENDER
 #include "render/render_plugin.h"
 #endif
@@ -145,7 +145,7 @@ void addTrialCommand(CLI::App& app) {
 /// Main job: MVC at the thesis's five angles, in parallel.
 void runMvcAngles(const MainJobContext& ctx) {
     ArmSetup setup = ctx.muscle.loadSetup();
-    const double angles[] = {45, 60, 90, 120, 150};
+    const auto& angles = kThesisMvcAnglesDeg;
     std::vector<IsometricTrialSettings> settings;
     for (double a : angles) {
         IsometricTrialSettings s;
@@ -188,7 +188,7 @@ void runMvcAngles(const MainJobContext& ctx) {
 /// torque over the biceps moment arm) beside every muscle's true force.
 void runElbowMvcAngles(const MainJobContext& ctx) {
     const ArmSetup setup = loadModel("elbow");
-    const double angles[] = {45, 60, 90, 120, 150};  // thesis: included angle, 180 = extended
+    const auto& angles = kThesisMvcAnglesDeg;
     std::vector<IsometricTrialSettings> settings;
     for (double a : angles) {
         IsometricTrialSettings s;

@@ -1,6 +1,7 @@
 #include "experiments/data_files.h"
 
-#include "muscles/param_file.h"
+#include "basics/errors.h"
+#include "basics/files.h"
 
 #include <charconv>
 #include <cmath>

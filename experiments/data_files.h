@@ -2,7 +2,7 @@
 // Framework-free.
 #pragma once
 
-#include "muscles/table.h"
+#include "basics/table.h"
 
 #include <string>
 

@@ -1,7 +1,7 @@
 #include "experiments/emg.h"
 
+#include "basics/bound.h"
 #include "experiments/spectrum.h"
-#include "muscles/param_file.h"
 
 #include <algorithm>
 #include <cmath>

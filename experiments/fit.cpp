@@ -1,6 +1,6 @@
 #include "experiments/fit.h"
 
-#include "muscles/param_file.h"
+#include "basics/errors.h"
 
 #include <Eigen/Dense>
 

@@ -1,10 +1,11 @@
 #include "experiments/model_report.h"
 
-#include "experiments/plot.h"
+#include "basics/files.h"
+#include "basics/param_node.h"
+#include "basics/plot.h"
 #include "model/geometry.h"
 #include "model/muscle_arm.h"
 #include "muscles/muscle_file.h"
-#include "muscles/param_file.h"
 
 #include <algorithm>
 #include <cmath>

@@ -2,9 +2,9 @@
 // PNG, with the published reference points of assets/measured/elbow_reference.yaml on the plots.
 #pragma once
 
+#include "basics/table.h"
 #include "model/model_file.h"
 #include "model/mvc_curve.h"
-#include "muscles/table.h"
 
 #include <string>
 #include <vector>

@@ -1,9 +1,8 @@
 #include "experiments/population.h"
 
-#include "experiments/portable_random.h"
-
+#include "basics/param_node.h"
+#include "basics/portable_random.h"
 #include "muscles/muscle_file.h"
-#include "muscles/param_file.h"
 
 #include <algorithm>
 #include <cmath>

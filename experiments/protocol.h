@@ -17,10 +17,10 @@
 //   composition   steady force at one activation and path for every slow x fast unit count (7.3).
 #pragma once
 
+#include "basics/table.h"
 #include "experiments/emg.h"
 #include "experiments/fit.h"
 #include "model/trial.h"
-#include "muscles/table.h"
 
 #include <cstdint>
 #include <functional>

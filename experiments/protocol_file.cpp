@@ -1,8 +1,10 @@
+#include "basics/files.h"
+#include "basics/param_node.h"
 #include "experiments/protocol.h"
-
 #include "model/geometry.h"
 #include "muscles/muscle_file.h"
-#include "muscles/param_file.h"
+
+#include <fmt/format.h>
 
 #include <algorithm>
 #include <cmath>
@@ -15,12 +17,6 @@ namespace fs = std::filesystem;
 namespace armsim {
 
 namespace {
-
-std::string fmt(const char* format, double v) {
-    char buf[64];
-    std::snprintf(buf, sizeof buf, format, v);
-    return buf;
-}
 
 // ---- Reading --------------------------------------------------------------------------------------
 
@@ -97,7 +93,7 @@ void readEmg(const ParamNode& n, Protocol& p) {
         e.validate();
     } catch (const FieldError& err) {
         if (err.getField() == "outputRate")
-            throw InputError(n.where() + ": the EMG output rate is trial.sample_rate = " + fmt("%g", a.outputRate) +
+            throw InputError(n.where() + ": the EMG output rate is trial.sample_rate = " + fmt::format("{:g}", a.outputRate) +
                              " Hz: " + err.getDetail());
         n.throwLocated(FieldError(n.path(acquisitionKey(err.getField())), err.getDetail()));
     }
@@ -184,7 +180,7 @@ Protocol readProtocol(const std::string& path) {
     if (armTrials) {
         const double seed = root.getNumber("seed", Bound::closed(0, 9007199254740992.0));
         if (seed != std::floor(seed))
-            throw InputError(root.where("seed") + ": field 'seed' = " + fmt("%g", seed) + ": expected a whole number");
+            throw InputError(root.where("seed") + ": field 'seed' = " + fmt::format("{:g}", seed) + ": expected a whole number");
         p.seed = std::uint64_t(seed);
         p.randomOrder = root.getChoice("order", {"random", "listed"}, "random") == "random";
         p.repetitions = root.getInt("repetitions", 1, 1000, 1);

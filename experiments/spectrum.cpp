@@ -1,6 +1,6 @@
 #include "experiments/spectrum.h"
 
-#include "muscles/param_file.h"
+#include "basics/bound.h"
 
 #include <fftw3.h>
 

@@ -1,12 +1,13 @@
 #include "experiments/torque_protocol.h"
 
-#include "experiments/plot.h"
-#include "experiments/portable_random.h"
+#include "basics/files.h"
+#include "basics/param_node.h"
+#include "basics/plot.h"
+#include "basics/portable_random.h"
+#include "basics/table.h"
 #include "model/geometry.h"
 #include "model/trial.h"
 #include "muscles/muscle_file.h"
-#include "muscles/param_file.h"
-#include "muscles/table.h"
 
 #include <algorithm>
 #include <map>

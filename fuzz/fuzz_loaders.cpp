@@ -3,6 +3,7 @@
 // study, force_csv, torque_csv, sto, trace). Each input is written to a scratch file and loaded; a loader
 // may reject it only with InputError (bad input) or SimulationError (a model it cannot solve). Any
 // other exception, a crash, a hang or a sanitizer report is a finding.
+#include "basics/errors.h"
 #include "experiments/data_files.h"
 #include "experiments/population.h"
 #include "experiments/protocol.h"
@@ -13,7 +14,6 @@
 #include "model/model_file.h"
 #include "muscles/activation.h"
 #include "muscles/muscle_file.h"
-#include "muscles/param_file.h"
 
 #include <unistd.h>
 

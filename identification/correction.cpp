@@ -1,8 +1,7 @@
 // Output correction: identification with a cheap model shifted by an expensive model's offset
 // (identifier.h, identifyCorrected).
+#include "basics/bound.h"
 #include "identification/identifier.h"
-
-#include "muscles/param_file.h"
 
 #include <chrono>
 #include <cmath>

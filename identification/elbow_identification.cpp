@@ -1,14 +1,15 @@
 #include "identification/elbow_identification.h"
 
+#include "basics/bound.h"
+#include "basics/csv.h"
+#include "basics/parallel.h"
+#include "basics/portable_random.h"
 #include "identification/identifier.h"
 #include "identification/map_estimate.h"
 #include "identification/statistics.h"
-#include "experiments/portable_random.h"
 #include "model/geometry.h"
 #include "model/mvc_curve.h"
-#include "model/parallel.h"
 #include "model/trial.h"
-#include "muscles/param_file.h"
 
 #include <algorithm>
 #include <cmath>
@@ -521,43 +522,71 @@ std::vector<ElbowValidationSummary> summarizeElbowValidation(const std::vector<E
 
 namespace {
 
-std::string formatCell(double v) { return std::isfinite(v) ? formatNumber(v) : ""; }
-
 }  // namespace
 
 std::string formatElbowValidationCsv(const std::vector<ElbowValidationRow>& rows) {
-    std::string out =
-        "subject,noise,method,converged,true_mass_kg,mass_kg,mass_lower_kg,mass_upper_kg,mass_error_pct,mass_covered,"
-        "true_tendon_length_m,tendon_length_m,tendon_lower_m,tendon_upper_m,tendon_error_mm,tendon_covered,"
-        "voluntary_activation,co_contraction,strength_level,biceps_short_scale,synergist_scale,noise_level_used,"
-        "rms_residual\n";
+    CsvText csv({"subject", "noise", "method", "converged", "true_mass_kg", "mass_kg", "mass_lower_kg", "mass_upper_kg",
+                 "mass_error_pct", "mass_covered", "true_tendon_length_m", "tendon_length_m", "tendon_lower_m",
+                 "tendon_upper_m", "tendon_error_mm", "tendon_covered", "voluntary_activation", "co_contraction",
+                 "strength_level", "biceps_short_scale", "synergist_scale", "noise_level_used", "rms_residual"});
+    auto flag = [](CsvRow& row, int c) -> CsvRow& { return c < 0 ? row.addEmpty() : row.addInteger(c); };
     for (const ElbowValidationRow& r : rows) {
         const BicepsEstimate& e = r.estimate;
-        const std::vector<double> cells = {r.trueMass, e.mass, e.massLower, e.massUpper, 100 * r.massError};
-        out += std::to_string(r.subject) + "," + formatNumber(r.noise) + "," + r.method + "," +
-               (e.converged ? "1" : "0");
-        for (double v : cells) out += "," + formatCell(v);
-        out += "," + (r.massCovered < 0 ? std::string() : std::to_string(r.massCovered));
-        for (double v : {r.trueTendonLength, e.tendonLength, e.tendonLower, e.tendonUpper, 1000 * r.tendonError})
-            out += "," + formatCell(v);
-        out += "," + (r.tendonCovered < 0 ? std::string() : std::to_string(r.tendonCovered));
-        for (double v : {r.voluntaryActivation, r.coContraction, r.strengthLevel, r.bicepsShortScale, r.synergistScale,
-                         e.noiseLevel, e.rmsResidual})
-            out += "," + formatCell(v);
-        out += "\n";
+        CsvRow row;
+        row.addInteger(r.subject).addNumber(r.noise).addText(r.method).addInteger(e.converged ? 1 : 0);
+        row.addNumber(r.trueMass).addNumber(e.mass).addNumber(e.massLower).addNumber(e.massUpper);
+        flag(row.addNumber(100 * r.massError), r.massCovered);
+        row.addNumber(r.trueTendonLength).addNumber(e.tendonLength).addNumber(e.tendonLower).addNumber(e.tendonUpper);
+        flag(row.addNumber(1000 * r.tendonError), r.tendonCovered);
+        row.addNumber(r.voluntaryActivation).addNumber(r.coContraction).addNumber(r.strengthLevel);
+        row.addNumber(r.bicepsShortScale).addNumber(r.synergistScale).addNumber(e.noiseLevel).addNumber(e.rmsResidual);
+        csv.addRow(row);
     }
-    return out;
+    return csv.getText();
 }
 
 std::string formatElbowValidationSummaryCsv(const std::vector<ElbowValidationSummary>& summaries) {
-    std::string out = "method,noise,subjects,converged,mass_bias_pct,mass_rmse_pct,mass_coverage,tendon_bias_mm,"
-                      "tendon_rmse_mm,tendon_coverage\n";
-    for (const ElbowValidationSummary& s : summaries)
-        out += s.method + "," + formatNumber(s.noise) + "," + std::to_string(s.subjects) + "," +
-               std::to_string(s.converged) + "," + formatCell(100 * s.massBias) + "," + formatCell(100 * s.massRmse) +
-               "," + formatCell(s.massCoverage) + "," + formatCell(1000 * s.tendonBias) + "," +
-               formatCell(1000 * s.tendonRmse) + "," + formatCell(s.tendonCoverage) + "\n";
-    return out;
+    CsvText csv({"method", "noise", "subjects", "converged", "mass_bias_pct", "mass_rmse_pct", "mass_coverage",
+                 "tendon_bias_mm", "tendon_rmse_mm", "tendon_coverage"});
+    for (const ElbowValidationSummary& s : summaries) {
+        CsvRow row;
+        row.addText(s.method).addNumber(s.noise).addInteger(s.subjects).addInteger(s.converged);
+        row.addNumber(100 * s.massBias).addNumber(100 * s.massRmse).addNumber(s.massCoverage);
+        row.addNumber(1000 * s.tendonBias).addNumber(1000 * s.tendonRmse).addNumber(s.tendonCoverage);
+        csv.addRow(row);
+    }
+    return csv.getText();
+}
+
+std::string formatTorqueEstimatesCsv(const std::vector<TorqueObservation>& data,
+                                     const std::vector<BicepsEstimate>& estimates, double noiseLevel) {
+    CsvText csv({"method", "converged", "mass_kg", "mass_lower_kg", "mass_upper_kg", "tendon_length_m",
+                 "tendon_lower_m", "tendon_upper_m", "rms_residual_Nm", "chi_square", "dof", "p_value", "noise_level"});
+    for (const BicepsEstimate& e : estimates) {
+        const TorqueResidualCheck c = checkTorqueResiduals(data, e, noiseLevel);
+        CsvRow row;
+        row.addText(e.method).addInteger(e.converged ? 1 : 0).addNumber(e.mass).addNumber(e.massLower);
+        row.addNumber(e.massUpper).addNumber(e.tendonLength).addNumber(e.tendonLower).addNumber(e.tendonUpper);
+        row.addNumber(c.rms).addNumber(c.chiSquare).addInteger(c.dof).addNumber(c.p).addNumber(noiseLevel);
+        csv.addRow(row);
+    }
+    return csv.getText();
+}
+
+std::string formatTorquePredictionsCsv(const std::vector<TorqueObservation>& data,
+                                       const std::vector<BicepsEstimate>& estimates) {
+    std::vector<std::string> header = {"flexion_deg", "effort", "level", "repetition", "torque_Nm"};
+    for (const BicepsEstimate& e : estimates) header.push_back(e.method + "_Nm");
+    CsvText csv(header);
+    for (std::size_t k = 0; k < data.size(); ++k) {
+        const TorqueObservation& d = data[k];
+        CsvRow row;
+        row.addNumber(d.flexionDeg).addInteger(d.effort == MuscleGroup::Flexor ? 1 : -1).addNumber(d.level);
+        row.addInteger(d.repetition).addNumber(d.torque);
+        for (const BicepsEstimate& e : estimates) row.addNumber(e.predictedTorque[k]);
+        csv.addRow(row);
+    }
+    return csv.getText();
 }
 
 void TorqueIdentificationOptions::validate() const {

@@ -158,6 +158,13 @@ struct TorqueResidualCheck {
 };
 TorqueResidualCheck checkTorqueResiduals(const std::vector<TorqueObservation>& data, const BicepsEstimate& estimate,
                                          double noiseLevel);
+/// torque_estimates.csv of `armsim identify-torque`: per estimate its interval, its residual check against
+/// noiseLevel (checkTorqueResiduals) and the noise level.
+std::string formatTorqueEstimatesCsv(const std::vector<TorqueObservation>& data,
+                                     const std::vector<BicepsEstimate>& estimates, double noiseLevel);
+/// torque_predictions.csv: every observation with each estimate's predicted torque (empty where none).
+std::string formatTorquePredictionsCsv(const std::vector<TorqueObservation>& data,
+                                       const std::vector<BicepsEstimate>& estimates);
 /// The noise level residuals are judged against: the given one, or else the last (synergist) fit's
 /// estimate from the repetitions.
 double findJudgingNoiseLevel(const TorqueIdentificationOptions& options, const std::vector<BicepsEstimate>& estimates);

@@ -1,8 +1,11 @@
 #include "identification/experiment_design.h"
 
-#include "experiments/portable_random.h"
-#include "model/parallel.h"
-#include "muscles/param_file.h"
+#include "basics/bound.h"
+#include "basics/csv.h"
+#include "basics/parallel.h"
+#include "basics/portable_random.h"
+
+#include <fmt/format.h>
 
 #include <Eigen/Dense>
 
@@ -260,33 +263,44 @@ DesignResult designProtocol(const Population& prior, const DesignSettings& setti
             p.conditions.push_back(tc);
         }
     result.predicted = evaluate(s, counts, p.name);
-    char text[256];
-    std::snprintf(text, sizeof text,
-                  "designed by armsim design: %d trials, %d prior draws (seed %u); predicted posterior sd of ln M "
-                  "%.1f %%, of L0T %.1f mm",
-                  result.predicted.trials, settings.draws, settings.seed, 100 * result.predicted.massSd,
-                  1000 * result.predicted.tendonSd);
-    p.description = text;
+    p.description = fmt::format(
+        "designed by armsim design: {} trials, {} prior draws (seed {}); predicted posterior sd of ln M {:.1f} %, of "
+        "L0T {:.1f} mm",
+        result.predicted.trials, settings.draws, settings.seed, 100 * result.predicted.massSd,
+        1000 * result.predicted.tendonSd);
     return result;
+}
+
+std::string formatDesignStepsCsv(const DesignResult& result) {
+    CsvText csv({"step", "effort", "flexion_deg", "level", "repetitions", "criterion"});
+    for (std::size_t k = 0; k < result.steps.size(); ++k) {
+        const DesignStep& s = result.steps[k];
+        CsvRow row;
+        row.addInteger(long(k) + 1).addText(getEffortName(s.condition.effort)).addNumber(s.condition.flexionDeg);
+        row.addNumber(s.condition.level).addInteger(s.condition.repetitions).addNumber(s.criterion);
+        csv.addRow(row);
+    }
+    return csv.getText();
 }
 
 std::string formatPredictionsCsv(const std::vector<ProtocolPrediction>& predictions) {
     if (predictions.empty()) return "";
-    std::string out = "protocol,trials,draws_used,criterion,mass_sd_pct,tendon_sd_mm,flexor_strength_sd_pct,prior_mass_sd_pct,"
-                      "prior_tendon_sd_mm,prior_flexor_strength_sd_pct";
-    for (const std::string& n : predictions.front().parameterNames) out += ",corr_lnM_" + n;
-    for (const std::string& n : predictions.front().parameterNames) out += ",sd_" + n;
-    out += "\n";
+    std::vector<std::string> header = {"protocol", "trials", "draws_used", "criterion", "mass_sd_pct", "tendon_sd_mm",
+                                       "flexor_strength_sd_pct", "prior_mass_sd_pct", "prior_tendon_sd_mm",
+                                       "prior_flexor_strength_sd_pct"};
+    for (const std::string& n : predictions.front().parameterNames) header.push_back("corr_lnM_" + n);
+    for (const std::string& n : predictions.front().parameterNames) header.push_back("sd_" + n);
+    CsvText csv(header);
     for (const ProtocolPrediction& p : predictions) {
-        out += p.name + "," + std::to_string(p.trials) + "," + std::to_string(p.drawsUsed) + "," + formatNumber(p.criterion) + "," +
-               formatNumber(100 * p.massSd) + "," + formatNumber(1000 * p.tendonSd) + "," +
-               formatNumber(100 * p.flexorStrengthSd) + "," + formatNumber(100 * p.priorMassSd) + "," +
-               formatNumber(1000 * p.priorTendonSd) + "," + formatNumber(100 * p.priorFlexorStrengthSd);
-        for (double v : p.massCorrelation) out += "," + formatNumber(v);
-        for (double v : p.posteriorSd) out += "," + formatNumber(v);
-        out += "\n";
+        CsvRow row;
+        row.addText(p.name).addInteger(p.trials).addInteger(p.drawsUsed).addNumber(p.criterion);
+        row.addNumber(100 * p.massSd).addNumber(1000 * p.tendonSd).addNumber(100 * p.flexorStrengthSd);
+        row.addNumber(100 * p.priorMassSd).addNumber(1000 * p.priorTendonSd).addNumber(100 * p.priorFlexorStrengthSd);
+        for (double v : p.massCorrelation) row.addNumber(v);
+        for (double v : p.posteriorSd) row.addNumber(v);
+        csv.addRow(row);
     }
-    return out;
+    return csv.getText();
 }
 
 }  // namespace armsim

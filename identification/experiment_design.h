@@ -78,6 +78,9 @@ struct DesignResult {
     std::vector<TorqueCondition> candidates;  ///< every condition considered
 };
 
+/// design_steps.csv: step, effort, flexion_deg, level, repetitions, criterion after the pick.
+std::string formatDesignStepsCsv(const DesignResult& result);
+
 /// `draws` parameter vectors of the identifier's prior (Gaussian, clipped to its bounds), seeded by
 /// (seed, draw): the draws the predictions average over.
 std::vector<std::vector<double>> drawFromPrior(const SynergistModel& model, unsigned seed, int draws);

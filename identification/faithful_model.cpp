@@ -1,8 +1,8 @@
 #include "identification/faithful_model.h"
 
+#include "basics/bound.h"
 #include "model/geometry.h"
 #include "model/trial.h"
-#include "muscles/param_file.h"
 
 #include <algorithm>
 #include <cmath>

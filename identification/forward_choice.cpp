@@ -1,7 +1,7 @@
 #include "identification/forward_choice.h"
 
+#include "basics/bound.h"
 #include "model/geometry.h"
-#include "muscles/param_file.h"
 
 #include <algorithm>
 

@@ -1,7 +1,7 @@
 #include "identification/identifier.h"
 
+#include "basics/bound.h"
 #include "identification/solver_context.h"
-#include "muscles/param_file.h"
 
 #include <algorithm>
 #include <chrono>

@@ -1,7 +1,10 @@
 #include "identification/observations.h"
 
-#include "muscles/param_file.h"
-#include "muscles/table.h"
+#include "basics/errors.h"
+#include "basics/format.h"
+#include "basics/table.h"
+#include "model/arm_parameters.h"
+#include "model/geometry.h"
 
 #include <cmath>
 #include <set>
@@ -9,19 +12,6 @@
 #include <tuple>
 
 namespace armsim {
-
-namespace {
-
-constexpr double kPi = 3.14159265358979323846;
-
-std::string fmt(double v) {
-    std::ostringstream s;
-    s.precision(10);
-    s << v;
-    return s.str();
-}
-
-}  // namespace
 
 int ObservationSet::countDistinctPoints() const {
     std::set<std::pair<double, double>> distinct;
@@ -36,8 +26,8 @@ std::string ObservationSet::where(int i) const {
 }
 
 double calcThesisPathLength(double theta) {
-    const double A = kThesisOriginDistance, B = kThesisInsertionDistance;
-    return std::sqrt(A * A + B * B - 2.0 * A * B * std::cos(theta));
+    static const ArmParameters thesis;
+    return calcBicepsPathLength(thesis.originDistance, thesis.insertionDistance, theta);
 }
 
 void validateObservations(const ObservationSet& set) {
@@ -46,7 +36,7 @@ void validateObservations(const ObservationSet& set) {
         const Observation& o = set.points[i];
         const std::string at = set.where(i);
         auto fail = [&](const std::string& field, double v, const std::string& expected) {
-            throw InputError(at + ": " + field + " = " + fmt(v) + ": expected " + expected);
+            throw InputError(at + ": " + field + " = " + formatNumber(v) + ": expected " + expected);
         };
         if (!std::isfinite(o.force) || o.force > 1e5)
             fail("force_N", o.force, "a finite force of at most 1e5 N (100 kN, beyond any muscle)");
@@ -56,8 +46,8 @@ void validateObservations(const ObservationSet& set) {
         if (!std::isfinite(o.activation) || o.activation < 0 || o.activation > 1)
             fail("activation", o.activation, "in [0, 1]");
         if (!seen.insert({o.subject, o.trial, o.pathLength, o.activation}).second)
-            throw InputError(at + ": duplicate point: path " + fmt(o.pathLength) + " m, activation " +
-                             fmt(o.activation) + ", trial " + std::to_string(o.trial) + ", subject " +
+            throw InputError(at + ": duplicate point: path " + formatNumber(o.pathLength) + " m, activation " +
+                             formatNumber(o.activation) + ", trial " + std::to_string(o.trial) + ", subject " +
                              std::to_string(o.subject) +
                              " appear earlier: expected each point once (give repeated trials a "
                              "`trial` column, or average them)");
@@ -90,7 +80,7 @@ ObservationSet makeObservations(const Table& t, const std::string& path, const O
     for (int r = 0; r < t.getNumRows(); ++r) {
         const std::string at = t.describeRow(path, r);
         auto fail = [&](const std::string& column, double v, const std::string& expected) {
-            throw InputError(at + ": column '" + column + "' = " + fmt(v) + ": expected " + expected);
+            throw InputError(at + ": column '" + column + "' = " + formatNumber(v) + ": expected " + expected);
         };
         auto integer = [&](const std::string& column) {
             if (!t.hasColumn(column)) return 0;
@@ -117,10 +107,10 @@ ObservationSet makeObservations(const Table& t, const std::string& path, const O
             const double deg = t.get(r, "angle_deg");
             if (!std::isfinite(deg) || !(deg > 0) || deg > 180)
                 fail("angle_deg", deg, "in (0, 180] (included elbow angle, 180 = extended)");
-            o.angle = deg * kPi / 180.0;
+            o.angle = degToRad(deg);
             o.pathLength = options.pathFromAngle(o.angle);
             if (!std::isfinite(o.pathLength) || !(o.pathLength > 0))
-                fail("angle_deg", deg, "an angle whose path length is > 0 (got " + fmt(o.pathLength) + " m)");
+                fail("angle_deg", deg, "an angle whose path length is > 0 (got " + formatNumber(o.pathLength) + " m)");
         } else {
             const bool cm = t.hasColumn("path_cm");
             const double v = t.get(r, cm ? "path_cm" : "path_m");

@@ -35,14 +35,9 @@ struct ObservationSet {
 /// Path length [m] as a function of the included elbow angle theta [rad].
 using PathFromAngle = std::function<double(double angleRad)>;
 
-/// Origin distance A of the thesis geometry [m] (thesis 5.2.2 after van Zuylen 1988).
-constexpr double kThesisOriginDistance = 0.37;
-/// Insertion distance B of the thesis geometry [m] (thesis 5.2.2).
-constexpr double kThesisInsertionDistance = 0.06;
-
-/// The thesis's straight-line biceps, P(theta) = sqrt(A^2 + B^2 - 2 A B cos theta), with A = 0.37 m and
-/// B = 0.06 m (P(90 deg) = 37.48 cm, the thesis's "37.5 cm"; P(180 deg) = 43 cm). The default angle to
-/// path conversion; the Simbody arm (model/) can inject its own.
+/// The thesis's straight-line biceps: calcBicepsPathLength (model/geometry.h) with the default arm's
+/// A = 0.37 m and B = 0.06 m (thesis 6.1.2; P(90 deg) = 37.48 cm, the thesis's "37.5 cm"; P(180 deg) =
+/// 43 cm). The default angle to path conversion; another arm injects its own (makeArmPathFromAngle).
 double calcThesisPathLength(double angleRad);
 
 /// How to read a force file.

@@ -1,8 +1,11 @@
 #include "identification/report_io.h"
 
-#include "experiments/plot.h"
-#include "muscles/param_file.h"
-#include "muscles/table.h"
+#include "basics/files.h"
+#include "basics/output_folder.h"
+#include "basics/plot.h"
+#include "basics/table.h"
+
+#include <fmt/format.h>
 
 #include <cmath>
 #include <cstdio>
@@ -134,63 +137,59 @@ void writeConvergencePlot(const std::string& path, const IdentificationReport& r
     writePlotPng(path, spec);
 }
 
-std::vector<std::string> writeReportFiles(const IdentificationReport& report, const std::string& dir,
-                                          const std::string& stem) {
-    const std::filesystem::path d(dir);
-    std::vector<std::string> paths = {(d / (stem + ".json")).string(), (d / (stem + "_history.csv")).string()};
-    writeReportJson(paths[0], report);
-    writeHistoryCsv(paths[1], report);
+std::vector<std::string> addReportFiles(const IdentificationReport& report, OutputFolder& out, const std::string& stem) {
+    std::vector<std::string> names = {stem + ".json", stem + "_history.csv"};
+    writeReportJson(out.addFile(names[0]), report);
+    writeHistoryCsv(out.addFile(names[1]), report);
     // A run whose forward model failed from the start has no finite cost to plot: no plot, the report says why.
     bool finite = false;
     for (const IterationRecord& h : report.history) finite = finite || std::isfinite(h.cost);
     if (finite) {
-        paths.push_back((d / (stem + "_convergence.png")).string());
-        writeConvergencePlot(paths.back(), report);
+        names.push_back(stem + "_convergence.png");
+        writeConvergencePlot(out.addFile(names.back()), report);
     }
+    std::vector<std::string> paths;
+    for (const std::string& n : names) paths.push_back(out.getTargetPath(n));
+    return paths;
+}
+
+std::vector<std::string> writeReportFiles(const IdentificationReport& report, const std::string& dir,
+                                          const std::string& stem) {
+    OutputFolder out(dir, OutputFolder::Mode::AddFiles);
+    std::vector<std::string> paths = addReportFiles(report, out, stem);
+    out.commit();
     return paths;
 }
 
 std::string formatReport(const IdentificationReport& r) {
     std::ostringstream s;
-    char buf[256];
     s << "method " << r.method << " (" << r.forceModel << " model), data " << r.dataSource << "\n";
     s << "stop: " << getStopReasonName(r.stopReason) << ": " << r.message << "\n";
     for (const ParameterEstimate& e : r.parameters) {
-        std::snprintf(buf, sizeof buf, "  %-24s %.6g %s", e.name.c_str(), e.value, e.unit.c_str());
-        s << buf;
-        if (std::isfinite(e.standardError)) {
-            std::snprintf(buf, sizeof buf, "  (se %.3g, interval [%.6g, %.6g])", e.standardError, e.ciLower, e.ciUpper);
-            s << buf;
-        }
+        s << fmt::format("  {:<24} {:.6g} {}", e.name, e.value, e.unit);
+        if (std::isfinite(e.standardError))
+            s << fmt::format("  (se {:.3g}, interval [{:.6g}, {:.6g}])", e.standardError, e.ciLower, e.ciUpper);
         s << (e.atBound ? "  AT BOUND" : "") << "\n";
     }
     if (!r.uncertaintyNote.empty()) s << "uncertainty: " << r.uncertaintyNote << "\n";
     if (r.correlation.size() == 2) {
-        std::snprintf(buf, sizeof buf, "correlation %s / %s: %.4f\n", r.parameters[0].name.c_str(),
-                      r.parameters[1].name.c_str(), r.correlation[0][1]);
-        s << buf;
+        s << fmt::format("correlation {} / {}: {:.4f}\n", r.parameters[0].name, r.parameters[1].name,
+                         r.correlation[0][1]);
     }
-    for (std::size_t k = 0; k < r.observations.size(); ++k) {
-        std::snprintf(buf, sizeof buf, "  path %.4f m  U %.3g  measured %.2f N  model %.2f N  residual %+.3f N\n",
-                      r.observations[k].pathLength, r.observations[k].activation, r.observations[k].force,
-                      r.modelForces[k], r.residuals[k]);
-        s << buf;
-    }
-    std::snprintf(buf, sizeof buf, "rms residual %.4g N, %d iterations, %d forward evaluations, %.3g s\n",
-                  r.rmsResidual, r.iterations, r.forwardEvaluations, r.wallTime);
-    s << buf;
+    for (std::size_t k = 0; k < r.observations.size(); ++k)
+        s << fmt::format("  path {:.4f} m  U {:.3g}  measured {:.2f} N  model {:.2f} N  residual {:+.3f} N\n",
+                         r.observations[k].pathLength, r.observations[k].activation, r.observations[k].force,
+                         r.modelForces[k], r.residuals[k]);
+    s << fmt::format("rms residual {:.4g} N, {} iterations, {} forward evaluations, {:.3g} s\n", r.rmsResidual,
+                     r.iterations, r.forwardEvaluations, r.wallTime);
     for (const ModelCheck& c : r.checks) {
         s << "re-check with the " << (c.note.empty() ? c.model + " model" : c.note) << ": ";
         if (!c.failure.empty()) {
             s << "failed: " << c.failure << "\n";
             continue;
         }
-        std::snprintf(buf, sizeof buf, "rms residual %.4g N; residuals", c.rmsResidual);
-        s << buf;
-        for (double v : c.residuals) {
-            std::snprintf(buf, sizeof buf, " %+.3f", v);
-            s << buf;
-        }
+        s << fmt::format("rms residual {:.4g} N; residuals", c.rmsResidual);
+        for (double v : c.residuals) s << fmt::format(" {:+.3f}", v);
         s << " N\n";
     }
     return s.str();

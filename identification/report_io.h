@@ -2,8 +2,8 @@
 // Every file is written whole or not at all.
 #pragma once
 
+#include "basics/table.h"
 #include "identification/identifier.h"
-#include "muscles/table.h"
 
 #include <nlohmann/json.hpp>
 
@@ -11,6 +11,8 @@
 #include <vector>
 
 namespace armsim {
+
+class OutputFolder;
 
 /// The whole report as JSON (SI units; NaN -> null).
 nlohmann::json toJson(const IdentificationReport& report);
@@ -23,8 +25,12 @@ Table makeHistoryTable(const IdentificationReport& report);
 void writeHistoryCsv(const std::string& path, const IdentificationReport& report);
 /// PNG of the residual norm ||r|| [N] against the iteration, log y (zeros drawn at 1e-12 N).
 void writeConvergencePlot(const std::string& path, const IdentificationReport& report);
-/// Writes <dir>/<stem>.json, <dir>/<stem>_history.csv and <dir>/<stem>_convergence.png; returns the paths.
-/// (The convergence plot is left out when no iteration has a finite cost.)
+/// Adds <stem>.json, <stem>_history.csv and <stem>_convergence.png to `out` (the plot is left out when no
+/// iteration has a finite cost); returns their final paths.
+std::vector<std::string> addReportFiles(const IdentificationReport& report, OutputFolder& out,
+                                        const std::string& stem = "identification");
+/// The same files written to `dir` together (OutputFolder, Mode::AddFiles: all of them or none); returns
+/// their paths.
 std::vector<std::string> writeReportFiles(const IdentificationReport& report, const std::string& dir,
                                           const std::string& stem = "identification");
 /// A few lines for a terminal: stop reason, estimate with intervals, residuals, cost, counts (SI).

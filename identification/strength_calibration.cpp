@@ -1,6 +1,6 @@
 #include "identification/strength_calibration.h"
 
-#include "muscles/param_file.h"
+#include "basics/errors.h"
 
 #include <ceres/ceres.h>
 

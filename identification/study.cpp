@@ -1,6 +1,10 @@
 #include "identification/study.h"
 
-#include "muscles/param_file.h"
+#include "basics/csv.h"
+#include "basics/files.h"
+#include "basics/param_node.h"
+
+#include <fmt/format.h>
 
 #include <algorithm>
 #include <charconv>
@@ -17,52 +21,14 @@ namespace {
 
 constexpr long kMaxTasks = 1000000000L;
 // Changes whenever a result's meaning or format changes, so old journals are not resumed into new files.
-constexpr const char* kResultsVersion = "armsim-study-results-1";
+constexpr const char* kResultsVersion = "armsim-study-results-2";
 
 std::uint64_t hashFnv1a(const std::string& text, std::uint64_t h = 1469598103934665603ULL) {
     for (unsigned char c : text) h = (h ^ c) * 1099511628211ULL;
     return h;
 }
 
-std::string toHex(std::uint64_t v) {
-    char buf[17];
-    std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(v));
-    return buf;
-}
-
-// NaN as an empty cell, integers without exponent.
-std::string num(double v) { return std::isfinite(v) ? formatNumber(v) : ""; }
-
-std::string quoteCsv(const std::string& text) {
-    std::string q = "\"";
-    for (char c : text) {
-        if (c == '"') q += "\"\"";
-        else if (c == '\n' || c == '\r' || c == '\t') q += ' ';
-        else q += c;
-    }
-    return q + "\"";
-}
-
-// Splits one CSV line (RFC 4180 quoting, no newlines inside cells).
-std::vector<std::string> splitCsv(const std::string& line) {
-    std::vector<std::string> cells(1);
-    bool quoted = false;
-    for (std::size_t i = 0; i < line.size(); ++i) {
-        const char c = line[i];
-        if (quoted) {
-            if (c == '"' && i + 1 < line.size() && line[i + 1] == '"') cells.back() += '"', ++i;
-            else if (c == '"') quoted = false;
-            else cells.back() += c;
-        } else if (c == '"') {
-            quoted = true;
-        } else if (c == ',') {
-            cells.emplace_back();
-        } else {
-            cells.back() += c;
-        }
-    }
-    return cells;
-}
+std::string toHex(std::uint64_t v) { return fmt::format("{:016x}", v); }
 
 bool parseDouble(const std::string& s, double& v) {
     if (s.empty()) {
@@ -188,7 +154,8 @@ std::string calcStudyFingerprint(const Study& s) {
     for (double v : s.noiseLevels) t << ' ' << formatNumber(v);
     for (const ElbowMethod& m : s.methods)
         t << "\nmethod " << m.label << ' ' << m.kind << ' ' << formatNumber(m.options.activationSd) << ' '
-          << m.options.freeSlowFraction << ' ' << m.options.includeSynergists << ' ' << num(m.options.noiseLevel);
+          << m.options.freeSlowFraction << ' ' << m.options.includeSynergists << ' '
+          << (std::isfinite(m.options.noiseLevel) ? formatNumber(m.options.noiseLevel) : "");
     for (const StudyProtocol& p : s.protocols) t << "\nprotocol\n" << formatTorqueProtocol(p.protocol);
     if (!s.population.file.empty()) t << "\npopulation\n" << readFileText(s.population.file);
     if (!s.population.base.file.empty()) t << "\nmodel\n" << readFileText(s.population.base.file);
@@ -307,17 +274,17 @@ std::string getStudyResultsHeader() {
 std::string formatStudyResult(const StudyResult& r) {
     const ElbowValidationRow& w = r.row;
     const BicepsEstimate& e = w.estimate;
-    auto flag = [](int c) { return c < 0 ? std::string() : std::to_string(c); };
-    std::ostringstream s;
-    s << r.task << ',' << w.subject << ',' << quoteCsv(r.protocol) << ',' << quoteCsv(w.method) << ',' << num(w.noise)
-      << ',' << r.status << ',' << num(w.trueMass) << ',' << num(e.mass) << ',' << num(e.massLower) << ','
-      << num(e.massUpper) << ',' << num(w.massError) << ',' << flag(w.massCovered) << ',' << num(w.trueTendonLength)
-      << ',' << num(e.tendonLength) << ',' << num(e.tendonLower) << ',' << num(e.tendonUpper) << ','
-      << num(w.tendonError) << ',' << flag(w.tendonCovered) << ',' << num(e.noiseLevel) << ',' << num(e.rmsResidual)
-      << ',' << e.iterations << ',' << e.numParameters << ',' << num(e.massTendonCorrelation) << ','
-      << num(w.voluntaryActivation) << ',' << num(w.coContraction) << ',' << num(w.strengthLevel) << ','
-      << num(w.bicepsShortScale) << ',' << num(w.synergistScale) << ',' << quoteCsv(r.reason);
-    return s.str();
+    auto flag = [](CsvRow& row, int c) -> CsvRow& { return c < 0 ? row.addEmpty() : row.addInteger(c); };
+    CsvRow row;
+    row.addInteger(r.task).addInteger(w.subject).addText(r.protocol).addText(w.method).addNumber(w.noise);
+    row.addText(r.status).addNumber(w.trueMass).addNumber(e.mass).addNumber(e.massLower).addNumber(e.massUpper);
+    flag(row.addNumber(w.massError), w.massCovered).addNumber(w.trueTendonLength).addNumber(e.tendonLength);
+    row.addNumber(e.tendonLower).addNumber(e.tendonUpper);
+    flag(row.addNumber(w.tendonError), w.tendonCovered).addNumber(e.noiseLevel).addNumber(e.rmsResidual);
+    row.addInteger(e.iterations).addInteger(e.numParameters).addNumber(e.massTendonCorrelation);
+    row.addNumber(w.voluntaryActivation).addNumber(w.coContraction).addNumber(w.strengthLevel);
+    row.addNumber(w.bicepsShortScale).addNumber(w.synergistScale).addText(r.reason);
+    return row.getText();
 }
 
 std::string formatStudyJournalLine(const StudyResult& r) {
@@ -332,7 +299,8 @@ bool parseStudyJournalLine(const std::string& line, StudyResult& r) {
     if (toHex(hashFnv1a(body)) != line.substr(0, 16)) return false;
     const std::size_t tab = body.find('\t');
     if (tab == std::string::npos) return false;
-    const std::vector<std::string> c = splitCsv(body.substr(0, tab)), timing = splitCsv(body.substr(tab + 1));
+    const std::vector<std::string> c = splitCsvRecord(body.substr(0, tab)),
+                                   timing = splitCsvRecord(body.substr(tab + 1));
     if (c.size() != 29 || timing.size() != 3) return false;
     r = StudyResult();
     ElbowValidationRow& w = r.row;
@@ -391,18 +359,19 @@ std::vector<StudySummaryRow> summarizeStudy(const Study& study, const std::vecto
 }
 
 std::string formatStudySummaryCsv(const std::vector<StudySummaryRow>& rows) {
-    std::ostringstream s;
-    s << "protocol,method,noise,tasks,ok,not_converged,failed,mass_bias,mass_rmse,mass_coverage,mass_interval_width,"
-         "tendon_bias_m,tendon_rmse_m,tendon_coverage,tendon_interval_width_m\n";
+    CsvText csv({"protocol", "method", "noise", "tasks", "ok", "not_converged", "failed", "mass_bias", "mass_rmse",
+                 "mass_coverage", "mass_interval_width", "tendon_bias_m", "tendon_rmse_m", "tendon_coverage",
+                 "tendon_interval_width_m"});
     for (const StudySummaryRow& r : rows) {
         const ElbowValidationSummary& x = r.stats;
-        s << quoteCsv(r.protocol) << ',' << quoteCsv(x.method) << ',' << num(x.noise) << ',' << x.subjects << ','
-          << x.converged << ',' << r.notConverged << ',' << r.failed << ',' << num(x.massBias) << ','
-          << num(x.massRmse) << ',' << num(x.massCoverage) << ',' << num(x.massIntervalWidth) << ','
-          << num(x.tendonBias) << ',' << num(x.tendonRmse) << ',' << num(x.tendonCoverage) << ','
-          << num(x.tendonIntervalWidth) << '\n';
+        CsvRow row;
+        row.addText(r.protocol).addText(x.method).addNumber(x.noise).addInteger(x.subjects).addInteger(x.converged);
+        row.addInteger(r.notConverged).addInteger(r.failed).addNumber(x.massBias).addNumber(x.massRmse);
+        row.addNumber(x.massCoverage).addNumber(x.massIntervalWidth).addNumber(x.tendonBias).addNumber(x.tendonRmse);
+        row.addNumber(x.tendonCoverage).addNumber(x.tendonIntervalWidth);
+        csv.addRow(row);
     }
-    return s.str();
+    return csv.getText();
 }
 
 }  // namespace armsim

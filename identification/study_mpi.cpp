@@ -1,6 +1,6 @@
 #include "identification/study_mpi.h"
 
-#include "muscles/param_file.h"
+#include "basics/errors.h"
 
 #include <mpi.h>
 

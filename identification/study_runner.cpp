@@ -1,9 +1,10 @@
 // The study's machinery: the output folder (lock, journal, final files), the worker threads of one
 // process, the coordinator (rank 0) and the worker-rank loop. The numbers come from runStudyGroup.
+#include "basics/errors.h"
+#include "basics/files.h"
+#include "basics/format.h"
+#include "basics/plot.h"
 #include "identification/study.h"
-
-#include "experiments/plot.h"
-#include "muscles/param_file.h"
 
 #include <algorithm>
 #include <chrono>

@@ -1,6 +1,9 @@
 #include "identification/thesis_cases.h"
 
+#include "basics/csv.h"
 #include "muscles/muscle_file.h"
+
+#include <fmt/format.h>
 
 #include <cmath>
 #include <cstdio>
@@ -40,8 +43,7 @@ std::vector<ThesisComparisonRow> resultRows(const std::string& name, const Ident
                         r.parameters[j].value, j < thesisParams.size() ? thesisParams[j] : kNaN});
     }
     for (std::size_t k = 0; k < r.observations.size(); ++k) {
-        char q[64];
-        std::snprintf(q, sizeof q, "Y%zu (%.1f cm)", k + 1, r.observations[k].pathLength * 100);
+        const std::string q = fmt::format("Y{} ({:.1f} cm)", k + 1, r.observations[k].pathLength * 100);
         rows.push_back({name, q, "N", r.modelForces[k], k < thesisForces.size() ? thesisForces[k] : kNaN});
     }
     rows.push_back({name, "iterations", "", double(r.iterations), thesisIterations});
@@ -55,8 +57,7 @@ std::vector<ThesisComparisonRow> startRows(const std::string& name, const Muscle
     const std::vector<double> y = model.calcForces(start, data.points);
     std::vector<ThesisComparisonRow> rows;
     for (std::size_t k = 0; k < y.size(); ++k) {
-        char q[64];
-        std::snprintf(q, sizeof q, "Y%zu at start (%.1f cm)", k + 1, data.points[k].pathLength * 100);
+        const std::string q = fmt::format("Y{} at start ({:.1f} cm)", k + 1, data.points[k].pathLength * 100);
         rows.push_back({name, q, "N", y[k], k < thesisForces.size() ? thesisForces[k] : kNaN});
     }
     return rows;
@@ -98,7 +99,7 @@ std::vector<ThesisCase> reproduceThesisCases(const MuscleParameters& base, const
         IdentificationProblem pr;
         pr.base = base;
         pr.data = synthetic;
-        pr.unknowns = unknownsFrom(0.330, 0.22);
+        pr.unknowns = unknownsFrom(kThesisStartMass, kThesisStartTendonLength);
         IdentificationOptions o;
         o.method = Method::IlcConstant;
         ThesisCase c{"7.2.1 ilc-constant", identify(pr, model, o), {}};
@@ -113,18 +114,18 @@ std::vector<ThesisCase> reproduceThesisCases(const MuscleParameters& base, const
     };
     const TwoOutput twoOutput[] = {
         {"Table 7.2", &synthetic, {0.3359, 0.245}, {595.9, 448}, {575.3, 513.1}, 52},
-        {"Table 7.3", &measured, {0.3377, 0.244}, {599.8, 457.9}, {575.3, 513.1}, 49}};
+        {"Table 7.3", &measured, {kThesisMeasuredMass, kThesisMeasuredTendonLength}, {599.8, 457.9}, {575.3, 513.1}, 49}};
     for (const TwoOutput& t : twoOutput)
         for (Method m : {Method::IlcSignSearch, Method::LevenbergMarquardt}) {
             IdentificationProblem pr;
             pr.base = base;
             pr.data = *t.data;
-            pr.unknowns = unknownsFrom(0.330, 0.22);
+            pr.unknowns = unknownsFrom(kThesisStartMass, kThesisStartTendonLength);
             IdentificationOptions o;
             o.method = m;
             ThesisCase c{std::string(t.table) + " " + getMethodName(m), identify(pr, model, o), {}};
             c.rows = resultRows(c.name, c.report, t.params, t.forces, t.iterations);
-            const auto s = startRows(c.name, ParameterMap(pr.base, pr.unknowns).toMuscle({0.330, 0.22}), model,
+            const auto s = startRows(c.name, ParameterMap(pr.base, pr.unknowns).toMuscle({kThesisStartMass, kThesisStartTendonLength}), model,
                                      pr.data, t.startForces);
             c.rows.insert(c.rows.end(), s.begin(), s.end());
             cases.push_back(std::move(c));
@@ -140,25 +141,30 @@ std::vector<ThesisComparisonRow> collectRows(const std::vector<ThesisCase>& case
 
 std::string formatThesisComparison(const std::vector<ThesisCase>& cases) {
     std::ostringstream s;
-    char buf[256];
-    std::snprintf(buf, sizeof buf, "%-30s %-22s %12s %12s  %s\n", "case", "quantity", "ours", "thesis", "unit");
-    s << buf;
+    s << fmt::format("{:<30} {:<22} {:>12} {:>12}  {}\n", "case", "quantity", "ours", "thesis", "unit");
     for (const ThesisCase& c : cases) {
         for (const ThesisComparisonRow& r : c.rows) {
             double k = 1;
             std::string unit = r.unit;
             if (unit == "kg") k = 1000, unit = "g";
             if (unit == "m") k = 100, unit = "cm";
-            char thesis[32] = "-";
-            if (std::isfinite(r.thesis)) std::snprintf(thesis, sizeof thesis, "%.2f", r.thesis * k);
-            std::snprintf(buf, sizeof buf, "%-30s %-22s %12.2f %12s  %s\n", r.caseName.c_str(), r.quantity.c_str(),
-                          r.ours * k, thesis, unit.c_str());
-            s << buf;
+            const std::string thesis = std::isfinite(r.thesis) ? fmt::format("{:.2f}", r.thesis * k) : "-";
+            s << fmt::format("{:<30} {:<22} {:12.2f} {:>12}  {}\n", r.caseName, r.quantity, r.ours * k, thesis, unit);
         }
         s << "    -> " << getStopReasonName(c.report.stopReason) << ", " << c.report.forwardEvaluations
           << " forward evaluations: " << c.report.message << "\n";
     }
     return s.str();
+}
+
+std::string formatThesisCasesCsv(const std::vector<ThesisCase>& cases) {
+    CsvText csv({"case", "quantity", "unit", "ours", "thesis"});
+    for (const ThesisComparisonRow& r : collectRows(cases)) {
+        CsvRow row;
+        row.addText(r.caseName).addText(r.quantity).addText(r.unit).addNumber(r.ours).addNumber(r.thesis);
+        csv.addRow(row);
+    }
+    return csv.getText();
 }
 
 }  // namespace armsim

@@ -8,6 +8,13 @@
 
 namespace armsim {
 
+/// The thesis's start of its two-output identifications (Tables 7.2, 7.3): M = 330 g, L0T = 22 cm.
+constexpr double kThesisStartMass = 0.330;           ///< [kg]
+constexpr double kThesisStartTendonLength = 0.22;    ///< [m]
+/// The thesis's estimate from its measured forces (Table 7.3): M = 337.7 g, L0T = 24.4 cm.
+constexpr double kThesisMeasuredMass = 0.3377;       ///< [kg]
+constexpr double kThesisMeasuredTendonLength = 0.244;  ///< [m]
+
 /// One compared quantity. Values are SI (kg, m, N; counts unitless); NaN thesis = not reported.
 struct ThesisComparisonRow {
     std::string caseName;   ///< e.g. "Table 7.2 ilc-sign-search"
@@ -40,5 +47,7 @@ std::vector<ThesisCase> reproduceThesisCases(const MuscleParameters& base, const
 std::vector<ThesisComparisonRow> collectRows(const std::vector<ThesisCase>& cases);
 /// A fixed-width table in thesis units (g, cm, N), with the stop reason of each case.
 std::string formatThesisComparison(const std::vector<ThesisCase>& cases);
+/// CSV of collectRows in SI units: case, quantity, unit, ours, thesis (empty when not reported).
+std::string formatThesisCasesCsv(const std::vector<ThesisCase>& cases);
 
 }  // namespace armsim

@@ -1,6 +1,6 @@
 #include "identification/unknowns.h"
 
-#include "muscles/param_file.h"
+#include "basics/bound.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,7 +1,10 @@
 #include "identification/validation.h"
 
+#include "basics/bound.h"
+#include "basics/csv.h"
 #include "model/geometry.h"
-#include "muscles/param_file.h"
+
+#include <fmt/format.h>
 
 #include <cmath>
 #include <cstdio>
@@ -22,13 +25,6 @@ struct Truth {
     std::string name;
     double mass, tendon;
 };
-
-std::string csvNumber(double v, const char* f = "%.10g") {
-    if (!std::isfinite(v)) return "";
-    char b[64];
-    std::snprintf(b, sizeof b, f, v);
-    return b;
-}
 
 }  // namespace
 
@@ -109,9 +105,7 @@ std::vector<ValidationRow> runValidation(const ArmParameters& arm, const MuscleP
             IdentificationProblem pr;
             pr.base = base;
             pr.data = clean;
-            char src[96];
-            std::snprintf(src, sizeof src, "synthetic MVC (%s truth, %.3g %% noise)", truth.name.c_str(), 100 * sd);
-            pr.data.source = src;
+            pr.data.source = fmt::format("synthetic MVC ({} truth, {:.3g} % noise)", truth.name, 100 * sd);
             for (std::size_t k = 0; k < y0.size(); ++k)
                 pr.data.points[k].force = std::max(0.0, y0[k] * (1.0 + sd * eps[k]));
             pr.unknowns[0].start = settings.startMass;
@@ -154,35 +148,35 @@ std::vector<ValidationRow> runValidation(const ArmParameters& arm, const MuscleP
 }
 
 std::string formatValidationCsv(const std::vector<ValidationRow>& rows) {
-    std::ostringstream s;
-    s << "truth,noise_pct,method,true_mass_kg,true_tendon_length_m,mass_kg,tendon_length_m,mass_error_pct,"
-         "tendon_length_error_pct,mass_covered,tendon_length_covered,stop_reason,iterations,evaluations,wall_time_s\n";
-    auto cover = [](int c) { return c < 0 ? std::string() : std::to_string(c); };
-    for (const ValidationRow& r : rows)
-        s << r.truth << "," << csvNumber(100 * r.noise) << "," << r.method << "," << csvNumber(r.trueMass) << ","
-          << csvNumber(r.trueTendonLength) << "," << csvNumber(r.mass) << "," << csvNumber(r.tendonLength) << ","
-          << csvNumber(100 * r.massError) << "," << csvNumber(100 * r.tendonLengthError) << ","
-          << cover(r.massCovered) << "," << cover(r.tendonLengthCovered) << "," << r.stopReason << ","
-          << r.iterations << "," << r.evaluations << "," << csvNumber(r.wallTime, "%.4g") << "\n";
-    return s.str();
+    CsvText csv({"truth", "noise_pct", "method", "true_mass_kg", "true_tendon_length_m", "mass_kg", "tendon_length_m",
+                 "mass_error_pct", "tendon_length_error_pct", "mass_covered", "tendon_length_covered", "stop_reason",
+                 "iterations", "evaluations", "wall_time_s"});
+    auto flag = [](CsvRow& row, int c) -> CsvRow& { return c < 0 ? row.addEmpty() : row.addInteger(c); };
+    for (const ValidationRow& r : rows) {
+        CsvRow row;
+        row.addText(r.truth).addNumber(100 * r.noise).addText(r.method).addNumber(r.trueMass);
+        row.addNumber(r.trueTendonLength).addNumber(r.mass).addNumber(r.tendonLength).addNumber(100 * r.massError);
+        row.addNumber(100 * r.tendonLengthError);
+        flag(flag(row, r.massCovered), r.tendonLengthCovered).addText(r.stopReason).addInteger(r.iterations);
+        row.addInteger(r.evaluations).addNumber(r.wallTime, 4);
+        csv.addRow(row);
+    }
+    return csv.getText();
 }
 
 std::string formatValidationTable(const std::vector<ValidationRow>& rows) {
     std::ostringstream s;
-    char b[256];
-    std::snprintf(b, sizeof b, "%-9s %5s %-19s %8s %7s %9s %9s %5s %-15s %5s %5s %7s\n", "truth", "noise", "method",
-                  "M (g)", "L0T(cm)", "dM (%)", "dL0T (%)", "in CI", "stop", "iter", "evals", "time(s)");
-    s << b;
+    s << fmt::format("{:<9} {:>5} {:<19} {:>8} {:>7} {:>9} {:>9} {:>5} {:<15} {:>5} {:>5} {:>7}\n", "truth", "noise",
+                     "method", "M (g)", "L0T(cm)", "dM (%)", "dL0T (%)", "in CI", "stop", "iter", "evals", "time(s)");
     auto cover = [](int m, int t) {
         if (m < 0 || t < 0) return std::string("-");
         return std::string(m ? "y" : "n") + (t ? "y" : "n");
     };
     for (const ValidationRow& r : rows) {
-        std::snprintf(b, sizeof b, "%-9s %4.0f%% %-19s %8.2f %7.3f %+9.4f %+9.4f %5s %-15s %5d %5d %7.3f\n",
-                      r.truth.c_str(), 100 * r.noise, r.method.c_str(), 1000 * r.mass, 100 * r.tendonLength,
-                      100 * r.massError, 100 * r.tendonLengthError, cover(r.massCovered, r.tendonLengthCovered).c_str(),
-                      r.stopReason.c_str(), r.iterations, r.evaluations, r.wallTime);
-        s << b;
+        s << fmt::format("{:<9} {:4.0f}% {:<19} {:8.2f} {:7.3f} {:+9.4f} {:+9.4f} {:>5} {:<15} {:5} {:5} {:7.3f}\n",
+                         r.truth, 100 * r.noise, r.method, 1000 * r.mass, 100 * r.tendonLength, 100 * r.massError,
+                         100 * r.tendonLengthError, cover(r.massCovered, r.tendonLengthCovered), r.stopReason,
+                         r.iterations, r.evaluations, r.wallTime);
     }
     // Coverage per (method, noise) over the truths, where intervals exist.
     std::map<std::pair<std::string, double>, std::pair<int, int>> mass, tendon;
@@ -195,9 +189,8 @@ std::string formatValidationTable(const std::vector<ValidationRow>& rows) {
     }
     for (const auto& [key, m] : mass) {
         const auto& t = tendon[key];
-        std::snprintf(b, sizeof b, "95 %% interval coverage, %s at %.0f %% noise: mass %d/%d, L0T %d/%d\n",
-                      key.first.c_str(), 100 * key.second, m.first, m.second, t.first, t.second);
-        s << b;
+        s << fmt::format("95 % interval coverage, {} at {:.0f} % noise: mass {}/{}, L0T {}/{}\n", key.first,
+                         100 * key.second, m.first, m.second, t.first, t.second);
     }
     return s.str();
 }

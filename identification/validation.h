@@ -5,6 +5,7 @@
 
 #include "identification/faithful_model.h"
 #include "identification/identifier.h"
+#include "model/geometry.h"
 
 #include <functional>
 #include <string>
@@ -34,7 +35,7 @@ struct ValidationSettings {
     int seeds = 1;                 ///< random truths in addition to the thesis's (M = 336 g, L0T = 24.5 cm)
     unsigned seed = 1;             ///< seed of the truths and the noise
     std::vector<Method> methods;   ///< empty: getValidationMethods()
-    std::vector<double> anglesDeg = {45, 60, 90, 120, 150};  ///< MVC angles (thesis 6.1.2)
+    std::vector<double> anglesDeg{std::begin(kThesisMvcAnglesDeg), std::end(kThesisMvcAnglesDeg)};  ///< MVC angles [deg]
     ForceEstimate estimate = ForceEstimate::MomentArm;       ///< what the simulated experimenter reports
     ValidationModel model = ValidationModel::Corrected;
     double startMass = 0.330;      ///< [kg] every run's start (thesis Tables 7.2, 7.3)

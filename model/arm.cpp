@@ -1,7 +1,7 @@
 #include "model/arm.h"
 
+#include "basics/bound.h"
 #include "model/geometry.h"
-#include "muscles/param_file.h"
 
 #include <cmath>
 #include <stdexcept>

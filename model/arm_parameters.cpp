@@ -1,6 +1,6 @@
 #include "model/arm_parameters.h"
 
-#include "muscles/param_file.h"
+#include "basics/param_node.h"
 
 namespace armsim {
 

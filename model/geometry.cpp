@@ -1,6 +1,6 @@
 #include "model/geometry.h"
 
-#include "muscles/param_file.h"
+#include "basics/bound.h"
 
 #include <cmath>
 

@@ -12,14 +12,12 @@
 // forearm (both points on the segment axes through the elbow centre).
 #pragma once
 
+#include "basics/angles.h"
+
 namespace armsim {
 
-constexpr double kPi = 3.14159265358979323846;
-
-/// Degrees to radians.
-constexpr double degToRad(double deg) { return deg * (kPi / 180.0); }
-/// Radians to degrees.
-constexpr double radToDeg(double rad) { return rad * (180.0 / kPi); }
+/// The thesis's MVC elbow angles theta [deg] (6.1.2; assets/protocols/mvc_force_angle.yaml).
+inline constexpr double kThesisMvcAnglesDeg[] = {45, 60, 90, 120, 150};
 /// Flexion angle q (pin coordinate, 0 = extended) from the included elbow angle theta [rad].
 constexpr double flexionFromElbowAngle(double theta) { return kPi - theta; }
 /// Included elbow angle theta (pi = extended) from the flexion angle q [rad].

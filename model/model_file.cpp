@@ -1,8 +1,8 @@
 #include "model/model_file.h"
 
+#include "basics/param_node.h"
 #include "model/muscle_arm.h"
 #include "muscles/muscle_file.h"
-#include "muscles/param_file.h"
 
 #include <algorithm>
 #include <cmath>

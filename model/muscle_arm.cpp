@@ -1,7 +1,7 @@
 #include "model/muscle_arm.h"
 
+#include "basics/errors.h"
 #include "model/geometry.h"
-#include "muscles/param_file.h"
 
 #include <cmath>
 

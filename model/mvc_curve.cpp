@@ -1,8 +1,8 @@
 #include "model/mvc_curve.h"
 
+#include "basics/bound.h"
 #include "model/geometry.h"
 #include "model/muscle_arm.h"
-#include "muscles/param_file.h"
 
 #include <cmath>
 

@@ -1,8 +1,8 @@
 #include "model/trial.h"
 
+#include "basics/parallel.h"
+#include "basics/param_node.h"
 #include "model/geometry.h"
-#include "model/parallel.h"
-#include "muscles/param_file.h"
 
 #include <cmath>
 

@@ -4,9 +4,10 @@
 // Simbody System, so trials run in parallel threads and give the same numbers as a sequential run.
 #pragma once
 
+#include "basics/angles.h"
+#include "basics/table.h"
 #include "model/muscle_arm.h"
 #include "muscles/simbody_isometric.h"
-#include "muscles/table.h"
 
 #include <functional>
 #include <string>
@@ -52,7 +53,7 @@ enum class TrialSolver {
 };
 
 struct IsometricTrialSettings {
-    double elbowAngle = 90 * 3.14159265358979323846 / 180;  ///< theta, included angle [rad]
+    double elbowAngle = degToRad(90);  ///< theta, included angle [rad]
     double activation = 1.0;       ///< target U of the agonists during the hold [1]
     MuscleGroup effort = MuscleGroup::Flexor;  ///< which group pulls: a flexion or an extension effort
     double antagonistActivation = 0.0;  ///< target U of the other group during the hold [1]
@@ -119,7 +120,7 @@ std::vector<IsometricTrialResult> runIsometricTrials(const ArmSetup& setup,
 /// Free movement: the elbow unlocked, an optional load in the hand, an activation profile for the
 /// flexors (the other muscles rest).
 struct FreeMovementSettings {
-    double initialAngle = 150 * 3.14159265358979323846 / 180;  ///< theta at t = 0 [rad]
+    double initialAngle = degToRad(150);  ///< theta at t = 0 [rad]
     double initialVelocity = 0.0;      ///< dtheta/dt at t = 0 [rad/s]
     ActivationProfile activation = ActivationProfile::step(0.2, 0.0, 0.5);  ///< U(t)
     double duration = 2.0;             ///< [s]

@@ -1,7 +1,7 @@
 #include "muscles/activation.h"
 
-#include "muscles/param_file.h"
-#include "muscles/table.h"
+#include "basics/bound.h"
+#include "basics/table.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,6 +1,6 @@
 #include "muscles/muscle_file.h"
 
-#include "muscles/param_file.h"
+#include "basics/param_node.h"
 
 #include <cmath>
 #include <cstdlib>

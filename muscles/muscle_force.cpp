@@ -1,6 +1,6 @@
 #include "muscles/muscle_force.h"
 
-#include "muscles/param_file.h"
+#include "basics/errors.h"
 
 #include <cmath>
 #include <sstream>

@@ -1,6 +1,6 @@
 #include "muscles/muscle_path.h"
 
-#include "muscles/param_file.h"
+#include "basics/bound.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,7 +1,7 @@
 #include "muscles/simbody_isometric.h"
 
+#include "basics/bound.h"
 #include "muscles/muscle_force.h"
-#include "muscles/param_file.h"
 
 #include <algorithm>
 #include <cmath>

@@ -2,10 +2,10 @@
 // (both path ends on Ground at a fixed path length).
 #pragma once
 
+#include "basics/table.h"
 #include "muscles/activation.h"
 #include "muscles/simbody.h"
 #include "muscles/stiff_ode.h"
-#include "muscles/table.h"
 #include "muscles/virtual_muscle.h"
 
 #include <functional>

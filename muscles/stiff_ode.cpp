@@ -1,6 +1,6 @@
 #include "muscles/stiff_ode.h"
 
-#include "muscles/param_file.h"
+#include "basics/bound.h"
 #include "muscles/simbody.h"
 
 #include <algorithm>

@@ -1,6 +1,6 @@
 #include "muscles/virtual_muscle.h"
 
-#include "muscles/param_file.h"
+#include "basics/bound.h"
 
 #include <algorithm>
 #include <charconv>

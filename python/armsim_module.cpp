@@ -2,10 +2,11 @@
 // population studies on the C++ libraries, numpy arrays out. SI units and the YAML files' names;
 // errors keep the C++ messages (InputError -> ValueError, a missing file -> FileNotFoundError,
 // SimulationError -> RuntimeError). Long calls release the GIL.
+#include "basics/angles.h"
+#include "basics/bound.h"
 #include "identification/study.h"
 #include "model/mvc_curve.h"
 #include "model/trial.h"
-#include "muscles/param_file.h"
 #include "muscles/simbody_isometric.h"
 #include "python/module_support.h"
 
@@ -190,7 +191,7 @@ PYBIND11_MODULE(_armsim, mod) {
         [](const Model& m, double angleDeg, double activation, const std::string& effort, double antagonist,
            double rest, double rise, double hold, double rate, double window) {
             IsometricTrialSettings s;
-            s.elbowAngle = angleDeg * M_PI / 180;
+            s.elbowAngle = degToRad(angleDeg);
             s.activation = activation;
             s.effort = parseEffort(effort);
             s.antagonistActivation = antagonist;

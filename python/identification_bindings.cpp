@@ -3,13 +3,13 @@
 // runElbowValidation, designProtocol, runProtocol), with keyword arguments named as the YAML files
 // and the command's options, numpy arrays out. The identification report has the keys of the JSON
 // report `armsim identify` writes (report_io.h).
+#include "basics/bound.h"
 #include "experiments/protocol.h"
 #include "identification/elbow_identification.h"
 #include "identification/experiment_design.h"
 #include "identification/forward_choice.h"
 #include "identification/report_io.h"
 #include "identification/validation.h"
-#include "muscles/param_file.h"
 #include "python/module_support.h"
 
 #include <cmath>

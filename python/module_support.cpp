@@ -1,7 +1,7 @@
 #include "python/module_support.h"
 
+#include "basics/errors.h"
 #include "muscles/muscle_file.h"
-#include "muscles/param_file.h"
 
 namespace armsim::python {
 

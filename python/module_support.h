@@ -3,8 +3,8 @@
 // FileNotFoundError of the command line's wording.
 #pragma once
 
+#include "basics/table.h"
 #include "model/model_file.h"
-#include "muscles/table.h"
 
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>

@@ -2,7 +2,7 @@
 // an (H, W, 3) uint8 RGB array (TrialRenderer), offscreen through OSMesa. A separate extension so
 // that `import armsim` does not load the render stack (OSMesa, OpenCV video); armsim.render_video
 // and render_frame import it on first use.
-#include "muscles/param_file.h"
+#include "basics/bound.h"
 #include "python/module_support.h"
 #include "render/trial_video.h"
 

@@ -1,5 +1,7 @@
 #include "render/meshes.h"
 
+#include "basics/angles.h"
+
 #include <algorithm>
 #include <cmath>
 
@@ -37,9 +39,9 @@ TriMesh makeSphere(int level) {
     TriMesh m;
     const int slices = 16 * level, stacks = 8 * level;
     for (int i = 0; i < stacks; ++i) {
-        const double t0 = M_PI * i / stacks, t1 = M_PI * (i + 1) / stacks;
+        const double t0 = kPi * i / stacks, t1 = kPi * (i + 1) / stacks;
         for (int j = 0; j < slices; ++j) {
-            const double f0 = 2 * M_PI * j / slices, f1 = 2 * M_PI * (j + 1) / slices;
+            const double f0 = 2 * kPi * j / slices, f1 = 2 * kPi * (j + 1) / slices;
             const Vec3 a = spherePoint(t0, f0), b = spherePoint(t1, f0), c = spherePoint(t1, f1),
                        d = spherePoint(t0, f1);
             if (i > 0) addTriangle(m, a, a, b, b, d, d);
@@ -54,7 +56,7 @@ TriMesh makeCylinder(int level) {
     const int slices = 16 * level;
     const Vec3 up(0, 1, 0), down(0, -1, 0);
     for (int j = 0; j < slices; ++j) {
-        const double f0 = 2 * M_PI * j / slices, f1 = 2 * M_PI * (j + 1) / slices;
+        const double f0 = 2 * kPi * j / slices, f1 = 2 * kPi * (j + 1) / slices;
         const Vec3 n0(std::cos(f0), 0, -std::sin(f0)), n1(std::cos(f1), 0, -std::sin(f1));
         const Vec3 b0 = n0 + down, t0 = n0 + up, b1 = n1 + down, t1 = n1 + up;
         addTriangle(m, n0, b0, n1, b1, n1, t1);
@@ -70,7 +72,7 @@ TriMesh makeCone(int level) {
     const int slices = 16 * level;
     const Vec3 apex(0, 1, 0), down(0, -1, 0), centre(0, 0, 0);
     for (int j = 0; j < slices; ++j) {
-        const double f0 = 2 * M_PI * j / slices, f1 = 2 * M_PI * (j + 1) / slices;
+        const double f0 = 2 * kPi * j / slices, f1 = 2 * kPi * (j + 1) / slices;
         const double fm = 0.5 * (f0 + f1);
         const Vec3 r0(std::cos(f0), 0, -std::sin(f0)), r1(std::cos(f1), 0, -std::sin(f1));
         // Side normal of a cone with unit radius and height: (radial + y)/sqrt(2).
@@ -108,7 +110,7 @@ TriMesh makeDisk(int level) {
     const int slices = 16 * level;
     const Vec3 n(0, 0, 1), centre(0);
     for (int j = 0; j < slices; ++j) {
-        const double f0 = 2 * M_PI * j / slices, f1 = 2 * M_PI * (j + 1) / slices;
+        const double f0 = 2 * kPi * j / slices, f1 = 2 * kPi * (j + 1) / slices;
         addTriangle(m, n, centre, n, Vec3(std::cos(f0), std::sin(f0), 0), n,
                     Vec3(std::cos(f1), std::sin(f1), 0));
     }
@@ -119,7 +121,7 @@ TriMesh makeTorus(double torusRadius, double tubeRadius, int level) {
     TriMesh m;
     const int slices = 18 * level, sides = 8 * level;
     auto point = [&](int i, int j, Vec3& normal) {
-        const double u = 2 * M_PI * i / slices, v = 2 * M_PI * j / sides;
+        const double u = 2 * kPi * i / slices, v = 2 * kPi * j / sides;
         const Vec3 radial(std::cos(u), std::sin(u), 0);
         normal = std::cos(v) * radial + std::sin(v) * Vec3(0, 0, 1);
         return torusRadius * radial + tubeRadius * normal;

@@ -1,6 +1,8 @@
 #include "render/overlay.h"
 
-#include "muscles/param_file.h"
+#include "basics/bound.h"
+
+#include <fmt/format.h>
 
 #include <opencv2/imgproc.hpp>
 
@@ -30,11 +32,7 @@ void checkColor(const std::string& field, const SimTK::Vec3& c) {
                                         std::to_string(c[2]) + "]: expected each of r, g, b in [0, 1]");
 }
 
-std::string formatTick(double v) {
-    char buf[32];
-    std::snprintf(buf, sizeof buf, "%.3g", v);
-    return buf;
-}
+std::string formatTick(double v) { return fmt::format("{:.3g}", v); }
 
 cv::Size textSize(const std::string& s, double scale, int* baseline = nullptr) {
     int b = 0;

@@ -1,6 +1,6 @@
 #include "render/render_plugin.h"
 
-#include "muscles/param_file.h"
+#include "basics/errors.h"
 
 extern "C" __attribute__((visibility("default"))) const armsim::RenderPlugin* armsim_get_render_plugin() {
     static const armsim::RenderPlugin plugin = [] {

@@ -1,7 +1,10 @@
 #include "render/renderer.h"
 
-#include "muscles/param_file.h"
+#include "basics/angles.h"
+#include "basics/param_node.h"
 #include "render/meshes.h"
+
+#include <fmt/format.h>
 
 #include <GL/osmesa.h>
 #include <opencv2/imgproc.hpp>
@@ -34,11 +37,7 @@ const Vec3 kDefaultPointColor(1, 0, 1);        // Simbody's visualizer default (
 constexpr double kPointArmLength = 0.05;       // half-length of a DecorativePoint's cross (m)
 constexpr double kArrowHeadRadiusRatio = 0.35; // arrow head base radius / tip length
 
-std::string formatVec(const Vec3& v) {
-    char buf[96];
-    std::snprintf(buf, sizeof buf, "[%g, %g, %g]", v[0], v[1], v[2]);
-    return buf;
-}
+std::string formatVec(const Vec3& v) { return fmt::format("[{:g}, {:g}, {:g}]", v[0], v[1], v[2]); }
 
 void checkEvenSize(const std::string& field, int value) {
     checkField(field, value, Bound::closed(kMinSize, kMaxSize, "px"));
@@ -172,7 +171,7 @@ void RenderSettings::validate() const {
     if (camera.orthographic)
         checkField("camera.ortho_height", camera.orthoHeight, Bound::positive("m"));
     else
-        checkField("camera.vertical_fov", camera.verticalFov, Bound::open(0, M_PI, "rad"));
+        checkField("camera.vertical_fov", camera.verticalFov, Bound::open(0, kPi, "rad"));
     checkField("camera.near_clip", camera.nearClip, Bound::positive("m"));
     checkField("camera.far_clip", camera.farClip, {camera.nearClip, 1e300, true, false, "m (> near_clip)"});
 }
@@ -201,7 +200,7 @@ RenderSettings readRenderSettings(const ParamNode& node) {
         s.camera.lookAt = readVec3(c, "look_at", s.camera.lookAt, Bound::any("m"));
         s.camera.up = readVec3(c, "up", s.camera.up, Bound::any());
         s.camera.orthographic = c.getBool("orthographic", s.camera.orthographic);
-        s.camera.verticalFov = c.getNumber("vertical_fov", Bound::open(0, M_PI, "rad"), s.camera.verticalFov);
+        s.camera.verticalFov = c.getNumber("vertical_fov", Bound::open(0, kPi, "rad"), s.camera.verticalFov);
         s.camera.orthoHeight = c.getNumber("ortho_height", Bound::positive("m"), s.camera.orthoHeight);
         s.camera.nearClip = c.getNumber("near_clip", Bound::positive("m"), s.camera.nearClip);
         s.camera.farClip = c.getNumber("far_clip", Bound::positive("m"), s.camera.farClip);

@@ -1,9 +1,11 @@
 #include "render/trial_video.h"
 
+#include "basics/bound.h"
 #include "model/geometry.h"
 #include "model/trial.h"
-#include "muscles/param_file.h"
 #include "render/video.h"
+
+#include <fmt/format.h>
 
 #include <algorithm>
 #include <cmath>
@@ -58,12 +60,6 @@ double calcFloorTop(const ArmParameters& a) { return -calcReach(a) - kFloorGap; 
 std::string rowName(const Table& t, int row) {
     const int line = t.getSourceLine(row);
     return line > 0 ? "line " + std::to_string(line) : "row " + std::to_string(row + 1);
-}
-
-std::string format(const char* fmt, double v) {
-    char buf[64];
-    std::snprintf(buf, sizeof buf, fmt, v);
-    return buf;
 }
 
 // (t, y) samples of a column, at most ~maxPoints of them, each with its row.
@@ -125,9 +121,9 @@ void TrialVideoSettings::validate() const {
     overlayStyle.validate();
     scene.validate();
     if (stillTime && !std::isfinite(*stillTime))
-        throw FieldError("still_at", "= " + format("%g", *stillTime) + ": expected a finite trial time (s)");
+        throw FieldError("still_at", "= " + fmt::format("{:g}", *stillTime) + ": expected a finite trial time (s)");
     if (stillTime && stillPath.empty())
-        throw FieldError("still", "is empty: expected a .png path for the still at t = " + format("%g", *stillTime) +
+        throw FieldError("still", "is empty: expected a .png path for the still at t = " + fmt::format("{:g}", *stillTime) +
                                       " s");
     if (!stillTime && !stillPath.empty())
         throw FieldError("still_at", "is not set: expected the trial time of the still '" + stillPath + "'");
@@ -178,8 +174,8 @@ struct TrialRenderer::Impl {
         checkTable();
         const double frames = (time.back() - time.front()) * settings.fps / settings.playbackSpeed;
         if (!settings.videoPath.empty() && !(frames <= 1e6))
-            throw FieldError("playback_speed", "= " + format("%g", settings.playbackSpeed) + ": the " + name + " would give " +
-                                                   format("%g", frames) + " frames at " + format("%g", settings.fps) +
+            throw FieldError("playback_speed", "= " + fmt::format("{:g}", settings.playbackSpeed) + ": the " + name + " would give " +
+                                                   fmt::format("{:g}", frames) + " frames at " + fmt::format("{:g}", settings.fps) +
                                                    " fps: expected at most 1e6 (a faster playback or a lower rate)");
         isometric = table.hasColumn("strap_force_N");
         if (isometric) {
@@ -226,7 +222,7 @@ struct TrialRenderer::Impl {
         overlayStyle = scaleOverlayStyle(settings.overlayStyle, renderSettings.height);
         if (settings.scene.floor) makeFloor();
         makeTraces();
-        title = isometric ? "isometric, " + format("%.0f deg", angleDeg[0]) : "free movement";
+        title = isometric ? "isometric, " + fmt::format("{:.0f} deg", angleDeg[0]) : "free movement";
     }
 
     void checkTable() {
@@ -244,10 +240,10 @@ struct TrialRenderer::Impl {
             for (const char* c : kRequiredColumns)
                 if (!std::isfinite(table.get(i, c)))
                     throw InputError(name + " " + rowName(table, i) + ": column '" + c + "' = " +
-                                     format("%g", table.get(i, c)) + ": expected a finite number");
+                                     fmt::format("{:g}", table.get(i, c)) + ": expected a finite number");
             if (i > 0 && !(time[i] > time[i - 1]))
-                throw InputError(name + " " + rowName(table, i) + ": time_s = " + format("%.10g", time[i]) +
-                                 ": expected a time after the previous row's " + format("%.10g", time[i - 1]) + " s");
+                throw InputError(name + " " + rowName(table, i) + ": time_s = " + fmt::format("{:.10g}", time[i]) +
+                                 ": expected a time after the previous row's " + fmt::format("{:.10g}", time[i - 1]) + " s");
         }
     }
 
@@ -297,7 +293,7 @@ struct TrialRenderer::Impl {
         return {Vec3(0, a.originDistance, 0), a.insertionDistance * along, a.strapDistance * along,
                 a.calcHandComDistance() * along, Vec3(std::cos(q), std::sin(q), 0)};
     }
-    double calcLoadRadius() const { return std::cbrt(3 * settings.scene.handLoad / (4 * SimTK::Pi * kSteelDensity)); }
+    double calcLoadRadius() const { return std::cbrt(3 * settings.scene.handLoad / (4 * kPi * kSteelDensity)); }
 
     // Transducer anchor (top of its body) and bottom.
     static std::pair<Vec3, Vec3> calcTransducer(const Pose& p) {
@@ -378,17 +374,17 @@ struct TrialRenderer::Impl {
 
     void drawOverlayAt(int row, cv::Mat& frame) const {
         std::vector<OverlayText> text = {{"trial", title},
-                                         {"time", format("%.3f s", time[row])},
-                                         {"elbow angle", format("%.1f deg", angleDeg[row])},
-                                         {"activation", format("%.2f", activation[row])},
-                                         {getForceLabel(), format("%.1f N", force[row])}};
+                                         {"time", fmt::format("{:.3f} s", time[row])},
+                                         {"elbow angle", fmt::format("{:.1f} deg", angleDeg[row])},
+                                         {"activation", fmt::format("{:.2f}", activation[row])},
+                                         {getForceLabel(), fmt::format("{:.1f} N", force[row])}};
         if (isometric)
-            text.push_back({"transducer", format("%.1f N", strap[row]) +
+            text.push_back({"transducer", fmt::format("{:.1f} N", strap[row]) +
                                               (!saturated.empty() && saturated[row] > 0.5 ? " (saturated)" : "")});
         else
-            text.push_back({"elbow velocity", format("%.0f deg/s", velocityDeg[row])});
+            text.push_back({"elbow velocity", fmt::format("{:.0f} deg/s", velocityDeg[row])});
         if (settings.scene.floor) text.push_back({"floor ticks", "10 cm"});
-        if (arrow != ForceArrowKind::None) text.push_back({"arrow", format("%.3g N/cm", 0.01 / arrowScale)});
+        if (arrow != ForceArrowKind::None) text.push_back({"arrow", fmt::format("{:.3g} N/cm", 0.01 / arrowScale)});
 
         std::vector<PlotTrace> plots;
         for (const Trace& tr : traces) {

@@ -12,8 +12,8 @@
 // to the right, +Y up; the overlay shows time, elbow angle, activation, forces and live force plots.
 #pragma once
 
+#include "basics/table.h"
 #include "model/muscle_arm.h"
-#include "muscles/table.h"
 #include "render/overlay.h"
 #include "render/renderer.h"
 

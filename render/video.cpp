@@ -1,6 +1,6 @@
 #include "render/video.h"
 
-#include "muscles/param_file.h"
+#include "basics/bound.h"
 
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>

@@ -6,8 +6,8 @@
 #include "identification/elbow_identification.h"
 #include "identification/faithful_model.h"
 #include "identification/identifier.h"
-#include "model/muscle_arm.h"
 #include "model/geometry.h"
+#include "model/muscle_arm.h"
 #include "muscles/muscle_file.h"
 
 #include <benchmark/benchmark.h>
@@ -25,9 +25,9 @@ IdentificationProblem makeFiveAngleProblem() {
     truth.mass = 0.336;
     truth.optimalTendonLength = 0.245;
     pr.data.source = "synthetic five angles";
-    for (double deg : {45.0, 60.0, 90.0, 120.0, 150.0}) {
+    for (double deg : kThesisMvcAnglesDeg) {
         Observation o;
-        o.pathLength = calcThesisPathLength(deg * 3.14159265358979323846 / 180.0);
+        o.pathLength = calcThesisPathLength(degToRad(deg));
         pr.data.points.push_back(o);
     }
     const std::vector<double> y = SteadyForceModel().calcForces(truth, pr.data.points);
@@ -77,7 +77,7 @@ struct FaithfulCase {
         truth.mass = 0.336;
         truth.optimalTendonLength = 0.245;
         problem.data.source = "faithful five angles";
-        for (double deg : {45.0, 60.0, 90.0, 120.0, 150.0}) {
+        for (double deg : kThesisMvcAnglesDeg) {
             Observation o;
             o.angle = degToRad(deg);
             o.pathLength = calcBicepsPathLength(setup.arm.originDistance, setup.arm.insertionDistance, o.angle);

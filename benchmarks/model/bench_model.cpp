@@ -43,7 +43,7 @@ BENCHMARK(BM_IsometricMvcTrial)->Arg(1000)->Arg(100)->Unit(benchmark::kMilliseco
 
 void BM_FiveAnglesMvc(benchmark::State& state) {
     std::vector<IsometricTrialSettings> settings;
-    for (double deg : {45, 60, 90, 120, 150}) {
+    for (double deg : kThesisMvcAnglesDeg) {
         IsometricTrialSettings s;
         s.elbowAngle = degToRad(deg);
         settings.push_back(s);

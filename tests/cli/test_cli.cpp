@@ -1,6 +1,5 @@
 // The armsim command end to end: exit codes, messages, and files written whole or not at all.
-#include "muscles/table.h"
-
+#include "basics/table.h"
 #include "tests/support/run_armsim.h"
 #include "tests/support/temp_files.h"
 

@@ -1,9 +1,9 @@
 // Synthetic surface EMG from the muscle's motor units: f0.5 in the fibre-type file, firing rates,
 // spike counts, the MUAP shape, amplitude against activation, spectrum, reproducibility.
+#include "basics/errors.h"
 #include "experiments/emg.h"
 #include "experiments/spectrum.h"
 #include "muscles/muscle_file.h"
-#include "muscles/param_file.h"
 
 #include <gtest/gtest.h>
 

@@ -1,7 +1,7 @@
 // Least-squares fits: a known parabola and its vertex, exact polynomials, optimality of the
 // least-squares solution (residual orthogonal to the basis), errors, mean and sd.
+#include "basics/errors.h"
 #include "experiments/fit.h"
-#include "muscles/param_file.h"
 
 #include <gtest/gtest.h>
 

@@ -1,8 +1,8 @@
 // Virtual-subject populations: reproducible draws, the stated distributions, valid people, and
 // population files read strictly.
+#include "basics/errors.h"
 #include "experiments/population.h"
 #include "model/mvc_curve.h"
-#include "muscles/param_file.h"
 
 #include <gtest/gtest.h>
 

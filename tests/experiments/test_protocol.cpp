@@ -1,11 +1,12 @@
 // Experiment protocols: the shipped files, malformed files, determinism (seed, threads), agreement
 // of the summary tables with the per-trial files, %MVC resolution and EMG normalisation, the
 // composition grid, and runs that fail without leaving output behind.
-#include "tests/support/temp_files.h"
+#include "basics/errors.h"
+#include "basics/files.h"
 #include "experiments/data_files.h"
 #include "experiments/protocol.h"
 #include "model/geometry.h"
-#include "muscles/param_file.h"
+#include "tests/support/temp_files.h"
 
 #include <gtest/gtest.h>
 
@@ -99,8 +100,7 @@ TEST(ProtocolFile, ShippedProtocolsReadWithTheThesisConditions) {
     const Protocol mvc = readProtocol(kProtocols + "mvc_force_angle.yaml");
     EXPECT_EQ(mvc.kind, ProtocolKind::Mvc);
     ASSERT_EQ(mvc.elbowAngles.size(), 5u);
-    const double angles[] = {45, 60, 90, 120, 150};
-    for (int i = 0; i < 5; ++i) EXPECT_NEAR(radToDeg(mvc.elbowAngles[i]), angles[i], kAngleTol);
+    for (int i = 0; i < 5; ++i) EXPECT_NEAR(radToDeg(mvc.elbowAngles[i]), kThesisMvcAnglesDeg[i], kAngleTol);
     EXPECT_EQ(mvc.repetitions, 3);
     EXPECT_EQ(mvc.trial.holdDuration, 3.0);
     EXPECT_TRUE(mvc.randomOrder);

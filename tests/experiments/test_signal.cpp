@@ -1,7 +1,8 @@
 // Filters, moving RMS and the EMG acquisition chain against the analytic Butterworth magnitude, the
 // designed frequency response (a second method for the time-domain realisation) and known values.
+#include "basics/angles.h"
+#include "basics/errors.h"
 #include "experiments/signal.h"
-#include "muscles/param_file.h"
 
 #include <gtest/gtest.h>
 
@@ -14,7 +15,6 @@
 namespace armsim {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 
 // Tolerances.
 constexpr double kEdgeDbTol = 0.1;             // -3 dB edges and flat passband (dB)

@@ -1,7 +1,8 @@
 // Power spectrum scaling (Parseval, white-noise level) and MNF/MDF on signals with known spectra.
+#include "basics/angles.h"
+#include "basics/errors.h"
 #include "experiments/signal.h"
 #include "experiments/spectrum.h"
-#include "muscles/param_file.h"
 
 #include <gtest/gtest.h>
 
@@ -14,7 +15,6 @@
 namespace armsim {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 
 // Tolerances.
 constexpr double kExactHz = 1e-6;              // features that are exact by symmetry (Hz)

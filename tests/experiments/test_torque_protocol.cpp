@@ -1,7 +1,7 @@
 // Torque protocols and torque data files: files read back what was written, bad files are refused
 // with file, line and field, and synthesized trials follow the stated effort model.
+#include "basics/errors.h"
 #include "experiments/torque_protocol.h"
-#include "muscles/param_file.h"
 
 #include <gtest/gtest.h>
 

@@ -1,7 +1,6 @@
 // armsim identify / validate end to end (the built binary through popen): reports written whole,
 // bad data rejected with file and line, a tiny validation table.
-#include "muscles/table.h"
-
+#include "basics/table.h"
 #include "tests/support/run_armsim.h"
 
 #include <gtest/gtest.h>

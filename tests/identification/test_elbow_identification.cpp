@@ -1,10 +1,10 @@
 // Identification on the realistic elbow (issue 11): the MAP machinery on a linear-Gaussian case, the
 // tared steady torque two ways, and both identifiers on a seeded population with the elbow as truth.
+#include "basics/parallel.h"
 #include "identification/elbow_identification.h"
 #include "identification/map_estimate.h"
 #include "model/geometry.h"
 #include "model/mvc_curve.h"
-#include "model/parallel.h"
 #include "model/trial.h"
 
 #include <gtest/gtest.h>

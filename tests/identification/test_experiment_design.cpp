@@ -1,9 +1,9 @@
 // Experiment design (issue 11): the predicted posterior width checked against a second method (the
 // spread of actual MAP estimates when the identifier's own model is the truth), information that only
 // grows with trials, and a greedy design that does at least as well as the reference it is compared to.
+#include "basics/parallel.h"
+#include "basics/portable_random.h"
 #include "identification/experiment_design.h"
-#include "experiments/portable_random.h"
-#include "model/parallel.h"
 
 #include <gtest/gtest.h>
 

@@ -2,12 +2,12 @@
 // the steady solve and the geometry, and identification of mass and tendon length from five-angle
 // data that the faithful model made itself. Holds are the thesis's 3 s (a shorter hold saves little
 // time, see faithful_model.h); iterations sample at 200 Hz, the data at 1000 Hz.
+#include "basics/errors.h"
 #include "identification/faithful_model.h"
 #include "identification/identifier.h"
 #include "identification/validation.h"
-#include "model/muscle_arm.h"
 #include "model/geometry.h"
-#include "muscles/param_file.h"
+#include "model/muscle_arm.h"
 #include "test_support.h"
 
 #include <algorithm>

@@ -1,13 +1,13 @@
 // The pieces the command and the Python module share: identifyAndRecheck (the forward model chosen by
 // name, then the two re-checks), observations and torque data from tables in memory, the torque
 // identifiers run together and their residual check.
+#include "basics/errors.h"
+#include "basics/table.h"
 #include "identification/elbow_identification.h"
 #include "identification/forward_choice.h"
 #include "identification/statistics.h"
 #include "model/geometry.h"
 #include "muscles/muscle_file.h"
-#include "muscles/param_file.h"
-#include "muscles/table.h"
 #include "test_support.h"
 
 #include <cmath>
@@ -27,7 +27,7 @@ IdentificationProblem makeFiveAngleProblem(const ArmSetup& setup) {
     std::vector<Observation> points;
     for (double d : deg) {
         Observation o;
-        o.pathLength = calcBicepsPathLength(setup.arm.originDistance, setup.arm.insertionDistance, d * M_PI / 180);
+        o.pathLength = calcBicepsPathLength(setup.arm.originDistance, setup.arm.insertionDistance, degToRad(d));
         points.push_back(o);
     }
     const std::vector<double> f = SteadyForceModel().calcForces(pr.base, points);

@@ -1,6 +1,6 @@
 // Reading and validating force files; input errors of identify().
+#include "basics/errors.h"
 #include "identification/identifier.h"
-#include "muscles/param_file.h"
 #include "test_support.h"
 
 #include <fstream>

@@ -1,6 +1,6 @@
 // JSON report, history CSV and convergence plot of a run.
+#include "basics/table.h"
 #include "identification/report_io.h"
-#include "muscles/table.h"
 #include "test_support.h"
 
 #include <fstream>

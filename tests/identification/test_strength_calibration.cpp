@@ -1,6 +1,6 @@
 // Strength calibration (identification/strength_calibration.h) against ground truth.
+#include "basics/errors.h"
 #include "identification/strength_calibration.h"
-#include "muscles/param_file.h"
 
 #include <gtest/gtest.h>
 

@@ -3,6 +3,7 @@
 #pragma once
 
 #include "identification/identifier.h"
+#include "model/geometry.h"
 #include "muscles/muscle_file.h"
 
 #include <gtest/gtest.h>
@@ -15,7 +16,6 @@
 
 namespace armsim::test {
 
-constexpr double kPi = 3.14159265358979323846;
 /// Thesis Table 7.2 "desired" parameters, used as the truth of synthetic data.
 constexpr double kTrueMass = 0.336;           // kg
 constexpr double kTrueTendonLength = 0.245;   // m
@@ -23,7 +23,7 @@ constexpr double kTrueTendonLength = 0.245;   // m
 constexpr double kStartMass = 0.330;          // kg
 constexpr double kStartTendonLength = 0.22;   // m
 /// Thesis MVC angles [deg] (section 6.1.2).
-inline const std::vector<double> kThesisAngles = {45, 60, 90, 120, 150};
+inline const std::vector<double> kThesisAngles{std::begin(kThesisMvcAnglesDeg), std::end(kThesisMvcAnglesDeg)};
 
 inline MuscleParameters loadBiceps() {
     return loadMuscleParameters(std::string(ARMSIM_ASSET_DIR) + "/muscles/biceps_long_head.yaml");
@@ -53,7 +53,7 @@ inline ObservationSet makeSyntheticData(const MuscleParameters& truth, const std
 
 inline std::vector<double> thesisAnglePaths() {
     std::vector<double> paths;
-    for (double deg : kThesisAngles) paths.push_back(calcThesisPathLength(deg * kPi / 180.0));
+    for (double deg : kThesisAngles) paths.push_back(calcThesisPathLength(degToRad(deg)));
     return paths;
 }
 

@@ -1,8 +1,8 @@
 // The Simbody arm (model/arm.h): stations vs closed forms, virtual work, holding torque, energy
 // conservation, joint stops and the force hook.
+#include "basics/errors.h"
 #include "model/arm.h"
 #include "model/geometry.h"
-#include "muscles/param_file.h"
 
 #include <gtest/gtest.h>
 

@@ -1,7 +1,8 @@
 // ArmParameters: defaults, the YAML asset, validation messages and scaling.
+#include "basics/errors.h"
+#include "basics/files.h"
 #include "model/arm_parameters.h"
 #include "model/geometry.h"
-#include "muscles/param_file.h"
 
 #include <gtest/gtest.h>
 

@@ -1,6 +1,6 @@
 // Closed-form biceps geometry and the thesis's force estimates (model/geometry.h).
+#include "basics/errors.h"
 #include "model/geometry.h"
-#include "muscles/param_file.h"
 
 #include <gtest/gtest.h>
 

@@ -1,9 +1,9 @@
 // Model files, muscle paths with wrapping, and the arm built from them.
+#include "basics/errors.h"
 #include "model/geometry.h"
 #include "model/muscle_arm.h"
 #include "model/mvc_curve.h"
 #include "model/trial.h"
-#include "muscles/param_file.h"
 
 #include <gtest/gtest.h>
 

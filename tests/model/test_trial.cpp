@@ -1,8 +1,8 @@
 // Trials on the biceps arm: isometric (locked elbow, transducer, tare) and free movement.
+#include "basics/param_node.h"
 #include "model/geometry.h"
 #include "model/model_file.h"
 #include "model/trial.h"
-#include "muscles/param_file.h"
 
 #include <gtest/gtest.h>
 
@@ -18,8 +18,6 @@ const ArmSetup& subject() {
     static const ArmSetup s = ArmSetup::loadDefault();
     return s;
 }
-
-constexpr double kThesisAnglesDeg[] = {45, 60, 90, 120, 150};
 
 IsometricTrialSettings mvcAt(double deg) {
     IsometricTrialSettings s;
@@ -39,7 +37,7 @@ TEST(IsometricTrial, SteadyForceInTheArmEqualsTheMuscleOnlySteadySolve) {
     constexpr double kRelTol = 1e-3;  // issue 3: 0.1 %
     constexpr double kAbsTol = 0.01;  // N, for the near-slack 45 deg path (~5 N)
     const VirtualMuscle m(subject().calcBicepsParameters());
-    for (double deg : kThesisAnglesDeg) {
+    for (double deg : kThesisMvcAnglesDeg) {
         const IsometricTrialResult r = runIsometricTrial(subject(), mvcAt(deg));
         const double P = calcBicepsPathLength(subject().arm.originDistance, subject().arm.insertionDistance,
                                               degToRad(deg));
@@ -73,7 +71,7 @@ TEST(IsometricTrial, TaredHoldingTorqueIsForceTimesMomentArm) {
 TEST(IsometricTrial, MomentArmEstimateRecoversTheForceAndTheFixedRatioErrorIsReported) {
     constexpr double kRelTol = 1e-3;
     const ArmParameters& a = subject().arm;
-    for (double deg : kThesisAnglesDeg) {
+    for (double deg : kThesisMvcAnglesDeg) {
         const IsometricTrialResult r = runIsometricTrial(subject(), mvcAt(deg));
         const auto& S = r.summary;
         // The tare hides the passive force at rest; the estimate recovers the rest of the force.
@@ -101,7 +99,7 @@ TEST(IsometricTrial, TransducerSaturationIsFlagged) {
 
 TEST(IsometricTrial, ParallelAndSequentialRunsGiveIdenticalNumbers) {
     std::vector<IsometricTrialSettings> settings;
-    for (double deg : kThesisAnglesDeg) settings.push_back(mvcAt(deg));
+    for (double deg : kThesisMvcAnglesDeg) settings.push_back(mvcAt(deg));
     int calls = 0;
     const auto sequential = runIsometricTrials(subject(), settings, 1);
     const auto parallel = runIsometricTrials(subject(), settings, 2, [&](int done, int total) {

@@ -1,5 +1,5 @@
+#include "basics/errors.h"
 #include "muscles/activation.h"
-#include "muscles/param_file.h"
 
 #include <gtest/gtest.h>
 

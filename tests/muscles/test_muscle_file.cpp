@@ -1,6 +1,6 @@
 // Parameter files: the shipped ones load; bad ones fail with a message naming file, field and value.
+#include "basics/errors.h"
 #include "muscles/muscle_file.h"
-#include "muscles/param_file.h"
 
 #include <gtest/gtest.h>
 

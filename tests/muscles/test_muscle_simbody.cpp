@@ -1,8 +1,8 @@
 // The Simbody adapter: the release-build trap, states, the force it applies, and steady solve vs
 // time integration (the same quantity two ways).
+#include "basics/errors.h"
 #include "muscles/muscle_file.h"
 #include "muscles/muscle_force.h"
-#include "muscles/param_file.h"
 #include "muscles/simbody_isometric.h"
 
 #include <gtest/gtest.h>

@@ -1,6 +1,7 @@
 // The direct stiff integrator (CPodes without a Simbody System): closed-form solutions, restarts at
 // breakpoints, sampling, and failures reported with the time and the model's message.
-#include "muscles/param_file.h"
+#include "basics/errors.h"
+#include "basics/format.h"
 #include "muscles/stiff_ode.h"
 
 #include <gtest/gtest.h>

@@ -55,7 +55,7 @@ int main() {
     printList("moment_arms", arms);
 
     IsometricTrialSettings s;
-    s.elbowAngle = 100 * M_PI / 180;
+    s.elbowAngle = degToRad(100);
     s.activation = 0.7;
     s.antagonistActivation = 0.05;
     s.holdDuration = 1.0;
@@ -73,7 +73,7 @@ int main() {
     const std::vector<double> anglesDeg = {45, 60, 90, 120, 150}, factors = {1.01, 0.99, 1.02, 0.985, 1.0};
     for (double deg : anglesDeg) {
         Observation o;
-        o.angle = deg * M_PI / 180;
+        o.angle = degToRad(deg);
         o.pathLength = makeArmPathFromAngle(thesis.arm)(o.angle);
         pr.data.points.push_back(o);
     }

@@ -1,7 +1,6 @@
 // Tests of the OpenCV overlay: where text and plots land, where a trace is drawn, and clipping.
+#include "basics/errors.h"
 #include "render/overlay.h"
-
-#include "muscles/param_file.h"
 #include "tests/render/render_test_util.h"
 
 #include <gtest/gtest.h>

@@ -1,8 +1,7 @@
 // armsim render and armsim trial --video end to end (no X display): exit codes, the written video
 // and still, and named errors that leave no file behind.
-#include "muscles/table.h"
+#include "basics/table.h"
 #include "tests/render/render_test_util.h"
-
 #include "tests/support/run_armsim.h"
 
 #include <gtest/gtest.h>

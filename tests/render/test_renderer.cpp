@@ -1,8 +1,7 @@
 // Tests of the OSMesa renderer: settings validation, camera projection against the pinhole formula,
 // and pixel checks on rendered Simbody systems.
+#include "basics/param_node.h"
 #include "render/renderer.h"
-
-#include "muscles/param_file.h"
 #include "tests/render/pendulum_scene.h"
 #include "tests/render/render_test_util.h"
 

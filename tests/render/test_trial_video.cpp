@@ -1,11 +1,10 @@
 // Tests of trial videos: replay of recorded trial tables into the arm, pixel checks on the rendered
 // arm (forearm motion, muscle colour, nothing outside the scene), the written video, and bad input.
 // Runs without an X display.
-#include "render/trial_video.h"
-
+#include "basics/errors.h"
 #include "model/geometry.h"
 #include "model/trial.h"
-#include "muscles/param_file.h"
+#include "render/trial_video.h"
 #include "render/video.h"
 #include "tests/render/render_test_util.h"
 

@@ -1,9 +1,8 @@
 // Tests of video and PNG output: files reopen with the expected properties and content, are written
 // whole or not at all, and bad settings are rejected before anything is written.
-#include "render/video.h"
-
-#include "muscles/param_file.h"
+#include "basics/errors.h"
 #include "render/renderer.h"
+#include "render/video.h"
 #include "tests/render/pendulum_scene.h"
 #include "tests/render/render_test_util.h"
 

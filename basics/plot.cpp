@@ -1,6 +1,8 @@
-#include "experiments/plot.h"
+#include "basics/plot.h"
 
-#include "muscles/param_file.h"
+#include "basics/errors.h"
+
+#include <fmt/format.h>
 
 #include <plplot/plplot.h>
 
@@ -211,14 +213,13 @@ void writeHeatMapPng(const std::string& path, const HeatMapSpec& spec) {
         pllab(spec.xLabel.c_str(), spec.yLabel.c_str(), spec.title.c_str());
         if (spec.cellLabels) {
             plschr(0, 0.75);
-            char text[64];
             for (std::size_t i = 0; i < nx; ++i)
                 for (std::size_t j = 0; j < ny; ++j) {
                     const double v = spec.z[i * ny + j];
                     if (!std::isfinite(v)) continue;
-                    std::snprintf(text, sizeof text, "%.*f", spec.labelDecimals, v);
+                    const std::string text = fmt::format("{:.{}f}", v, spec.labelDecimals);
                     plcol0((v - zmin) / (zmax - zmin) > 0.6 ? 9 : 0);  // black on light cells, white on dark
-                    plptex(spec.x[i], spec.y[j], 1, 0, 0.5, text);
+                    plptex(spec.x[i], spec.y[j], 1, 0, 0.5, text.c_str());
                 }
             plschr(0, 1.1);
         }

@@ -1,75 +1,13 @@
-#include "muscles/param_file.h"
+#include "basics/param_node.h"
+
+#include "basics/files.h"
 
 #include <yaml-cpp/yaml.h>
 
-#include <atomic>
-#include <charconv>
-#include <cmath>
-#include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <sstream>
-#include <unistd.h>
 
 namespace armsim {
-
-namespace {
-std::atomic<int> interruption{0};
-}
-
-void checkInputFile(const std::string& path, std::uintmax_t maxBytes) {
-    std::error_code ec;
-    if (std::filesystem::exists(path, ec) && !std::filesystem::is_regular_file(path, ec))
-        throw InputError(path + ": not a regular file (a folder, device or pipe): expected a file");
-    const std::uintmax_t size = std::filesystem::file_size(path, ec);
-    if (!ec && size > maxBytes)
-        throw InputError(path + ": " + std::to_string(size) + " bytes: expected at most " + std::to_string(maxBytes) +
-                         " for this kind of file");
-}
-
-void requestInterruption(int sig) { interruption.store(sig); }
-int getInterruption() { return interruption.load(); }
-void checkInterruption() {
-    if (const int sig = interruption.load())
-        throw InterruptedError("interrupted by signal " + std::to_string(sig));
-}
-
-std::string formatNumber(double v) {
-    char buf[32];
-    const auto r = std::to_chars(buf, buf + sizeof buf, v);  // shortest round-trip form
-    return std::string(buf, r.ptr);
-}
-
-FieldError::FieldError(std::string field, const std::string& message)
-    : InputError("field '" + field + "' " + message), field_(std::move(field)), detail_(message) {}
-
-bool Bound::contains(double v) const {
-    if (!std::isfinite(v)) return false;
-    if (loOpen ? !(v > lo) : !(v >= lo)) return false;
-    if (hiOpen ? !(v < hi) : !(v <= hi)) return false;
-    return true;
-}
-
-std::string Bound::describe() const {
-    const bool hasLo = lo > -1e299, hasHi = hi < 1e299;
-    std::string s;
-    if (hasLo && hasHi)
-        s = std::string("in ") + (loOpen ? "(" : "[") + formatNumber(lo) + ", " + formatNumber(hi) +
-            (hiOpen ? ")" : "]");
-    else if (hasLo)
-        s = std::string(loOpen ? "> " : ">= ") + formatNumber(lo);
-    else if (hasHi)
-        s = std::string(hiOpen ? "< " : "<= ") + formatNumber(hi);
-    else
-        s = "a finite number";
-    if (unit && *unit) s += std::string(" (") + unit + ")";
-    return s;
-}
-
-void checkField(const std::string& field, double value, const Bound& bound) {
-    if (!bound.contains(value))
-        throw FieldError(field, "= " + formatNumber(value) + ": expected " + bound.describe());
-}
 
 struct ParamNode::Impl {
     std::string source;
@@ -94,15 +32,6 @@ ParamNode ParamNode::loadString(const std::string& text, const std::string& sour
     if (!impl->node.IsMap())
         throw InputError(sourceName + ":1: expected a mapping of 'key: value' lines at the top level");
     return ParamNode(impl);
-}
-
-std::string readFileText(const std::string& path) {
-    checkInputFile(path, 64 << 20);
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw InputError(path + ": cannot open file (does it exist and is it readable?)");
-    std::stringstream buf;
-    buf << in.rdbuf();
-    return buf.str();
 }
 
 ParamNode ParamNode::loadFile(const std::string& path) { return loadString(readFileText(path), path); }
@@ -323,27 +252,5 @@ void ParamNode::throwLocated(const FieldError& e) const {
                      e.getDetail());
 }
 
-void writeFileAtomically(const std::string& path, const std::string& text) {
-    namespace fs = std::filesystem;
-    const fs::path target(path);
-    std::error_code ec;
-    if (target.has_parent_path()) fs::create_directories(target.parent_path(), ec);
-    const fs::path tmp = target.string() + ".tmp." + std::to_string(::getpid());
-    {
-        std::ofstream out(tmp, std::ios::binary);
-        if (!out) throw InputError(path + ": cannot write (is the directory writable?)");
-        out << text;
-        out.flush();
-        if (!out) {
-            fs::remove(tmp, ec);
-            throw InputError(path + ": write failed (disk full?)");
-        }
-    }
-    fs::rename(tmp, target, ec);
-    if (ec) {
-        fs::remove(tmp, ec);
-        throw InputError(path + ": cannot replace file: " + ec.message());
-    }
-}
 
 }  // namespace armsim

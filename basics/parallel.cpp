@@ -1,6 +1,6 @@
-#include "model/parallel.h"
+#include "basics/parallel.h"
 
-#include "muscles/param_file.h"
+#include "basics/errors.h"
 
 #include <algorithm>
 #include <atomic>

@@ -1,5 +1,5 @@
-#include "experiments/plot.h"
-#include "muscles/param_file.h"
+#include "basics/errors.h"
+#include "basics/plot.h"
 
 #include <gtest/gtest.h>
 

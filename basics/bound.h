@@ -1,0 +1,31 @@
+// Bounds of scalar parameters and the check every parameter struct's validate() uses. Framework-free.
+#pragma once
+
+#include "basics/errors.h"
+#include "basics/format.h"
+
+#include <string>
+
+namespace armsim {
+
+/// A closed/open interval used to validate one scalar field.
+struct Bound {
+    double lo = -1e300;      ///< lower bound
+    double hi = 1e300;       ///< upper bound
+    bool loOpen = false;     ///< true: value must be > lo; false: >= lo
+    bool hiOpen = false;     ///< true: value must be < hi; false: <= hi
+    const char* unit = "";   ///< unit shown in messages
+
+    static Bound positive(const char* unit = "") { return {0, 1e300, true, false, unit}; }
+    static Bound nonNegative(const char* unit = "") { return {0, 1e300, false, false, unit}; }
+    static Bound closed(double lo, double hi, const char* unit = "") { return {lo, hi, false, false, unit}; }
+    static Bound open(double lo, double hi, const char* unit = "") { return {lo, hi, true, true, unit}; }
+    static Bound any(const char* unit = "") { return {-1e300, 1e300, false, false, unit}; }
+    bool contains(double v) const;
+    std::string describe() const;   ///< e.g. "> 0 (kg)" or "in [0, 1]"
+};
+
+/// Throws FieldError naming field, value and bound unless value is finite and inside bound.
+void checkField(const std::string& field, double value, const Bound& bound);
+
+}  // namespace armsim

@@ -1,0 +1,63 @@
+// Output folders that appear whole or not at all. Framework-free.
+//
+// Every command that writes several result files writes them through an OutputFolder: the files go to
+// a hidden sibling of the target (".NAME.partial.<pid>"), and commit() moves them into place once the
+// whole result exists. An exception, an interruption or a failing writer before commit() leaves the
+// target untouched and the sibling removed (destructor). A run killed outright (SIGKILL) leaves the
+// sibling behind; the next OutputFolder on the same target removes it (its process is gone).
+#pragma once
+
+#include <filesystem>
+#include <mutex>
+#include <set>
+#include <string>
+#include <vector>
+
+namespace armsim {
+
+class OutputFolder {
+public:
+    /// How commit() treats a target that exists.
+    enum class Mode {
+        /// The folder is one run: an earlier run (an empty folder or one holding `marker`) is replaced
+        /// as a whole by one rename; any other existing folder or file is refused (InputError).
+        ReplaceRun,
+        /// The files join the folder: each replaces a file of the same name by a rename; other files in
+        /// the folder are kept (a user's own results folder).
+        AddFiles,
+    };
+
+    /// outDir empty: a disabled folder (isEnabled() false, commit() does nothing). Throws InputError
+    /// naming outDir when the target cannot be replaced or the sibling cannot be made.
+    OutputFolder(const std::string& outDir, Mode mode, std::string marker = "");
+    OutputFolder(const OutputFolder&) = delete;
+    OutputFolder& operator=(const OutputFolder&) = delete;
+    ~OutputFolder();
+
+    bool isEnabled() const { return !temp_.empty(); }
+    /// The final path of a file of the folder (for messages and reports).
+    std::string getTargetPath(const std::string& relative) const { return (target_ / relative).string(); }
+    /// The path to write a file to before commit(); records the file; creates its sub-folders.
+    /// Thread-safe.
+    std::string addFile(const std::string& relative);
+    /// Writes a whole file (thread-safe for distinct names). InputError naming the final path on failure.
+    void write(const std::string& relative, const std::string& text);
+    /// Relative names of the files added so far, sorted.
+    std::vector<std::string> getFiles() const;
+    /// Moves the files into place. InputError naming the target when a rename fails; in ReplaceRun mode
+    /// the earlier run is then restored.
+    void commit();
+
+private:
+    void removeStaleLeftovers(const std::filesystem::path& parent, const std::string& stem) const;
+    void checkReplaceable() const;
+
+    Mode mode_;
+    std::string marker_;
+    std::filesystem::path target_, temp_, old_;
+    bool committed_ = false;
+    mutable std::mutex mutex_;
+    std::set<std::string> files_;
+};
+
+}  // namespace armsim

@@ -1,0 +1,65 @@
+// Internal to experiments/: what the protocol runner (protocol.cpp, compute only) hands to the protocol
+// writer (protocol_output.cpp: tables, fits, plots, protocol.yaml, manifest.json).
+#pragma once
+
+#include "basics/angles.h"
+#include "basics/output_folder.h"
+#include "experiments/emg.h"
+#include "experiments/protocol.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace armsim::detail {
+
+/// One arm trial of the protocol.
+struct ArmTrialPlan {
+    int index = 0;            ///< canonical index
+    std::string id;           ///< file stem
+    double angle = 0;         ///< [rad]
+    double level = 1;         ///< fraction of MVC
+    int repetition = 1;       ///< 1-based
+    double activation = 1;    ///< U during the hold
+    std::uint64_t seed = 0;   ///< trial seed
+};
+
+/// What an arm trial gives, per-trial metrics and (for the example plot) its time series.
+struct ArmTrialOutcome {
+    IsometricSummary summary;
+    double muscleForce = NAN, activeForce = NAN, forceMeasured = NAN, forceFixedRatio = NAN, strapForce = NAN;
+    bool saturated = false;
+    EmgFeatures emg{NAN, NAN, NAN};
+    std::vector<double> time, emgSignal, emgRms;
+};
+
+/// A computed protocol run.
+struct ProtocolRun {
+    ProtocolResult result;
+    std::vector<ArmTrialPlan> plans;      ///< canonical order
+    std::vector<int> runPosition;         ///< run order of each plan
+    std::vector<std::string> muscleIds;   ///< file stems of the muscle-alone trials
+    ArmTrialOutcome example;              ///< trial 0 with its series (the EMG example plot)
+};
+
+/// Sorted distinct values.
+inline std::vector<double> uniqueSorted(std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    v.erase(std::unique(v.begin(), v.end()), v.end());
+    return v;
+}
+
+/// Degrees of an angle read in degrees and stored in radians, without the round-trip's last-digit noise.
+inline double cleanDegrees(double radians) { return std::round(radToDeg(radians) * 1e9) / 1e9; }
+
+/// Significant digits of the numbers in result files.
+constexpr int kCsvDigits = 10;
+
+/// Writes the run's tables, fits, plots, protocol.yaml and manifest.json into dir and commits it; fills
+/// run.result.files.
+void writeProtocolFiles(OutputFolder& dir, const Protocol& protocol, const ArmSetup& subject,
+                        const VirtualMuscle& muscle, ProtocolRun& run);
+
+}  // namespace armsim::detail

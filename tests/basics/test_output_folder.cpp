@@ -1,0 +1,97 @@
+#include "basics/errors.h"
+#include "basics/files.h"
+#include "basics/output_folder.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+using namespace armsim;
+namespace fs = std::filesystem;
+
+namespace {
+
+struct OutputFolderTest : ::testing::Test {
+    fs::path root = fs::temp_directory_path() / ("armsim_out_" + std::to_string(::getpid()));
+    void SetUp() override { fs::remove_all(root); fs::create_directories(root); }
+    void TearDown() override { fs::remove_all(root); }
+    int countEntries(const fs::path& dir) const {
+        int n = 0;
+        for ([[maybe_unused]] const auto& e : fs::directory_iterator(dir)) ++n;
+        return n;
+    }
+};
+
+}  // namespace
+
+TEST_F(OutputFolderTest, NothingAppearsWithoutCommitAndNothingIsLeftBeside) {
+    const fs::path target = root / "run";
+    {
+        OutputFolder out(target.string(), OutputFolder::Mode::ReplaceRun, "manifest.json");
+        out.write("a.csv", "1\n");
+        out.write("trials/b.csv", "2\n");
+        EXPECT_FALSE(fs::exists(target));
+    }
+    EXPECT_FALSE(fs::exists(target));
+    EXPECT_EQ(countEntries(root), 0);
+}
+
+TEST_F(OutputFolderTest, ReplaceRunSwapsTheWholeFolderAndRefusesAForeignOne) {
+    const fs::path target = root / "run";
+    {
+        OutputFolder out(target.string(), OutputFolder::Mode::ReplaceRun, "manifest.json");
+        out.write("old_only.csv", "x");
+        out.write("manifest.json", "{}");
+        out.commit();
+    }
+    {
+        OutputFolder out(target.string(), OutputFolder::Mode::ReplaceRun, "manifest.json");
+        out.write("trials/t.csv", "y");
+        out.write("manifest.json", "{}");
+        EXPECT_EQ(out.getFiles(), (std::vector<std::string>{"manifest.json", "trials/t.csv"}));
+        out.commit();
+    }
+    EXPECT_FALSE(fs::exists(target / "old_only.csv"));
+    EXPECT_EQ(readFileText((target / "trials/t.csv").string()), "y");
+    EXPECT_EQ(countEntries(root), 1);  // no .old or .partial sibling
+    const fs::path foreign = root / "mine";
+    fs::create_directories(foreign);
+    std::ofstream(foreign / "notes.txt") << "keep";
+    EXPECT_THROW(OutputFolder(foreign.string(), OutputFolder::Mode::ReplaceRun, "manifest.json"), InputError);
+    EXPECT_TRUE(fs::exists(foreign / "notes.txt"));
+}
+
+TEST_F(OutputFolderTest, AddFilesKeepsOtherFilesAndReplacesSameNames) {
+    const fs::path target = root / "results";
+    fs::create_directories(target);
+    std::ofstream(target / "notes.txt") << "keep";
+    std::ofstream(target / "estimates.json") << "old";
+    {
+        OutputFolder out(target.string(), OutputFolder::Mode::AddFiles);
+        out.write("estimates.json", "new");
+        out.write("plots/fit.png", "png");
+        EXPECT_EQ(readFileText((target / "estimates.json").string()), "old");
+        out.commit();
+    }
+    EXPECT_EQ(readFileText((target / "notes.txt").string()), "keep");
+    EXPECT_EQ(readFileText((target / "estimates.json").string()), "new");
+    EXPECT_EQ(readFileText((target / "plots/fit.png").string()), "png");
+    EXPECT_EQ(countEntries(root), 1);
+    std::ofstream(root / "file") << "x";
+    EXPECT_THROW(OutputFolder((root / "file").string(), OutputFolder::Mode::AddFiles), InputError);
+}
+
+TEST_F(OutputFolderTest, LeftoversOfDeadProcessesAreCleanedAndTheEarlierRunRestored) {
+    const fs::path target = root / "run";
+    // pid 999999999 exceeds pid_max, so no process has it.
+    fs::create_directories(root / ".run.partial.999999999");
+    fs::create_directories(root / ".run.old.999999999");
+    std::ofstream(root / ".run.old.999999999" / "manifest.json") << "{}";
+    {
+        OutputFolder out(target.string(), OutputFolder::Mode::ReplaceRun, "manifest.json");
+        EXPECT_FALSE(fs::exists(root / ".run.partial.999999999"));
+        EXPECT_TRUE(fs::exists(target / "manifest.json"));  // the earlier run moved back
+    }
+    EXPECT_EQ(countEntries(root), 1);
+}

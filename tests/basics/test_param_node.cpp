@@ -1,0 +1,98 @@
+#include "basics/bound.h"
+#include "basics/files.h"
+#include "basics/param_node.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <functional>
+
+using namespace armsim;
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string messageOf(const std::function<void()>& f) {
+    try {
+        f();
+    } catch (const InputError& e) {
+        return e.what();
+    }
+    return "(no InputError)";
+}
+
+bool has(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+
+}  // namespace
+
+TEST(Bound, DescribesAndContainsByOpenness) {
+    EXPECT_TRUE(Bound::positive().contains(1e-300));
+    EXPECT_FALSE(Bound::positive().contains(0));
+    EXPECT_TRUE(Bound::nonNegative().contains(0));
+    EXPECT_FALSE(Bound::closed(0, 1).contains(1.0000001));
+    EXPECT_FALSE(Bound::open(0, 1).contains(1));
+    EXPECT_FALSE(Bound::any().contains(std::nan("")));
+    EXPECT_FALSE(Bound::any().contains(HUGE_VAL));
+    EXPECT_EQ(Bound::positive("kg").describe(), "> 0 (kg)");
+    EXPECT_EQ(Bound::closed(0, 1).describe(), "in [0, 1]");
+    EXPECT_EQ(Bound::open(0, 0.5, "m").describe(), "in (0, 0.5) (m)");
+}
+
+TEST(Bound, CheckFieldNamesFieldValueAndBound) {
+    const std::string m = messageOf([] { checkField("slow.Tf1", -0.25, Bound::positive("s")); });
+    EXPECT_EQ(m, "field 'slow.Tf1' = -0.25: expected > 0 (s)");
+    EXPECT_NO_THROW(checkField("x", 0.5, Bound::closed(0, 1)));
+}
+
+TEST(ParamNode, ReadsValuesAndRejectsUnreadKeysWithTheirLine) {
+    const ParamNode n = ParamNode::loadString("mass: 0.3\nname: biceps\nlist: [1, 2]\nsub:\n  a: 2\ntypo: 1\n", "x.yaml");
+    EXPECT_DOUBLE_EQ(n.getNumber("mass", Bound::positive("kg")), 0.3);
+    EXPECT_EQ(n.getString("name"), "biceps");
+    EXPECT_EQ(n.getNumbers("list", Bound::any()), (std::vector<double>{1, 2}));
+    const ParamNode sub = n.child("sub");
+    EXPECT_EQ(sub.getInt("a", 0, 5), 2);
+    sub.finish();
+    EXPECT_EQ(n.getNumber("missing", Bound::any(), 7.0), 7.0);
+    EXPECT_EQ(messageOf([&] { n.finish(); }), "x.yaml:6: unknown field 'typo' (misspelt, or not a field here)");
+}
+
+TEST(ParamNode, OutOfBoundValueNamesFileLineFieldValueAndBound) {
+    const ParamNode n = ParamNode::loadString("a: 1\nsub:\n  mass: -3\n", "f.yaml");
+    const std::string m = messageOf([&] { n.child("sub").getNumber("mass", Bound::positive("kg")); });
+    EXPECT_TRUE(has(m, "f.yaml:3")) << m;
+    EXPECT_TRUE(has(m, "sub.mass")) << m;
+    EXPECT_TRUE(has(m, "-3")) << m;
+    EXPECT_TRUE(has(m, "> 0 (kg)")) << m;
+}
+
+TEST(ParamNode, FieldErrorIsLocatedAtTheLineOfItsKey) {
+    const ParamNode n = ParamNode::loadString("slow:\n  Tf1: 0.1\n  Tf2: 5\n", "m.yaml");
+    const std::string m = messageOf([&] {
+        n.rethrowWithLocation([] { checkField("slow.Tf2", 5, Bound::closed(0, 1, "s")); });
+    });
+    EXPECT_EQ(m, "m.yaml:3: field 'slow.Tf2' = 5: expected in [0, 1] (s)");
+}
+
+TEST(ParamNode, BadYamlAndNonMappingsAreInputErrors) {
+    EXPECT_TRUE(has(messageOf([] { ParamNode::loadString("a: [1, 2\n", "bad.yaml"); }), "bad.yaml:"));
+    EXPECT_TRUE(has(messageOf([] { ParamNode::loadString("- 1\n- 2\n", "list.yaml"); }), "expected a mapping"));
+    EXPECT_TRUE(has(messageOf([] { ParamNode::loadString("a: x\n", "s.yaml").getNumber("a", Bound::any()); }),
+                    "s.yaml:1"));
+}
+
+TEST(Files, AtomicWriteReplacesWholeAndReadsBack) {
+    const fs::path dir = fs::temp_directory_path() / ("armsim_files_" + std::to_string(::getpid()));
+    fs::remove_all(dir);
+    const std::string path = (dir / "sub" / "f.txt").string();
+    writeFileAtomically(path, "first");
+    writeFileAtomically(path, "second");
+    EXPECT_EQ(readFileText(path), "second");
+    int entries = 0;
+    for ([[maybe_unused]] const auto& e : fs::directory_iterator(dir / "sub")) ++entries;
+    EXPECT_EQ(entries, 1);  // no temporary left
+    EXPECT_TRUE(has(messageOf([&] { readFileText((dir / "none").string()); }), "none"));
+    EXPECT_TRUE(has(messageOf([&] { readFileText(dir.string()); }), "not a regular file"));
+    EXPECT_TRUE(has(messageOf([&] { writeFileAtomically("/proc/armsim_cannot", "x"); }), "/proc/armsim_cannot"));
+    fs::remove_all(dir);
+}

@@ -1,0 +1,58 @@
+#include "basics/errors.h"
+#include "basics/table.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+using namespace armsim;
+namespace fs = std::filesystem;
+
+TEST(Table, CsvRoundTripsEveryDoubleAt17Digits) {
+    Table t({"time_s", "force_N"});
+    t.appendRow({0.1, 1.0 / 3.0});
+    t.appendRow({2e-300, -123456789.123456789});
+    t.appendRow({1e300, std::nan("")});
+    const fs::path p = fs::temp_directory_path() / ("armsim_table_" + std::to_string(::getpid()) + ".csv");
+    t.writeCsv(p.string(), 17);
+    const Table r = Table::readCsv(p.string());
+    fs::remove(p);
+    ASSERT_EQ(r.getColumnNames(), t.getColumnNames());
+    ASSERT_EQ(r.getNumRows(), 3);
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 2; ++j) {
+            if (std::isnan(t.get(i, j))) EXPECT_TRUE(std::isnan(r.get(i, j)));
+            else EXPECT_EQ(r.get(i, j), t.get(i, j)) << i << "," << j;  // exact: 17 digits round-trip
+        }
+    EXPECT_EQ(r.getSourceLine(0), 2);
+    EXPECT_EQ(r.describeRow("f.csv", 2), "f.csv:4");
+}
+
+TEST(Table, CsvTextIsLocaleFreeWithTheRequestedDigits) {
+    Table t({"a", "b"});
+    t.appendRow({1.0 / 3.0, 2500});
+    EXPECT_EQ(t.toCsv(4), "a,b\n0.3333,2500\n");
+    EXPECT_THROW(t.toCsv(0), std::invalid_argument);
+    EXPECT_THROW(t.appendRow({1}), std::invalid_argument);
+    EXPECT_THROW(t.findColumn("c"), std::invalid_argument);
+    EXPECT_EQ(t.getColumn("b"), std::vector<double>{2500});
+}
+
+TEST(Table, MalformedCellNamesFileLineAndColumn) {
+    const fs::path p = fs::temp_directory_path() / ("armsim_bad_" + std::to_string(::getpid()) + ".csv");
+    std::ofstream(p) << "time_s,force_N\n# a comment\n0,1\n0.1,abc\n";
+    try {
+        Table::readCsv(p.string());
+        ADD_FAILURE() << "no error";
+    } catch (const InputError& e) {
+        const std::string m = e.what();
+        EXPECT_NE(m.find(p.string() + ":4"), std::string::npos) << m;
+        EXPECT_NE(m.find("force_N"), std::string::npos) << m;
+        EXPECT_NE(m.find("abc"), std::string::npos) << m;
+    }
+    std::ofstream(p) << "a,b\n1,2,3\n";
+    EXPECT_THROW(Table::readCsv(p.string()), InputError);
+    fs::remove(p);
+}
