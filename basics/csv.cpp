@@ -15,13 +15,15 @@ void CsvRow::startCell() {
 
 CsvRow& CsvRow::addText(std::string_view text) {
     startCell();
-    const bool quote = text.find_first_of(",\"") != std::string_view::npos ||
-                       (!text.empty() && (text.front() == ' ' || text.back() == ' '));
+    std::string clean(text);
+    for (char& c : clean)
+        if (c == '\n' || c == '\r' || c == '\t') c = ' ';
+    const bool quote = clean.find_first_of(",\"") != std::string::npos ||
+                       (!clean.empty() && (clean.front() == ' ' || clean.back() == ' '));
     if (quote) text_ += '"';
-    for (char c : text) {
-        if (c == '"') text_ += "\"\"";
-        else if (c == '\n' || c == '\r' || c == '\t') text_ += ' ';
-        else text_ += c;
+    for (char c : clean) {
+        if (c == '"') text_ += '"';
+        text_ += c;
     }
     if (quote) text_ += '"';
     return *this;
@@ -29,7 +31,8 @@ CsvRow& CsvRow::addText(std::string_view text) {
 
 CsvRow& CsvRow::addNumber(double v) {
     startCell();
-    if (std::isfinite(v)) text_ += formatNumber(v);
+    if (std::isinf(v)) text_ += v > 0 ? "inf" : "-inf";
+    else if (!std::isnan(v)) text_ += formatNumber(v);
     return *this;
 }
 
@@ -37,7 +40,8 @@ CsvRow& CsvRow::addNumber(double v, int significantDigits) {
     if (significantDigits < 1 || significantDigits > 17)
         throw std::invalid_argument("CSV significant digits " + std::to_string(significantDigits) + ": expected 1..17");
     startCell();
-    if (std::isfinite(v)) text_ += fmt::format("{:.{}g}", v, significantDigits);
+    if (std::isinf(v)) text_ += v > 0 ? "inf" : "-inf";
+    else if (!std::isnan(v)) text_ += fmt::format("{:.{}g}", v, significantDigits);
     return *this;
 }
 

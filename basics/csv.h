@@ -12,7 +12,8 @@ namespace armsim {
 /// One CSV record, built cell by cell, without the line end. Text is quoted (RFC 4180) when it holds a
 /// comma, a quote or leading/trailing spaces; line breaks and tabs in text become spaces, so a record is
 /// always one line. Numbers are locale-free: by default the shortest form that reads back as the same
-/// double; a missing value (NaN, infinity) is an empty cell, as spreadsheets and pandas read it.
+/// double; a missing value (NaN) is an empty cell, as spreadsheets and pandas read it; infinities are
+/// "inf" and "-inf".
 class CsvRow {
 public:
     CsvRow& addText(std::string_view text);

@@ -5,12 +5,27 @@
 #include <signal.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <cerrno>
 #include <fstream>
+#include <stdexcept>
 
 namespace fs = std::filesystem;
 
 namespace armsim {
+
+namespace {
+
+std::atomic<int> folderCounter{0};
+std::mutex liveMutex;
+std::set<std::string> liveStaging;  // staging folders of this process's OutputFolders still alive
+
+bool isLive(const fs::path& p) {
+    std::lock_guard<std::mutex> lock(liveMutex);
+    return liveStaging.count(p.lexically_normal().string()) > 0;
+}
+
+}  // namespace
 
 OutputFolder::OutputFolder(const std::string& outDir, Mode mode, std::string marker)
     : mode_(mode), marker_(std::move(marker)) {
@@ -18,24 +33,35 @@ OutputFolder::OutputFolder(const std::string& outDir, Mode mode, std::string mar
     target_ = fs::path(outDir).lexically_normal();
     if (target_.filename().empty()) target_ = target_.parent_path();
     checkReplaceable();
-    const fs::path parent = target_.has_parent_path() ? target_.parent_path() : fs::path(".");
     std::error_code ec;
+    // AddFiles into an existing folder stages inside it (same file system, no write access to its parent
+    // needed); a new folder or a whole run is staged beside the target and renamed into place.
+    const bool inside = mode_ == Mode::AddFiles && fs::is_directory(target_, ec);
+    const fs::path parent = inside ? target_ : target_.has_parent_path() ? target_.parent_path() : fs::path(".");
     fs::create_directories(parent, ec);
-    const std::string stem = "." + target_.filename().string();
+    const std::string stem = inside ? ".armsim" : "." + target_.filename().string();
     removeStaleLeftovers(parent, stem);
-    temp_ = parent / (stem + ".partial." + std::to_string(::getpid()));
-    old_ = parent / (stem + ".old." + std::to_string(::getpid()));
+    const std::string id = std::to_string(::getpid()) + "-" + std::to_string(folderCounter++);
+    temp_ = (parent / (stem + ".partial." + id)).lexically_normal();
+    old_ = (parent / (stem + ".old." + id)).lexically_normal();
     fs::remove_all(temp_, ec);
     if (!fs::create_directories(temp_, ec) || ec)
-        throw InputError(outDir + ": cannot create the output folder next to it (" + ec.message() + ")");
+        throw InputError(outDir + ": cannot create the output folder's staging folder " + temp_.string() + " (" +
+                         ec.message() + ")");
+    std::lock_guard<std::mutex> lock(liveMutex);
+    liveStaging.insert(temp_.string());
 }
 
 OutputFolder::~OutputFolder() {
+    if (temp_.empty()) return;
     std::error_code ec;
-    if (!temp_.empty() && !committed_) fs::remove_all(temp_, ec);
+    if (!committed_) fs::remove_all(temp_, ec);
+    std::lock_guard<std::mutex> lock(liveMutex);
+    liveStaging.erase(temp_.string());
 }
 
 std::string OutputFolder::addFile(const std::string& relative) {
+    if (temp_.empty()) throw std::logic_error("OutputFolder::addFile('" + relative + "') on a disabled folder");
     const fs::path path = temp_ / relative;
     std::lock_guard<std::mutex> lock(mutex_);
     files_.insert(relative);
@@ -62,17 +88,7 @@ void OutputFolder::commit() {
     checkReplaceable();
     std::error_code ec;
     const bool exists = fs::exists(target_, ec);
-    if (mode_ == Mode::AddFiles && exists) {
-        for (const std::string& f : getFiles()) {
-            const fs::path to = target_ / f;
-            fs::create_directories(to.parent_path(), ec);
-            fs::rename(temp_ / f, to, ec);
-            if (ec) throw InputError(to.string() + ": cannot move the file into place: " + ec.message());
-        }
-        committed_ = true;
-        fs::remove_all(temp_, ec);
-        return;
-    }
+    if (mode_ == Mode::AddFiles && exists) return commitInto();
     if (exists) {
         fs::rename(target_, old_, ec);
         if (ec) throw InputError(target_.string() + ": cannot move the earlier run aside: " + ec.message());
@@ -87,10 +103,51 @@ void OutputFolder::commit() {
     if (exists) fs::remove_all(old_, ec);
 }
 
-// What a run killed before its cleanup (SIGKILL, a second Ctrl-C) left beside the target:
-// <stem>.partial.<pid> folders of processes that no longer exist are removed; a <stem>.old.<pid> folder
-// holds the earlier run, moved aside just before the kill: moved back when the target is missing,
-// removed otherwise.
+// Every destination is checked first; files replaced are moved aside (into old_) so that a rename
+// failing part-way puts everything back: the folder ends with all the new files or none.
+void OutputFolder::commitInto() {
+    const std::vector<std::string> files = getFiles();
+    std::error_code ec;
+    for (const std::string& f : files) {
+        const fs::path to = target_ / f;
+        if (fs::exists(to, ec) && !fs::is_regular_file(to, ec))
+            throw InputError(to.string() + ": exists and is not a file: cannot replace it with the output file");
+    }
+    std::vector<std::pair<fs::path, fs::path>> moved, aside;  // (from, to)
+    auto rollback = [&] {
+        std::error_code ignored;
+        for (auto it = moved.rbegin(); it != moved.rend(); ++it) fs::rename(it->second, it->first, ignored);
+        for (auto it = aside.rbegin(); it != aside.rend(); ++it) fs::rename(it->second, it->first, ignored);
+    };
+    for (const std::string& f : files) {
+        const fs::path to = target_ / f;
+        fs::create_directories(to.parent_path(), ec);
+        if (fs::exists(to, ec)) {
+            const fs::path keep = old_ / f;
+            fs::create_directories(keep.parent_path(), ec);
+            fs::rename(to, keep, ec);
+            if (ec) {
+                rollback();
+                throw InputError(to.string() + ": cannot move the earlier file aside: " + ec.message());
+            }
+            aside.push_back({to, keep});
+        }
+        fs::rename(temp_ / f, to, ec);
+        if (ec) {
+            rollback();
+            throw InputError(to.string() + ": cannot move the file into place: " + ec.message());
+        }
+        moved.push_back({temp_ / f, to});
+    }
+    committed_ = true;
+    fs::remove_all(temp_, ec);
+    fs::remove_all(old_, ec);
+}
+
+// What a run killed before its cleanup (SIGKILL, a second Ctrl-C) left: <stem>.partial.<pid>-<n> folders
+// of processes that no longer exist are removed (this process's own only when no live OutputFolder
+// uses them: pids repeat in containers); a <stem>.old.<pid>-<n> folder holds the earlier run, moved aside
+// just before the kill: moved back when the target is missing (ReplaceRun), removed otherwise.
 void OutputFolder::removeStaleLeftovers(const fs::path& parent, const std::string& stem) const {
     std::error_code ec;
     std::vector<fs::path> entries;
@@ -100,13 +157,15 @@ void OutputFolder::removeStaleLeftovers(const fs::path& parent, const std::strin
         for (const std::string kind : {".partial.", ".old."}) {
             const std::string prefix = stem + kind;
             if (name.rfind(prefix, 0) != 0) continue;
-            const std::string digits = name.substr(prefix.size());
-            if (digits.empty() || digits.size() > 9 || digits.find_first_not_of("0123456789") != std::string::npos)
-                continue;
-            const pid_t pid = pid_t(std::stol(digits));
-            // Ours are stale too: this run has not made its folders yet (pids repeat in containers).
-            if (pid != ::getpid() && (::kill(pid, 0) == 0 || errno == EPERM)) continue;  // its process still runs
-            if (kind == ".old." && !fs::exists(target_, ec)) fs::rename(p, target_, ec);
+            std::string id = name.substr(prefix.size());
+            id = id.substr(0, id.find('-'));
+            if (id.empty() || id.size() > 9 || id.find_first_not_of("0123456789") != std::string::npos) continue;
+            const pid_t pid = pid_t(std::stol(id));
+            if (pid == ::getpid() ? isLive(p.lexically_normal()) || isLive(fs::path(p.string()).replace_filename(
+                                                                        stem + ".partial." + name.substr(prefix.size())))
+                                  : (::kill(pid, 0) == 0 || errno == EPERM))
+                continue;  // its process still runs, or it is one of ours in use
+            if (kind == ".old." && mode_ == Mode::ReplaceRun && !fs::exists(target_, ec)) fs::rename(p, target_, ec);
             else fs::remove_all(p, ec);
         }
     }

@@ -1,8 +1,9 @@
 // Output folders that appear whole or not at all. Framework-free.
 //
 // Every command that writes several result files writes them through an OutputFolder: the files go to
-// a hidden sibling of the target (".NAME.partial.<pid>"), and commit() moves them into place once the
-// whole result exists. An exception, an interruption or a failing writer before commit() leaves the
+// a hidden staging folder (".NAME.partial.<pid>-<n>" beside the target, or ".armsim.partial.<pid>-<n>"
+// inside a folder that files are added to), and commit() moves them into place once the whole result
+// exists. An exception, an interruption or a failing writer before commit() leaves the
 // target untouched and the sibling removed (destructor). A run killed outright (SIGKILL) leaves the
 // sibling behind; the next OutputFolder on the same target removes it (its process is gone).
 #pragma once
@@ -38,19 +39,20 @@ public:
     /// The final path of a file of the folder (for messages and reports).
     std::string getTargetPath(const std::string& relative) const { return (target_ / relative).string(); }
     /// The path to write a file to before commit(); records the file; creates its sub-folders.
-    /// Thread-safe.
+    /// Thread-safe. std::logic_error on a disabled folder.
     std::string addFile(const std::string& relative);
     /// Writes a whole file (thread-safe for distinct names). InputError naming the final path on failure.
     void write(const std::string& relative, const std::string& text);
     /// Relative names of the files added so far, sorted.
     std::vector<std::string> getFiles() const;
-    /// Moves the files into place. InputError naming the target when a rename fails; in ReplaceRun mode
-    /// the earlier run is then restored.
+    /// Moves the files into place, all or none: InputError naming the path when a rename fails, after
+    /// restoring what was there (the earlier run, or the files the new ones were replacing).
     void commit();
 
 private:
     void removeStaleLeftovers(const std::filesystem::path& parent, const std::string& stem) const;
     void checkReplaceable() const;
+    void commitInto();
 
     Mode mode_;
     std::string marker_;

@@ -4,6 +4,8 @@
 // 64-bit output, so seeded results (populations, synthetic data) reproduce on any platform.
 #pragma once
 
+#include "basics/angles.h"
+
 #include <cmath>
 #include <cstdint>
 #include <initializer_list>
@@ -24,7 +26,7 @@ public:
     double drawNormal() {
         const double u1 = 1.0 - drawUniform();  // (0, 1]: log finite
         const double u2 = drawUniform();
-        return std::sqrt(-2.0 * std::log(u1)) * std::cos(6.283185307179586 * u2);
+        return std::sqrt(-2.0 * std::log(u1)) * std::cos(2 * kPi * u2);
     }
 
 private:

@@ -2,7 +2,6 @@
 // uncertainty of the biceps mass and tendon length over a population (identification/experiment_design.h),
 // compared with the thesis's five-angle protocol, predicted and (with --validate-subjects) obtained.
 #include "basics/csv.h"
-#include "basics/files.h"
 #include "basics/format.h"
 #include "basics/output_folder.h"
 #include "basics/plot.h"
@@ -139,7 +138,9 @@ void runDesign(const DesignOptions& o) {
     }
     std::printf("  (predicted: synergist-%s; the RMSE is the obtained counterpart of the predicted sd)\n",
                 o.activationSd > 0 ? "va" : "aware");
-    writeFileAtomically(o.out + "/design_validation.csv", csv.getText());
+    OutputFolder validation(o.out, OutputFolder::Mode::AddFiles);
+    validation.write("design_validation.csv", csv.getText());
+    validation.commit();
     std::printf("wrote %s/design_validation.csv\n", o.out.c_str());
 }
 

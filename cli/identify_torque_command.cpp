@@ -1,7 +1,6 @@
 // armsim identify-torque: the biceps long head's mass and tendon length from tared elbow torque data
 // (a torque data file: measured, or written by `armsim protocol` for a torque protocol) with every
 // elbow method (thesis, synergist, synergist-va), with residuals checked against the measurement noise.
-#include "basics/format.h"
 #include "basics/output_folder.h"
 #include "basics/plot.h"
 #include "cli/commands.h"

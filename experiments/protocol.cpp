@@ -11,10 +11,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
-#include <filesystem>
-
-namespace fs = std::filesystem;
 
 namespace armsim {
 
@@ -302,10 +298,11 @@ std::optional<QuadraticFit> fitPeak(const std::vector<double>& x, const std::vec
 
 namespace {
 
-using Tick = std::function<void()>;
+/// Reports how many trials (or composition rows) have finished in all.
+using Progress = std::function<void(int done)>;
 
 /// Composition: the steady force over the grid of slow x fast unit counts.
-void runComposition(const Protocol& protocol, const ArmSetup& subject, ProtocolResult& result, const Tick& tick) {
+void runComposition(const Protocol& protocol, const ArmSetup& subject, ProtocolResult& result, const Progress& progress) {
     MuscleParameters mp = subject.calcBicepsParameters();
     result.composition = Table({"slow_units", "fast_units", "force_N"});
     for (int slow = protocol.slowUnitsFrom; slow <= protocol.slowUnitsTo; ++slow) {
@@ -315,7 +312,8 @@ void runComposition(const Protocol& protocol, const ArmSetup& subject, ProtocolR
             const SteadyState ss = VirtualMuscle(mp).calcSteadyState(protocol.compositionPath, protocol.compositionActivation);
             result.composition.appendRow({double(slow), double(fast), ss.converged ? ss.force : NAN});
         }
-        tick();
+        checkInterruption();
+        progress(slow - protocol.slowUnitsFrom + 1);
     }
 }
 
@@ -353,7 +351,7 @@ void planArmTrials(const Protocol& protocol, ProtocolRun& run, std::vector<int>&
 /// Arm and muscle-alone trials (their time series go to dir as they finish), the trial, summary and
 /// sweep tables.
 void runTrials(const Protocol& protocol, const ArmSetup& subject, const VirtualMuscle& muscle, OutputFolder& dir,
-               int jobs, ProtocolRun& run, const std::function<void(int, int)>& tick) {
+               int jobs, ProtocolRun& run, const Progress& progress) {
     std::vector<int> phase1, phase2;
     planArmTrials(protocol, run, phase1, phase2);
     std::vector<ArmTrialPlan>& plans = run.plans;
@@ -376,7 +374,7 @@ void runTrials(const Protocol& protocol, const ArmSetup& subject, const VirtualM
                 muscleOutcomes[m] = runMuscleTrial(protocol.pathLengths[m], run.muscleIds[m], protocol, sweepMuscle, dir);
             }
         },
-        tick);
+        [&](int done, int) { progress(done); });
 
     // Phase 2: resolve each level against the simulated MVC at its angle.
     if (!phase2.empty()) {
@@ -398,7 +396,7 @@ void runTrials(const Protocol& protocol, const ArmSetup& subject, const VirtualM
                 const int i = phase2[k];
                 outcomes[i] = runArmTrial(plans[i], protocol, subject, muscle, dir, i == 0);
             },
-            tick);
+            [&, base = int(phase1.size()) + numMuscle](int done, int) { progress(base + done); });
     }
 
     ProtocolResult& result = run.result;
@@ -453,18 +451,17 @@ ProtocolResult runProtocol(const Protocol& protocol, const ArmSetup& subject, co
     OutputFolder dir(options.outDir, OutputFolder::Mode::ReplaceRun, "manifest.json");
     const VirtualMuscle muscle(subject.calcBicepsParameters());
     ProtocolRun run;
-    int done = 0, total = 0;
-    auto tick = [&] {
-        ++done;
+    int total = 0;
+    const Progress progress = [&](int done) {
         if (options.progress) options.progress(done, total);
     };
     if (protocol.kind == ProtocolKind::Composition) {
         total = protocol.slowUnitsTo - protocol.slowUnitsFrom + 1;
-        runComposition(protocol, subject, run.result, tick);
+        runComposition(protocol, subject, run.result, progress);
     } else {
         total = int(protocol.elbowAngles.size() * protocol.levels.size()) * protocol.repetitions +
                 int(protocol.pathLengths.size());
-        runTrials(protocol, subject, muscle, dir, options.jobs, run, [&](int, int) { tick(); });
+        runTrials(protocol, subject, muscle, dir, options.jobs, run, progress);
         fitResults(protocol, run.result);
     }
     if (dir.isEnabled()) detail::writeProtocolFiles(dir, protocol, subject, muscle, run);

@@ -1,8 +1,6 @@
 // The files of a protocol run: tables, fits, plots, protocol.yaml and manifest.json (protocol_run.h).
 #include "basics/plot.h"
-#include "experiments/data_files.h"
 #include "experiments/protocol_run.h"
-#include "model/geometry.h"
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>

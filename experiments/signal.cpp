@@ -1,5 +1,6 @@
 #include "experiments/signal.h"
 
+#include "basics/angles.h"
 #include "basics/bound.h"
 
 #include <algorithm>
@@ -12,7 +13,6 @@ namespace armsim {
 namespace {
 
 using Complex = std::complex<double>;
-constexpr double kPi = 3.14159265358979323846;
 
 // Pre-warped analog frequency (rad/s) that the bilinear transform maps onto f:
 // W = 2 fs tan(pi f / fs) (Oppenheim & Schafer, Discrete-Time Signal Processing, 3rd ed., 7.1.2).

@@ -1,5 +1,6 @@
 #include "experiments/spectrum.h"
 
+#include "basics/angles.h"
 #include "basics/bound.h"
 
 #include <fftw3.h>
@@ -17,7 +18,6 @@ namespace armsim {
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 
 // FFTW's planner is not thread-safe (FFTW 3.3 manual, 5.2 "Thread safety"); only fftw_execute is.
 std::mutex& fftwPlannerMutex() {

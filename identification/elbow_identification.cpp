@@ -520,10 +520,6 @@ std::vector<ElbowValidationSummary> summarizeElbowValidation(const std::vector<E
     return out;
 }
 
-namespace {
-
-}  // namespace
-
 std::string formatElbowValidationCsv(const std::vector<ElbowValidationRow>& rows) {
     CsvText csv({"subject", "noise", "method", "converged", "true_mass_kg", "mass_kg", "mass_lower_kg", "mass_upper_kg",
                  "mass_error_pct", "mass_covered", "true_tendon_length_m", "tendon_length_m", "tendon_lower_m",

@@ -1,5 +1,6 @@
 #include "identification/study.h"
 
+#include "basics/format.h"
 #include "basics/csv.h"
 #include "basics/files.h"
 #include "basics/param_node.h"
@@ -21,7 +22,7 @@ namespace {
 
 constexpr long kMaxTasks = 1000000000L;
 // Changes whenever a result's meaning or format changes, so old journals are not resumed into new files.
-constexpr const char* kResultsVersion = "armsim-study-results-2";
+constexpr const char* kResultsVersion = "armsim-study-results-1";
 
 std::uint64_t hashFnv1a(const std::string& text, std::uint64_t h = 1469598103934665603ULL) {
     for (unsigned char c : text) h = (h ^ c) * 1099511628211ULL;

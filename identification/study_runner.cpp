@@ -169,9 +169,9 @@ private:
 
 // The output folder: an exclusive lock for this run (released by the kernel when the process dies) and
 // the journal of finished cells.
-class OutputFolder {
+class StudyFolder {
 public:
-    OutputFolder(const std::string& dir, const std::string& fingerprint, const Study& study, bool restart) : dir_(dir) {
+    StudyFolder(const std::string& dir, const std::string& fingerprint, const Study& study, bool restart) : dir_(dir) {
         std::error_code ec;
         fs::create_directories(dir_, ec);
         if (ec || !fs::is_directory(dir_))
@@ -307,7 +307,7 @@ StudyOutcome runStudy(const Study& study, const StudyRunOptions& options, StudyC
     outcome.output = options.output.empty() ? study.output : options.output;
     if (outcome.output.empty()) throw InputError("study: no output folder (set `output:` or --out)");
     const std::string fingerprint = calcStudyFingerprint(study);
-    OutputFolder folder(outcome.output, fingerprint, study, options.restart);
+    StudyFolder folder(outcome.output, fingerprint, study, options.restart);
 
     // Missing cells, grouped, in task order.
     std::deque<GroupWork> pending;

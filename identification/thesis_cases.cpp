@@ -6,7 +6,6 @@
 #include <fmt/format.h>
 
 #include <cmath>
-#include <cstdio>
 #include <limits>
 #include <sstream>
 
@@ -88,7 +87,7 @@ std::vector<ThesisCase> reproduceThesisCases(const MuscleParameters& base, const
         IdentificationProblem pr;
         pr.base = base;
         pr.data = onlyPath(synthetic, 0.40);
-        pr.unknowns = unknownsFrom(0.330, 0.26);
+        pr.unknowns = unknownsFrom(kThesisStartMass, 0.26);
         IdentificationOptions o;
         o.method = Method::IlcStandard;
         ThesisCase c{"Table 7.1 ilc-standard", identify(pr, model, o), {}};
@@ -161,7 +160,7 @@ std::string formatThesisCasesCsv(const std::vector<ThesisCase>& cases) {
     CsvText csv({"case", "quantity", "unit", "ours", "thesis"});
     for (const ThesisComparisonRow& r : collectRows(cases)) {
         CsvRow row;
-        row.addText(r.caseName).addText(r.quantity).addText(r.unit).addNumber(r.ours).addNumber(r.thesis);
+        row.addText(r.caseName).addText(r.quantity).addText(r.unit).addNumber(r.ours, 10).addNumber(r.thesis, 10);
         csv.addRow(row);
     }
     return csv.getText();

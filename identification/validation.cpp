@@ -7,7 +7,6 @@
 #include <fmt/format.h>
 
 #include <cmath>
-#include <cstdio>
 #include <map>
 #include <random>
 #include <sstream>
@@ -154,9 +153,9 @@ std::string formatValidationCsv(const std::vector<ValidationRow>& rows) {
     auto flag = [](CsvRow& row, int c) -> CsvRow& { return c < 0 ? row.addEmpty() : row.addInteger(c); };
     for (const ValidationRow& r : rows) {
         CsvRow row;
-        row.addText(r.truth).addNumber(100 * r.noise).addText(r.method).addNumber(r.trueMass);
-        row.addNumber(r.trueTendonLength).addNumber(r.mass).addNumber(r.tendonLength).addNumber(100 * r.massError);
-        row.addNumber(100 * r.tendonLengthError);
+        row.addText(r.truth).addNumber(100 * r.noise, 10).addText(r.method).addNumber(r.trueMass, 10);
+        row.addNumber(r.trueTendonLength, 10).addNumber(r.mass, 10).addNumber(r.tendonLength, 10);
+        row.addNumber(100 * r.massError, 10).addNumber(100 * r.tendonLengthError, 10);
         flag(flag(row, r.massCovered), r.tendonLengthCovered).addText(r.stopReason).addInteger(r.iterations);
         row.addInteger(r.evaluations).addNumber(r.wallTime, 4);
         csv.addRow(row);

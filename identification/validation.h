@@ -5,9 +5,11 @@
 
 #include "identification/faithful_model.h"
 #include "identification/identifier.h"
+#include "identification/thesis_cases.h"
 #include "model/geometry.h"
 
 #include <functional>
+#include <iterator>
 #include <string>
 #include <vector>
 
@@ -38,8 +40,8 @@ struct ValidationSettings {
     std::vector<double> anglesDeg{std::begin(kThesisMvcAnglesDeg), std::end(kThesisMvcAnglesDeg)};  ///< MVC angles [deg]
     ForceEstimate estimate = ForceEstimate::MomentArm;       ///< what the simulated experimenter reports
     ValidationModel model = ValidationModel::Corrected;
-    double startMass = 0.330;      ///< [kg] every run's start (thesis Tables 7.2, 7.3)
-    double startTendonLength = 0.22;  ///< [m]
+    double startMass = kThesisStartMass;                 ///< [kg] every run's start (thesis Tables 7.2, 7.3)
+    double startTendonLength = kThesisStartTendonLength;  ///< [m]
     int jobs = 2;                  ///< threads for the trials of one evaluation
     /// InputError naming the field for bad values (noise in [0, 0.5), seeds >= 0, angles in the arm's range).
     void validate(const ArmParameters& arm) const;

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <unistd.h>
 #include <fstream>
 
 using namespace armsim;
@@ -94,4 +95,50 @@ TEST_F(OutputFolderTest, LeftoversOfDeadProcessesAreCleanedAndTheEarlierRunResto
         EXPECT_TRUE(fs::exists(target / "manifest.json"));  // the earlier run moved back
     }
     EXPECT_EQ(countEntries(root), 1);
+}
+
+TEST_F(OutputFolderTest, AddFilesIntoANewFolderCreatesItWhole) {
+    const fs::path target = root / "new" / "results";
+    {
+        OutputFolder out(target.string(), OutputFolder::Mode::AddFiles);
+        out.write("a.csv", "1");
+        EXPECT_FALSE(fs::exists(target));
+        out.commit();
+    }
+    EXPECT_EQ(readFileText((target / "a.csv").string()), "1");
+    EXPECT_EQ(countEntries(root / "new"), 1);
+}
+
+TEST_F(OutputFolderTest, TwoFoldersOnOneTargetKeepTheirOwnFiles) {
+    const fs::path target = root / "results";
+    fs::create_directories(target);
+    OutputFolder a(target.string(), OutputFolder::Mode::AddFiles);
+    a.write("a.csv", "a");
+    OutputFolder b(target.string(), OutputFolder::Mode::AddFiles);
+    b.write("b.csv", "b");
+    a.commit();
+    b.commit();
+    EXPECT_EQ(readFileText((target / "a.csv").string()), "a");
+    EXPECT_EQ(readFileText((target / "b.csv").string()), "b");
+}
+
+TEST_F(OutputFolderTest, AFileThatCannotBeReplacedMovesNothing) {
+    const fs::path target = root / "results";
+    fs::create_directories(target / "z.csv");  // a folder where a file should go
+    std::ofstream(target / "a.csv") << "old";
+    {
+        OutputFolder out(target.string(), OutputFolder::Mode::AddFiles);
+        out.write("a.csv", "new");
+        out.write("z.csv", "z");
+        EXPECT_THROW(out.commit(), InputError);
+    }
+    EXPECT_EQ(readFileText((target / "a.csv").string()), "old");
+    EXPECT_EQ(countEntries(target), 2);  // a.csv and the z.csv folder; no staging left
+}
+
+TEST_F(OutputFolderTest, ADisabledFolderWritesNothing) {
+    OutputFolder out("", OutputFolder::Mode::AddFiles);
+    EXPECT_FALSE(out.isEnabled());
+    EXPECT_THROW(out.addFile("a.csv"), std::logic_error);
+    EXPECT_NO_THROW(out.commit());
 }

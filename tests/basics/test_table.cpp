@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <unistd.h>
 #include <fstream>
 
 using namespace armsim;
@@ -30,7 +31,7 @@ TEST(Table, CsvRoundTripsEveryDoubleAt17Digits) {
     EXPECT_EQ(r.describeRow("f.csv", 2), "f.csv:4");
 }
 
-TEST(Table, CsvTextIsLocaleFreeWithTheRequestedDigits) {
+TEST(Table, CsvTextHasTheRequestedDigitsAndChecksShapes) {
     Table t({"a", "b"});
     t.appendRow({1.0 / 3.0, 2500});
     EXPECT_EQ(t.toCsv(4), "a,b\n0.3333,2500\n");
