@@ -1,5 +1,6 @@
 // The direct stiff integrator (CPodes without a Simbody System): closed-form solutions, restarts at
 // breakpoints, sampling, and failures reported with the time and the model's message.
+#include "muscles/cpodes_c.h"
 #include "muscles/param_file.h"
 #include "muscles/stiff_ode.h"
 
@@ -92,4 +93,11 @@ TEST(StiffOde, ACheckAtStepBoundariesStopsTheRunAndNonFiniteStatesAreNamed) {
     std::vector<double> ok{1.0};
     EXPECT_THROW(integrateSampled(grow, 0.0, ok, -1.0, 10.0, {}, IntegrationSettings{}, [](double, const double*) {}),
                  InputError);
+}
+
+// Issue 14: integrateSampled drives CPODES through its C interface with armsim's own N_Vector; the
+// declarations in muscles/cpodes_c.h must match the loaded libSimTKmath (ops table order, serial
+// content, dispatch), or every run would corrupt memory.
+TEST(StiffOde, TheDeclaredCpodesLayoutMatchesTheLoadedLibrary) {
+    EXPECT_EQ(cpodes::findCpodesLayoutMismatch(), "");
 }
