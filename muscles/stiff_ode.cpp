@@ -5,6 +5,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <stdexcept>
 #include <regex>
 #include <sstream>
 
@@ -85,11 +87,18 @@ void checkFinite(double t, const double* y, int n) {
 
 // What CPODES calls back: f, counted, and its diagnostics. A throwing f becomes a recoverable error
 // (CPODES cuts the step), as in Simbody's CPodesIntegrator; the last message is kept for the report
-// if CPODES gives up.
+// if CPODES gives up. With blocks, a call that differs from the last full evaluation (same t) in one
+// block evaluates only that block.
 class RhsContext {
 public:
-    explicit RhsContext(const OdeRhs& f) : f_(f) {}
+    RhsContext(const OdeRhs& f, const OdeBlocks* blocks, int n) : f_(f), blocks_(blocks) {
+        if (blocks_) {
+            baseY_.resize(n);
+            baseYdot_.resize(n);
+        }
+    }
     int getNumEvaluations() const { return count_; }
+    int getNumPartialEvaluations() const { return partial_; }
     const std::string& getLastError() const { return lastError_; }
     void clearLastError() { lastError_.clear(); }
     const std::string& getSolverMessage() const { return solverMessage_; }
@@ -112,7 +121,16 @@ private:
     int calc(double t, const double* y, double* ydot) {
         ++count_;
         try {
-            f_(t, y, ydot);
+            if (!blocks_) {
+                f_(t, y, ydot);
+            } else if (!calcFromBase(t, y, ydot)) {
+                hasBase_ = false;
+                f_(t, y, ydot);
+                baseT_ = t;
+                std::copy(y, y + baseY_.size(), baseY_.begin());
+                std::copy(ydot, ydot + baseYdot_.size(), baseYdot_.begin());
+                hasBase_ = true;
+            }
         } catch (const std::exception& e) {
             lastError_ = e.what();
             return 1;  // recoverable
@@ -122,8 +140,28 @@ private:
         }
         return 0;
     }
+    // ydot from the last full evaluation and at most one block, if y differs from it in at most one
+    // block at the same t (bitwise: a block function may tell -0 from +0).
+    bool calcFromBase(double t, const double* y, double* ydot) {
+        if (!hasBase_ || t != baseT_) return false;
+        int changed = -1;
+        for (int b = 0; b < int(blocks_->first.size()); ++b) {
+            const std::size_t first = std::size_t(blocks_->first[b]), bytes = sizeof(double) * blocks_->size[b];
+            if (std::memcmp(y + first, &baseY_[first], bytes) == 0) continue;
+            if (changed >= 0) return false;
+            changed = b;
+        }
+        std::copy(baseYdot_.begin(), baseYdot_.end(), ydot);
+        if (changed >= 0) blocks_->calcBlock(changed, t, y, ydot);
+        ++partial_;
+        return true;
+    }
     const OdeRhs& f_;
-    int count_ = 0;
+    const OdeBlocks* blocks_;
+    int count_ = 0, partial_ = 0;
+    bool hasBase_ = false;
+    double baseT_ = 0;
+    std::vector<double> baseY_, baseYdot_;  // the last full evaluation
     std::string lastError_, solverMessage_;
 };
 
@@ -184,12 +222,10 @@ void checkCpodesLayout() {
                               "written for (Simbody 3.7): " + mismatch);
 }
 
-}  // namespace
-
-IntegrationStats integrateSampled(const OdeRhs& f, double t0, std::vector<double>& y, double duration,
-                                  double sampleRate, const std::vector<double>& breakpoints,
-                                  const IntegrationSettings& settings, const OdeVisitor& sample,
-                                  const OdeVisitor& check) {
+// integrateSampled for f, whose blocks (if any) are `blocks`.
+IntegrationStats integrate(const OdeRhs& f, const OdeBlocks* blocks, double t0, std::vector<double>& y,
+                           double duration, double sampleRate, const std::vector<double>& breakpoints,
+                           const IntegrationSettings& settings, const OdeVisitor& sample, const OdeVisitor& check) {
     settings.validate();
     checkField("duration", duration, Bound::nonNegative("s"));
     checkField("sample_rate", sampleRate, Bound::positive("Hz"));
@@ -197,7 +233,7 @@ IntegrationStats integrateSampled(const OdeRhs& f, double t0, std::vector<double
     const int n = int(y.size());
     detail::SampledRun run(t0, duration, sampleRate, breakpoints, n);
     IntegrationStats stats;
-    RhsContext context(f);
+    RhsContext context(f, blocks, n);
 
     if (check) check(t0, y.data());
     checkFinite(t0, y.data(), n);
@@ -244,8 +280,41 @@ IntegrationStats integrateSampled(const OdeRhs& f, double t0, std::vector<double
     }
     stats.restarts -= 1;
     stats.realizations = context.getNumEvaluations();
+    stats.partialEvaluations = context.getNumPartialEvaluations();
     y = yv;
     return stats;
+}
+
+}  // namespace
+
+IntegrationStats integrateSampled(const OdeRhs& f, double t0, std::vector<double>& y, double duration,
+                                  double sampleRate, const std::vector<double>& breakpoints,
+                                  const IntegrationSettings& settings, const OdeVisitor& sample,
+                                  const OdeVisitor& check) {
+    return integrate(f, nullptr, t0, y, duration, sampleRate, breakpoints, settings, sample, check);
+}
+
+IntegrationStats integrateSampled(const OdeBlocks& f, double t0, std::vector<double>& y, double duration,
+                                  double sampleRate, const std::vector<double>& breakpoints,
+                                  const IntegrationSettings& settings, const OdeVisitor& sample,
+                                  const OdeVisitor& check) {
+    const std::size_t numBlocks = f.first.size();
+    if (f.size.size() != numBlocks || !f.calcBlock)
+        throw std::invalid_argument("integrateSampled: blocks need a first state, a size and calcBlock");
+    std::vector<int> owner(y.size(), -1);
+    for (std::size_t b = 0; b < numBlocks; ++b)
+        for (int i = f.first[b]; i < f.first[b] + f.size[b]; ++i) {
+            if (f.size[b] <= 0 || i < 0 || i >= int(y.size()) || owner[i] >= 0)
+                throw std::invalid_argument("integrateSampled: block " + std::to_string(b) +
+                                            " is empty, outside y or overlaps another block");
+            owner[i] = int(b);
+        }
+    if (std::count(owner.begin(), owner.end(), -1) > 0)
+        throw std::invalid_argument("integrateSampled: the blocks do not cover y");
+    const OdeRhs whole = [&f, numBlocks](double t, const double* yIn, double* ydot) {
+        for (std::size_t b = 0; b < numBlocks; ++b) f.calcBlock(int(b), t, yIn, ydot);
+    };
+    return integrate(whole, &f, t0, y, duration, sampleRate, breakpoints, settings, sample, check);
 }
 
 }  // namespace armsim
