@@ -202,15 +202,26 @@ IsometricTrialResult runIsometricTrial(const ArmSetup& setup, const IsometricTri
 
     if (settings.solver == TrialSolver::LockedOde) {
         // The locked arm's ODE on Simbody's own state vector: q' = u = 0 and u' = 0 (locked), each
-        // muscle's z' from its pure model at its fixed path length and its own activation.
+        // muscle's z' from its pure model at its fixed path length and its own activation. Blocks:
+        // [q u], then one per muscle (a Jacobian column evaluates one muscle).
         std::vector<double> y(state.getNY());
         for (int i = 0; i < state.getNY(); ++i) y[i] = state.getY()[i];
         const std::vector<double>& P = sum.pathLengths;
-        const OdeRhs f = [&](double t, const double* yIn, double* ydot) {
-            std::fill(ydot, ydot + nqu, 0.0);
-            for (int i = 0; i < n; ++i)
-                muscles[i]->calcStateDerivative(P[i], activations[i]->getValue(t), yIn + firstState[i],
-                                                ydot + firstState[i]);
+        OdeBlocks f;
+        f.first.push_back(0);
+        f.size.push_back(nqu);
+        for (int i = 0; i < n; ++i) {
+            f.first.push_back(firstState[i]);
+            f.size.push_back(muscles[i]->getNumStates());
+        }
+        f.calcBlock = [&](int b, double t, const double* yIn, double* ydot) {
+            if (b == 0) {
+                std::fill(ydot, ydot + nqu, 0.0);
+                return;
+            }
+            const int i = b - 1;
+            muscles[i]->calcStateDerivative(P[i], activations[i]->getValue(t), yIn + firstState[i],
+                                            ydot + firstState[i]);
         };
         sum.stats = integrateSampled(
             f, state.getTime(), y, settings.getDuration(), settings.sampleRate, profile.getBreakpoints(),

@@ -39,6 +39,7 @@ struct IntegrationStats {
     int steps = 0;              ///< internal steps taken
     int restarts = 0;           ///< restarts at input discontinuities (breakpoints)
     int realizations = 0;       ///< right-hand-side evaluations (Simbody realizations or f calls), Jacobians included
+    int partialEvaluations = 0; ///< of those, calls of a block-structured f that evaluated one block or none
 };
 
 /// f(t, y, ydot): writes dy/dt. May throw SimulationError for a state outside the model: the solver
@@ -54,6 +55,25 @@ using OdeVisitor = std::function<void(double t, const double* y)>;
 /// SimulationError; every y is checked for NaN there too. Throws SimulationError naming the time
 /// when the solver fails.
 IntegrationStats integrateSampled(const OdeRhs& f, double t0, std::vector<double>& y, double duration,
+                                  double sampleRate, const std::vector<double>& breakpoints,
+                                  const IntegrationSettings& settings, const OdeVisitor& sample,
+                                  const OdeVisitor& check = {});
+
+/// y' = f(t, y) made of independent blocks (the muscles of a locked arm): block b holds the states
+/// [first[b], first[b] + size[b]), the blocks partition y, and block b's derivative depends on t and
+/// its own states only. calcBlock(b, t, y, ydot) gets whole-length arrays and writes block b's
+/// entries of ydot only. It must be a pure function: the same arguments give the same bits.
+struct OdeBlocks {
+    std::vector<int> first, size;
+    std::function<void(int block, double t, const double* y, double* ydot)> calcBlock;
+};
+
+/// integrateSampled for a block-structured f, with the same steps and samples as for the equivalent
+/// OdeRhs: a call at the time of the last full evaluation whose state differs from that one in a
+/// single block (a column of CPODES' difference-quotient Jacobian) evaluates that block and copies the
+/// others' derivatives, which are bit-for-bit what a full evaluation would give. std::invalid_argument
+/// if the blocks do not partition y.
+IntegrationStats integrateSampled(const OdeBlocks& f, double t0, std::vector<double>& y, double duration,
                                   double sampleRate, const std::vector<double>& breakpoints,
                                   const IntegrationSettings& settings, const OdeVisitor& sample,
                                   const OdeVisitor& check = {});

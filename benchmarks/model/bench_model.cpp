@@ -34,6 +34,7 @@ void measureIsometricTrial(benchmark::State& state, const ArmSetup& setup, Isome
     for (auto _ : state) stats = runIsometricTrial(setup, s).summary.stats;
     state.counters["steps"] = stats.steps;
     state.counters["rhs"] = stats.realizations;  // right-hand sides, finite-difference Jacobians included
+    state.counters["partial"] = stats.partialEvaluations;  // of those, one muscle (a Jacobian column)
 }
 
 void BM_IsometricMvcTrial(benchmark::State& state) {

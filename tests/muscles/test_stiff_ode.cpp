@@ -2,6 +2,7 @@
 // breakpoints, sampling, and failures reported with the time and the model's message.
 #include "basics/errors.h"
 #include "basics/format.h"
+#include "muscles/cpodes_c.h"
 #include "muscles/stiff_ode.h"
 
 #include <gtest/gtest.h>
@@ -93,4 +94,56 @@ TEST(StiffOde, ACheckAtStepBoundariesStopsTheRunAndNonFiniteStatesAreNamed) {
     std::vector<double> ok{1.0};
     EXPECT_THROW(integrateSampled(grow, 0.0, ok, -1.0, 10.0, {}, IntegrationSettings{}, [](double, const double*) {}),
                  InputError);
+}
+
+// Issue 14: integrateSampled drives CPODES through its C interface with armsim's own N_Vector; the
+// declarations in muscles/cpodes_c.h must match the loaded libSimTKmath (ops table order, serial
+// content, dispatch), or every run would corrupt memory.
+TEST(StiffOde, TheDeclaredCpodesLayoutMatchesTheLoadedLibrary) {
+    EXPECT_EQ(cpodes::findCpodesLayoutMismatch(), "");
+}
+
+// Issue 14: a block-structured f (independent blocks, one evaluated per Jacobian column) takes the
+// same steps and gives the same samples, bit for bit, as the same f handed over whole.
+TEST(StiffOde, BlocksGiveTheSameStepsAndSamplesAsTheWholeRightHandSide) {
+    // Three independent blocks: a constant pair, a stiff nonlinear pair with a step input, a scalar.
+    auto calcBlock = [](int b, double t, const double* y, double* ydot) {
+        if (b == 0) {
+            ydot[0] = ydot[1] = 0;
+        } else if (b == 1) {
+            const double u = t >= kStepTime ? 1.0 : 0.2;
+            ydot[2] = -kStiffRate * (y[2] - u * y[3] * y[3]);
+            ydot[3] = -kSlowRate * y[3] + std::sin(3 * t) * y[2];
+        } else {
+            ydot[4] = -std::exp(y[4]) + 1.5;
+        }
+    };
+    OdeBlocks blocks;
+    blocks.first = {0, 2, 4};
+    blocks.size = {2, 2, 1};
+    blocks.calcBlock = calcBlock;
+    const OdeRhs whole = [&](double t, const double* y, double* ydot) {
+        for (int b = 0; b < 3; ++b) calcBlock(b, t, y, ydot);
+    };
+    std::vector<std::vector<double>> samplesWhole, samplesBlocks;
+    std::vector<double> y1{0.3, 0.0, 0.5, 0.8, -1.0}, y2 = y1;
+    const IntegrationStats a = integrateSampled(whole, 0.0, y1, 1.0, 200.0, {kStepTime}, IntegrationSettings{},
+                                                [&](double, const double* y) { samplesWhole.emplace_back(y, y + 5); });
+    const IntegrationStats b = integrateSampled(blocks, 0.0, y2, 1.0, 200.0, {kStepTime}, IntegrationSettings{},
+                                                [&](double, const double* y) { samplesBlocks.emplace_back(y, y + 5); });
+    EXPECT_EQ(a.steps, b.steps);
+    EXPECT_EQ(a.realizations, b.realizations);
+    EXPECT_EQ(a.partialEvaluations, 0);
+    EXPECT_GT(b.partialEvaluations, 0);
+    EXPECT_EQ(samplesWhole, samplesBlocks);  // exactly
+    EXPECT_EQ(y1, y2);
+
+    OdeBlocks overlapping = blocks;
+    overlapping.first = {0, 1, 4};
+    EXPECT_THROW(integrateSampled(overlapping, 0.0, y2, 1.0, 10.0, {}, IntegrationSettings{}, [](double, const double*) {}),
+                 std::invalid_argument);
+    OdeBlocks gap = blocks;
+    gap.size = {2, 1, 1};
+    EXPECT_THROW(integrateSampled(gap, 0.0, y2, 1.0, 10.0, {}, IntegrationSettings{}, [](double, const double*) {}),
+                 std::invalid_argument);
 }
