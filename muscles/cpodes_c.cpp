@@ -250,7 +250,12 @@ std::string findCpodesLayoutMismatch() {
     if (c->length != 3 || c->own_data != 1 || c->data != N_VGetArrayPointer_Serial(v))
         out << "serial content {length, own_data, data} not as declared; ";
     N_VDestroy_Serial(v);
-    if (!out.str().empty()) return out.str();
+    auto report = [&out] {
+        std::string r = out.str();
+        if (r.size() >= 2) r.resize(r.size() - 2);  // the last "; "
+        return r;
+    };
+    if (!out.str().empty()) return report();
 
     // The library's dispatchers on armsim's vectors: they must reach the slots declared here.
     double xd[3] = {1, 2, 3}, wd[3] = {1, 1, 1}, zd[3] = {0, 0, 0};
@@ -258,7 +263,7 @@ std::string findCpodesLayoutMismatch() {
     if (N_VWrmsNorm(&x, &w) != std::sqrt(14.0 / 3)) out << "N_VWrmsNorm did not dispatch to nvwrmsnorm; ";
     N_VLinearSum(2, &x, -1, &w, &z);
     if (zd[0] != 1 || zd[1] != 3 || zd[2] != 5) out << "N_VLinearSum did not dispatch to nvlinearsum; ";
-    return out.str();
+    return report();
 }
 
 }  // namespace cpodes

@@ -173,17 +173,23 @@ public:
            double absTol, const IntegrationSettings& settings)
         : mem_(cpodes::CPodeCreate(cpodes::CP_EXPL, cpodes::CP_BDF, cpodes::CP_NEWTON)), absTol_(absTol) {
         if (!mem_) throw std::bad_alloc();
-        const int n = int(y0.size());
-        cpodes::ArrayVector y(n, y0.data()), yp(n, yp0.data());
-        check(cpodes::CPodeInit(mem_, reinterpret_cast<void*>(&RhsContext::calcRhs), &context, t0, &y, &yp,
-                                cpodes::CP_SS, relTol, &absTol_),
-              "CPodeInit", t0);
-        check(cpodes::CPodeSetErrHandlerFn(mem_, &RhsContext::handleError, &context), "CPodeSetErrHandlerFn", t0);
-        check(cpodes::CPLapackDense(mem_, n), "CPLapackDense", t0);
-        check(cpodes::CPodeSetNonlinConvCoef(mem_, 0.01), "CPodeSetNonlinConvCoef", t0);
-        check(cpodes::CPodeSetMinStep(mem_, IntegrationSettings::kMinStepSize), "CPodeSetMinStep", t0);
-        if (settings.maxStepSize > 0)
-            check(cpodes::CPodeSetMaxStep(mem_, settings.maxStepSize), "CPodeSetMaxStep", t0);
+        try {
+            const int n = int(y0.size());
+            cpodes::ArrayVector y(n, y0.data()), yp(n, yp0.data());
+            check(cpodes::CPodeInit(mem_, reinterpret_cast<void*>(&RhsContext::calcRhs), &context, t0, &y, &yp,
+                                    cpodes::CP_SS, relTol, &absTol_),
+                  "CPodeInit", t0);
+            check(cpodes::CPodeSetErrHandlerFn(mem_, &RhsContext::handleError, &context), "CPodeSetErrHandlerFn",
+                  t0);
+            check(cpodes::CPLapackDense(mem_, n), "CPLapackDense", t0);
+            check(cpodes::CPodeSetNonlinConvCoef(mem_, 0.01), "CPodeSetNonlinConvCoef", t0);
+            check(cpodes::CPodeSetMinStep(mem_, IntegrationSettings::kMinStepSize), "CPodeSetMinStep", t0);
+            if (settings.maxStepSize > 0)
+                check(cpodes::CPodeSetMaxStep(mem_, settings.maxStepSize), "CPodeSetMaxStep", t0);
+        } catch (...) {
+            cpodes::CPodeFree(&mem_);
+            throw;
+        }
     }
     Cpodes(const Cpodes&) = delete;
     Cpodes& operator=(const Cpodes&) = delete;

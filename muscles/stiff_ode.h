@@ -8,7 +8,9 @@
 // atol = accuracy / 10, nonlinear convergence coefficient 0.01, one internal step per call, restart
 // at every breakpoint, end of segment interpolated by CPodes), and samples come from the same cubic
 // Hermite interpolation as simulateSampled's, so for the same y and f both paths take the same steps
-// and give the same samples (checked in tests to 1e-6 relative).
+// and give the same samples (checked in tests to 1e-6 relative). CPodes is called through its C
+// interface with an N_Vector over plain arrays that does the arithmetic of Simbody's own
+// (muscles/cpodes_c.h), so no SimTK::Vector temporaries are made.
 #pragma once
 
 #include <functional>
