@@ -451,9 +451,13 @@ ProtocolResult runProtocol(const Protocol& protocol, const ArmSetup& subject, co
     OutputFolder dir(options.outDir, OutputFolder::Mode::ReplaceRun, "manifest.json");
     const VirtualMuscle muscle(subject.calcBicepsParameters());
     ProtocolRun run;
-    int total = 0;
+    int total = 0, reported = 0;
+    // runParallel may report several finished tasks at once: every count is passed on, in order.
     const Progress progress = [&](int done) {
-        if (options.progress) options.progress(done, total);
+        while (reported < done) {
+            ++reported;
+            if (options.progress) options.progress(reported, total);
+        }
     };
     if (protocol.kind == ProtocolKind::Composition) {
         total = protocol.slowUnitsTo - protocol.slowUnitsFrom + 1;
