@@ -157,14 +157,15 @@ void OutputFolder::removeStaleLeftovers(const fs::path& parent, const std::strin
         for (const std::string kind : {".partial.", ".old."}) {
             const std::string prefix = stem + kind;
             if (name.rfind(prefix, 0) != 0) continue;
-            std::string id = name.substr(prefix.size());
-            id = id.substr(0, id.find('-'));
-            if (id.empty() || id.size() > 9 || id.find_first_not_of("0123456789") != std::string::npos) continue;
-            const pid_t pid = pid_t(std::stol(id));
-            if (pid == ::getpid() ? isLive(p.lexically_normal()) || isLive(fs::path(p.string()).replace_filename(
-                                                                        stem + ".partial." + name.substr(prefix.size())))
-                                  : (::kill(pid, 0) == 0 || errno == EPERM))
-                continue;  // its process still runs, or it is one of ours in use
+            const std::string id = name.substr(prefix.size());
+            const std::string digits = id.substr(0, id.find('-'));
+            if (digits.empty() || digits.size() > 9 || digits.find_first_not_of("0123456789") != std::string::npos)
+                continue;
+            const pid_t pid = pid_t(std::stol(digits));
+            // Ours count as stale unless a live OutputFolder stages there (pids repeat in containers).
+            const bool inUse = pid == ::getpid() ? isLive(parent / (stem + ".partial." + id))
+                                                 : (::kill(pid, 0) == 0 || errno == EPERM);
+            if (inUse) continue;
             if (kind == ".old." && mode_ == Mode::ReplaceRun && !fs::exists(target_, ec)) fs::rename(p, target_, ec);
             else fs::remove_all(p, ec);
         }

@@ -45,16 +45,20 @@ void runParallel(int n, int jobs, const std::function<void(int)>& task,
     const int numThreads = std::max(1, std::min(jobs, n));
     for (int k = 0; k < numThreads; ++k) threads.emplace_back(worker);
     for (int reported = 0; reported < n;) {
+        int now;
         {
             std::unique_lock<std::mutex> lock(mutex);
             finished.wait(lock, [&] { return done != reported; });
-            reported = done;
+            now = done;
         }
-        if (stop || !onDone) continue;
-        try {
-            onDone(reported, n);
-        } catch (...) {
-            fail();
+        // Tasks may finish together: every count is reported, in order.
+        for (; reported < now; ++reported) {
+            if (stop || !onDone) continue;
+            try {
+                onDone(reported + 1, n);
+            } catch (...) {
+                fail();
+            }
         }
     }
     for (auto& t : threads) t.join();

@@ -294,10 +294,6 @@ std::optional<QuadraticFit> fitPeak(const std::vector<double>& x, const std::vec
                         {y.begin() + std::ptrdiff_t(lo), y.begin() + std::ptrdiff_t(hi)});
 }
 
-}  // namespace
-
-namespace {
-
 /// Reports how many trials (or composition rows) have finished in all.
 using Progress = std::function<void(int done)>;
 
@@ -451,13 +447,9 @@ ProtocolResult runProtocol(const Protocol& protocol, const ArmSetup& subject, co
     OutputFolder dir(options.outDir, OutputFolder::Mode::ReplaceRun, "manifest.json");
     const VirtualMuscle muscle(subject.calcBicepsParameters());
     ProtocolRun run;
-    int total = 0, reported = 0;
-    // runParallel may report several finished tasks at once: every count is passed on, in order.
+    int total = 0;
     const Progress progress = [&](int done) {
-        while (reported < done) {
-            ++reported;
-            if (options.progress) options.progress(reported, total);
-        }
+        if (options.progress) options.progress(done, total);
     };
     if (protocol.kind == ProtocolKind::Composition) {
         total = protocol.slowUnitsTo - protocol.slowUnitsFrom + 1;

@@ -229,21 +229,19 @@ void writeComposition(OutputFolder& dir, const Protocol& protocol, const Table& 
     heat.z.assign(heat.x.size() * heat.y.size(), NAN);
     std::vector<std::string> header = {"slow_units"};
     for (double f : heat.x) header.push_back("fast_" + std::to_string(int(f)));
-    std::string matrix;
-    for (const std::string& h : header) matrix += (matrix.empty() ? "" : ",") + h;
-    matrix += "\n";
+    Table matrix(header);
     // composition rows are slow-major: row j * nx + i holds (slow y[j], fast x[i]).
     for (std::size_t j = 0; j < heat.y.size(); ++j) {
-        matrix += std::to_string(int(heat.y[j]));
+        std::vector<double> row = {heat.y[j]};
         for (std::size_t i = 0; i < heat.x.size(); ++i) {
             const double F = composition.get(int(j * heat.x.size() + i), 2);
             heat.z[i * heat.y.size() + j] = F;
-            matrix += "," + (std::isnan(F) ? std::string("NaN") : fmt::format("{:.10g}", F));
+            row.push_back(F);
         }
-        matrix += "\n";
+        matrix.appendRow(row);
     }
     dir.write("composition.csv", composition.toCsv(kCsvDigits));
-    dir.write("composition_matrix.csv", matrix);
+    dir.write("composition_matrix.csv", matrix.toCsv(kCsvDigits));
     writeHeatMapPng(dir.addFile("composition_heatmap.png"), heat);
 }
 

@@ -308,13 +308,16 @@ IntegrationStats integrateSampled(const OdeBlocks& f, double t0, std::vector<dou
     if (f.size.size() != numBlocks || !f.calcBlock)
         throw std::invalid_argument("integrateSampled: blocks need a first state, a size and calcBlock");
     std::vector<int> owner(y.size(), -1);
-    for (std::size_t b = 0; b < numBlocks; ++b)
+    for (std::size_t b = 0; b < numBlocks; ++b) {
+        if (f.size[b] <= 0)
+            throw std::invalid_argument("integrateSampled: block " + std::to_string(b) + " is empty");
         for (int i = f.first[b]; i < f.first[b] + f.size[b]; ++i) {
-            if (f.size[b] <= 0 || i < 0 || i >= int(y.size()) || owner[i] >= 0)
+            if (i < 0 || i >= int(y.size()) || owner[i] >= 0)
                 throw std::invalid_argument("integrateSampled: block " + std::to_string(b) +
-                                            " is empty, outside y or overlaps another block");
+                                            " is outside y or overlaps another block");
             owner[i] = int(b);
         }
+    }
     if (std::count(owner.begin(), owner.end(), -1) > 0)
         throw std::invalid_argument("integrateSampled: the blocks do not cover y");
     const OdeRhs whole = [&f, numBlocks](double t, const double* yIn, double* ydot) {
