@@ -19,13 +19,34 @@ void checkInputFile(const std::string& path, std::uintmax_t maxBytes) {
                          " for this kind of file");
 }
 
+namespace {
+thread_local FileReadRecorder* tInnermostRecorder = nullptr;
+}
+
+FileReadRecorder::FileReadRecorder() : outer_(tInnermostRecorder) { tInnermostRecorder = this; }
+
+FileReadRecorder::~FileReadRecorder() { tInnermostRecorder = outer_; }
+
 std::string readFileText(const std::string& path) {
     checkInputFile(path, 64 << 20);
     std::ifstream in(path, std::ios::binary);
     if (!in) throw InputError(path + ": cannot open file (does it exist and is it readable?)");
     std::stringstream buf;
     buf << in.rdbuf();
-    return buf.str();
+    std::string text = buf.str();
+    for (FileReadRecorder* r = tInnermostRecorder; r; r = r->outer_) r->files_.push_back({path, text});
+    return text;
+}
+
+bool areFilesUnchanged(const std::vector<FileSnapshot>& files) {
+    for (const FileSnapshot& f : files) {
+        try {
+            if (readFileText(f.path) != f.text) return false;
+        } catch (const InputError&) {
+            return false;
+        }
+    }
+    return true;
 }
 
 void writeFileAtomically(const std::string& path, const std::string& text) {

@@ -3,6 +3,7 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 namespace armsim {
 
@@ -11,6 +12,35 @@ std::string readFileText(const std::string& path);
 /// InputError unless `path` (when it exists) is a regular file of at most maxBytes (a folder, a device
 /// such as /dev/zero or a pipe would make a reader block or grow without bound).
 void checkInputFile(const std::string& path, std::uintmax_t maxBytes);
+
+/// One file as readFileText read it.
+struct FileSnapshot {
+    std::string path;  ///< as given to readFileText
+    std::string text;  ///< its bytes then
+};
+
+/// While alive, records every file readFileText reads on this thread (nested recorders all see each
+/// read), so that a result derived from files can be reused while none of them has changed (the model
+/// cache of loadModel). Not copyable: it registers itself for its thread.
+class FileReadRecorder {
+public:
+    FileReadRecorder();
+    ~FileReadRecorder();
+    FileReadRecorder(const FileReadRecorder&) = delete;
+    FileReadRecorder& operator=(const FileReadRecorder&) = delete;
+    /// The files read so far, in order (a file read twice appears twice).
+    const std::vector<FileSnapshot>& getFiles() const { return files_; }
+    /// Takes the files read so far (the recorder goes on recording into an empty list).
+    std::vector<FileSnapshot> releaseFiles() { return std::move(files_); }
+
+private:
+    friend std::string readFileText(const std::string& path);
+    std::vector<FileSnapshot> files_;
+    FileReadRecorder* outer_;
+};
+
+/// true when every file still reads as in its snapshot (false when one is missing or unreadable).
+bool areFilesUnchanged(const std::vector<FileSnapshot>& files);
 
 /// Writes text to path atomically: to a temporary beside it, then rename. Throws InputError naming
 /// the path when it cannot be written. Parent directories are created.

@@ -146,16 +146,14 @@ ArmTrialOutcome runArmTrial(const ArmTrialPlan& plan, const Protocol& protocol, 
     for (int i = 0; i < rows; ++i) {
         std::vector<double> row = t.getRow(i);
         if (protocol.transducerNoiseRms > 0) {
-            double strap = row[cStrap] + noise(noiseRng);
-            const bool saturated = std::abs(strap) > ap.transducerRange;
-            if (saturated) strap = std::copysign(ap.transducerRange, strap);
-            const double F = row[cForce];
-            row[cStrap] = strap;
-            row[cSat] = saturated ? 1.0 : 0.0;
-            row[cByArm] = calcBicepsForceFromTorque(strap * ap.strapDistance, h);
-            row[cByRatio] = calcBicepsForceFixedRatio(strap, plan.angle, kPi / 2);
-            row[cErrArm] = F > 0 ? 100 * (row[cByArm] - F) / F : NAN;
-            row[cErrRatio] = F > 0 ? 100 * (row[cByRatio] - F) / F : NAN;
+            const TransducerReading r =
+                calcTransducerReading(ap, row[cStrap] + noise(noiseRng), plan.angle, h, row[cForce]);
+            row[cStrap] = r.strapForce;
+            row[cSat] = r.saturated ? 1.0 : 0.0;
+            row[cByArm] = r.forceMomentArm;
+            row[cByRatio] = r.forceFixedRatio;
+            row[cErrArm] = r.errorMomentArmPct;
+            row[cErrRatio] = r.errorFixedRatioPct;
         }
         if (protocol.emgEnabled) {
             row.insert(row.begin() + std::ptrdiff_t(base.size()), {emg.emg[i], emgRms[i]});

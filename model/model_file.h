@@ -125,7 +125,9 @@ ArmSetup applyCalibration(const ArmSetup& setup, const std::vector<MuscleCalibra
 
 /// Loads a model: a name under assets/models/ ("thesis", "elbow") or a file path. Every error names
 /// the file, line, key and value. P_max of muscles with `max_path_length: range` is resolved
-/// (model/muscle_arm.h: resolveMaxPathLengths).
+/// (model/muscle_arm.h: resolveMaxPathLengths). A model loaded before is returned again without
+/// the work while its file and every file it read (arm, muscle and fibre-type files) read byte for byte
+/// as they did (thread-safe; up to 32 model files are kept).
 ArmSetup loadModel(const std::string& nameOrFile);
 
 /// Names of the shipped models (files in assets/models/).

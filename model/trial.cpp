@@ -114,6 +114,19 @@ std::vector<ActivationProfile> IsometricTrialSettings::calcActivationProfiles(co
     return profiles;
 }
 
+TransducerReading calcTransducerReading(const ArmParameters& arm, double strapForce, double elbowAngle,
+                                        double momentArm, double muscleForce) {
+    TransducerReading r;
+    r.saturated = std::abs(strapForce) > arm.transducerRange;
+    r.strapForce = r.saturated ? std::copysign(arm.transducerRange, strapForce) : strapForce;
+    r.forceMomentArm = calcBicepsForceFromTorque(r.strapForce * arm.strapDistance, momentArm);
+    r.forceFixedRatio = calcBicepsForceFixedRatio(r.strapForce, elbowAngle, kPi / 2);
+    const double F = muscleForce;
+    r.errorMomentArmPct = F > 0 ? 100 * (r.forceMomentArm - F) / F : NAN;
+    r.errorFixedRatioPct = F > 0 ? 100 * (r.forceFixedRatio - F) / F : NAN;
+    return r;
+}
+
 IsometricTrialResult runIsometricTrial(const ArmSetup& setup, const IsometricTrialSettings& settings) {
     settings.validate(setup.arm);
     const ActivationProfile profile = settings.calcActivationProfile();
@@ -184,17 +197,13 @@ IsometricTrialResult runIsometricTrial(const ArmSetup& setup, const IsometricTri
         }
         const double F = forces[primary];
         const double muscleTorque = sum.tareTorque - torque;  // tared, + = flexion
-        double strap = muscleTorque / ap.strapDistance;          // perpendicular strap at d1
-        const bool saturated = std::abs(strap) > ap.transducerRange;
-        if (saturated) strap = std::copysign(ap.transducerRange, strap);
-        sum.saturated = sum.saturated || saturated;
-        const double byMomentArm = calcBicepsForceFromTorque(strap * ap.strapDistance, h);
-        const double byFixedRatio = calcBicepsForceFixedRatio(strap, settings.elbowAngle, kPi / 2);
-        auto pct = [F](double estimate) { return F > 0 ? 100 * (estimate - F) / F : NAN; };
+        const TransducerReading r =
+            calcTransducerReading(ap, muscleTorque / ap.strapDistance, settings.elbowAngle, h, F);
+        sum.saturated = sum.saturated || r.saturated;
         const double* yp = y + firstState[primary];
         row.assign({t, profile.getValue(t), radToDeg(settings.elbowAngle), 0.0, F, yp[VirtualMuscle::kL] * L0,
-                    yp[VirtualMuscle::kV] * L0, torque, muscleTorque, strap, saturated ? 1.0 : 0.0, byMomentArm,
-                    byFixedRatio, pct(byMomentArm), pct(byFixedRatio)});
+                    yp[VirtualMuscle::kV] * L0, torque, muscleTorque, r.strapForce, r.saturated ? 1.0 : 0.0,
+                    r.forceMomentArm, r.forceFixedRatio, r.errorMomentArmPct, r.errorFixedRatioPct});
         appendMuscleForces(row, activations, forces, t);
         for (int i = 0; i < n; ++i) row.insert(row.end(), y + firstState[i], y + firstState[i] + muscles[i]->getNumStates());
         result.series.appendRow(row);

@@ -110,6 +110,23 @@ struct IsometricTrialResult {
 
 IsometricTrialResult runIsometricTrial(const ArmSetup& setup, const IsometricTrialSettings& settings);
 
+/// What the strap transducer reports and what the thesis derives from it (the trial table's columns
+/// strap_force_N .. error_fixed_ratio_pct).
+struct TransducerReading {
+    double strapForce = 0;          ///< reading, clipped to the transducer's range [N]
+    bool saturated = false;         ///< the force was beyond the range
+    double forceMomentArm = 0;      ///< estimate strap x d1 / h [N]
+    double forceFixedRatio = 0;     ///< the thesis's fixed-ratio estimate at this elbow angle [N]
+    double errorMomentArmPct = 0;   ///< against the true muscle force [%] (NaN when that is <= 0)
+    double errorFixedRatioPct = 0;  ///< likewise [%]
+};
+
+/// The reading of a (tared, perpendicular) strap force [N] at elbow angle theta [rad] for a primary
+/// muscle of moment arm h [m] and true force F [N]: the trial's own reading and a protocol's noisy
+/// one (strap force plus noise) go through here.
+TransducerReading calcTransducerReading(const ArmParameters& arm, double strapForce, double elbowAngle,
+                                        double momentArm, double muscleForce);
+
 /// Runs several isometric trials on `jobs` threads (one System per trial). Results are in input
 /// order and identical to a sequential run. progress(done, total) is called from the caller's thread.
 std::vector<IsometricTrialResult> runIsometricTrials(const ArmSetup& setup,

@@ -8,6 +8,12 @@
 
 #include <benchmark/benchmark.h>
 
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <sstream>
+#include <unistd.h>
+
 using namespace armsim;
 
 namespace {
@@ -113,5 +119,31 @@ void BM_ElbowSteadyMvcCurve(benchmark::State& state) {
             benchmark::DoNotOptimize(calcSteadyMvcCurve(elbow(), g, elbow().effort, q));
 }
 BENCHMARK(BM_ElbowSteadyMvcCurve)->Unit(benchmark::kMillisecond);
+
+// loadModel("elbow") as a command's second load (the model reused: its files re-read and compared)
+// and as a first load (a copy of the file with a comment that changes every iteration).
+void BM_LoadElbowModel(benchmark::State& state) {
+    const bool reused = state.range(0) == 1;
+    std::ifstream in(std::string(ARMSIM_ASSET_DIR) + "/models/elbow.yaml");
+    std::stringstream text;
+    text << in.rdbuf();
+    const std::string body = std::regex_replace(text.str(), std::regex("\\.\\./muscles/"),
+                                                std::string(ARMSIM_ASSET_DIR) + "/muscles/");
+    const std::string file = (std::filesystem::temp_directory_path() /
+                              ("armsim_bench_elbow_" + std::to_string(::getpid()) + ".yaml")).string();
+    std::ofstream(file) << body;
+    loadShippedModel(file.c_str());
+    long n = 0;
+    for (auto _ : state) {
+        if (!reused) {
+            state.PauseTiming();
+            std::ofstream(file) << body << "# " << ++n << "\n";
+            state.ResumeTiming();
+        }
+        benchmark::DoNotOptimize(loadModel(file));
+    }
+    std::filesystem::remove(file);
+}
+BENCHMARK(BM_LoadElbowModel)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 
 }  // namespace

@@ -7,6 +7,8 @@
 
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -284,4 +286,36 @@ TEST(ModelFile, BadFilesNameTheFileLineAndKey) {
     msg = messageOf("no_such_model");
     EXPECT_NE(msg.find("no such model"), std::string::npos) << msg;
     EXPECT_NE(msg.find("elbow"), std::string::npos) << msg;  // lists the shipped models
+}
+
+// loadModel reuses a model while its files are unchanged: the reused model equals a fresh load, and an
+// edit of a file the model only refers to (its muscle file) is seen by the next load.
+TEST(ModelFile, AReloadSeesAnEditedMuscleFile) {
+    const auto dir = std::filesystem::temp_directory_path() / ("armsim_model_cache_" + std::to_string(::getpid()));
+    std::filesystem::remove_all(dir);
+    std::filesystem::create_directories(dir);
+    const std::string asset = ARMSIM_ASSET_DIR;
+    auto writeMuscle = [&](double mass) {
+        std::ofstream(dir / "m.yaml") << "name: m\nmass: " << mass
+                                      << "\noptimal_fascicle_length: 0.16\noptimal_tendon_length: 0.245\n"
+                                         "max_path_length: 0.43\nfibre_fractions: {slow: 0.3, fast: 0.7}\n"
+                                         "motor_units: {slow: 3, fast: 3}\nfibre_types: "
+                                      << asset << "/muscles/human_fibre_types.yaml\n";
+    };
+    writeMuscle(0.3);
+    const std::string model = (dir / "model.yaml").string();
+    std::ofstream(model) << "name: cached\narm: arm/default_male.yaml\nmuscles:\n  - name: m\n    parameters: m.yaml\n"
+                            "    path:\n      origin: {body: upper_arm, location: [0, 0.3, 0]}\n"
+                            "      insertion: {body: forearm, location: [0, -0.05, 0]}\n";
+    const ArmSetup first = loadModel(model);
+    const ArmSetup again = loadModel(model);
+    EXPECT_EQ(again.muscles.at(0).params.mass, 0.3);
+    EXPECT_EQ(again.muscles.at(0).params.maxPathLength, first.muscles.at(0).params.maxPathLength);
+    EXPECT_EQ(again.file, model);
+
+    writeMuscle(0.4);
+    EXPECT_EQ(loadModel(model).muscles.at(0).params.mass, 0.4);
+    std::filesystem::remove(dir / "m.yaml");
+    EXPECT_NE(messageOf(model).find("m.yaml"), std::string::npos) << messageOf(model);
+    std::filesystem::remove_all(dir);
 }

@@ -97,6 +97,27 @@ TEST(IsometricTrial, TransducerSaturationIsFlagged) {
     EXPECT_EQ(r.series.get(r.series.getNumRows() - 1, "saturated"), 1.0);
 }
 
+// The one transducer model of trials and protocols: clip at the range, estimates by the moment arm
+// (exact: strap d1 / h) and by the thesis's fixed ratio, errors against the true force.
+TEST(Transducer, ReadingClipsAtTheRangeAndEstimatesTheForce) {
+    constexpr double kTol = 1e-12;
+    const ArmParameters& a = subject().arm;
+    const double h = 0.04, F = 500, theta = degToRad(90);
+    const double strap = F * h / a.strapDistance;
+    const TransducerReading r = calcTransducerReading(a, strap, theta, h, F);
+    EXPECT_FALSE(r.saturated);
+    EXPECT_NEAR(r.strapForce, strap, kTol * strap);
+    EXPECT_NEAR(r.forceMomentArm, F, kTol * F);
+    EXPECT_NEAR(r.errorMomentArmPct, 0, kTol);
+    EXPECT_NEAR(r.forceFixedRatio, calcBicepsForceFixedRatio(strap, theta, kPi / 2), kTol * F);
+    EXPECT_NEAR(r.errorFixedRatioPct, 100 * (r.forceFixedRatio - F) / F, kTol);
+
+    const TransducerReading over = calcTransducerReading(a, -2 * a.transducerRange, theta, h, F);
+    EXPECT_TRUE(over.saturated);
+    EXPECT_EQ(over.strapForce, -a.transducerRange);
+    EXPECT_TRUE(std::isnan(calcTransducerReading(a, strap, theta, h, 0).errorMomentArmPct));
+}
+
 TEST(IsometricTrial, ParallelAndSequentialRunsGiveIdenticalNumbers) {
     std::vector<IsometricTrialSettings> settings;
     for (double deg : kThesisMvcAnglesDeg) settings.push_back(mvcAt(deg));

@@ -1,0 +1,58 @@
+// Whole-file reads and the recorder that lets a result derived from files be reused (basics/files.h).
+#include "basics/errors.h"
+#include "basics/files.h"
+#include "tests/support/temp_files.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+using namespace armsim;
+
+TEST(FileReadRecorder, NestedRecordersSeeTheReadsOfTheirLifetime) {
+    const auto dir = armsim::testing::makeFreshDir("files", "recorder");
+    const std::string a = (dir / "a.txt").string(), b = (dir / "b.txt").string();
+    writeFileAtomically(a, "alpha");
+    writeFileAtomically(b, "beta");
+    readFileText(a);  // before any recorder: nobody sees it
+    FileReadRecorder outer;
+    EXPECT_EQ(readFileText(a), "alpha");
+    std::vector<FileSnapshot> inner;
+    {
+        FileReadRecorder r;
+        EXPECT_EQ(readFileText(b), "beta");
+        inner = r.getFiles();
+    }
+    readFileText(a);  // after the inner one ended: the outer one only
+    ASSERT_EQ(inner.size(), 1u);
+    EXPECT_EQ(inner[0].path, b);
+    EXPECT_EQ(inner[0].text, "beta");
+    ASSERT_EQ(outer.getFiles().size(), 3u);
+    EXPECT_EQ(outer.getFiles()[0].path, a);
+    EXPECT_EQ(outer.getFiles()[1].path, b);
+    EXPECT_EQ(outer.getFiles()[2].path, a);
+    std::filesystem::remove_all(dir);
+}
+
+TEST(FileReadRecorder, SnapshotsGoStaleWhenAFileChangesOrGoes) {
+    const auto dir = armsim::testing::makeFreshDir("files", "stale");
+    const std::string a = (dir / "a.txt").string(), b = (dir / "b.txt").string();
+    writeFileAtomically(a, "alpha");
+    writeFileAtomically(b, "beta");
+    std::vector<FileSnapshot> files;
+    {
+        FileReadRecorder r;
+        readFileText(a);
+        readFileText(b);
+        files = r.releaseFiles();
+        EXPECT_TRUE(r.getFiles().empty());
+    }
+    EXPECT_TRUE(areFilesUnchanged(files));
+    writeFileAtomically(b, "betA");  // same size, one byte changed
+    EXPECT_FALSE(areFilesUnchanged(files));
+    writeFileAtomically(b, "beta");
+    EXPECT_TRUE(areFilesUnchanged(files));
+    std::filesystem::remove(a);
+    EXPECT_FALSE(areFilesUnchanged(files));
+    std::filesystem::remove_all(dir);
+}
