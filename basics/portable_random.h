@@ -1,7 +1,9 @@
 // Random draws that are the same with every C++ standard library: std::mt19937_64 and std::seed_seq
 // are specified exactly by the standard, the std distributions are not (libstdc++, libc++ and MSVC
 // draw different normals from the same engine). Uniform and normal draws are made here from the raw
-// 64-bit output, so seeded results (populations, synthetic data) reproduce on any platform.
+// 64-bit output, so seeded results reproduce on any platform: populations, synthetic torque data,
+// protocol effort variation, transducer noise, trial order and surface EMG, validation truths and the
+// identifier's multi-start points all draw from here (no std distribution or std::shuffle is used).
 #pragma once
 
 #include "basics/angles.h"
@@ -10,6 +12,8 @@
 #include <cstdint>
 #include <initializer_list>
 #include <random>
+#include <utility>
+#include <vector>
 
 namespace armsim {
 
@@ -20,8 +24,25 @@ public:
         std::seed_seq seq(seeds);
         rng_.seed(seq);
     }
+    /// Seeded with one 64-bit word (e.g. a splitmix of a trial's seed).
+    explicit PortableRandom(std::uint64_t seed) : rng_(seed) {}
     /// Uniform in [0, 1), 53 random bits.
     double drawUniform() { return double(rng_() >> 11) * 0x1.0p-53; }
+    /// Uniform in [lo, hi).
+    double drawUniform(double lo, double hi) { return lo + (hi - lo) * drawUniform(); }
+    /// Uniform integer in [0, n), n >= 1, without modulo bias (rejection of the incomplete last block).
+    std::uint64_t drawIndex(std::uint64_t n) {
+        const std::uint64_t limit = ~std::uint64_t(0) - (~std::uint64_t(0) % n + 1) % n;  // last full block
+        std::uint64_t x;
+        do x = rng_();
+        while (x > limit);
+        return x % n;
+    }
+    /// Fisher-Yates shuffle with drawIndex (std::shuffle's draws differ between standard libraries).
+    template <class T>
+    void shuffle(std::vector<T>& v) {
+        for (std::size_t i = v.size(); i > 1; --i) std::swap(v[i - 1], v[drawIndex(i)]);
+    }
     /// Standard normal (Box-Muller on two uniforms; one value per call).
     double drawNormal() {
         const double u1 = 1.0 - drawUniform();  // (0, 1]: log finite

@@ -53,7 +53,7 @@ double calcHermiteRodriguezMuap(double t, double lambda) {
 }
 
 SurfaceEmg calcSurfaceEmg(const VirtualMuscle& muscle, const ActivationProfile& activation, double t0,
-                          std::size_t numSamples, const SurfaceEmgSettings& settings, std::mt19937_64& rng) {
+                          std::size_t numSamples, const SurfaceEmgSettings& settings, PortableRandom& rng) {
     settings.validate();
     const double fs = settings.internalRate;
     const std::size_t m = std::size_t(std::round(fs / settings.acquisition.outputRate));
@@ -68,11 +68,9 @@ SurfaceEmg calcSurfaceEmg(const VirtualMuscle& muscle, const ActivationProfile& 
     out.sampleRate = settings.acquisition.outputRate;
     out.spikeCounts.assign(numUnits, 0);
     std::vector<double> electrode(n, 0.0);
-    std::uniform_real_distribution<double> uniform(0.0, 1.0);
-    std::normal_distribution<double> gauss(0.0, 1.0);
     auto drawInterval = [&] {  // in mean intervals
         double theta;
-        do theta = 1.0 + settings.isiCv * gauss(rng);
+        do theta = 1.0 + settings.isiCv * rng.drawNormal();
         while (theta < kMinIntervalFraction);
         return theta;
     };
@@ -102,7 +100,7 @@ SurfaceEmg calcSurfaceEmg(const VirtualMuscle& muscle, const ActivationProfile& 
                 if (i >= n) break;
                 // Recruited at i: start with a random phase of the first interval.
                 double theta = drawInterval();
-                double reference = cumulative[i] - uniform(rng) * theta;
+                double reference = cumulative[i] - rng.drawUniform() * theta;
                 for (; i < n && rate[i] > 0; ++i) {
                     if (cumulative[i] - reference < theta) continue;
                     ++out.spikeCounts[u];

@@ -11,12 +11,12 @@
 // Framework-free apart from the muscle model.
 #pragma once
 
+#include "basics/portable_random.h"
 #include "experiments/signal.h"
 #include "muscles/activation.h"
 #include "muscles/virtual_muscle.h"
 
 #include <cstddef>
-#include <random>
 #include <vector>
 
 namespace armsim {
@@ -71,7 +71,7 @@ struct SurfaceEmg {
 /// (spike phases and intervals, electrode noise, mains phase) comes from rng. Throws InputError if
 /// a fibre type with units has no f05, and what settings.validate() throws.
 SurfaceEmg calcSurfaceEmg(const VirtualMuscle& muscle, const ActivationProfile& activation, double t0,
-                          std::size_t numSamples, const SurfaceEmgSettings& settings, std::mt19937_64& rng);
+                          std::size_t numSamples, const SurfaceEmgSettings& settings, PortableRandom& rng);
 
 /// Amplitude and spectral features of an EMG window.
 struct EmgFeatures {

@@ -106,9 +106,9 @@ ArmTrialOutcome runArmTrial(const ArmTrialPlan& plan, const Protocol& protocol, 
     // The subject's effort: agonists at the planned drive times the voluntary activation, antagonists
     // co-contracting; both vary from trial to trial (seeded) and fade with fatigue over repetitions.
     const SubjectEffort& e = subject.effort;
-    std::mt19937_64 effortRng(splitMix(plan.seed ^ 0xE1F0E1F0ULL));
-    std::normal_distribution<double> unit(0.0, 1.0);
-    const double variation = 1 + e.trialCv * unit(effortRng), antagonistVariation = 1 + e.trialCv * unit(effortRng);
+    PortableRandom effortRng(splitMix(plan.seed ^ 0xE1F0E1F0ULL));
+    const double variation = 1 + e.trialCv * effortRng.drawNormal();
+    const double antagonistVariation = 1 + e.trialCv * effortRng.drawNormal();
     const double fatigue = std::pow(1 - e.fatigue, plan.repetition - 1);
     s.activation = std::clamp(plan.activation * e.voluntaryActivation * variation * fatigue, 0.0, 1.0);
     s.antagonistActivation = std::clamp(e.coContraction * antagonistVariation * fatigue, 0.0, 1.0);
@@ -119,8 +119,7 @@ ArmTrialOutcome runArmTrial(const ArmTrialPlan& plan, const Protocol& protocol, 
     const double h = r.summary.momentArm;
 
     // Transducer noise: every reading and the estimates derived from it.
-    std::mt19937_64 noiseRng(splitMix(plan.seed ^ 0x5A5A5A5AULL)), emgRng(splitMix(plan.seed));
-    std::normal_distribution<double> noise(0.0, protocol.transducerNoiseRms > 0 ? protocol.transducerNoiseRms : 1.0);
+    PortableRandom noiseRng(splitMix(plan.seed ^ 0x5A5A5A5AULL)), emgRng(splitMix(plan.seed));
     const int cForce = t.findColumn("muscle_force_N"), cStrap = t.findColumn("strap_force_N"),
               cSat = t.findColumn("saturated"), cByArm = t.findColumn("force_moment_arm_N"),
               cByRatio = t.findColumn("force_fixed_ratio_N"), cErrArm = t.findColumn("error_moment_arm_pct"),
@@ -147,7 +146,7 @@ ArmTrialOutcome runArmTrial(const ArmTrialPlan& plan, const Protocol& protocol, 
         std::vector<double> row = t.getRow(i);
         if (protocol.transducerNoiseRms > 0) {
             const TransducerReading r =
-                calcTransducerReading(ap, row[cStrap] + noise(noiseRng), plan.angle, h, row[cForce]);
+                calcTransducerReading(ap, row[cStrap] + protocol.transducerNoiseRms * noiseRng.drawNormal(), plan.angle, h, row[cForce]);
             row[cStrap] = r.strapForce;
             row[cSat] = r.saturated ? 1.0 : 0.0;
             row[cByArm] = r.forceMomentArm;
@@ -330,10 +329,10 @@ void planArmTrials(const Protocol& protocol, ProtocolRun& run, std::vector<int>&
                 run.plans.push_back(p);
             }
     for (const auto& p : run.plans) (p.level == 1.0 ? phase1 : phase2).push_back(p.index);
-    std::mt19937_64 orderRng(splitMix(protocol.seed ^ 0x0DDBA11ULL));
+    PortableRandom orderRng(splitMix(protocol.seed ^ 0x0DDBA11ULL));
     if (protocol.randomOrder) {
-        std::shuffle(phase1.begin(), phase1.end(), orderRng);
-        std::shuffle(phase2.begin(), phase2.end(), orderRng);
+        orderRng.shuffle(phase1);
+        orderRng.shuffle(phase2);
     }
     run.runPosition.assign(run.plans.size(), 0);
     int pos = 0;

@@ -289,14 +289,14 @@ BiquadCascade designAcquisitionFilter(const EmgAcquisitionSettings& settings, do
 }
 
 std::vector<double> calcAcquiredEmg(const std::vector<double>& electrodeVoltage, double inputRate,
-                                    const EmgAcquisitionSettings& settings, std::mt19937_64& rng) {
+                                    const EmgAcquisitionSettings& settings, PortableRandom& rng) {
     const BiquadCascade filter = designAcquisitionFilter(settings, inputRate);
     const std::size_t m = decimationFactor(inputRate, settings.outputRate);
     const std::size_t n = electrodeVoltage.size();
 
     std::vector<double> v(electrodeVoltage);
     if (settings.mainsAmplitude > 0) {
-        const double phase = std::uniform_real_distribution<double>(0, 2 * kPi)(rng);
+        const double phase = rng.drawUniform(0, 2 * kPi);
         const double w = 2 * kPi * settings.mainsFrequency / inputRate;
         for (std::size_t i = 0; i < n; ++i)
             v[i] += settings.mainsAmplitude * std::sin(w * double(i) + phase);
@@ -304,9 +304,8 @@ std::vector<double> calcAcquiredEmg(const std::vector<double>& electrodeVoltage,
     if (settings.electrodeNoiseRms > 0) {
         // White noise of RMS sigma over 0..outputRate/2 has per-sample RMS
         // sigma sqrt(inputRate / outputRate) at the internal rate.
-        std::normal_distribution<double> noise(
-            0.0, settings.electrodeNoiseRms * std::sqrt(double(m)));
-        for (double& x : v) x += noise(rng);
+        const double sd = settings.electrodeNoiseRms * std::sqrt(double(m));
+        for (double& x : v) x += sd * rng.drawNormal();
     }
     for (double& x : v) x *= settings.gain;
 

@@ -5,9 +5,10 @@
 // Framework-free (standard library only). Frequencies in Hz, times in s, signals in V.
 #pragma once
 
+#include "basics/portable_random.h"
+
 #include <complex>
 #include <cstddef>
-#include <random>
 #include <vector>
 
 namespace armsim {
@@ -122,6 +123,6 @@ BiquadCascade designAcquisitionFilter(const EmgAcquisitionSettings& settings, do
 /// only from rng. Throws FieldError naming "inputRate" unless it is an integer multiple (>= 1) of
 /// outputRate, and whatever settings.validate() throws.
 std::vector<double> calcAcquiredEmg(const std::vector<double>& electrodeVoltage, double inputRate,
-                                    const EmgAcquisitionSettings& settings, std::mt19937_64& rng);
+                                    const EmgAcquisitionSettings& settings, PortableRandom& rng);
 
 }  // namespace armsim

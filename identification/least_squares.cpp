@@ -1,4 +1,5 @@
 // Bounded Levenberg-Marquardt (Ceres) with covariance-based intervals and seeded multi-start.
+#include "basics/portable_random.h"
 #include "identification/solver_context.h"
 #include "identification/statistics.h"
 
@@ -7,7 +8,6 @@
 #include <cmath>
 #include <limits>
 #include <memory>
-#include <random>
 #include <sstream>
 
 namespace armsim::detail {
@@ -226,14 +226,14 @@ void addUncertainty(SolverContext& ctx, Run& run, const std::vector<double>& r, 
 
 SolverOutcome solveLeastSquares(SolverContext& ctx, IdentificationReport& report) {
     const int p = ctx.getNumUnknowns(), n = ctx.getNumObservations();
-    std::mt19937_64 rng(ctx.options.seed);
+    PortableRandom rng(std::uint64_t{ctx.options.seed});
     const std::vector<double> lo = ctx.map.getLower(), hi = ctx.map.getUpper();
     Run best;
     int iterations = 0;
     for (int s = 0; s < ctx.options.starts; ++s) {
         std::vector<double> x0 = ctx.map.getStart();
         if (s > 0)
-            for (int j = 0; j < p; ++j) x0[j] = std::uniform_real_distribution<double>(lo[j], hi[j])(rng);
+            for (int j = 0; j < p; ++j) x0[j] = rng.drawUniform(lo[j], hi[j]);
         Run run = runFrom(ctx, x0);
         iterations += int(run.summary.iterations.size()) - 1;
         report.startCosts.push_back(run.cost);

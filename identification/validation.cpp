@@ -1,6 +1,7 @@
 #include "identification/validation.h"
 
 #include "basics/bound.h"
+#include "basics/portable_random.h"
 #include "basics/csv.h"
 #include "model/geometry.h"
 
@@ -8,7 +9,6 @@
 
 #include <cmath>
 #include <map>
-#include <random>
 #include <sstream>
 
 namespace armsim {
@@ -65,10 +65,10 @@ std::vector<ValidationRow> runValidation(const ArmParameters& arm, const MuscleP
     const std::vector<Method> methods = settings.methods.empty() ? getValidationMethods() : settings.methods;
 
     std::vector<Truth> truths = {{"thesis", kThesisMass, kThesisTendonLength}};
-    std::mt19937_64 rng(settings.seed);
+    PortableRandom rng(std::uint64_t{settings.seed});
     for (int s = 0; s < settings.seeds; ++s) {
-        const double m = std::uniform_real_distribution<double>(kValidationMassLow, kValidationMassHigh)(rng);
-        const double t = std::uniform_real_distribution<double>(kValidationTendonLow, kValidationTendonHigh)(rng);
+        const double m = rng.drawUniform(kValidationMassLow, kValidationMassHigh);
+        const double t = rng.drawUniform(kValidationTendonLow, kValidationTendonHigh);
         truths.push_back({"random " + std::to_string(s + 1), m, t});
     }
 
@@ -99,7 +99,7 @@ std::vector<ValidationRow> runValidation(const ArmParameters& arm, const MuscleP
         muscle.optimalTendonLength = truth.tendon;
         const std::vector<double> y0 = reference.calcForces(muscle, clean.points);
         std::vector<double> eps;
-        for (std::size_t k = 0; k < y0.size(); ++k) eps.push_back(std::normal_distribution<double>()(rng));
+        for (std::size_t k = 0; k < y0.size(); ++k) eps.push_back(rng.drawNormal());
         for (double sd : settings.noiseLevels) {
             IdentificationProblem pr;
             pr.base = base;
