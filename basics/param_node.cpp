@@ -22,6 +22,35 @@ ParamNode::ParamNode(const ParamNode&) = default;
 ParamNode& ParamNode::operator=(const ParamNode&) = default;
 ParamNode::~ParamNode() = default;
 
+namespace {
+
+constexpr int kMaxDepth = 64;              ///< nesting of mappings and lists (parameter files use a handful)
+constexpr long kMaxValues = 1000000;       ///< values with aliases expanded (a few thousand in a protocol)
+
+// Every mapping key is a plain scalar (the readers compare keys as strings); nesting and the document
+// as aliases expand it are bounded (`&a [..]`, `&b [*a, *a, ..]`, ... grows exponentially).
+void checkKeysAndSize(const YAML::Node& n, const std::string& source, int depth, long& values) {
+    auto where = [&](const YAML::Node& at) { return source + ":" + std::to_string(at.Mark().line + 1); };
+    if (depth > kMaxDepth)
+        throw InputError(where(n) + ": nested deeper than " + std::to_string(kMaxDepth) +
+                         " levels: expected a parameter file");
+    if (++values > kMaxValues)
+        throw InputError(where(n) + ": more than " + std::to_string(kMaxValues) +
+                         " values (with aliases expanded): expected a parameter file");
+    if (n.IsMap()) {
+        for (auto it = n.begin(); it != n.end(); ++it) {
+            if (!it->first.IsScalar())
+                throw InputError(where(it->first) +
+                                 ": a key that is a list or mapping ('? ...' or '[...]: ...'): expected a name");
+            checkKeysAndSize(it->second, source, depth + 1, values);
+        }
+    } else if (n.IsSequence()) {
+        for (const YAML::Node& e : n) checkKeysAndSize(e, source, depth + 1, values);
+    }
+}
+
+}  // namespace
+
 ParamNode ParamNode::loadString(const std::string& text, const std::string& sourceName) {
     auto impl = std::make_shared<Impl>();
     impl->source = sourceName;
@@ -32,6 +61,8 @@ ParamNode ParamNode::loadString(const std::string& text, const std::string& sour
     }
     if (!impl->node.IsMap())
         throw InputError(sourceName + ":1: expected a mapping of 'key: value' lines at the top level");
+    long values = 0;
+    checkKeysAndSize(impl->node, sourceName, 0, values);
     return ParamNode(impl);
 }
 

@@ -82,6 +82,38 @@ TEST(ParamNode, BadYamlAndNonMappingsAreInputErrors) {
                     "s.yaml:1"));
 }
 
+// Found by fuzzing the population loader: a key that is itself a mapping ('? sd: 0.05') ended in a
+// yaml-cpp conversion exception (an internal error) when an error message looked for a key's line.
+TEST(ParamNode, KeysThatAreListsOrMappingsAreRefusedWithTheirLine) {
+    const std::string msg = messageOf([] {
+        const ParamNode n = ParamNode::loadString("a: 1\ntendon:\n? sd: 0.05\nb: 2\n", "p.yaml");
+        n.getNumber("b", Bound::any());
+    });
+    EXPECT_TRUE(has(msg, "p.yaml:3")) << msg;
+    EXPECT_TRUE(has(msg, "expected a name")) << msg;
+    EXPECT_TRUE(has(messageOf([] { ParamNode::loadString("[1, 2]: 3\n", "q.yaml"); }), "q.yaml:1"));
+}
+
+// Aliases can expand a short file exponentially, and nesting can be arbitrarily deep: both are refused
+// when the file is loaded, before any reader walks it.
+TEST(ParamNode, ExponentialAliasesAndDeepNestingAreRefused) {
+    std::string laughs = "l0: &l0 [1, 1, 1, 1, 1, 1, 1, 1, 1, 1]\n";
+    for (int i = 1; i <= 7; ++i) {  // 10^8 values once expanded
+        laughs += "l" + std::to_string(i) + ": &l" + std::to_string(i) + " [";
+        for (int k = 0; k < 10; ++k) laughs += std::string(k ? ", " : "") + "*l" + std::to_string(i - 1);
+        laughs += "]\n";
+    }
+    const std::string msg = messageOf([&] { ParamNode::loadString(laughs, "laughs.yaml"); });
+    EXPECT_TRUE(has(msg, "laughs.yaml:")) << msg;
+    EXPECT_TRUE(has(msg, "more than 1000000 values")) << msg;
+
+    const std::string deep = "a: " + std::string(100, '[') + std::string(100, ']') + "\n";
+    const std::string deepMsg = messageOf([&] { ParamNode::loadString(deep, "deep.yaml"); });
+    EXPECT_TRUE(has(deepMsg, "nested deeper than 64 levels")) << deepMsg;
+    // Within the bounds a file loads.
+    EXPECT_NO_THROW(ParamNode::loadString("a: " + std::string(20, '[') + std::string(20, ']') + "\n", "ok.yaml"));
+}
+
 TEST(Files, AtomicWriteReplacesWholeAndReadsBack) {
     const fs::path dir = fs::temp_directory_path() / ("armsim_files_" + std::to_string(::getpid()));
     fs::remove_all(dir);
