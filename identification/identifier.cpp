@@ -336,8 +336,8 @@ IdentificationReport identifyWarmStarted(const IdentificationProblem& problem, c
     if (warm.isConverged()) {
         for (std::size_t j = 0; j < second.unknowns.size(); ++j) second.unknowns[j].start = warm.parameters[j].value;
         how = "started from the " + warmModel.getName() + "-model lm estimate (" + std::to_string(warm.iterations) +
-              " iterations, " + std::to_string(warm.forwardEvaluations) + " evaluations, " + fmt(warm.wallTime) +
-              " s)";
+              " iterations, " + std::to_string(warm.forwardEvaluations) +
+              " evaluations; its time is in the wall time)";
     } else {
         how = "the " + warmModel.getName() + "-model warm start did not converge (" +
               getStopReasonName(warm.stopReason) + "), started from the given starts";

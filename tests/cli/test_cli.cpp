@@ -195,6 +195,40 @@ TEST(Cli, MainJobRunsTheThesisArmAndTheElbowSubject) {
         EXPECT_NEAR(t.get(i, "biceps_both_heads_N"), t.get(i, "force_BIClong_N") + t.get(i, "force_BICshort_N"), 1e-6);
     }
     EXPECT_NE(r.output.find("Elbow model (seven muscles)"), std::string::npos) << r.output;
+
+    // Issue 15: a second run (one thread, same folder: reports name their data files) writes the same
+    // bytes, videos and stills included; the identification reports differ only in their wall time.
+    const fs::path again = freshDir("run_first");
+    fs::remove_all(again);
+    fs::rename(d, again);
+    ASSERT_EQ(runArmsim("run --jobs 1 --out " + d.string()).exitCode, 0);
+    auto withoutWallTime = [](const std::string& text) {
+        std::istringstream in(text);
+        std::string line, out;
+        while (std::getline(in, line))
+            if (line.find("\"wall_time_s\"") == std::string::npos) out += line + "\n";
+        return out;
+    };
+    int files = 0, videos = 0, reports = 0;
+    for (const auto& e : fs::recursive_directory_iterator(d)) {
+        if (!e.is_regular_file()) continue;
+        const fs::path rel = fs::relative(e.path(), d), twin = again / rel;
+        ASSERT_TRUE(fs::exists(twin)) << rel;
+        std::string a = armsim::testing::readFileText(e.path()), b = armsim::testing::readFileText(twin);
+        if (rel.extension() == ".json") {
+            reports += a.find("\"wall_time_s\"") != std::string::npos;
+            a = withoutWallTime(a);
+            b = withoutWallTime(b);
+        }
+        EXPECT_TRUE(a == b) << "differs: " << rel;
+        videos += rel.extension() == ".mp4";
+        ++files;
+    }
+    EXPECT_GT(files, 60);
+    EXPECT_EQ(videos, 2);
+    EXPECT_GT(reports, 0);
+    fs::remove_all(again);
+    fs::remove_all(d);
 }
 
 // Issue 14: a command that neither renders nor runs under mpirun starts without the render stack and
