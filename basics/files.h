@@ -7,6 +7,12 @@
 
 namespace armsim {
 
+/// Whether something exists at path; false also when the name cannot be looked up (too long, a
+/// component that is a file, no permission), where std::filesystem::exists would throw.
+bool doesPathExist(const std::string& path);
+/// Whether path is a regular file (or a link to one); false also when it cannot be looked up.
+bool isRegularFile(const std::string& path);
+
 /// The whole file as bytes. Throws InputError naming the path when it cannot be read.
 std::string readFileText(const std::string& path);
 /// InputError unless `path` (when it exists) is a regular file of at most maxBytes (a folder, a device

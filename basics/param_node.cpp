@@ -80,9 +80,9 @@ std::string ParamNode::findFile(const std::string& key, const std::string& what,
     const std::string file = getString(key);
     const std::string dir = getDirectory();
     const std::string relative = dir.empty() ? file : dir + "/" + file;
-    if (std::filesystem::exists(relative)) return relative;
-    if (std::filesystem::exists(file)) return file;
-    if (!fallbackDirectory.empty() && std::filesystem::exists(fallbackDirectory + "/" + file))
+    if (doesPathExist(relative)) return relative;
+    if (doesPathExist(file)) return file;
+    if (!fallbackDirectory.empty() && doesPathExist(fallbackDirectory + "/" + file))
         return fallbackDirectory + "/" + file;
     throw InputError(where(key) + ": field '" + path(key) + "' = '" + file + "': no such " + what +
                      " (relative paths are taken from the file's directory" +

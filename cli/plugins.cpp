@@ -1,6 +1,7 @@
 #include "cli/plugins.h"
 
 #include "basics/errors.h"
+#include "basics/files.h"
 #include "identification/study_mpi.h"
 
 #ifdef ARMSIM_WITH_RENDER
@@ -53,7 +54,7 @@ const Api* loadPluginApi(const char* file, const char* symbol, std::string& why)
     // Beside the executable (the build tree), or <prefix>/lib/armsim/ for <prefix>/bin/armsim (installed).
     const std::vector<std::string> candidates = {folder + "/" + file, folder + "/../lib/armsim/" + file};
     for (const std::string& path : candidates) {
-        if (!std::filesystem::exists(path)) continue;
+        if (!doesPathExist(path)) continue;
         void* handle = dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);
         if (!handle) {
             why = "cannot load " + path + ": " + dlerror();

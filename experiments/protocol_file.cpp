@@ -157,7 +157,7 @@ Protocol readProtocol(const std::string& path) {
     }
     auto resolve = [&](const std::string& key, const std::string& file) {
         const std::string relative = root.getDirectory().empty() ? file : root.getDirectory() + "/" + file;
-        if (fs::exists(relative)) return relative;
+        if (doesPathExist(relative)) return relative;
         try {
             return findAsset(file);
         } catch (const InputError& e) {

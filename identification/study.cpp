@@ -53,9 +53,9 @@ std::string resolveStudyFile(const ParamNode& n, const std::string& field, const
     const fs::path p(value);
     if (p.is_relative() && !n.getDirectory().empty()) {
         const fs::path beside = fs::path(n.getDirectory()) / p;
-        if (fs::is_regular_file(beside)) return beside.string();
+        if (isRegularFile(beside.string())) return beside.string();
     }
-    if (fs::is_regular_file(p)) return p.string();
+    if (isRegularFile(p.string())) return p.string();
     throw InputError(n.where(field) + ": field '" + field + "' = '" + value + "': no such " + what +
                      " (looked beside the study file and in the working directory)");
 }

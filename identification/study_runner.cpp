@@ -183,7 +183,7 @@ public:
         journalPath_ = dir_ + "/journal.log";
         const std::string header = "# armsim study journal; fingerprint " + fingerprint + "; study " + study.name;
         std::string kept = header + '\n';
-        if (fs::exists(journalPath_) && !restart) {
+        if (doesPathExist(journalPath_) && !restart) {
             std::ifstream in(journalPath_, std::ios::binary);
             std::string first, line;
             std::getline(in, first);
@@ -291,7 +291,7 @@ std::vector<std::string> writeStudyFiles(const Study& study, const std::string& 
     };
     for (const auto& p : plots) {
         writeNoisePlot(dir + "/" + p.file, p.title, p.yLabel, summary, p.statistic);
-        if (fs::exists(dir + "/" + p.file)) files.push_back(p.file);
+        if (doesPathExist(dir + "/" + p.file)) files.push_back(p.file);
     }
     return files;
 }

@@ -221,14 +221,14 @@ ArmSetup loadModel(const std::string& nameOrFile) {
                                nameOrFile.find(".yaml") == std::string::npos;
     if (looksLikeName) {
         const std::string asset = getAssetDirectory() + "/models/" + nameOrFile + ".yaml";
-        if (!std::filesystem::exists(asset)) {
+        if (!doesPathExist(asset)) {
             std::string known;
             for (const std::string& m : listModels()) known += (known.empty() ? "" : ", ") + m;
             throw InputError("--model '" + nameOrFile + "': no such model (shipped models: " + known +
                              "; or give a model file path)");
         }
         file = asset;
-    } else if (!std::filesystem::exists(file)) {
+    } else if (!doesPathExist(file)) {
         throw InputError(file + ": no such model file");
     }
 

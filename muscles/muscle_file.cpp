@@ -1,5 +1,6 @@
 #include "muscles/muscle_file.h"
 
+#include "basics/files.h"
 #include "basics/param_node.h"
 
 #include <cmath>
@@ -25,9 +26,9 @@ std::string getAssetDirectory() {
 }
 
 std::string findAsset(const std::string& name) {
-    if (std::filesystem::exists(name)) return name;
+    if (doesPathExist(name)) return name;
     const std::string inAssets = getAssetDirectory() + "/" + name;
-    if (std::filesystem::exists(inAssets)) return inAssets;
+    if (doesPathExist(inAssets)) return inAssets;
     throw InputError(name + ": no such file (looked here and in " + getAssetDirectory() + ")");
 }
 

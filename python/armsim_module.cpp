@@ -4,6 +4,7 @@
 // SimulationError -> RuntimeError). Long calls release the GIL.
 #include "basics/angles.h"
 #include "basics/bound.h"
+#include "basics/files.h"
 #include "identification/study.h"
 #include "model/mvc_curve.h"
 #include "model/trial.h"
@@ -22,7 +23,7 @@ namespace {
 ArmSetup loadModelChecked(const std::string& nameOrFile) {
     const bool looksLikePath = nameOrFile.find('/') != std::string::npos || (nameOrFile.size() > 5 &&
                                nameOrFile.compare(nameOrFile.size() - 5, 5, ".yaml") == 0);
-    if (looksLikePath && !std::filesystem::is_regular_file(nameOrFile)) throwFileNotFound(nameOrFile, "model file");
+    if (looksLikePath && !isRegularFile(nameOrFile)) throwFileNotFound(nameOrFile, "model file");
     return loadModel(nameOrFile);
 }
 
@@ -229,7 +230,7 @@ PYBIND11_MODULE(_armsim, mod) {
     mod.def(
         "run_study",
         [](const std::string& file, int threads, const std::string& out, bool restart) {
-            if (!std::filesystem::is_regular_file(file)) throwFileNotFound(file, "study file");
+            if (!isRegularFile(file)) throwFileNotFound(file, "study file");
             const Study study = readStudy(file);
             StudyRunOptions o;
             o.threads = threads;

@@ -1,6 +1,7 @@
 // Whole-file reads and the recorder that lets a result derived from files be reused (basics/files.h).
 #include "basics/errors.h"
 #include "basics/files.h"
+#include "basics/param_node.h"
 #include "tests/support/temp_files.h"
 
 #include <gtest/gtest.h>
@@ -55,4 +56,21 @@ TEST(FileReadRecorder, SnapshotsGoStaleWhenAFileChangesOrGoes) {
     std::filesystem::remove(a);
     EXPECT_FALSE(areFilesUnchanged(files));
     std::filesystem::remove_all(dir);
+}
+
+// Found by fuzzing the population and study loaders: a referenced file name longer than the system
+// allows (ENAMETOOLONG) made std::filesystem::exists throw filesystem_error (an internal error).
+TEST(Files, NamesThatCannotBeLookedUpDoNotExist) {
+    const std::string tooLong = "/tmp/" + std::string(300, 'a') + "/b.yaml";
+    EXPECT_FALSE(doesPathExist(tooLong));
+    EXPECT_FALSE(isRegularFile(tooLong));
+    EXPECT_TRUE(doesPathExist("/tmp"));
+    EXPECT_FALSE(isRegularFile("/tmp"));
+    try {
+        ParamNode::loadString("model: " + tooLong + "\n", "p.yaml").findFile("model", "model file");
+        ADD_FAILURE() << "no error";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("p.yaml:1"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("no such model file"), std::string::npos) << e.what();
+    }
 }
