@@ -5,6 +5,7 @@
 
 #include <charconv>
 #include <string>
+#include <vector>
 
 namespace armsim {
 
@@ -14,6 +15,20 @@ inline std::string formatNumber(double v) {
     char buf[32];
     const auto r = std::to_chars(buf, buf + sizeof buf, v);
     return std::string(buf, r.ptr);
+}
+
+/// Numbers as a comma-separated list in formatNumber's form ("15,30,45"), as list options take them.
+inline std::string formatList(const std::vector<double>& values) {
+    std::string s;
+    for (double v : values) s += (s.empty() ? "" : ",") + formatNumber(v);
+    return s;
+}
+
+/// Names as a comma-separated list ("mass,optimal_tendon_length").
+inline std::string formatList(const std::vector<std::string>& names) {
+    std::string s;
+    for (std::size_t i = 0; i < names.size(); ++i) s += (i ? "," : "") + names[i];
+    return s;
 }
 
 }  // namespace armsim

@@ -58,10 +58,13 @@ void addRegisteredCommands(CLI::App& app);
 
 /// A finite number given to `option`; InputError naming the option and the text otherwise.
 double parseNumber(const std::string& option, const std::string& text);
-/// The non-empty items of a comma-separated list.
-std::vector<std::string> splitList(const std::string& text);
-/// A comma-separated list of finite numbers given to `option` (each checked by parseNumber).
-std::vector<double> parseNumberList(const std::string& option, const std::string& text);
+/// A CLI11 option taking a comma-separated list of finite numbers ("--angles 30,60,90"); an item that is
+/// not one is refused with the option and the item named.
+CLI::Option* addNumberListOption(CLI::App& app, const std::string& name, std::vector<double>& values,
+                                 const std::string& description);
+/// A CLI11 option taking a comma-separated list of names ("--methods lm,ilc-sign-search").
+CLI::Option* addNameListOption(CLI::App& app, const std::string& name, std::vector<std::string>& values,
+                               const std::string& description);
 
 /// Checks, before any work and without creating anything, that the output folder given to `option`
 /// can be created or written (it, or its nearest existing ancestor, is a writable folder): InputError

@@ -18,8 +18,8 @@ namespace {
 
 struct DesignOptions {
     std::string population;
-    std::string angles = "15,30,45,60,75,90,105,120,135";
-    std::string levels;
+    std::vector<double> angles = {15, 30, 45, 60, 75, 90, 105, 120, 135};
+    std::vector<double> levels;
     bool noExtension = false;
     int trials = 15;
     int repetitions = 3;
@@ -48,8 +48,8 @@ void runDesign(const DesignOptions& o) {
     checkOutputFolder("--out", o.out);
     const Population population = o.population.empty() ? loadDefaultPopulation() : loadPopulation(o.population);
     DesignSettings s;
-    s.flexionDeg = parseNumberList("--angles", o.angles);
-    if (!o.levels.empty()) s.levels = parseNumberList("--levels", o.levels);
+    s.flexionDeg = o.angles;
+    s.levels = o.levels;
     s.extension = !o.noExtension;
     s.trials = o.trials;
     s.repetitions = o.repetitions;
@@ -61,8 +61,8 @@ void runDesign(const DesignOptions& o) {
     s.validate();
     std::printf("experiment design for the synergist-aware identifier: population '%s', budget %d trials in blocks "
                 "of %d, angles %s deg, extension MVCs %s, submaximal EMG-feedback levels %s, VA %s; %d prior draws\n",
-                population.name.c_str(), s.trials, s.repetitions, o.angles.c_str(), s.extension ? "allowed" : "not allowed",
-                o.levels.empty() ? "none" : o.levels.c_str(),
+                population.name.c_str(), s.trials, s.repetitions, formatList(o.angles).c_str(), s.extension ? "allowed" : "not allowed",
+                o.levels.empty() ? "none" : formatList(o.levels).c_str(),
                 s.activationSd > 0 ? ("measured (sd " + formatNumber(s.activationSd) + ")").c_str() : "not measured",
                 s.draws);
     std::fflush(stdout);
@@ -150,8 +150,9 @@ void addDesignCommand(CLI::App& app) {
         "design", "torque protocol minimising the synergist-aware identifier's expected uncertainty of biceps mass "
                   "and tendon length (Bayesian, Laplace approximation, greedy), vs the thesis's five angles");
     c->add_option("--population", o->population, "prior population (default assets/subjects/default_population.yaml)");
-    c->add_option("--angles", o->angles, "allowed flexion angles [deg, 0 = extended], comma-separated")->capture_default_str();
-    c->add_option("--levels", o->levels,
+    addNumberListOption(*c, "--angles", o->angles, "allowed flexion angles [deg, 0 = extended], comma-separated")
+        ->capture_default_str();
+    addNumberListOption(*c, "--levels", o->levels,
                   "allowed submaximal levels (EMG feedback, fractions of MVC in (0, 1)), comma-separated; default none");
     c->add_flag("--no-extension", o->noExtension, "no extension MVCs");
     c->add_flag("--free-slow-fraction", o->freeSlowFraction,

@@ -86,7 +86,7 @@ struct IdentifyOptions {
     MuscleOptions muscle;
     std::string data;
     std::string method = "lm";
-    std::string freeList = "mass,optimal_tendon_length";
+    std::vector<std::string> freeList = {"mass", "optimal_tendon_length"};
     std::vector<std::string> bounds, starts;
     ModelOptions model;
     double forceSd = NAN;
@@ -138,13 +138,14 @@ void runIdentify(const IdentifyOptions& o) {
     pr.base = base;
     pr.data = readArmObservations(findAsset(o.data), setup.arm, o.subject);
     pr.unknowns.clear();
-    for (const std::string& name : splitList(o.freeList)) pr.unknowns.push_back(makeUnknown(parseParameter("--free", name)));
-    if (pr.unknowns.empty()) throw InputError("--free '" + o.freeList + "': expected at least one parameter");
+    const std::string freeList = formatList(o.freeList);
+    for (const std::string& name : o.freeList) pr.unknowns.push_back(makeUnknown(parseParameter("--free", name)));
+    if (pr.unknowns.empty()) throw InputError("--free '" + freeList + "': expected at least one parameter");
     auto findUnknown = [&](const std::string& option, const std::string& name) -> Unknown& {
         const ParameterId id = parseParameter(option, name);
         for (Unknown& u : pr.unknowns)
             if (u.id == id) return u;
-        throw InputError(option + " " + name + ": not a free parameter (--free " + o.freeList + ")");
+        throw InputError(option + " " + name + ": not a free parameter (--free " + freeList + ")");
     };
     for (const std::string& b : o.bounds) {
         const auto [name, range] = splitAssignment("--bounds", b);
@@ -183,7 +184,7 @@ void addIdentifyCommand(CLI::App& app) {
                                          "ilc-bounded-secant | ilc-sign-search")
         ->capture_default_str()
         ->check(CLI::IsMember(getMethodNames()));
-    c->add_option("--free", o->freeList, "comma-separated unknowns (mass, tendon_length, fascicle_length, "
+    addNameListOption(*c, "--free", o->freeList, "comma-separated unknowns (mass, tendon_length, fascicle_length, "
                                          "slow_fraction, max_path_length)")
         ->capture_default_str();
     c->add_option("--bounds", o->bounds, "name=lo:hi in SI units, repeatable");
@@ -213,8 +214,8 @@ struct ValidateOptions {
     MuscleOptions muscle;
     int seeds = 1;
     unsigned seed = 1;
-    std::string noise = "0,1,2,5";
-    std::string methods;
+    std::vector<double> noise = {0, 1, 2, 5};  // [% of the force]
+    std::vector<std::string> methods;
     std::string model = "corrected";
     std::string estimate = "moment-arm";
     int jobs = 2;
@@ -223,7 +224,7 @@ struct ValidateOptions {
     std::string population;
     int subjects = 200;
     double activationSd = 0.02;
-    std::string angles;     // flexion angles [deg] of the elbow protocol; empty: the thesis's five
+    std::vector<double> angles;  // flexion angles [deg] of the elbow protocol; empty: the thesis's five
     int repetitions = 3;
     std::string protocol;   // torque protocol file (replaces --angles/--repetitions)
     bool noiseGiven = false;
@@ -278,13 +279,11 @@ void runElbowValidate(const ValidateOptions& o) {
         s.protocol = readTorqueProtocol(o.protocol);
     } else {
         std::vector<double> angles = {135, 120, 90, 60, 30};
-        if (!o.angles.empty()) {
-            angles = parseNumberList("--angles", o.angles);
-        }
+        if (!o.angles.empty()) angles = o.angles;
         s.protocol.conditions = TorqueProtocol::makeFlexionMvcs(angles, o.repetitions);
     }
     if (o.noiseGiven)
-        for (const std::string& v : splitList(o.noise)) s.noiseLevels.push_back(parseNumber("--noise", v) / 100.0);
+        for (double pct : o.noise) s.noiseLevels.push_back(pct / 100.0);
     std::printf("validation on the elbow model as truth: population '%s' (%s), %d subjects, seed %u; protocol "
                 "'%s' (%d trials: %s); identifiers: thesis (biceps only), synergist-aware (MAP) and, with "
                 "--activation-sd > 0, synergist-aware with voluntary activation measured by twitch interpolation "
@@ -320,8 +319,8 @@ void runValidate(const ValidateOptions& o) {
     s.seeds = o.seeds;
     s.seed = o.seed;
     s.noiseLevels.clear();
-    for (const std::string& v : splitList(o.noise)) s.noiseLevels.push_back(parseNumber("--noise", v) / 100.0);
-    for (const std::string& m : splitList(o.methods)) s.methods.push_back(parseMethodName(m));
+    for (double pct : o.noise) s.noiseLevels.push_back(pct / 100.0);
+    for (const std::string& m : o.methods) s.methods.push_back(parseMethodName(m));
     s.model = parseValidationModelName(o.model);
     s.estimate = parseForceEstimateName(o.estimate);
     s.jobs = o.jobs;
@@ -345,8 +344,9 @@ void addValidateCommand(CLI::App& app) {
                                                  "transducer noise)");
     c->add_option("--seeds", o->seeds, "random true muscles besides the thesis's")->capture_default_str();
     c->add_option("--seed", o->seed, "generator seed (truths and noise)")->capture_default_str();
-    c->add_option("--noise", o->noise, "comma-separated transducer noise levels [% of the force]")->capture_default_str();
-    c->add_option("--methods", o->methods, "comma-separated methods (default: lm and the two-output learning family)");
+    addNumberListOption(*c, "--noise", o->noise, "comma-separated transducer noise levels [% of the force]")
+        ->capture_default_str();
+    addNameListOption(*c, "--methods", o->methods, "comma-separated methods (default: lm and the two-output learning family)");
     c->add_option("--forward", o->model, "identifying forward model: corrected | faithful | steady")
         ->capture_default_str()
         ->check(CLI::IsMember({"steady", "faithful", "corrected"}));
@@ -369,7 +369,7 @@ void addValidateCommand(CLI::App& app) {
                   "synergist-va identifier (0: leave it out)")
         ->capture_default_str()
         ->check(CLI::Range(0.0, 0.5));
-    c->add_option("--angles", o->angles,
+    addNumberListOption(*c, "--angles", o->angles,
                   "--truth elbow: comma-separated flexion angles of the MVC protocol [deg, 0 = extended] "
                   "(default the thesis's 135,120,90,60,30)");
     c->add_option("--repetitions", o->repetitions, "--truth elbow: efforts per angle")

@@ -57,18 +57,24 @@ double parseNumber(const std::string& option, const std::string& text) {
     return v;
 }
 
-std::vector<std::string> splitList(const std::string& text) {
-    std::vector<std::string> items;
-    std::stringstream s(text);
-    for (std::string item; std::getline(s, item, ',');)
-        if (!item.empty()) items.push_back(item);
-    return items;
+CLI::Option* addNumberListOption(CLI::App& app, const std::string& name, std::vector<double>& values,
+                                 const std::string& description) {
+    const CLI::Validator finite(
+        [](std::string& item) -> std::string {
+            try {
+                parseNumber("", item);
+            } catch (const InputError&) {
+                return "'" + item + "': expected a finite number";
+            }
+            return "";
+        },
+        "NUMBER");
+    return app.add_option(name, values, description)->delimiter(',')->check(finite)->allow_extra_args(false);
 }
 
-std::vector<double> parseNumberList(const std::string& option, const std::string& text) {
-    std::vector<double> v;
-    for (const std::string& item : splitList(text)) v.push_back(parseNumber(option, item));
-    return v;
+CLI::Option* addNameListOption(CLI::App& app, const std::string& name, std::vector<std::string>& values,
+                               const std::string& description) {
+    return app.add_option(name, values, description)->delimiter(',')->allow_extra_args(false);
 }
 
 void checkOutputFolder(const std::string& option, const std::string& dir) {

@@ -127,6 +127,7 @@ std::vector<BadInput> makeCatalogue() {
         {"TorqueNoiseLevelOutOfRange", {}, "identify-torque measured/thesis_mvc_torque.csv --noise-level 2 --out OUT/it",
          {"--noise-level", "2"}},
         {"ValidateNoiseNotANumber", {}, "validate --noise abc --out OUT/v", {"--noise", "abc"}},
+        {"ValidateNoiseNotFinite", {}, "validate --noise 0,inf --out OUT/v", {"--noise", "'inf'", "expected a finite number"}},
         {"ValidateSubjectsZero", {}, "validate --truth elbow --subjects 0 --out OUT/v", {"--subjects", "0"}},
         {"ValidateOutIsAFile", {{"afile", "x"}}, "validate --seeds 0 --noise 0 --out IN/afile", {"--out", "not a folder"}},
         {"DesignTrialsZero", {}, "design --trials 0 --out OUT/d", {"--trials", "0"}},
