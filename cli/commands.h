@@ -71,7 +71,10 @@ CLI::Option* addNameListOption(CLI::App& app, const std::string& name, std::vect
 /// naming the option, the path and the reason.
 void checkOutputFolder(const std::string& option, const std::string& dir);
 
-/// Prints a one-line progress bar to stderr ("label [#####     ] 5/10").
+/// Prints a one-line progress bar to stderr ("label [#####     ] 5/10"); nothing with --quiet.
 void printProgress(const std::string& label, int done, int total);
+/// --quiet (any command): progress lines are left out; results and errors are printed as always.
+void setQuiet(bool quiet);
+bool isQuiet();
 
 }  // namespace armsim::cli

@@ -75,6 +75,10 @@ int main(int argc, char** argv) {
     CLI::App app{"armsim: a Simbody elbow with a Virtual Muscle biceps (simulate, identify, render)"};
     app.require_subcommand(1);
     app.set_version_flag("--version", std::string("armsim ") + ARMSIM_VERSION);
+    app.add_flag_function(
+        "--quiet,-q", [](std::int64_t) { armsim::cli::setQuiet(true); },
+        "no progress lines on stderr (results and errors as always); before or after the command");
+    app.fallthrough();  // a command's unknown option may be one of these (armsim study s.yaml --quiet)
     armsim::cli::addRegisteredCommands(app);
     try {
         app.parse(argc, argv);

@@ -2,6 +2,7 @@
 #include "cli/commands.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <sstream>
 #include <cstdio>
@@ -91,7 +92,15 @@ void checkOutputFolder(const std::string& option, const std::string& dir) {
                          " is not writable)");
 }
 
+namespace {
+std::atomic<bool> gQuiet{false};
+}
+
+void setQuiet(bool quiet) { gQuiet = quiet; }
+bool isQuiet() { return gQuiet; }
+
 void printProgress(const std::string& label, int done, int total) {
+    if (isQuiet()) return;
     std::fflush(stdout);  // keep results and progress in order when both go to one log
     if (!isatty(fileno(stderr))) {  // a log file gets one line, not a stream of carriage returns
         if (done >= total) std::fprintf(stderr, "%s: %d/%d done\n", label.c_str(), done, total);

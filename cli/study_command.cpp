@@ -21,7 +21,6 @@ struct StudyOptions {
     std::string out;
     int threads = 0;
     bool restart = false;
-    bool quiet = false;
 };
 
 std::string formatDuration(double seconds) {
@@ -47,7 +46,7 @@ void runStudyCommand(const StudyOptions& o) {
     run.output = o.out;
     run.threads = o.threads;
     run.restart = o.restart;
-    if (!o.quiet) run.progress = printStudyProgress;
+    if (!isQuiet()) run.progress = printStudyProgress;
 
     std::optional<std::pair<Study, StudyOutcome>> done;
     if (isLaunchedByMpi()) {
@@ -87,7 +86,6 @@ void addStudyCommand(CLI::App& app) {
                                            "of a node under mpirun)")
         ->check(CLI::Range(1, 1024));
     c->add_flag("--restart", o->restart, "discard the output folder's journal and compute every task again");
-    c->add_flag("--quiet", o->quiet, "no progress lines");
     c->callback([o] { runStudyCommand(*o); });
 }
 

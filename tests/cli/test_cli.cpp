@@ -355,6 +355,23 @@ TEST(Cli, SeededCommandsWriteTheSameFilesTwice) {
     fs::remove_all(d);
 }
 
+// --quiet, before or after the command, leaves out the progress lines and nothing else.
+TEST(Cli, QuietLeavesOutProgressOnly) {
+    const std::string command = "validate --seeds 0 --noise 0 --methods lm --forward steady --out ";
+    const fs::path d = freshDir("quiet");
+    const armsim::testing::CommandResult loud = runArmsim(command + (d / "a").string());
+    const armsim::testing::CommandResult after = runArmsim(command + (d / "b").string() + " --quiet");
+    const armsim::testing::CommandResult before = runArmsim("-q " + command + (d / "c").string());
+    for (const auto* r : {&loud, &after, &before}) {
+        ASSERT_EQ(r->exitCode, 0) << r->output;
+        EXPECT_NE(r->output.find("validation.csv"), std::string::npos) << r->output;
+    }
+    EXPECT_NE(loud.output.find("identifications: 1/1 done"), std::string::npos) << loud.output;
+    EXPECT_EQ(after.output.find("identifications:"), std::string::npos) << after.output;
+    EXPECT_EQ(before.output.find("identifications:"), std::string::npos) << before.output;
+    fs::remove_all(d);
+}
+
 TEST(Cli, VersionPrintsTheProjectVersion) {
     const armsim::testing::CommandResult r = runArmsim("--version");
     EXPECT_EQ(r.exitCode, 0) << r.output;
