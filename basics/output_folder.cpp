@@ -78,6 +78,20 @@ void OutputFolder::write(const std::string& relative, const std::string& text) {
     if (!out) throw InputError(getTargetPath(relative) + ": write failed (disk full?)");
 }
 
+void OutputFolder::writeWith(const std::string& relative,
+                             const std::function<void(const std::string& path)>& writer) {
+    const std::string path = addFile(relative);
+    try {
+        writer(path);
+    } catch (const InputError& e) {
+        std::string message = e.what();
+        const std::string target = getTargetPath(relative);
+        for (std::size_t at = message.find(path); at != std::string::npos; at = message.find(path, at + target.size()))
+            message.replace(at, path.size(), target);
+        throw InputError(message);
+    }
+}
+
 std::vector<std::string> OutputFolder::getFiles() const {
     std::lock_guard<std::mutex> lock(mutex_);
     return {files_.begin(), files_.end()};

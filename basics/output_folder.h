@@ -9,6 +9,7 @@
 #pragma once
 
 #include <filesystem>
+#include <functional>
 #include <mutex>
 #include <set>
 #include <string>
@@ -43,6 +44,9 @@ public:
     std::string addFile(const std::string& relative);
     /// Writes a whole file (thread-safe for distinct names). InputError naming the final path on failure.
     void write(const std::string& relative, const std::string& text);
+    /// Runs writer(path) with addFile(relative)'s path (a plot, a JSON report); an InputError it throws
+    /// names the final path instead of the staging one.
+    void writeWith(const std::string& relative, const std::function<void(const std::string& path)>& writer);
     /// Relative names of the files added so far, sorted.
     std::vector<std::string> getFiles() const;
     /// Moves the files into place, all or none: InputError naming the path when a rename fails, after

@@ -100,7 +100,7 @@ void runDesign(const DesignOptions& o) {
         greedy.y.push_back(d.steps[k].criterion);
     }
     plot.series = {greedy, {"thesis five angles", {double(reference.trials)}, {reference.criterion}, true, 1}};
-    writePlotPng(out.addFile("design_criterion.png"), plot);
+    out.writeWith("design_criterion.png", [&](const std::string& p) { writePlotPng(p, plot); });
     out.commit();
     std::printf("wrote %s, %s/design_predictions.csv, design_steps.csv, design_criterion.png\n", protocolPath.c_str(),
                 o.out.c_str());

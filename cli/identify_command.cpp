@@ -263,9 +263,9 @@ void addElbowValidationPlots(const std::vector<ElbowValidationRow>& rows, Output
         vsSynergists.series.push_back(c);
     }
     vsTruth.series.push_back({"identity", {lo, hi}, {lo, hi}, false, 7});
-    writePlotPng(out.addFile("mass_identified_vs_true.png"), vsTruth);
-    writePlotPng(out.addFile("mass_error_vs_activation.png"), vsActivation);
-    writePlotPng(out.addFile("mass_error_vs_synergists.png"), vsSynergists);
+    out.writeWith("mass_identified_vs_true.png", [&](const std::string& p) { writePlotPng(p, vsTruth); });
+    out.writeWith("mass_error_vs_activation.png", [&](const std::string& p) { writePlotPng(p, vsActivation); });
+    out.writeWith("mass_error_vs_synergists.png", [&](const std::string& p) { writePlotPng(p, vsSynergists); });
 }
 
 void runElbowValidate(const ValidateOptions& o) {

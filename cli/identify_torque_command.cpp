@@ -83,7 +83,7 @@ void runIdentifyTorque(const IdentifyTorqueOptions& o) {
                 s.x.push_back(data[k].flexionDeg), s.y.push_back(estimates[m].predictedTorque[k]);
         plot.series.push_back(s);
     }
-    writePlotPng(out.addFile("torque_fit.png"), plot);
+    out.writeWith("torque_fit.png", [&](const std::string& p) { writePlotPng(p, plot); });
     out.commit();
     std::printf("wrote %s/torque_estimates.csv, torque_predictions.csv, torque_fit.png\n", o.out.c_str());
 }

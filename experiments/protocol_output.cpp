@@ -41,7 +41,7 @@ void plotExampleEmg(OutputFolder& dir, const std::string& id, const ArmTrialOutc
     for (double& v : raw.y) v *= 1000;
     for (double& v : rms.y) v *= 1000;
     spec.series = {raw, rms};
-    writePlotPng(dir.addFile("emg_trial.png"), spec);
+    dir.writeWith("emg_trial.png", [&](const std::string& p) { writePlotPng(p, spec); });
 }
 
 void plotMvc(OutputFolder& dir, const Table& trials, const Table& summary, const std::map<std::string, QuadraticFit>& fits) {
@@ -65,7 +65,7 @@ void plotMvc(OutputFolder& dir, const Table& trials, const Table& summary, const
     addFit("force_fixed_ratio", "fit, peak", 1);
     spec.legend = PlotSpec::Legend::BottomRight;
     spec.yMin = 0;
-    writePlotPng(dir.addFile("force_angle.png"), spec);
+    dir.writeWith("force_angle.png", [&](const std::string& p) { writePlotPng(p, spec); });
 
     PlotSpec fl;
     fl.title = "MVC force vs biceps path length (mean over repetitions)";
@@ -80,7 +80,7 @@ void plotMvc(OutputFolder& dir, const Table& trials, const Table& summary, const
     }
     fl.series = {truth, active};
     fl.legend = PlotSpec::Legend::BottomRight;
-    writePlotPng(dir.addFile("force_length.png"), fl);
+    dir.writeWith("force_length.png", [&](const std::string& p) { writePlotPng(p, fl); });
 }
 
 void plotSubmaximal(OutputFolder& dir, const Table& trials, const std::optional<PolynomialFit>& map) {
@@ -103,14 +103,14 @@ void plotSubmaximal(OutputFolder& dir, const Table& trials, const std::optional<
     fe.xLabel = "EMG RMS / MVC EMG RMS";
     fe.yLabel = "active force / MVC force";
     fe.series = byAngle("emg_norm", "force_norm");
-    writePlotPng(dir.addFile("force_emg.png"), fe);
+    dir.writeWith("force_emg.png", [&](const std::string& p) { writePlotPng(p, fe); });
 
     PlotSpec fa;
     fa.title = "force vs activation (levels resolved against the simulated MVC)";
     fa.xLabel = "activation U";
     fa.yLabel = "active force / MVC force";
     fa.series = byAngle("activation", "force_norm");
-    writePlotPng(dir.addFile("force_activation.png"), fa);
+    dir.writeWith("force_activation.png", [&](const std::string& p) { writePlotPng(p, fa); });
 
     if (map) {
         PlotSpec ea;
@@ -121,7 +121,7 @@ void plotSubmaximal(OutputFolder& dir, const Table& trials, const std::optional<
         const std::vector<double> e = trials.getColumn("emg_norm");
         ea.series.push_back(curve("quadratic fit, R^2 = " + fmt::format("{:.4f}", map->rSquared), *map,
                                   *std::min_element(e.begin(), e.end()), *std::max_element(e.begin(), e.end()), 7));
-        writePlotPng(dir.addFile("emg_activation.png"), ea);
+        dir.writeWith("emg_activation.png", [&](const std::string& p) { writePlotPng(p, ea); });
     }
 }
 
@@ -242,7 +242,7 @@ void writeComposition(OutputFolder& dir, const Protocol& protocol, const Table& 
     }
     dir.write("composition.csv", composition.toCsv(kCsvDigits));
     dir.write("composition_matrix.csv", matrix.toCsv(kCsvDigits));
-    writeHeatMapPng(dir.addFile("composition_heatmap.png"), heat);
+    dir.writeWith("composition_heatmap.png", [&](const std::string& p) { writeHeatMapPng(p, heat); });
 }
 
 void plotForceLength(OutputFolder& dir, const ProtocolResult& result) {
@@ -273,7 +273,7 @@ void plotForceLength(OutputFolder& dir, const ProtocolResult& result) {
         }
         spec.series.push_back(a);
     }
-    writePlotPng(dir.addFile("force_length.png"), spec);
+    dir.writeWith("force_length.png", [&](const std::string& p) { writePlotPng(p, spec); });
 }
 
 }  // namespace

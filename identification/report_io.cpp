@@ -139,14 +139,14 @@ void writeConvergencePlot(const std::string& path, const IdentificationReport& r
 
 std::vector<std::string> addReportFiles(const IdentificationReport& report, OutputFolder& out, const std::string& stem) {
     std::vector<std::string> names = {stem + ".json", stem + "_history.csv"};
-    writeReportJson(out.addFile(names[0]), report);
-    writeHistoryCsv(out.addFile(names[1]), report);
+    out.writeWith(names[0], [&](const std::string& p) { writeReportJson(p, report); });
+    out.writeWith(names[1], [&](const std::string& p) { writeHistoryCsv(p, report); });
     // A run whose forward model failed from the start has no finite cost to plot: no plot, the report says why.
     bool finite = false;
     for (const IterationRecord& h : report.history) finite = finite || std::isfinite(h.cost);
     if (finite) {
         names.push_back(stem + "_convergence.png");
-        writeConvergencePlot(out.addFile(names.back()), report);
+        out.writeWith(names.back(), [&](const std::string& p) { writeConvergencePlot(p, report); });
     }
     std::vector<std::string> paths;
     for (const std::string& n : names) paths.push_back(out.getTargetPath(n));

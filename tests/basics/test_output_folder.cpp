@@ -142,3 +142,26 @@ TEST_F(OutputFolderTest, ADisabledFolderWritesNothing) {
     EXPECT_THROW(out.addFile("a.csv"), std::logic_error);
     EXPECT_NO_THROW(out.commit());
 }
+
+// A writer's error names the file where the user will look for it, not the hidden staging folder.
+TEST_F(OutputFolderTest, AWritersErrorNamesTheFinalPath) {
+    const fs::path target = root / "id";
+    OutputFolder out(target.string(), OutputFolder::Mode::AddFiles);
+    std::string staged;
+    try {
+        out.writeWith("plot.png", [&](const std::string& path) {
+            staged = path;
+            throw InputError(path + ": the plot could not be written");
+        });
+        ADD_FAILURE() << "no error";
+    } catch (const InputError& e) {
+        const std::string message = e.what();
+        EXPECT_NE(message.find((target / "plot.png").string() + ": the plot could not be written"), std::string::npos)
+            << message;
+        EXPECT_EQ(message.find(".partial"), std::string::npos) << message;
+    }
+    EXPECT_NE(staged.find(".partial"), std::string::npos) << staged;  // the writer did get the staging path
+    out.writeWith("ok.txt", [](const std::string& path) { writeFileAtomically(path, "x"); });
+    out.commit();
+    EXPECT_TRUE(fs::exists(target / "ok.txt"));
+}
