@@ -452,14 +452,8 @@ void runIdentificationStep(const MainJobContext& ctx) {
     // 2. Our own MVC data: five angles, the faithful model at the thesis protocol, the default subject.
     const FaithfulModelOptions ro = faithful.makeChoice().makeReferenceOptions();
     const FaithfulForceModel reference(setup.arm, ro);
-    ObservationSet angles;
-    const PathFromAngle pathFromAngle = makeArmPathFromAngle(setup.arm);
-    for (double deg : kThesisMvcAnglesDeg) {
-        Observation ob;
-        ob.angle = degToRad(deg);
-        ob.pathLength = pathFromAngle(ob.angle);
-        angles.points.push_back(ob);
-    }
+    const std::vector<double> anglesDeg(std::begin(kThesisMvcAnglesDeg), std::end(kThesisMvcAnglesDeg));
+    const ObservationSet angles = makeAnglePoints(anglesDeg, makeArmPathFromAngle(setup.arm));
     const std::vector<double> y = reference.calcForces(base, angles.points);
     Table mvc({"angle_deg", "force_N"});
     for (std::size_t k = 0; k < y.size(); ++k) mvc.appendRow({kThesisMvcAnglesDeg[k], y[k]});

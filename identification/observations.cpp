@@ -30,6 +30,17 @@ double calcThesisPathLength(double theta) {
     return calcBicepsPathLength(thesis.originDistance, thesis.insertionDistance, theta);
 }
 
+ObservationSet makeAnglePoints(const std::vector<double>& anglesDeg, const PathFromAngle& pathFromAngle) {
+    ObservationSet set;
+    for (double deg : anglesDeg) {
+        Observation o;
+        o.angle = degToRad(deg);
+        o.pathLength = pathFromAngle(o.angle);
+        set.points.push_back(o);
+    }
+    return set;
+}
+
 void validateObservations(const ObservationSet& set) {
     std::set<std::tuple<int, int, double, double>> seen;
     for (int i = 0; i < int(set.points.size()); ++i) {

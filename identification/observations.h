@@ -56,6 +56,10 @@ ObservationSet readObservations(const std::string& path, const ObservationOption
 /// The same from a table already in memory (columns as in the file); `source` names it in messages.
 ObservationSet makeObservations(const Table& table, const std::string& source, const ObservationOptions& options = {});
 
+/// Points without forces at the included elbow angles anglesDeg [deg] (path lengths from
+/// pathFromAngle, activation 1): the conditions a synthetic data set is computed at.
+ObservationSet makeAnglePoints(const std::vector<double>& anglesDeg, const PathFromAngle& pathFromAngle);
+
 /// Validates an in-memory set with the same rules as readObservations (InputError naming source,
 /// line or index, field and value).
 void validateObservations(const ObservationSet& set);

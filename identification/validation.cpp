@@ -1,8 +1,9 @@
 #include "identification/validation.h"
 
 #include "basics/bound.h"
-#include "basics/portable_random.h"
 #include "basics/csv.h"
+#include "basics/portable_random.h"
+#include "identification/forward_choice.h"
 #include "model/geometry.h"
 
 #include <fmt/format.h>
@@ -82,13 +83,7 @@ std::vector<ValidationRow> runValidation(const ArmParameters& arm, const MuscleP
     const FaithfulForceModel fast(arm, fastOptions);
     const SteadyForceModel steady;
 
-    ObservationSet clean;
-    for (double deg : settings.anglesDeg) {
-        Observation o;
-        o.angle = degToRad(deg);
-        o.pathLength = calcBicepsPathLength(arm.originDistance, arm.insertionDistance, o.angle);
-        clean.points.push_back(o);
-    }
+    const ObservationSet clean = makeAnglePoints(settings.anglesDeg, makeArmPathFromAngle(arm));
 
     const int total = int(truths.size() * settings.noiseLevels.size() * methods.size());
     int done = 0;

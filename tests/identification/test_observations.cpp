@@ -152,3 +152,13 @@ TEST(Unknowns, ParameterMapRoundTripsAndScalesToOrderOne) {
     u.start = 2.0;   // outside 0.05..1 kg
     EXPECT_THROW(ParameterMap(loadBiceps(), {u}), FieldError);
 }
+
+// Synthetic data sets start from these points: one per angle, in order, the path from the angle.
+TEST(Observations, AnglePointsCarryTheAngleAndItsPath) {
+    const ObservationSet s = makeAnglePoints({150, 90}, calcThesisPathLength);
+    ASSERT_EQ(s.points.size(), 2u);
+    EXPECT_EQ(s.points[0].angle, degToRad(150));
+    EXPECT_EQ(s.points[1].pathLength, calcThesisPathLength(degToRad(90)));
+    EXPECT_NEAR(s.points[1].pathLength, 0.3748, 1e-4);  // thesis 6.1.2: "37.5 cm" at 90 deg
+    EXPECT_EQ(s.points[0].activation, 1.0);
+}
