@@ -1,4 +1,5 @@
 // The files of a protocol run: tables, fits, plots, protocol.yaml and manifest.json (protocol_run.h).
+#include "basics/csv.h"
 #include "basics/plot.h"
 #include "experiments/protocol_run.h"
 
@@ -134,20 +135,20 @@ nlohmann::ordered_json fitJson(const PolynomialFit& f) {
     return j;
 }
 
+// One row per fit; a cell without a value (no peak, the EMG map's peak) is empty, as in every CSV.
 std::string fitsCsv(const std::map<std::string, QuadraticFit>& quadratic, const std::optional<PolynomialFit>& map) {
-    std::string s = "fit,c0,c1,c2,r_squared,rms_residual,points,peak_x,peak_y\n";
-    auto num = [](double v) { return std::isnan(v) ? std::string("NaN") : fmt::format("{:.10g}", v); };
-    for (const auto& [name, q] : quadratic) {
-        const auto& c = q.fit.coefficients;
-        s += name + "," + num(c[0]) + "," + num(c[1]) + "," + num(c[2]) + "," + num(q.fit.rSquared) + "," +
-             num(q.fit.rmsResidual) + "," + std::to_string(q.fit.points) + "," + num(q.peakX) + "," + num(q.peakY) + "\n";
-    }
-    if (map) {
-        const auto& c = map->coefficients;
-        s += "emg_to_activation," + num(c[0]) + "," + num(c[1]) + "," + num(c[2]) + "," + num(map->rSquared) + "," +
-             num(map->rmsResidual) + "," + std::to_string(map->points) + ",NaN,NaN\n";
-    }
-    return s;
+    CsvText csv({"fit", "c0", "c1", "c2", "r_squared", "rms_residual", "points", "peak_x", "peak_y"});
+    auto fitRow = [](const std::string& name, const PolynomialFit& f) {
+        CsvRow row;
+        row.addText(name);
+        for (std::size_t k = 0; k < 3; ++k) row.addNumber(k < f.coefficients.size() ? f.coefficients[k] : NAN, kCsvDigits);
+        row.addNumber(f.rSquared, kCsvDigits).addNumber(f.rmsResidual, kCsvDigits).addInteger(f.points);
+        return row;
+    };
+    for (const auto& [name, q] : quadratic)
+        csv.addRow(fitRow(name, q.fit).addNumber(q.peakX, kCsvDigits).addNumber(q.peakY, kCsvDigits));
+    if (map) csv.addRow(fitRow("emg_to_activation", *map).addEmpty().addEmpty());
+    return csv.getText();
 }
 
 nlohmann::ordered_json protocolJson(const Protocol& p) {

@@ -1,6 +1,7 @@
 // Experiment protocols: the shipped files, malformed files, determinism (seed, threads), agreement
 // of the summary tables with the per-trial files, %MVC resolution and EMG normalisation, the
 // composition grid, and runs that fail without leaving output behind.
+#include "basics/csv.h"
 #include "basics/errors.h"
 #include "basics/files.h"
 #include "experiments/data_files.h"
@@ -255,6 +256,23 @@ TEST(ProtocolRun, SummaryTablesAgreeWithThePerTrialFiles) {
     constexpr double kPeakTol = 1e-6;  // deg and N: fit of 10-digit file values vs full precision
     EXPECT_NEAR(r.quadraticFits.at("muscle_force").peakX, q.peakX, kPeakTol);
     EXPECT_NEAR(r.quadraticFits.at("muscle_force").peakY, q.peakY, kPeakTol);
+    // fits.csv holds the result's fits (10 digits).
+    std::istringstream fits(readText(d / "run" / "fits.csv"));
+    std::string line;
+    std::getline(fits, line);
+    EXPECT_EQ(splitCsvRecord(line), std::vector<std::string>({"fit", "c0", "c1", "c2", "r_squared", "rms_residual",
+                                                              "points", "peak_x", "peak_y"}));
+    int rows = 0;
+    while (std::getline(fits, line)) {
+        const std::vector<std::string> cells = splitCsvRecord(line);
+        ASSERT_EQ(cells.size(), 9u) << line;
+        const QuadraticFit& f = r.quadraticFits.at(cells[0]);
+        for (int k = 0; k < 3; ++k) EXPECT_TRUE(near(std::stod(cells[1 + k]), f.fit.coefficients[k])) << line;
+        EXPECT_EQ(std::stoi(cells[6]), f.fit.points);
+        EXPECT_TRUE(near(std::stod(cells[8]), f.peakY)) << line;
+        ++rows;
+    }
+    EXPECT_EQ(rows, int(r.quadraticFits.size()));
     fs::remove_all(d);
 }
 
