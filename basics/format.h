@@ -17,6 +17,10 @@ inline std::string formatNumber(double v) {
     return std::string(buf, r.ptr);
 }
 
+/// v with `significantDigits` (1..17) significant digits in printf's %g form ("0.33599", "1e-05",
+/// "inf"): numbers in descriptions and progress messages, where the round-trip form would be noise.
+std::string formatNumber(double v, int significantDigits);
+
 /// Numbers as a comma-separated list in formatNumber's form ("15,30,45"), as list options take them.
 inline std::string formatList(const std::vector<double>& values) {
     std::string s;

@@ -2,6 +2,7 @@
 
 #include "basics/angles.h"
 #include "basics/bound.h"
+#include "basics/format.h"
 
 #include <algorithm>
 #include <cmath>
@@ -63,13 +64,6 @@ void checkDesign(int order, double f, const char* field, double fs) {
     checkField("sampleRate", fs, Bound::positive("Hz"));
     checkField("order", order, Bound::closed(1, 20));
     checkField(field, f, Bound::open(0, fs / 2, "Hz"));
-}
-
-std::string formatNumber(double v) {
-    std::ostringstream s;
-    s.precision(10);
-    s << v;
-    return s.str();
 }
 
 }  // namespace
@@ -265,9 +259,9 @@ std::size_t decimationFactor(double inputRate, double outputRate) {
     const double ratio = inputRate / outputRate;
     const double m = std::round(ratio);
     if (m < 1 || std::abs(ratio - m) > 1e-9 * ratio)
-        throw FieldError("inputRate", "= " + formatNumber(inputRate) +
+        throw FieldError("inputRate", "= " + formatNumber(inputRate, 10) +
                                           ": expected an integer multiple of outputRate = " +
-                                          formatNumber(outputRate) + " (Hz)");
+                                          formatNumber(outputRate, 10) + " (Hz)");
     return std::size_t(m);
 }
 }  // namespace

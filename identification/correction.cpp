@@ -1,6 +1,7 @@
 // Output correction: identification with a cheap model shifted by an expensive model's offset
 // (identifier.h, identifyCorrected).
 #include "basics/bound.h"
+#include "basics/format.h"
 #include "identification/identifier.h"
 
 #include <chrono>
@@ -29,13 +30,6 @@ private:
     const ForceModel& base_;
     std::vector<double> offset_;
 };
-
-std::string fmt(double v) {
-    std::ostringstream s;
-    s.precision(6);
-    s << v;
-    return s.str();
-}
 
 }  // namespace
 
@@ -129,7 +123,7 @@ IdentificationReport identifyCorrected(const IdentificationProblem& problem, con
         if (!settled) {
             report.stopReason = StopReason::MaxIterations;
             report.message = "corrections did not settle within " + std::to_string(correction.maxCorrections) +
-                             " (tolerance " + fmt(tolerance) + " of the scale); " + counts +
+                             " (tolerance " + formatNumber(tolerance, 6) + " of the scale); " + counts +
                              "; last inner run: " + report.message;
         } else {
             report.message = counts + " settled; last inner run: " + report.message;

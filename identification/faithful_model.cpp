@@ -1,6 +1,7 @@
 #include "identification/faithful_model.h"
 
 #include "basics/bound.h"
+#include "basics/format.h"
 #include "model/geometry.h"
 #include "model/trial.h"
 
@@ -19,13 +20,6 @@ constexpr double kCosineSlack = 1e-12;    // rounding slack of the law of cosine
 
 constexpr std::pair<ForceEstimate, const char*> kEstimates[] = {
     {ForceEstimate::MomentArm, "moment-arm"}, {ForceEstimate::FixedRatio, "fixed-ratio"}, {ForceEstimate::TrueForce, "true"}};
-
-std::string fmt(double v) {
-    std::ostringstream s;
-    s.precision(8);
-    s << v;
-    return s.str();
-}
 
 }  // namespace
 
@@ -83,8 +77,8 @@ std::vector<double> FaithfulForceModel::calcElbowAngles(const ObservationSet& se
     const double A = arm_.originDistance, B = arm_.insertionDistance;
     const double lo = arm_.minElbowAngleDeg, hi = arm_.maxElbowAngleDeg;
     const double pLo = calcBicepsPathLength(A, B, degToRad(lo)), pHi = calcBicepsPathLength(A, B, degToRad(hi));
-    const std::string range = "the arm's elbow range " + fmt(lo) + ".." + fmt(hi) + " deg (paths " + fmt(pLo) + ".." +
-                              fmt(pHi) + " m for A = " + fmt(A) + " m, B = " + fmt(B) + " m)";
+    const std::string range = "the arm's elbow range " + formatNumber(lo, 8) + ".." + formatNumber(hi, 8) + " deg (paths " + formatNumber(pLo, 8) + ".." +
+                              formatNumber(pHi, 8) + " m for A = " + formatNumber(A, 8) + " m, B = " + formatNumber(B, 8) + " m)";
     std::vector<double> angles;
     for (int i = 0; i < int(set.points.size()); ++i) {
         const Observation& o = set.points[i];
@@ -92,8 +86,8 @@ std::vector<double> FaithfulForceModel::calcElbowAngles(const ObservationSet& se
         if (std::isfinite(theta)) {
             const double p = calcBicepsPathLength(A, B, theta);
             if (!(std::abs(p - o.pathLength) <= kPathMatchTol))
-                throw InputError(set.where(i) + ": angle " + fmt(radToDeg(theta)) + " deg with path " +
-                                 fmt(o.pathLength) + " m, but the arm's geometry gives " + fmt(p) +
+                throw InputError(set.where(i) + ": angle " + formatNumber(radToDeg(theta), 8) + " deg with path " +
+                                 formatNumber(o.pathLength, 8) + " m, but the arm's geometry gives " + formatNumber(p, 8) +
                                  " m there: expected the path of the arm's biceps (convert angles with "
                                  "the arm's A and B)");
         } else {
@@ -101,8 +95,8 @@ std::vector<double> FaithfulForceModel::calcElbowAngles(const ObservationSet& se
         }
         const double deg = radToDeg(theta);
         if (!(deg >= lo - kAngleRangeTol && deg <= hi + kAngleRangeTol))
-            throw InputError(set.where(i) + ": path " + fmt(o.pathLength) + " m" +
-                             (std::isfinite(theta) ? " (elbow angle " + fmt(deg) + " deg)" : "") +
+            throw InputError(set.where(i) + ": path " + formatNumber(o.pathLength, 8) + " m" +
+                             (std::isfinite(theta) ? " (elbow angle " + formatNumber(deg, 8) + " deg)" : "") +
                              " is outside " + range + ": expected a path the arm can take");
         angles.push_back(std::clamp(theta, degToRad(lo), degToRad(hi)));
     }
@@ -148,9 +142,9 @@ std::vector<double> FaithfulForceModel::calcForces(const MuscleParameters& param
 
 std::string FaithfulForceModel::describe() const {
     const FaithfulProtocol& p = options_.protocol;
-    return "faithful model (" + getForceEstimateName(options_.estimate) + " estimate, " + fmt(p.holdDuration) +
-           " s hold, mean of the last " + fmt(p.averagingWindow) + " s, " + fmt(p.sampleRate) + " Hz, accuracy " +
-           fmt(p.accuracy) + ")";
+    return "faithful model (" + getForceEstimateName(options_.estimate) + " estimate, " + formatNumber(p.holdDuration, 8) +
+           " s hold, mean of the last " + formatNumber(p.averagingWindow, 8) + " s, " + formatNumber(p.sampleRate, 8) + " Hz, accuracy " +
+           formatNumber(p.accuracy, 8) + ")";
 }
 
 }  // namespace armsim

@@ -1,4 +1,5 @@
 // Regula falsi with the Illinois modification for one unknown (thesis 4.5.1, eq. 4.33).
+#include "basics/format.h"
 #include "identification/solver_context.h"
 
 #include <cmath>
@@ -7,12 +8,6 @@
 namespace armsim::detail {
 
 namespace {
-std::string fmt(double v) {
-    std::ostringstream s;
-    s.precision(8);
-    s << v;
-    return s.str();
-}
 }  // namespace
 
 SolverOutcome solveFalsePosition(SolverContext& ctx) {
@@ -26,7 +21,7 @@ SolverOutcome solveFalsePosition(SolverContext& ctx) {
     const bool okB = ctx.calcResiduals({b}, rb);
     if (!okA || !okB) {
         out.x = {okA ? b : a};
-        out.message = "false-position needs the model at both ends of the bracket [" + fmt(a) + ", " + fmt(b) + "]" +
+        out.message = "false-position needs the model at both ends of the bracket [" + formatNumber(a, 8) + ", " + formatNumber(b, 8) + "]" +
                       unit + ": " + (okA ? ctx.getLastFailure() : failA);
         return out;
     }
@@ -42,8 +37,8 @@ SolverOutcome solveFalsePosition(SolverContext& ctx) {
     if ((fa > 0) == (fb > 0)) {
         out.x = {std::abs(fa) < std::abs(fb) ? a : b};
         out.r = std::abs(fa) < std::abs(fb) ? ra : rb;
-        out.message = "no sign change of model - measured force on the bracket [" + fmt(a) + ", " + fmt(b) + "]" +
-                      unit + " (" + fmt(fa) + " N, " + fmt(fb) + " N): the measured force is " +
+        out.message = "no sign change of model - measured force on the bracket [" + formatNumber(a, 8) + ", " + formatNumber(b, 8) + "]" +
+                      unit + " (" + formatNumber(fa, 8) + " N, " + formatNumber(fb, 8) + " N): the measured force is " +
                       (fa > 0 ? "below" : "above") +
                       " the model's at both ends, or the bracket holds two roots; change the bounds";
         return out;
@@ -76,7 +71,7 @@ SolverOutcome solveFalsePosition(SolverContext& ctx) {
             out.x = {c};
             out.r = rc;
             out.reason = StopReason::Converged;
-            out.message = "bracket narrower than the tolerance " + fmt(u.tolerance) + unit + " after " +
+            out.message = "bracket narrower than the tolerance " + formatNumber(u.tolerance, 8) + unit + " after " +
                           std::to_string(it) + " iterations";
             return out;
         }
@@ -84,7 +79,7 @@ SolverOutcome solveFalsePosition(SolverContext& ctx) {
     out.x = {c};
     out.r = rc;
     out.reason = StopReason::MaxIterations;
-    out.message = "bracket still " + fmt(std::abs(b - a)) + unit + " wide after " +
+    out.message = "bracket still " + formatNumber(std::abs(b - a), 8) + unit + " wide after " +
                   std::to_string(ctx.options.maxIterations) + " iterations";
     return out;
 }

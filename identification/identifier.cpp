@@ -1,6 +1,7 @@
 #include "identification/identifier.h"
 
 #include "basics/bound.h"
+#include "basics/format.h"
 #include "identification/solver_context.h"
 
 #include <algorithm>
@@ -20,13 +21,6 @@ constexpr std::pair<Method, const char*> kMethods[] = {
     {Method::LevenbergMarquardt, "lm"}};
 
 constexpr std::size_t kCacheSize = 64;
-
-std::string fmt(double v) {
-    std::ostringstream s;
-    s.precision(8);
-    s << v;
-    return s.str();
-}
 
 void validateOptions(const IdentificationOptions& o) {
     checkField("options.max_iterations", o.maxIterations, Bound::closed(1, 1e7));
@@ -130,8 +124,8 @@ bool SolverContext::calcResiduals(const std::vector<double>& x, std::vector<doub
             if (!std::isfinite(y[k]) && entry.ok) {
                 entry.ok = false;
                 entry.failure = "the " + model.getName() + " model has no solution at path " +
-                                fmt(observations[k].pathLength) + " m, activation " +
-                                fmt(observations[k].activation) + " for " + describe(x);
+                                formatNumber(observations[k].pathLength, 8) + " m, activation " +
+                                formatNumber(observations[k].activation, 8) + " for " + describe(x);
             }
         }
     } catch (const InterruptedError&) {
@@ -167,7 +161,7 @@ std::vector<IterationRecord> SolverContext::takeHistory() {
 std::string SolverContext::describe(const std::vector<double>& x) const {
     std::string s;
     for (int j = 0; j < map.size() && j < int(x.size()); ++j)
-        s += (j ? ", " : "") + getParameterName(map.getUnknowns()[j].id) + " = " + fmt(x[j]) + " " +
+        s += (j ? ", " : "") + getParameterName(map.getUnknowns()[j].id) + " = " + formatNumber(x[j], 8) + " " +
              getParameterUnit(map.getUnknowns()[j].id);
     return s;
 }
@@ -206,17 +200,17 @@ IdentificationReport identify(const IdentificationProblem& problem, const ForceM
     const auto pmax = std::find_if(unknowns.begin(), unknowns.end(),
                                    [](const Unknown& u) { return u.id == ParameterId::MaxPathLength; });
     if (pmax == unknowns.end() && maxPath > problem.base.maxPathLength)
-        throw InputError(data.where(maxPathIndex) + ": path " + fmt(maxPath) + " m exceeds max_path_length = " +
-                         fmt(problem.base.maxPathLength) + " m of muscle '" + problem.base.name +
+        throw InputError(data.where(maxPathIndex) + ": path " + formatNumber(maxPath, 8) + " m exceeds max_path_length = " +
+                         formatNumber(problem.base.maxPathLength, 8) + " m of muscle '" + problem.base.name +
                          "': expected paths no longer than the anatomical limit");
     if (pmax != unknowns.end() && pmax->lower < maxPath)
-        throw InputError("unknowns.max_path_length.lower = " + fmt(pmax->lower) + " m: expected >= the longest path " +
-                         fmt(maxPath) + " m (" + data.where(maxPathIndex) + ")");
+        throw InputError("unknowns.max_path_length.lower = " + formatNumber(pmax->lower, 8) + " m: expected >= the longest path " +
+                         formatNumber(maxPath, 8) + " m (" + data.where(maxPathIndex) + ")");
 
     if (options.method == Method::LevenbergMarquardt && options.noise == NoiseModel::Relative)
         for (int k = 0; k < n; ++k)
             if (!(data.points[k].force > 0))
-                throw InputError(data.where(k) + ": force_N = " + fmt(data.points[k].force) +
+                throw InputError(data.where(k) + ": force_N = " + formatNumber(data.points[k].force, 8) +
                                  ": expected > 0 for the relative noise model (residuals are divided by it)");
     const int distinct = data.countDistinctPoints();
     std::string names;
@@ -307,14 +301,14 @@ IdentificationReport identify(const IdentificationProblem& problem, const ForceM
             e.ciUpper = e.value + report.intervalQuantile * e.standardError;
         }
         if (e.atBound)
-            atBound += (atBound.empty() ? "" : "; ") + e.name + " = " + fmt(e.value) + " " + e.unit + " at its " +
-                       (low ? "lower" : "upper") + " bound " + fmt(low ? u.lower : u.upper) + " " + e.unit;
+            atBound += (atBound.empty() ? "" : "; ") + e.name + " = " + formatNumber(e.value, 8) + " " + e.unit + " at its " +
+                       (low ? "lower" : "upper") + " bound " + formatNumber(low ? u.lower : u.upper, 8) + " " + e.unit;
     }
     if (!atBound.empty()) {
         if (!ctx.isReproduced(out.r) && report.stopReason != StopReason::NotConverged) {
             report.stopReason = StopReason::BoundHit;
             report.message = atBound + ": the data ask for a value outside the bounds (forces not reproduced, rms " +
-                             fmt(report.rmsResidual) + " N); " + report.message;
+                             formatNumber(report.rmsResidual, 8) + " N); " + report.message;
         } else {
             report.message += " (note: " + atBound + ")";
         }

@@ -1,5 +1,6 @@
 // Iterative learning identification (thesis 4.6, 7.1, 7.2): x_{i+1} = x_i + G_i (y_d - y_i).
 // How G_i is built for each variant is documented in identifier.h.
+#include "basics/format.h"
 #include "identification/solver_context.h"
 
 #include <Eigen/Dense>
@@ -15,13 +16,6 @@ namespace {
 
 using Eigen::MatrixXd;
 using Eigen::VectorXd;
-
-std::string fmt(double v) {
-    std::ostringstream s;
-    s.precision(8);
-    s << v;
-    return s.str();
-}
 
 VectorXd toEigen(const std::vector<double>& v) { return Eigen::Map<const VectorXd>(v.data(), Eigen::Index(v.size())); }
 std::vector<double> toStd(const VectorXd& v) { return {v.data(), v.data() + v.size()}; }
@@ -51,7 +45,7 @@ public:
     bool done(int it) {
         out_.iterations = it;
         if (!ctx_.isReproduced(r_)) return false;
-        finish(StopReason::Converged, "every force within " + fmt(ctx_.options.forceTolerance) + " N after " +
+        finish(StopReason::Converged, "every force within " + formatNumber(ctx_.options.forceTolerance, 8) + " N after " +
                                           std::to_string(it) + " iterations");
         return true;
     }
@@ -75,7 +69,7 @@ public:
         }
         if (!std::isfinite(cost_) || cost_ > 1e6 * (1.0 + startCost_)) {
             out_.iterations = it;
-            finish(StopReason::NotConverged, "diverging: cost " + fmt(cost_) + " N^2");
+            finish(StopReason::NotConverged, "diverging: cost " + formatNumber(cost_, 8) + " N^2");
             return false;
         }
         return true;
@@ -93,7 +87,7 @@ public:
     SolverOutcome outcome(int maxIterations) {
         if (out_.x.empty()) {
             out_.iterations = maxIterations;
-            finish(StopReason::MaxIterations, "forces not reproduced within " + fmt(ctx_.options.forceTolerance) +
+            finish(StopReason::MaxIterations, "forces not reproduced within " + formatNumber(ctx_.options.forceTolerance, 8) +
                                                   " N after " + std::to_string(maxIterations) + " iterations");
         }
         return out_;
@@ -261,7 +255,7 @@ SolverOutcome solveSignSearch(SolverContext& ctx) {
         if (bestX.empty()) {
             lambdaNow *= 0.5;
             if (lambdaNow < 1e-10 * lambda) {
-                L.stop(it, StopReason::NoProgress, "no sign combination descends even with the step shrunk to " + fmt(lambdaNow) +
+                L.stop(it, StopReason::NoProgress, "no sign combination descends even with the step shrunk to " + formatNumber(lambdaNow, 8) +
                               " lambda; forces not reproduced" +
                               (ctx.getLastFailure().empty() ? "" : " (last model failure: " + ctx.getLastFailure() + ")"));
                 return L.outcome(0);

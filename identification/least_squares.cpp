@@ -1,4 +1,5 @@
 // Bounded Levenberg-Marquardt (Ceres) with covariance-based intervals and seeded multi-start.
+#include "basics/format.h"
 #include "basics/portable_random.h"
 #include "identification/solver_context.h"
 #include "identification/statistics.h"
@@ -36,13 +37,6 @@ double calcWeightedCost(const std::vector<double>& r, const std::vector<double>&
     double c = 0;
     for (std::size_t k = 0; k < r.size(); ++k) c += (w[k] * r[k]) * (w[k] * r[k]);
     return 0.5 * c;
-}
-
-std::string fmt(double v) {
-    std::ostringstream s;
-    s.precision(8);
-    s << v;
-    return s.str();
 }
 
 /// r(z) = model(x = z * scale) - measured, with the Jacobian from central differences.
@@ -184,7 +178,7 @@ void addUncertainty(SolverContext& ctx, Run& run, const std::vector<double>& r, 
         report.residualSd = givenSd;
         report.intervalQuantile = calcNormalQuantile(0.5 + 0.5 * o.confidenceLevel);
         report.uncertaintyNote = "covariance (J^T J)^-1 sd^2 with the given " + getNoiseModelName(o.noise) +
-                                 " force sd " + fmt(givenSd) + unit + "; normal quantile";
+                                 " force sd " + formatNumber(givenSd, 8) + unit + "; normal quantile";
     } else if (n > p) {
         variance = 2.0 * calcWeightedCost(r, calcWeights(ctx)) / (n - p);
         report.residualSd = std::sqrt(variance);
@@ -266,8 +260,8 @@ SolverOutcome solveLeastSquares(SolverContext& ctx, IdentificationReport& report
     }
     if (out.reason == StopReason::Converged && n == p && !ctx.isReproduced(out.r))
         out.reason = StopReason::NotConverged, out.message =
-            "least-squares minimum with forces not reproduced within " + fmt(ctx.options.forceTolerance) +
-            " N (rms " + fmt(std::sqrt(2.0 * calcCost(out.r) / n)) +
+            "least-squares minimum with forces not reproduced within " + formatNumber(ctx.options.forceTolerance, 8) +
+            " N (rms " + formatNumber(std::sqrt(2.0 * calcCost(out.r) / n), 8) +
             " N) although there are as many observations as unknowns: the model cannot produce these "
             "forces, or this is a local minimum (try more starts); " + out.message;
     addUncertainty(ctx, best, out.r, report);
