@@ -9,14 +9,28 @@
 
 namespace armsim {
 
+namespace {
+thread_local FileReadRecorder* tInnermostRecorder = nullptr;
+}
+
 bool doesPathExist(const std::string& path) {
     std::error_code ec;
-    return std::filesystem::exists(path, ec) && !ec;
+    const bool exists = std::filesystem::exists(path, ec) && !ec;
+    for (FileReadRecorder* r = tInnermostRecorder; r; r = r->outer_) r->files_.push_back({path, exists, false, {}});
+    return exists;
 }
 
 bool isRegularFile(const std::string& path) {
     std::error_code ec;
     return std::filesystem::is_regular_file(path, ec) && !ec;
+}
+
+void createFolder(const std::string& path) {
+    std::error_code ec;
+    std::filesystem::create_directories(path, ec);
+    if (ec || !std::filesystem::is_directory(path, ec))
+        throw InputError(path + ": cannot create the folder (" + (ec ? ec.message() : std::string("a file is in the way")) +
+                         ")");
 }
 
 void checkInputFile(const std::string& path, std::uintmax_t maxBytes) {
@@ -29,13 +43,19 @@ void checkInputFile(const std::string& path, std::uintmax_t maxBytes) {
                          " for this kind of file");
 }
 
-namespace {
-thread_local FileReadRecorder* tInnermostRecorder = nullptr;
-}
-
 FileReadRecorder::FileReadRecorder() : outer_(tInnermostRecorder) { tInnermostRecorder = this; }
 
-FileReadRecorder::~FileReadRecorder() { tInnermostRecorder = outer_; }
+FileReadRecorder::~FileReadRecorder() {  // unlinks itself, also when recorders end out of order
+    if (tInnermostRecorder == this) {
+        tInnermostRecorder = outer_;
+        return;
+    }
+    for (FileReadRecorder* r = tInnermostRecorder; r; r = r->outer_)
+        if (r->outer_ == this) {
+            r->outer_ = outer_;
+            return;
+        }
+}
 
 std::string readFileText(const std::string& path) {
     checkInputFile(path, 64 << 20);
@@ -44,12 +64,16 @@ std::string readFileText(const std::string& path) {
     std::stringstream buf;
     buf << in.rdbuf();
     std::string text = buf.str();
-    for (FileReadRecorder* r = tInnermostRecorder; r; r = r->outer_) r->files_.push_back({path, text});
+    for (FileReadRecorder* r = tInnermostRecorder; r; r = r->outer_) r->files_.push_back({path, true, true, text});
     return text;
 }
 
 bool areFilesUnchanged(const std::vector<FileSnapshot>& files) {
     for (const FileSnapshot& f : files) {
+        if (!f.read) {
+            if (doesPathExist(f.path) != f.exists) return false;
+            continue;
+        }
         try {
             if (readFileText(f.path) != f.text) return false;
         } catch (const InputError&) {

@@ -13,21 +13,28 @@ bool doesPathExist(const std::string& path);
 /// Whether path is a regular file (or a link to one); false also when it cannot be looked up.
 bool isRegularFile(const std::string& path);
 
+/// Creates the folder and its parents (nothing when it exists). InputError naming the path and the
+/// reason when it cannot (a file in the way, no permission, a name too long).
+void createFolder(const std::string& path);
+
 /// The whole file as bytes. Throws InputError naming the path when it cannot be read.
 std::string readFileText(const std::string& path);
 /// InputError unless `path` (when it exists) is a regular file of at most maxBytes (a folder, a device
 /// such as /dev/zero or a pipe would make a reader block or grow without bound).
 void checkInputFile(const std::string& path, std::uintmax_t maxBytes);
 
-/// One file as readFileText read it.
+/// One file as readFileText read it, or a lookup as doesPathExist answered it.
 struct FileSnapshot {
-    std::string path;  ///< as given to readFileText
-    std::string text;  ///< its bytes then
+    std::string path;     ///< as given
+    bool exists = true;   ///< a lookup's answer (true for a read)
+    bool read = true;     ///< a read (text holds the bytes) or only a lookup
+    std::string text;     ///< the bytes read
 };
 
-/// While alive, records every file readFileText reads on this thread (nested recorders all see each
-/// read), so that a result derived from files can be reused while none of them has changed (the model
-/// cache of loadModel). Not copyable: it registers itself for its thread.
+/// While alive, records every file readFileText reads and every doesPathExist lookup on this thread
+/// (nested recorders all see each), so that a result derived from files can be reused while none of
+/// them has changed and no file it looked for has appeared or gone (the model cache of loadModel).
+/// Not copyable: it registers itself for its thread.
 class FileReadRecorder {
 public:
     FileReadRecorder();
@@ -41,11 +48,13 @@ public:
 
 private:
     friend std::string readFileText(const std::string& path);
+    friend bool doesPathExist(const std::string& path);
     std::vector<FileSnapshot> files_;
     FileReadRecorder* outer_;
 };
 
-/// true when every file still reads as in its snapshot (false when one is missing or unreadable).
+/// true when every file still reads as in its snapshot (false when one is missing or unreadable) and
+/// every lookup gives the same answer.
 bool areFilesUnchanged(const std::vector<FileSnapshot>& files);
 
 /// Writes text to path atomically: to a temporary beside it, then rename. Throws InputError naming

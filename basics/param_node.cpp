@@ -39,6 +39,8 @@ void checkKeysAndSize(const YAML::Node& n, const std::string& source, int depth,
                          " values (with aliases expanded): expected a parameter file");
     if (n.IsMap()) {
         for (auto it = n.begin(); it != n.end(); ++it) {
+            if (it->first.IsNull())
+                throw InputError(where(it->first) + ": an empty key ('~', 'null' or a bare '?'): expected a name");
             if (!it->first.IsScalar())
                 throw InputError(where(it->first) +
                                  ": a key that is a list or mapping ('? ...' or '[...]: ...'): expected a name");

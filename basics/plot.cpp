@@ -52,7 +52,7 @@ std::string beginPng(const std::string& path) {
 void finishPng(const std::string& tmp, const std::string& path) {
     namespace fs = std::filesystem;
     std::error_code ec;
-    if (!fs::exists(tmp) || fs::file_size(tmp, ec) == 0) {
+    if (!fs::exists(tmp, ec) || fs::file_size(tmp, ec) == 0) {
         fs::remove(tmp, ec);
         throw InputError(path + ": the plot could not be written (PLplot pngcairo driver failed)");
     }

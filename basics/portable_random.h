@@ -24,8 +24,9 @@ public:
         std::seed_seq seq(seeds);
         rng_.seed(seq);
     }
-    /// Seeded with one 64-bit word (e.g. a splitmix of a trial's seed).
-    explicit PortableRandom(std::uint64_t seed) : rng_(seed) {}
+    /// Seeded with one 64-bit word directly (e.g. a splitmix of a trial's seed). A named constructor:
+    /// PortableRandom{seed} would take the seed_seq constructor and give another stream.
+    static PortableRandom fromSeed(std::uint64_t seed) { return PortableRandom(seed, 0); }
     /// Uniform in [0, 1), 53 random bits.
     double drawUniform() { return double(rng_() >> 11) * 0x1.0p-53; }
     /// Uniform in [lo, hi).
@@ -51,6 +52,7 @@ public:
     }
 
 private:
+    PortableRandom(std::uint64_t seed, int) : rng_(seed) {}
     std::mt19937_64 rng_;
 };
 

@@ -418,7 +418,7 @@ void runIdentificationStep(const MainJobContext& ctx) {
     ModelOptions steadyOnly = faithful;
     steadyOnly.model = "steady";
     const std::string dir = ctx.outDir + "/identification";
-    std::filesystem::create_directories(dir);
+    createFolder(dir);
     auto problemFor = [&](const ObservationSet& data) {
         IdentificationProblem pr;
         pr.base = base;

@@ -1,6 +1,7 @@
 // armsim protocol: runs an experiment protocol file (assets/protocols/*.yaml); and the thesis MVC
 // protocol as a main-job step.
 #include "basics/errors.h"
+#include "basics/files.h"
 #include "basics/parallel.h"
 #include "basics/table.h"
 #include "cli/commands.h"
@@ -41,7 +42,7 @@ void renderProtocolVideos(const ProtocolOptions& o, const ArmSetup& subject, con
         return;
     }
     const RenderPlugin& render = getRenderPlugin("--video");
-    std::filesystem::create_directories(out + "/videos");
+    createFolder(out + "/videos");
     runParallel(
         n, o.jobs,
         [&](int i) {

@@ -157,7 +157,7 @@ MvcCurveSummary summarizeMvcCurve(const SteadyMvcCurve& curve) {
 ModelReportFiles writeModelReport(const ArmSetup& setup, const std::string& outDir, double stepDeg,
                                   const ElbowReference& reference) {
     namespace fs = std::filesystem;
-    fs::create_directories(outDir);
+    createFolder(outDir);
     ModelReportFiles out;
     auto path = [&](const std::string& f) { return (fs::path(outDir) / f).string(); };
 

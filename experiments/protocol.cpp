@@ -106,7 +106,7 @@ ArmTrialOutcome runArmTrial(const ArmTrialPlan& plan, const Protocol& protocol, 
     // The subject's effort: agonists at the planned drive times the voluntary activation, antagonists
     // co-contracting; both vary from trial to trial (seeded) and fade with fatigue over repetitions.
     const SubjectEffort& e = subject.effort;
-    PortableRandom effortRng(splitMix(plan.seed ^ 0xE1F0E1F0ULL));
+    auto effortRng = PortableRandom::fromSeed(splitMix(plan.seed ^ 0xE1F0E1F0ULL));
     const double variation = 1 + e.trialCv * effortRng.drawNormal();
     const double antagonistVariation = 1 + e.trialCv * effortRng.drawNormal();
     const double fatigue = std::pow(1 - e.fatigue, plan.repetition - 1);
@@ -119,7 +119,8 @@ ArmTrialOutcome runArmTrial(const ArmTrialPlan& plan, const Protocol& protocol, 
     const double h = r.summary.momentArm;
 
     // Transducer noise: every reading and the estimates derived from it.
-    PortableRandom noiseRng(splitMix(plan.seed ^ 0x5A5A5A5AULL)), emgRng(splitMix(plan.seed));
+    auto noiseRng = PortableRandom::fromSeed(splitMix(plan.seed ^ 0x5A5A5A5AULL));
+    auto emgRng = PortableRandom::fromSeed(splitMix(plan.seed));
     const int cForce = t.findColumn("muscle_force_N"), cStrap = t.findColumn("strap_force_N"),
               cSat = t.findColumn("saturated"), cByArm = t.findColumn("force_moment_arm_N"),
               cByRatio = t.findColumn("force_fixed_ratio_N"), cErrArm = t.findColumn("error_moment_arm_pct"),
@@ -329,7 +330,7 @@ void planArmTrials(const Protocol& protocol, ProtocolRun& run, std::vector<int>&
                 run.plans.push_back(p);
             }
     for (const auto& p : run.plans) (p.level == 1.0 ? phase1 : phase2).push_back(p.index);
-    PortableRandom orderRng(splitMix(protocol.seed ^ 0x0DDBA11ULL));
+    auto orderRng = PortableRandom::fromSeed(splitMix(protocol.seed ^ 0x0DDBA11ULL));
     if (protocol.randomOrder) {
         orderRng.shuffle(phase1);
         orderRng.shuffle(phase2);

@@ -220,7 +220,7 @@ void addUncertainty(SolverContext& ctx, Run& run, const std::vector<double>& r, 
 
 SolverOutcome solveLeastSquares(SolverContext& ctx, IdentificationReport& report) {
     const int p = ctx.getNumUnknowns(), n = ctx.getNumObservations();
-    PortableRandom rng(std::uint64_t{ctx.options.seed});
+    auto rng = PortableRandom::fromSeed(ctx.options.seed);
     const std::vector<double> lo = ctx.map.getLower(), hi = ctx.map.getUpper();
     Run best;
     int iterations = 0;

@@ -66,7 +66,7 @@ std::vector<ValidationRow> runValidation(const ArmParameters& arm, const MuscleP
     const std::vector<Method> methods = settings.methods.empty() ? getValidationMethods() : settings.methods;
 
     std::vector<Truth> truths = {{"thesis", kThesisMass, kThesisTendonLength}};
-    PortableRandom rng(std::uint64_t{settings.seed});
+    auto rng = PortableRandom::fromSeed(settings.seed);
     for (int s = 0; s < settings.seeds; ++s) {
         const double m = rng.drawUniform(kValidationMassLow, kValidationMassHigh);
         const double t = rng.drawUniform(kValidationTendonLow, kValidationTendonHigh);

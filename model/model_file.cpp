@@ -213,6 +213,7 @@ std::vector<std::string> listModels() {
 namespace {
 ArmSetup loadModelFile(const std::string& file);
 constexpr std::size_t kModelCacheSize = 32;  ///< distinct model files kept (then the cache starts over)
+constexpr std::size_t kModelCacheBytes = 4 << 20;  ///< a model whose files hold more is not kept
 }  // namespace
 
 ArmSetup loadModel(const std::string& nameOrFile) {
@@ -233,7 +234,8 @@ ArmSetup loadModel(const std::string& nameOrFile) {
     }
 
     // Loading resolves paths over the elbow's range (a few ms, 40 ms under sanitizers): a model is
-    // reused while the model file and every file it read are byte for byte as they were.
+    // reused while the model file and every file it read are byte for byte as they were and every
+    // file it looked for (a relative reference tried beside the model first) is still there or absent.
     struct CachedModel {
         std::vector<FileSnapshot> files;
         ArmSetup setup;
@@ -241,8 +243,9 @@ ArmSetup loadModel(const std::string& nameOrFile) {
     static std::mutex cacheMutex;
     static std::map<std::string, CachedModel> cache;
     std::error_code ec;
-    const std::string key =
-        getAssetDirectory() + '\n' + std::filesystem::absolute(file, ec).lexically_normal().string();
+    const std::string real = std::filesystem::weakly_canonical(file, ec).string();  // links resolved
+    if (ec) return loadModelFile(file);
+    const std::string key = getAssetDirectory() + '\n' + real;
     {
         std::lock_guard<std::mutex> lock(cacheMutex);
         const auto it = cache.find(key);
@@ -254,6 +257,9 @@ ArmSetup loadModel(const std::string& nameOrFile) {
     }
     FileReadRecorder recorder;
     ArmSetup s = loadModelFile(file);
+    std::size_t bytes = 0;
+    for (const FileSnapshot& f : recorder.getFiles()) bytes += f.text.size();
+    if (bytes > kModelCacheBytes) return s;
     std::lock_guard<std::mutex> lock(cacheMutex);
     if (cache.size() >= kModelCacheSize) cache.clear();
     cache[key] = CachedModel{recorder.releaseFiles(), s};

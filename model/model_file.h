@@ -127,7 +127,8 @@ ArmSetup applyCalibration(const ArmSetup& setup, const std::vector<MuscleCalibra
 /// the file, line, key and value. P_max of muscles with `max_path_length: range` is resolved
 /// (model/muscle_arm.h: resolveMaxPathLengths). A model loaded before is returned again without
 /// the work while its file and every file it read (arm, muscle and fibre-type files) read byte for byte
-/// as they did (thread-safe; up to 32 model files are kept).
+/// as they did and no file it looked for has appeared or gone (thread-safe; up to 32 model files of
+/// up to 4 MB are kept).
 ArmSetup loadModel(const std::string& nameOrFile);
 
 /// Names of the shipped models (files in assets/models/).

@@ -4,6 +4,7 @@
 // and the command's options, numpy arrays out. The identification report has the keys of the JSON
 // report `armsim identify` writes (report_io.h).
 #include "basics/bound.h"
+#include "basics/files.h"
 #include "experiments/protocol.h"
 #include "identification/elbow_identification.h"
 #include "identification/experiment_design.h"
@@ -299,7 +300,7 @@ py::dict identifyPy(const Model& m, const py::object& data, const std::string& m
     py::dict d = toPython(r);
     if (!out.is_none()) {
         const std::string dir = pathOf(out, "out");
-        std::filesystem::create_directories(dir);
+        createFolder(dir);
         d["files"] = writeReportFiles(r, dir);
     }
     return d;

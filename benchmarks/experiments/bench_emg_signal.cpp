@@ -24,7 +24,7 @@ void BM_AcquireEmg3s(benchmark::State& state) {
     s.mainsAmplitude = 1e-4;
     s.electrodeNoiseRms = 5e-6;
     s.zeroPhase = state.range(0) != 0;
-    armsim::PortableRandom rng(2);
+    auto rng = armsim::PortableRandom::fromSeed(2);
     for (auto _ : state) benchmark::DoNotOptimize(armsim::calcAcquiredEmg(x, 10000, s, rng));
 }
 BENCHMARK(BM_AcquireEmg3s)->Arg(0)->Arg(1)->ArgName("zeroPhase")->Unit(benchmark::kMicrosecond);

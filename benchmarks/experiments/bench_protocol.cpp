@@ -34,7 +34,7 @@ void BM_SurfaceEmgTrial(benchmark::State& state) {
     const armsim::ActivationProfile U = armsim::ActivationProfile::step(0.5, 0.0, 1.0);
     armsim::SurfaceEmgSettings s;
     s.acquisition.electrodeNoiseRms = 5e-6;
-    armsim::PortableRandom rng(1);
+    auto rng = armsim::PortableRandom::fromSeed(1);
     for (auto _ : state) benchmark::DoNotOptimize(armsim::calcSurfaceEmg(m, U, 0.0, 3501, s, rng));
 }
 BENCHMARK(BM_SurfaceEmgTrial)->Unit(benchmark::kMillisecond);

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <memory>
 
 using namespace armsim;
 
@@ -73,4 +74,48 @@ TEST(Files, NamesThatCannotBeLookedUpDoNotExist) {
         EXPECT_NE(std::string(e.what()).find("p.yaml:1"), std::string::npos) << e.what();
         EXPECT_NE(std::string(e.what()).find("no such model file"), std::string::npos) << e.what();
     }
+}
+
+// A lookup is part of what a result depends on: a file that appears where one was looked for makes the
+// snapshots stale; recorders ended out of order unlink themselves (no dangling chain).
+TEST(FileReadRecorder, LookupsAreRecordedAndRecordersMayEndInAnyOrder) {
+    const auto dir = armsim::testing::makeFreshDir("files", "lookups");
+    const std::string absent = (dir / "later.yaml").string();
+    std::vector<FileSnapshot> files;
+    {
+        FileReadRecorder r;
+        EXPECT_FALSE(doesPathExist(absent));
+        files = r.getFiles();
+    }
+    ASSERT_EQ(files.size(), 1u);
+    EXPECT_FALSE(files[0].read);
+    EXPECT_TRUE(areFilesUnchanged(files));
+    writeFileAtomically(absent, "x");
+    EXPECT_FALSE(areFilesUnchanged(files));
+
+    auto outer = std::make_unique<FileReadRecorder>();
+    auto inner = std::make_unique<FileReadRecorder>();
+    outer.reset();  // the outer one ends first
+    readFileText(absent);
+    EXPECT_EQ(inner->getFiles().size(), 1u);
+    inner.reset();
+    readFileText(absent);  // no recorder left: nothing to write into
+    std::filesystem::remove_all(dir);
+}
+
+TEST(Files, CreateFolderNamesThePathWhenItCannot) {
+    const auto dir = armsim::testing::makeFreshDir("files", "folders");
+    createFolder((dir / "a" / "b").string());
+    EXPECT_TRUE(std::filesystem::is_directory(dir / "a" / "b"));
+    createFolder((dir / "a").string());  // exists: nothing to do
+    writeFileAtomically((dir / "f").string(), "x");
+    for (const std::string bad : {(dir / "f").string(), (dir / "f" / "sub").string(), (dir / std::string(300, 'n')).string()}) {
+        try {
+            createFolder(bad);
+            ADD_FAILURE() << "no error for " << bad;
+        } catch (const InputError& e) {
+            EXPECT_NE(std::string(e.what()).find(bad + ": cannot create the folder"), std::string::npos) << e.what();
+        }
+    }
+    std::filesystem::remove_all(dir);
 }

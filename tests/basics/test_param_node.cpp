@@ -92,6 +92,7 @@ TEST(ParamNode, KeysThatAreListsOrMappingsAreRefusedWithTheirLine) {
     EXPECT_TRUE(has(msg, "p.yaml:3")) << msg;
     EXPECT_TRUE(has(msg, "expected a name")) << msg;
     EXPECT_TRUE(has(messageOf([] { ParamNode::loadString("[1, 2]: 3\n", "q.yaml"); }), "q.yaml:1"));
+    EXPECT_TRUE(has(messageOf([] { ParamNode::loadString("a: 1\n~: 2\n", "n.yaml"); }), "n.yaml:2: an empty key"));
 }
 
 // Aliases can expand a short file exponentially, and nesting can be arbitrarily deep: both are refused

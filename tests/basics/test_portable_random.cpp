@@ -12,14 +12,28 @@ using namespace armsim;
 // 14514284786278117030 (and the 10000th 9981545732273789042, [rand.predef]). The draws are exact
 // functions of it.
 TEST(PortableRandom, DrawsAreExactFunctionsOfTheStandardEngine) {
-    PortableRandom r(std::uint64_t{5489});
+    auto r = PortableRandom::fromSeed(5489);
     EXPECT_EQ(r.drawUniform(), double(14514284786278117030ULL >> 11) * 0x1.0p-53);
     std::mt19937_64 reference(5489);
     reference.discard(9999);
-    PortableRandom s(std::uint64_t{5489});
+    auto s = PortableRandom::fromSeed(5489);
     for (int i = 0; i < 9999; ++i) s.drawUniform();
     EXPECT_EQ(s.drawUniform(), double(9981545732273789042ULL >> 11) * 0x1.0p-53);
     EXPECT_EQ(reference(), 9981545732273789042ULL);
+
+    // Indices and shuffles: the engine's output modulo n (rejection removes only the last
+    // 2^64 mod n values, never met here), positions swapped from the end (Fisher-Yates).
+    auto i = PortableRandom::fromSeed(99);
+    std::mt19937_64 engine(99);
+    for (int k = 0; k < 100; ++k) EXPECT_EQ(i.drawIndex(6), engine() % 6);
+    auto shuffled = PortableRandom::fromSeed(7);
+    std::mt19937_64 byHand(7);
+    std::vector<int> v(10), w(10);
+    std::iota(v.begin(), v.end(), 0);
+    std::iota(w.begin(), w.end(), 0);
+    shuffled.shuffle(v);
+    for (std::size_t k = w.size(); k > 1; --k) std::swap(w[k - 1], w[byHand() % k]);
+    EXPECT_EQ(v, w);
 }
 
 // drawIndex is unbiased: counts of 600,000 draws in [0, 6) within 4 standard deviations of 100,000
@@ -27,7 +41,7 @@ TEST(PortableRandom, DrawsAreExactFunctionsOfTheStandardEngine) {
 TEST(PortableRandom, IndicesAreUniformAndInRange) {
     constexpr int kDraws = 600000, kBins = 6;
     constexpr double kSdTol = 4;
-    PortableRandom r(std::uint64_t{42});
+    auto r = PortableRandom::fromSeed(42);
     std::vector<int> count(kBins, 0);
     for (int i = 0; i < kDraws; ++i) ++count[r.drawIndex(kBins)];
     const double p = 1.0 / kBins, sd = std::sqrt(kDraws * p * (1 - p));
@@ -41,7 +55,7 @@ TEST(PortableRandom, IndicesAreUniformAndInRange) {
 TEST(PortableRandom, ShuffleIsAnUnbiasedPermutation) {
     constexpr int kRounds = 60000, kSize = 4;
     constexpr double kSdTol = 4;
-    PortableRandom r(std::uint64_t{7});
+    auto r = PortableRandom::fromSeed(7);
     std::vector<std::vector<int>> at(kSize, std::vector<int>(kSize, 0));
     for (int k = 0; k < kRounds; ++k) {
         std::vector<int> v(kSize);

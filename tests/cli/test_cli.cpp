@@ -224,6 +224,9 @@ TEST(Cli, MainJobRunsTheThesisArmAndTheElbowSubject) {
         videos += rel.extension() == ".mp4";
         ++files;
     }
+    int firstFiles = 0;  // and the first run wrote nothing the second did not
+    for (const auto& e : fs::recursive_directory_iterator(again)) firstFiles += e.is_regular_file();
+    EXPECT_EQ(firstFiles, files);
     EXPECT_GT(files, 60);
     EXPECT_EQ(videos, 2);
     EXPECT_GT(reports, 0);

@@ -28,7 +28,7 @@ VirtualMuscle thesisMuscle() {
 /// Constant activation U for `seconds` of acquired EMG (1000 Hz) with the default settings.
 SurfaceEmg constantEmg(const VirtualMuscle& m, double U, double seconds, std::uint64_t seed,
                        const SurfaceEmgSettings& s = {}) {
-    PortableRandom rng(seed);
+    auto rng = PortableRandom::fromSeed(seed);
     return calcSurfaceEmg(m, ActivationProfile::constant(U), 0.0, std::size_t(seconds * 1000), s, rng);
 }
 
@@ -76,7 +76,7 @@ TEST(SurfaceEmg, MissingF05IsAnErrorNamingIt) {
     MuscleParameters p = thesisMuscle().getParameters();
     p.fast.f05 = 0;  // "not given"
     const VirtualMuscle m(p);
-    PortableRandom rng(1);
+    auto rng = PortableRandom::fromSeed(1);
     try {
         calcSurfaceEmg(m, ActivationProfile::constant(1), 0, 100, {}, rng);
         FAIL() << "expected an error";
@@ -178,7 +178,7 @@ TEST(SurfaceEmg, SameSeedSameSignalOtherSeedOtherSignal) {
 
 TEST(SurfaceEmg, BadSettingsNameTheField) {
     const VirtualMuscle m = thesisMuscle();
-    PortableRandom rng(1);
+    auto rng = PortableRandom::fromSeed(1);
     SurfaceEmgSettings s;
     s.internalRate = 2500;  // not a multiple of 1000 Hz
     try {

@@ -282,7 +282,7 @@ TEST(MovingRms, SineGivesAmplitudeOverSqrt2) {
 TEST(Acquisition, AppliesGainInPassband) {
     const double fsIn = 10000, amplitude = 1e-6, f = 100;
     const EmgAcquisitionSettings s;
-    PortableRandom rng(1);
+    auto rng = PortableRandom::fromSeed(1);
     const std::vector<double> y = calcAcquiredEmg(sine(amplitude, f, fsIn, 20000), fsIn, s, rng);
     ASSERT_EQ(y.size(), 2000u);
     const Tone t = fitTone(y, f, s.outputRate, 1000, 2000);
@@ -296,7 +296,7 @@ TEST(Acquisition, ZeroPhaseOptionHasNoPhaseShift) {
     const double fsIn = 5000, f = 80;
     EmgAcquisitionSettings s;
     s.zeroPhase = true;
-    PortableRandom rng(1);
+    auto rng = PortableRandom::fromSeed(1);
     const std::vector<double> y = calcAcquiredEmg(sine(1e-6, f, fsIn, 20000), fsIn, s, rng);
     const Tone t = fitTone(y, f, s.outputRate, 1000, 3000);
     const std::complex<double> h = calcFrequencyResponse(designAcquisitionFilter(s, fsIn), f, fsIn);
@@ -309,7 +309,7 @@ TEST(Acquisition, NotchRemovesMainsInterference) {
     EmgAcquisitionSettings s;
     s.mainsAmplitude = 1e-3;
     const std::vector<double> zero(100000, 0.0);
-    PortableRandom rng(3);
+    auto rng = PortableRandom::fromSeed(3);
     const std::vector<double> with = calcAcquiredEmg(zero, fsIn, s, rng);
     s.notch = false;
     const std::vector<double> without = calcAcquiredEmg(zero, fsIn, s, rng);
@@ -327,7 +327,7 @@ TEST(Acquisition, NoiseRmsMatchesResponseIntegral) {
     EmgAcquisitionSettings s;
     s.electrodeNoiseRms = 5e-6;
     const std::vector<double> zero(600000, 0.0);   // 60 s
-    PortableRandom rng(11);
+    auto rng = PortableRandom::fromSeed(11);
     const std::vector<double> y = calcAcquiredEmg(zero, fsIn, s, rng);
     const double measured = calcRms(std::vector<double>(y.begin() + 1000, y.end()));
 
@@ -350,7 +350,7 @@ TEST(Acquisition, SeededNoiseIsReproducible) {
     s.electrodeNoiseRms = 1e-6;
     s.mainsAmplitude = 1e-5;
     const std::vector<double> zero(5000, 0.0);
-    PortableRandom a(5), b(5), c(6);
+    auto a = PortableRandom::fromSeed(5), b = PortableRandom::fromSeed(5), c = PortableRandom::fromSeed(6);
     const std::vector<double> ya = calcAcquiredEmg(zero, 5000, s, a);
     EXPECT_EQ(ya, calcAcquiredEmg(zero, 5000, s, b));
     EXPECT_NE(ya, calcAcquiredEmg(zero, 5000, s, c));
@@ -358,7 +358,7 @@ TEST(Acquisition, SeededNoiseIsReproducible) {
 
 TEST(Acquisition, BadSettingsNameTheField) {
     const std::vector<double> x(1000, 0.0);
-    PortableRandom rng(1);
+    auto rng = PortableRandom::fromSeed(1);
     auto acquire = [&](const EmgAcquisitionSettings& s, double fsIn) {
         return [&x, &rng, s, fsIn] { calcAcquiredEmg(x, fsIn, s, rng); };
     };

@@ -13,6 +13,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 
 using namespace armsim;
 using SimTK::Vec2;
@@ -313,8 +314,28 @@ TEST(ModelFile, AReloadSeesAnEditedMuscleFile) {
     EXPECT_EQ(again.muscles.at(0).params.maxPathLength, first.muscles.at(0).params.maxPathLength);
     EXPECT_EQ(again.file, model);
 
+    const std::string otherSpelling = (dir / "." / "model.yaml").string();
+    EXPECT_EQ(loadModel(otherSpelling).file, otherSpelling);
+
     writeMuscle(0.4);
     EXPECT_EQ(loadModel(model).muscles.at(0).params.mass, 0.4);
+
+    // `arm: arm/default_male.yaml` was found in the assets; an arm file that appears beside the model
+    // is looked up first, so the next load takes it.
+    const ArmSetup before = loadModel(model);
+    std::filesystem::create_directories(dir / "arm");
+    {
+        std::ifstream in(asset + "/arm/default_male.yaml");
+        std::stringstream text;
+        text << in.rdbuf();
+        std::string arm = text.str();
+        const std::size_t at = arm.find("mass: 73.0");
+        ASSERT_NE(at, std::string::npos);
+        arm.replace(at, 10, "mass: 90.0");
+        std::ofstream(dir / "arm" / "default_male.yaml") << arm;
+    }
+    EXPECT_EQ(before.arm.bodyMass, 73.0);
+    EXPECT_EQ(loadModel(model).arm.bodyMass, 90.0);
     std::filesystem::remove(dir / "m.yaml");
     EXPECT_NE(messageOf(model).find("m.yaml"), std::string::npos) << messageOf(model);
     std::filesystem::remove_all(dir);
