@@ -84,6 +84,16 @@ void checkOutputFolder(const std::string& option, const std::string& dir) {
     std::error_code ec;
     fs::path p = fs::absolute(dir, ec);
     const fs::path given = p;
+    // Files are staged in a sibling ".NAME.partial.<pid>-<n>": the name needs room for that suffix.
+    constexpr std::size_t kNameMax = 255, kStagingExtra = 40;
+    for (const fs::path& part : given)
+        if (part.string().size() > kNameMax)
+            throw InputError(option + " '" + dir + "': a folder name of " + std::to_string(part.string().size()) +
+                             " characters: expected at most " + std::to_string(kNameMax));
+    if (given.filename().string().size() > kNameMax - kStagingExtra)
+        throw InputError(option + " '" + dir + "': a folder name of " + std::to_string(given.filename().string().size()) +
+                         " characters: expected at most " + std::to_string(kNameMax - kStagingExtra) +
+                         " (the output is staged in a hidden sibling with a longer name)");
     while (!fs::exists(p, ec) && p.has_parent_path() && p != p.parent_path()) p = p.parent_path();
     if (!fs::is_directory(p, ec))
         throw InputError(option + " '" + dir + "': cannot create the folder (" + p.string() + " is not a folder)");
