@@ -83,11 +83,11 @@ void OutputFolder::writeWith(const std::string& relative,
     const std::string path = addFile(relative);
     try {
         writer(path);
-    } catch (const InputError& e) {
+    } catch (const InputError& e) {  // the staging folder, or anything in it, named as the target
         std::string message = e.what();
-        const std::string target = getTargetPath(relative);
-        for (std::size_t at = message.find(path); at != std::string::npos; at = message.find(path, at + target.size()))
-            message.replace(at, path.size(), target);
+        const std::string from = temp_.string(), to = target_.string();
+        for (std::size_t at = message.find(from); at != std::string::npos; at = message.find(from, at + to.size()))
+            message.replace(at, from.size(), to);
         throw InputError(message);
     }
 }

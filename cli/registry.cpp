@@ -82,15 +82,17 @@ void checkOutputFolder(const std::string& option, const std::string& dir) {
     namespace fs = std::filesystem;
     if (dir.empty()) throw InputError(option + " is empty: expected a folder path");
     std::error_code ec;
-    fs::path p = fs::absolute(dir, ec);
+    fs::path p = fs::absolute(dir, ec).lexically_normal();
+    if (p.filename().empty() && p.has_parent_path()) p = p.parent_path();  // "out/" and "." name "out", the cwd
     const fs::path given = p;
-    // Files are staged in a sibling ".NAME.partial.<pid>-<n>": the name needs room for that suffix.
+    // A new folder is staged in a sibling ".NAME.partial.<pid>-<n>": its name needs room for the suffix
+    // (an existing folder stages inside itself).
     constexpr std::size_t kNameMax = 255, kStagingExtra = 40;
     for (const fs::path& part : given)
         if (part.string().size() > kNameMax)
             throw InputError(option + " '" + dir + "': a folder name of " + std::to_string(part.string().size()) +
                              " characters: expected at most " + std::to_string(kNameMax));
-    if (given.filename().string().size() > kNameMax - kStagingExtra)
+    if (!fs::is_directory(given, ec) && given.filename().string().size() > kNameMax - kStagingExtra)
         throw InputError(option + " '" + dir + "': a folder name of " + std::to_string(given.filename().string().size()) +
                          " characters: expected at most " + std::to_string(kNameMax - kStagingExtra) +
                          " (the output is staged in a hidden sibling with a longer name)");

@@ -325,7 +325,7 @@ void writeProtocolFiles(OutputFolder& dir, const Protocol& protocol, const ArmSe
     dir.addFile("manifest.json");
     result.files = dir.getFiles();
     manifest["files"] = result.files;
-    dir.write("manifest.json", manifest.dump(2) + "\n");
+    dir.write("manifest.json", manifest.dump(2, ' ', false, nlohmann::ordered_json::error_handler_t::replace) + "\n");
     dir.commit();
 }
 

@@ -94,7 +94,7 @@ nlohmann::json toJson(const IdentificationReport& r) {
 }
 
 void writeReportJson(const std::string& path, const IdentificationReport& report) {
-    writeFileAtomically(path, toJson(report).dump(2) + "\n");
+    writeFileAtomically(path, toJson(report).dump(2, ' ', false, nlohmann::ordered_json::error_handler_t::replace) + "\n");
 }
 
 Table makeHistoryTable(const IdentificationReport& r) {

@@ -174,7 +174,7 @@ public:
     StudyFolder(const std::string& dir, const std::string& fingerprint, const Study& study, bool restart) : dir_(dir) {
         std::error_code ec;
         fs::create_directories(dir_, ec);
-        if (ec || !fs::is_directory(dir_))
+        if (ec || !fs::is_directory(dir_, ec))
             throw InputError("study output '" + dir_ + "': cannot create the folder" + (ec ? ": " + ec.message() : ""));
         lock_.fd = ::open((dir_ + "/.lock").c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
         if (lock_.fd < 0) throw InputError("study output '" + dir_ + "': cannot write in the folder");

@@ -243,7 +243,12 @@ ArmSetup loadModel(const std::string& nameOrFile) {
     static std::mutex cacheMutex;
     static std::map<std::string, CachedModel> cache;
     std::error_code ec;
-    const std::string real = std::filesystem::weakly_canonical(file, ec).string();  // links resolved
+    // The folder with links resolved (link/.. names another file), the name as given: references are
+    // looked up beside the path as given, so two links to one file in two folders are two models.
+    const std::filesystem::path given(file);
+    const std::string real =
+        (std::filesystem::weakly_canonical(std::filesystem::absolute(given, ec).parent_path(), ec) / given.filename())
+            .string();
     if (ec) return loadModelFile(file);
     const std::string key = getAssetDirectory() + '\n' + real;
     {

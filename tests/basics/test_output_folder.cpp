@@ -161,6 +161,15 @@ TEST_F(OutputFolderTest, AWritersErrorNamesTheFinalPath) {
         EXPECT_EQ(message.find(".partial"), std::string::npos) << message;
     }
     EXPECT_NE(staged.find(".partial"), std::string::npos) << staged;  // the writer did get the staging path
+    try {  // a message naming the staging folder itself (or a sub-folder) names the target folder
+        out.writeWith("sub/plot.png", [&](const std::string& path) {
+            throw InputError(std::filesystem::path(path).parent_path().string() + ": no space left");
+        });
+        ADD_FAILURE() << "no error";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find((target / "sub").string() + ": no space left"), std::string::npos)
+            << e.what();
+    }
     out.writeWith("ok.txt", [](const std::string& path) { writeFileAtomically(path, "x"); });
     out.commit();
     EXPECT_TRUE(fs::exists(target / "ok.txt"));

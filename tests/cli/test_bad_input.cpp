@@ -148,6 +148,8 @@ std::vector<BadInput> makeCatalogue() {
         {"OutEmpty", {}, "identify-torque measured/thesis_mvc_torque.csv --out ''", {"--out is empty", "expected a folder path"}},
         {"OutNameTooLong", {}, "identify measured/thesis_measured.csv --out OUT/" + std::string(230, 'n'),
          {"--out", "a folder name of 230 characters", "expected at most 215"}},
+        {"OutNameTooLongWithSlash", {}, "identify measured/thesis_measured.csv --out OUT/" + std::string(230, 'n') + "/",
+         {"--out", "a folder name of 230 characters", "expected at most 215"}},
         {"IdentifyFaithfulHoldHuge", {}, "identify measured/thesis_measured.csv --forward faithful --hold 1e9 --out OUT/id",
          {"samples", "at most 1e+07"}},
         {"EmgInternalRateHuge", {{"p.yaml", "name: bad\nkind: submaximal\nseed: 1\nsubject:\n  arm: arm/default_male.yaml\n"

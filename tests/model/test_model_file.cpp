@@ -340,3 +340,28 @@ TEST(ModelFile, AReloadSeesAnEditedMuscleFile) {
     EXPECT_NE(messageOf(model).find("m.yaml"), std::string::npos) << messageOf(model);
     std::filesystem::remove_all(dir);
 }
+
+// Two links to one model file from two folders: the model's references are looked up beside the link,
+// so each folder's muscle file counts and the cache keeps them apart.
+TEST(ModelFile, LinksInTwoFoldersAreTwoModels) {
+    namespace fs = std::filesystem;
+    const fs::path dir = fs::temp_directory_path() / ("armsim_model_links_" + std::to_string(::getpid()));
+    fs::remove_all(dir);
+    for (const char* sub : {"shared", "a", "b"}) fs::create_directories(dir / sub);
+    std::ofstream(dir / "shared" / "model.yaml")
+        << "name: linked\narm: arm/default_male.yaml\nmuscles:\n  - name: m\n    parameters: m.yaml\n"
+           "    path:\n      origin: {body: upper_arm, location: [0, 0.3, 0]}\n"
+           "      insertion: {body: forearm, location: [0, -0.05, 0]}\n";
+    for (const auto& [sub, mass] : {std::pair<const char*, double>{"a", 0.3}, {"b", 0.5}}) {
+        std::ofstream(dir / sub / "m.yaml") << "name: m\nmass: " << mass
+                                            << "\noptimal_fascicle_length: 0.16\noptimal_tendon_length: 0.245\n"
+                                               "max_path_length: 0.43\nfibre_fractions: {slow: 0.3, fast: 0.7}\n"
+                                               "motor_units: {slow: 3, fast: 3}\nfibre_types: "
+                                            << ARMSIM_ASSET_DIR << "/muscles/human_fibre_types.yaml\n";
+        fs::create_symlink(dir / "shared" / "model.yaml", dir / sub / "model.yaml");
+    }
+    EXPECT_EQ(loadModel((dir / "a" / "model.yaml").string()).muscles.at(0).params.mass, 0.3);
+    EXPECT_EQ(loadModel((dir / "b" / "model.yaml").string()).muscles.at(0).params.mass, 0.5);
+    EXPECT_EQ(loadModel((dir / "a" / "model.yaml").string()).muscles.at(0).params.mass, 0.3);
+    fs::remove_all(dir);
+}
