@@ -8,6 +8,7 @@
 // sibling behind; the next OutputFolder on the same target removes it (its process is gone).
 #pragma once
 
+#include <cstddef>
 #include <filesystem>
 #include <functional>
 #include <mutex>
@@ -19,6 +20,10 @@ namespace armsim {
 
 class OutputFolder {
 public:
+    /// Characters a new target's staging sibling (".NAME.partial.<pid>-<n>") adds to NAME, with room
+    /// to spare: a target name must leave this much below the system's 255.
+    static constexpr std::size_t kStagingNameExtra = 40;
+
     /// How commit() treats a target that exists.
     enum class Mode {
         /// The folder is one run: an earlier run (an empty folder or one holding `marker`) is replaced

@@ -1,10 +1,10 @@
 #include "basics/errors.h"
+#include "basics/output_folder.h"
 #include "cli/commands.h"
 
 #include <algorithm>
 #include <atomic>
 #include <cmath>
-#include <sstream>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -87,7 +87,7 @@ void checkOutputFolder(const std::string& option, const std::string& dir) {
     const fs::path given = p;
     // A new folder is staged in a sibling ".NAME.partial.<pid>-<n>": its name needs room for the suffix
     // (an existing folder stages inside itself).
-    constexpr std::size_t kNameMax = 255, kStagingExtra = 40;
+    constexpr std::size_t kNameMax = 255, kStagingExtra = OutputFolder::kStagingNameExtra;
     for (const fs::path& part : given)
         if (part.string().size() > kNameMax)
             throw InputError(option + " '" + dir + "': a folder name of " + std::to_string(part.string().size()) +

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <filesystem>
 #include <map>
+#include <memory>
 #include <mutex>
 #include <regex>
 
@@ -241,7 +242,7 @@ ArmSetup loadModel(const std::string& nameOrFile) {
         ArmSetup setup;
     };
     static std::mutex cacheMutex;
-    static std::map<std::string, CachedModel> cache;
+    static std::map<std::string, std::shared_ptr<const CachedModel>> cache;
     std::error_code ec;
     // The folder with links resolved (link/.. names another file), the name as given: references are
     // looked up beside the path as given, so two links to one file in two folders are two models.
@@ -251,14 +252,16 @@ ArmSetup loadModel(const std::string& nameOrFile) {
             .string();
     if (ec) return loadModelFile(file);
     const std::string key = getAssetDirectory() + '\n' + real;
+    std::shared_ptr<const CachedModel> cached;
     {
         std::lock_guard<std::mutex> lock(cacheMutex);
         const auto it = cache.find(key);
-        if (it != cache.end() && areFilesUnchanged(it->second.files)) {
-            ArmSetup s = it->second.setup;
-            s.file = file;
-            return s;
-        }
+        if (it != cache.end()) cached = it->second;
+    }
+    if (cached && areFilesUnchanged(cached->files)) {  // the files are read outside the lock
+        ArmSetup s = cached->setup;
+        s.file = file;
+        return s;
     }
     FileReadRecorder recorder;
     ArmSetup s = loadModelFile(file);
@@ -267,7 +270,7 @@ ArmSetup loadModel(const std::string& nameOrFile) {
     if (bytes > kModelCacheBytes) return s;
     std::lock_guard<std::mutex> lock(cacheMutex);
     if (cache.size() >= kModelCacheSize) cache.clear();
-    cache[key] = CachedModel{recorder.releaseFiles(), s};
+    cache[key] = std::make_shared<const CachedModel>(CachedModel{recorder.releaseFiles(), s});
     return s;
 }
 
