@@ -62,6 +62,7 @@ CLI::Option* addNumberListOption(CLI::App& app, const std::string& name, std::ve
                                  const std::string& description) {
     const CLI::Validator finite(
         [](std::string& item) -> std::string {
+            if (item.empty()) return "'': expected a finite number (for no values, leave the option out)";
             try {
                 parseNumber("", item);
             } catch (const InputError&) {
@@ -69,13 +70,17 @@ CLI::Option* addNumberListOption(CLI::App& app, const std::string& name, std::ve
             }
             return "";
         },
-        "NUMBER");
-    return app.add_option(name, values, description)->delimiter(',')->check(finite)->allow_extra_args(false);
+        "");
+    return app.add_option(name, values, description)
+        ->delimiter(',')
+        ->check(finite)
+        ->allow_extra_args(false)
+        ->type_name("NUMBERS");
 }
 
 CLI::Option* addNameListOption(CLI::App& app, const std::string& name, std::vector<std::string>& values,
                                const std::string& description) {
-    return app.add_option(name, values, description)->delimiter(',')->allow_extra_args(false);
+    return app.add_option(name, values, description)->delimiter(',')->allow_extra_args(false)->type_name("NAMES");
 }
 
 void checkOutputFolder(const std::string& option, const std::string& dir) {

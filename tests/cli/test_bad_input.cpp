@@ -132,6 +132,7 @@ std::vector<BadInput> makeCatalogue() {
         {"ValidateOutIsAFile", {{"afile", "x"}}, "validate --seeds 0 --noise 0 --out IN/afile", {"--out", "not a folder"}},
         {"DesignTrialsZero", {}, "design --trials 0 --out OUT/d", {"--trials", "0"}},
         {"DesignAnglesNotNumbers", {}, "design --angles 30,abc --out OUT/d", {"--angles", "abc"}},
+        {"DesignLevelsEmpty", {}, "design --levels '' --out OUT/d", {"--levels", "''", "leave the option out"}},
         {"StudyMissing", {}, "study IN/none.yaml --out OUT/s", {"none.yaml"}},
         {"StudyUnknownKey", {{"s.yaml", kStudyHead + "methods:\n  - {method: thesis}\nweather: rain\n"}},
          "study IN/s.yaml --out OUT/s", {"s.yaml", "weather"}},
