@@ -16,7 +16,6 @@ namespace armsim {
 
 using detail::ArmTrialOutcome;
 using detail::ArmTrialPlan;
-using detail::cleanDegrees;
 using detail::kCsvDigits;
 using detail::ProtocolRun;
 using detail::uniqueSorted;

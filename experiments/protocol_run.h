@@ -51,9 +51,6 @@ inline std::vector<double> uniqueSorted(std::vector<double> v) {
     return v;
 }
 
-/// Degrees of an angle read in degrees and stored in radians, without the round-trip's last-digit noise.
-inline double cleanDegrees(double radians) { return std::round(radToDeg(radians) * 1e9) / 1e9; }
-
 /// Significant digits of the numbers in result files.
 constexpr int kCsvDigits = 10;
 

@@ -23,7 +23,7 @@ double calcStrapTorque(double strapForce, double beta, double strapDistance) {
 }
 
 double calcBicepsForceFixedRatio(double strapForce, double alpha, double beta, double ratio) {
-    checkField("alpha", radToDeg(alpha), Bound::open(0, 180, "deg"));
+    checkField("alpha", cleanDegrees(alpha), Bound::open(0, 180, "deg"));
     checkField("d1/d2 ratio", ratio, Bound::positive());
     return strapForce * std::sin(beta) * ratio / std::sin(alpha);
 }

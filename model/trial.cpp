@@ -13,7 +13,7 @@ namespace armsim {
 namespace {
 
 void checkElbowAngle(const std::string& field, double theta, const ArmParameters& arm) {
-    checkField(field, radToDeg(theta), Bound::closed(arm.minElbowAngleDeg, arm.maxElbowAngleDeg, "deg"));
+    checkField(field, cleanDegrees(theta), Bound::closed(arm.minElbowAngleDeg, arm.maxElbowAngleDeg, "deg"));
 }
 
 // Per-muscle force and activation columns (models with several muscles), then the state columns.
@@ -81,8 +81,8 @@ std::vector<ActivationProfile> readActivationProfiles(const ArmSetup& setup, con
 
 void IsometricTrialSettings::validate(const ArmParameters& arm) const {
     checkElbowAngle("elbow_angle_deg", elbowAngle, arm);
-    if (radToDeg(elbowAngle) >= 180 - 1e-9)  // the straight-line biceps passes through the joint there
-        throw FieldError("elbow_angle_deg", "= " + formatNumber(radToDeg(elbowAngle)) +
+    if (cleanDegrees(elbowAngle) >= 180)  // the straight-line biceps passes through the joint there
+        throw FieldError("elbow_angle_deg", "= " + formatNumber(cleanDegrees(elbowAngle)) +
                                                 ": an isometric trial reads the biceps force as torque / moment arm, and the "
                                                 "moment arm vanishes at full extension: expected an angle below 180 deg");
     checkField("activation", activation, Bound::closed(0, 1));
@@ -277,7 +277,7 @@ std::vector<IsometricTrialResult> runIsometricTrials(const ArmSetup& setup,
 
 void FreeMovementSettings::validate(const ArmParameters& arm) const {
     checkElbowAngle("initial_angle_deg", initialAngle, arm);
-    checkField("initial_velocity_degps", radToDeg(initialVelocity), Bound::closed(-2000, 2000, "deg/s"));
+    checkField("initial_velocity_degps", cleanDegrees(initialVelocity), Bound::closed(-2000, 2000, "deg/s"));
     checkField("duration", duration, Bound::positive("s"));
     checkField("hand_load", handLoad, Bound::closed(0, 50, "kg"));
     checkField("sample_rate", sampleRate, Bound::positive("Hz"));

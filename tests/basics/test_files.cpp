@@ -109,7 +109,7 @@ TEST(Files, CreateFolderNamesThePathWhenItCannot) {
     EXPECT_TRUE(std::filesystem::is_directory(dir / "a" / "b"));
     createFolder((dir / "a").string());  // exists: nothing to do
     writeFileAtomically((dir / "f").string(), "x");
-    for (const std::string bad : {(dir / "f").string(), (dir / "f" / "sub").string(), (dir / std::string(300, 'n')).string()}) {
+    for (const std::string& bad : {(dir / "f").string(), (dir / "f" / "sub").string(), (dir / std::string(300, 'n')).string()}) {
         try {
             createFolder(bad);
             ADD_FAILURE() << "no error for " << bad;

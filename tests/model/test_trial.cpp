@@ -171,6 +171,27 @@ TEST(IsometricTrial, BadSettingsGiveNamedErrors) {
     }
 }
 
+// Degrees typed by a user come back from radians with last-bit noise (30 -> 29.999999999999996,
+// 2000 -> 2000.0000000000002): the checks and their messages must see the typed value, so a bound
+// given exactly is accepted and a message quotes '30', not the noise.
+TEST(TrialSettings, DegreeBoundsAndMessagesSeeTheValueAsTyped) {
+    ASSERT_NE(radToDeg(degToRad(2000.0)), 2000.0);  // the noise this test is about
+    ASSERT_NE(radToDeg(degToRad(30.0)), 30.0);
+    FreeMovementSettings f;
+    f.initialVelocity = degToRad(2000.0);
+    EXPECT_NO_THROW(f.validate(subject().arm));
+    f.initialVelocity = degToRad(-2000.0);
+    EXPECT_NO_THROW(f.validate(subject().arm));
+    f.initialVelocity = degToRad(2000.001);
+    EXPECT_THROW(f.validate(subject().arm), InputError);
+    try {
+        mvcAt(30).validate(subject().arm);
+        ADD_FAILURE() << "30 deg is below the thesis arm's extension range";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("'elbow_angle_deg' = 30:"), std::string::npos) << e.what();
+    }
+}
+
 TEST(FreeMovement, ActiveBicepsFlexesTheElbowAndAHandLoadSlowsIt) {
     FreeMovementSettings s;
     s.initialAngle = degToRad(160);
