@@ -103,6 +103,18 @@ TEST(Cli, FailedRunLeavesNoHalfWrittenOutput) {
     for (const auto& e : fs::directory_iterator(d)) EXPECT_EQ(e.path().filename().string().find(".tmp"), std::string::npos);
 }
 
+// A muscle whose fascicle starts beyond L = 1.73 L0 (where nf turns negative): the state check at the
+// step boundary stops the run; exit 3 with the time, the muscle and the state, and neither file written.
+TEST(Cli, ASimulationFailureExits3NamingTimeMuscleAndStateAndWritesNothing) {
+    const fs::path d = freshDir("simfail");
+    const CommandResult r = runArmsim("muscle trial --max-path 0.9 --path 0.9 --duration 0.5 --out " +
+                                      (d / "t.csv").string() + " --plot " + (d / "t.png").string());
+    EXPECT_EQ(r.exitCode, 3) << r.output;
+    for (const char* part : {"simulation failed", "t = 0 s", "muscle 'biceps'", "fascicle length L = 4.16"})
+        EXPECT_NE(r.output.find(part), std::string::npos) << part << " in " << r.output;
+    EXPECT_TRUE(fs::is_empty(d)) << "files left in " << d;
+}
+
 TEST(Cli, TrialWithASampledTraceFollowsIt) {
     const fs::path d = freshDir("trace");
     std::ofstream(d / "trace.csv") << "time_s,activation\n0,0\n0.2,0\n0.2,1\n0.5,1\n";
