@@ -106,6 +106,25 @@ TEST(CliIdentify, BadDataExitsNonZeroNamingFileAndLine) {
     EXPECT_NE(r.output.find("far.csv:3"), std::string::npos) << r.output;
 }
 
+// 600 N at 37.5 cm and 50 N at 40 cm: no mass and tendon length make this force ratio. The command
+// reports the stop as not converged with the reason, and keeps the report, history and plot.
+TEST(CliIdentify, DataNoModelReproducesStopNotConvergedWithTheReasonAndTheHistory) {
+    const fs::path d = freshDir("noconverge");
+    const std::string data = writeData(d, "d.csv", "37.5,600\n40,50\n");
+    const CommandResult r = runArmsim("identify " + data + " --out " + (d / "id").string());
+    EXPECT_EQ(r.exitCode, 0) << r.output;
+    EXPECT_NE(r.output.find("not-converged"), std::string::npos) << r.output;
+    expectReportFiles(d / "id");
+    std::ifstream in(d / "id" / "identification.json");
+    const nlohmann::json j = nlohmann::json::parse(in);
+    EXPECT_FALSE(j["converged"].get<bool>());
+    EXPECT_EQ(j["stop_reason"], "not-converged");
+    EXPECT_NE(j["message"].get<std::string>().find("the model cannot produce these forces"), std::string::npos)
+        << j["message"];
+    const armsim::Table h = armsim::Table::readCsv((d / "id" / "identification_history.csv").string());
+    EXPECT_EQ(h.getNumRows(), j["history_length"].get<int>());
+}
+
 TEST(CliIdentify, BadOptionsNameTheOption) {
     CommandResult r = runArmsim("identify " + measuredFile() + " --bounds mass=0.5");
     EXPECT_EQ(r.exitCode, kInputErrorExit) << r.output;
