@@ -81,8 +81,9 @@ std::vector<ActivationProfile> readActivationProfiles(const ArmSetup& setup, con
 
 void IsometricTrialSettings::validate(const ArmParameters& arm) const {
     checkElbowAngle("elbow_angle_deg", elbowAngle, arm);
-    if (cleanDegrees(elbowAngle) >= 180)  // the straight-line biceps passes through the joint there
-        throw FieldError("elbow_angle_deg", "= " + formatNumber(cleanDegrees(elbowAngle)) +
+    const double angleDeg = cleanDegrees(elbowAngle);
+    if (angleDeg >= 180)  // the straight-line biceps passes through the joint there
+        throw FieldError("elbow_angle_deg", "= " + formatNumber(angleDeg) +
                                                 ": an isometric trial reads the biceps force as torque / moment arm, and the "
                                                 "moment arm vanishes at full extension: expected an angle below 180 deg");
     checkField("activation", activation, Bound::closed(0, 1));
