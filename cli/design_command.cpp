@@ -1,12 +1,13 @@
 // armsim design: the torque protocol that minimises the synergist-aware identifier's expected posterior
-// uncertainty of the biceps mass and tendon length over a population (identification/experiment_design.h),
+// uncertainty of the biceps mass and tendon length over a population (studies/experiment_design.h),
 // compared with the thesis's five-angle protocol, predicted and (with --validate-subjects) obtained.
 #include "basics/csv.h"
 #include "basics/format.h"
 #include "basics/output_folder.h"
 #include "basics/plot.h"
 #include "cli/commands.h"
-#include "identification/experiment_design.h"
+#include "studies/experiment_design.h"
+#include "studies/torque_validation.h"
 
 #include <cmath>
 #include <cstdio>
@@ -85,7 +86,7 @@ void runDesign(const DesignOptions& o) {
     OutputFolder out(o.out, OutputFolder::Mode::AddFiles);
     const std::string protocolPath = out.getTargetPath("designed_protocol.yaml");
     out.write("designed_protocol.yaml",
-                        "# Written by `armsim design` (identification/experiment_design.h). Run it with\n"
+                        "# Written by `armsim design` (studies/experiment_design.h). Run it with\n"
                         "#   armsim protocol " + protocolPath + "\n#   armsim validate --truth elbow --protocol " +
                             protocolPath + "\n" + formatTorqueProtocol(d.protocol));
     out.write("design_predictions.csv", formatPredictionsCsv({reference, d.predicted}));

@@ -4,7 +4,7 @@
 #include "basics/output_folder.h"
 #include "basics/plot.h"
 #include "cli/commands.h"
-#include "identification/elbow_identification.h"
+#include "identification/torque_identification.h"
 #include "muscles/muscle_file.h"
 
 #include <cmath>
@@ -36,7 +36,7 @@ void runIdentifyTorque(const IdentifyTorqueOptions& o) {
     to.activation = o.activation;
     to.activationSd = o.activationSd;
     std::string skipped;
-    const std::vector<BicepsEstimate> estimates = identifyTorqueData(prior, data, to, &skipped);
+    const std::vector<MuscleEstimate> estimates = identifyTorqueData(prior, data, to, &skipped);
     if (!skipped.empty()) std::printf("%s\n", skipped.c_str());
     const double noise = findJudgingNoiseLevel(to, estimates);
     const MuscleParameters& b = prior.base.biceps();
@@ -46,7 +46,7 @@ void runIdentifyTorque(const IdentifyTorqueOptions& o) {
                 std::isfinite(o.noiseLevel) ? "--noise-level" : "estimated from the repetitions");
     std::printf("%-13s %9s %21s %9s %21s %10s %12s %6s %8s\n", "method", "M (g)", "95 % interval", "L0T (cm)",
                 "95 % interval", "rms (N m)", "chi2 / dof", "p", "verdict");
-    for (const BicepsEstimate& e : estimates) {
+    for (const MuscleEstimate& e : estimates) {
         const TorqueResidualCheck c = checkTorqueResiduals(data, e, noise);
         std::printf("%-13s %9.1f   [%7.1f, %7.1f] %9.2f   [%7.2f, %7.2f] %10.2f %6.1f / %-4d %6.3f %8s%s\n",
                     e.method.c_str(), 1000 * e.mass, 1000 * e.massLower, 1000 * e.massUpper, 100 * e.tendonLength,
@@ -56,12 +56,12 @@ void runIdentifyTorque(const IdentifyTorqueOptions& o) {
     std::printf("verdict: 'noise' = residuals consistent with the measurement noise (chi-square p >= 0.05), "
                 "'misfit' = larger than the noise explains\n");
     std::printf("%-9s %6s %6s %4s %11s", "effort", "angle", "level", "rep", "measured");
-    for (const BicepsEstimate& e : estimates) std::printf(" %13s", e.method.c_str());
+    for (const MuscleEstimate& e : estimates) std::printf(" %13s", e.method.c_str());
     std::printf("   (predicted torque, N m)\n");
     for (std::size_t k = 0; k < data.size(); ++k) {
         const TorqueObservation& d = data[k];
         std::printf("%-9s %6.1f %6.2f %4d %11.2f", getEffortName(d.effort), d.flexionDeg, d.level, d.repetition, d.torque);
-        for (const BicepsEstimate& e : estimates) {
+        for (const MuscleEstimate& e : estimates) {
             std::printf(" %13.2f", e.predictedTorque[k]);
         }
         std::printf("\n");

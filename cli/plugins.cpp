@@ -2,7 +2,7 @@
 
 #include "basics/errors.h"
 #include "basics/files.h"
-#include "identification/study_mpi.h"
+#include "studies/study_mpi.h"
 
 #ifdef ARMSIM_WITH_RENDER
 #include "render/render_plugin.h"

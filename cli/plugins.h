@@ -19,7 +19,7 @@ const RenderPlugin& getRenderPlugin(const std::string& option);
 /// copy of the interruption flag.
 void forwardInterruption(int sig);
 
-/// Studies over MPI ranks (identification/study_mpi.h). InputError saying how to get MPI when the
+/// Studies over MPI ranks (studies/study_mpi.h). InputError saying how to get MPI when the
 /// plugin is missing (built without libopenmpi-dev).
 const StudyMpiPlugin& getStudyMpiPlugin();
 

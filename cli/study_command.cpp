@@ -2,8 +2,8 @@
 #include "basics/errors.h"
 #include "cli/commands.h"
 #include "cli/plugins.h"
-#include "identification/study.h"
-#include "identification/study_mpi.h"
+#include "studies/study.h"
+#include "studies/study_mpi.h"
 
 #include <fmt/format.h>
 

@@ -9,7 +9,7 @@
 #include "experiments/protocol.h"
 #include "experiments/torque_protocol.h"
 #include "identification/observations.h"
-#include "identification/study.h"
+#include "studies/study.h"
 #include "model/arm_parameters.h"
 #include "model/model_file.h"
 #include "muscles/activation.h"

@@ -2,7 +2,7 @@
 #include "basics/format.h"
 #include "basics/portable_random.h"
 #include "identification/solver_context.h"
-#include "identification/statistics.h"
+#include "estimation/statistics.h"
 
 #include <ceres/ceres.h>
 

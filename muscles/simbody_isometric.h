@@ -5,7 +5,7 @@
 #include "basics/table.h"
 #include "muscles/activation.h"
 #include "muscles/simbody.h"
-#include "muscles/stiff_ode.h"
+#include "numerics/stiff_ode.h"
 #include "muscles/virtual_muscle.h"
 
 #include <functional>

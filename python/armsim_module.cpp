@@ -5,7 +5,7 @@
 #include "basics/angles.h"
 #include "basics/bound.h"
 #include "basics/files.h"
-#include "identification/study.h"
+#include "studies/study.h"
 #include "model/mvc_curve.h"
 #include "model/trial.h"
 #include "muscles/simbody_isometric.h"

@@ -6,11 +6,11 @@
 #include "basics/bound.h"
 #include "basics/files.h"
 #include "experiments/protocol.h"
-#include "identification/elbow_identification.h"
-#include "identification/experiment_design.h"
+#include "studies/torque_validation.h"
+#include "studies/experiment_design.h"
 #include "identification/forward_choice.h"
 #include "identification/report_io.h"
-#include "identification/validation.h"
+#include "studies/validation.h"
 #include "python/module_support.h"
 
 #include <cmath>
@@ -152,7 +152,7 @@ py::dict toDict(const std::vector<TorqueObservation>& data) {
     return d;
 }
 
-py::dict toDict(const BicepsEstimate& e) {
+py::dict toDict(const MuscleEstimate& e) {
     py::dict d;
     d["method"] = e.method;
     d["converged"] = e.converged;
@@ -314,7 +314,7 @@ py::list identifyTorquePy(const py::object& data, const py::object& population, 
     o.noiseLevel = optionalNumber(noiseLevel, "noise_level");
     o.activation = optionalNumber(activation, "activation");
     o.activationSd = activationSd;
-    std::vector<BicepsEstimate> estimates;
+    std::vector<MuscleEstimate> estimates;
     std::string skipped;
     {
         py::gil_scoped_release release;
@@ -323,7 +323,7 @@ py::list identifyTorquePy(const py::object& data, const py::object& population, 
     if (!skipped.empty() && PyErr_WarnEx(PyExc_UserWarning, skipped.c_str(), 1) != 0) throw py::error_already_set();
     const double noise = findJudgingNoiseLevel(o, estimates);
     py::list l;
-    for (const BicepsEstimate& e : estimates) {
+    for (const MuscleEstimate& e : estimates) {
         py::dict d = toDict(e);
         const TorqueResidualCheck c = checkTorqueResiduals(obs, e, noise);
         py::dict check;

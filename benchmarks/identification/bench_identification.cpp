@@ -3,7 +3,7 @@
 // the loop, warm-started from steady lm, and as corrections of the steady model. Counters:
 // forward_evaluations (ForceModel::calcForces calls; faithful: five arm trials each), iterations, and
 // thesis_iterations = 52 (thesis Table 7.2, one forward run per iteration) for comparison.
-#include "identification/elbow_identification.h"
+#include "identification/torque_identification.h"
 #include "identification/faithful_model.h"
 #include "identification/identifier.h"
 #include "model/geometry.h"
@@ -141,7 +141,7 @@ void BM_SynergistAwareIdentification(benchmark::State& state) {
     static const std::vector<TorqueObservation> data = synthesizeTorqueData(drawSubject(population, 1, 0), {}, 1, 2);
     double error = 0;
     for (auto _ : state) {
-        const BicepsEstimate e = identifySynergistAware(population, data);
+        const MuscleEstimate e = identifySynergistAware(population, data);
         error = e.mass / drawSubject(population, 1, 0).setup.biceps().mass - 1;
     }
     state.counters["mass_error_pct"] = 100 * error;

@@ -5,7 +5,6 @@
 #include "basics/errors.h"
 #include "identification/faithful_model.h"
 #include "identification/identifier.h"
-#include "identification/validation.h"
 #include "model/geometry.h"
 #include "model/muscle_arm.h"
 #include "test_support.h"
@@ -193,24 +192,4 @@ TEST(FaithfulIdentification, ModelChecksRecordBothModelsResiduals) {
     EXPECT_TRUE(r.checks[1].failure.empty()) << r.checks[1].failure;
     // At the steady estimate the faithful model does not reproduce its own data.
     EXPECT_GT(r.checks[1].rmsResidual, kForceTol);
-}
-
-TEST(Validation, TinyRunRecoversTheThesisTruthAndWritesOneRowPerMethodAndNoiseLevel) {
-    const Fixture f;
-    ValidationSettings s;
-    s.seeds = 0;
-    s.noiseLevels = {0.0, 0.02};
-    s.methods = {Method::LevenbergMarquardt};
-    const std::vector<ValidationRow> rows = runValidation(f.setup.arm, f.base, s);
-    ASSERT_EQ(rows.size(), 2u);
-    EXPECT_EQ(rows[0].truth, "thesis");
-    EXPECT_LT(std::abs(rows[0].massError), kRecoveryTol) << rows[0].mass;
-    EXPECT_LT(std::abs(rows[0].tendonLengthError), kRecoveryTol) << rows[0].tendonLength;
-    EXPECT_GT(std::abs(rows[1].massError), std::abs(rows[0].massError));  // noise moves the estimate
-    EXPECT_NE(rows[1].massCovered, -1);                                    // lm with n > p has intervals
-    const std::string csv = formatValidationCsv(rows);
-    EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 3);
-    EXPECT_NE(formatValidationTable(rows).find("lm"), std::string::npos);
-    s.noiseLevels = {0.6};
-    EXPECT_THROW(runValidation(f.setup.arm, f.base, s), InputError);
 }

@@ -3,9 +3,9 @@
 // identifiers run together and their residual check.
 #include "basics/errors.h"
 #include "basics/table.h"
-#include "identification/elbow_identification.h"
+#include "identification/torque_identification.h"
 #include "identification/forward_choice.h"
-#include "identification/statistics.h"
+#include "estimation/statistics.h"
 #include "model/geometry.h"
 #include "muscles/muscle_file.h"
 #include "test_support.h"
@@ -121,7 +121,7 @@ TEST(TorqueIdentification, RunsThesisOnlyWithMvcsAtTwoAnglesAndChecksResidualsIn
     std::vector<TorqueObservation> data = readTorqueData(findAsset("measured/thesis_mvc_torque.csv"));
     TorqueIdentificationOptions o;
     o.activation = 0.95;
-    const std::vector<BicepsEstimate> all = identifyTorqueData(prior, data, o);
+    const std::vector<MuscleEstimate> all = identifyTorqueData(prior, data, o);
     ASSERT_EQ(all.size(), 3u);
     EXPECT_EQ(all[0].method, "thesis");
     EXPECT_EQ(all[2].method, "synergist-va");
@@ -147,7 +147,7 @@ TEST(TorqueIdentification, RunsThesisOnlyWithMvcsAtTwoAnglesAndChecksResidualsIn
     for (const TorqueObservation& d : data)
         if (d.flexionDeg == data[0].flexionDeg) oneAngle.push_back(d);
     std::string skipped;
-    const std::vector<BicepsEstimate> some = identifyTorqueData(prior, oneAngle, {}, &skipped);
+    const std::vector<MuscleEstimate> some = identifyTorqueData(prior, oneAngle, {}, &skipped);
     ASSERT_EQ(some.size(), 1u);
     EXPECT_EQ(some[0].method, "synergist");
     EXPECT_NE(skipped.find("thesis method: skipped"), std::string::npos) << skipped;

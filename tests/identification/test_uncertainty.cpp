@@ -1,6 +1,6 @@
 // Standard errors, intervals and their coverage (lm).
 #include "identification/identifier.h"
-#include "identification/statistics.h"
+#include "estimation/statistics.h"
 #include "test_support.h"
 
 #include <random>

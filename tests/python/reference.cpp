@@ -3,8 +3,8 @@
 // trial, identification (steady lm with intervals; torque data with every elbow method), the elbow
 // validation, experiment design, a torque protocol, and a rendered frame.
 #include "experiments/protocol.h"
-#include "identification/elbow_identification.h"
-#include "identification/experiment_design.h"
+#include "studies/torque_validation.h"
+#include "studies/experiment_design.h"
 #include "identification/forward_choice.h"
 #include "model/geometry.h"
 #include "model/mvc_curve.h"
@@ -96,10 +96,10 @@ int main() {
     // Torque data with every elbow method (measured VA 0.95).
     TorqueIdentificationOptions to;
     to.activation = 0.95;
-    const std::vector<BicepsEstimate> torqueEstimates =
+    const std::vector<MuscleEstimate> torqueEstimates =
         identifyTorqueData(loadDefaultPopulation(), readTorqueData(findAsset("measured/thesis_mvc_torque.csv")), to);
     std::vector<double> torqueMasses;
-    for (const BicepsEstimate& e : torqueEstimates) torqueMasses.push_back(e.mass);
+    for (const MuscleEstimate& e : torqueEstimates) torqueMasses.push_back(e.mass);
     printList("identify_torque_masses", torqueMasses);
 
     ElbowValidationSettings v;

@@ -1,0 +1,328 @@
+#include "identification/synergist_identifier.h"
+
+#include "basics/bound.h"
+#include "basics/portable_random.h"
+#include "estimation/map_estimate.h"
+#include "estimation/statistics.h"
+#include "model/geometry.h"
+#include "model/trial.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <tuple>
+
+namespace armsim {
+
+namespace {
+
+// Tared steady torque at each angle of the geometry: the curve of an effort of `group` less the
+// relaxed one, summed over the muscles not left out. Throws SimulationError when a muscle has no steady
+// state.
+std::vector<double> calcTaredTorque(const std::vector<MuscleSpec>& muscles, const MvcGeometry& g, MuscleGroup group,
+                                    const SubjectEffort& effort, const SteadyMvcCurve& relaxed,
+                                    const std::vector<int>& leftOut = {}) {
+    const SteadyMvcCurve active = calcSteadyMvcCurve(muscles, g, group, effort);
+    std::vector<double> torque;
+    for (std::size_t a = 0; a < g.flexionDeg.size(); ++a) {
+        double t = 0;
+        for (std::size_t i = 0; i < muscles.size(); ++i)
+            if (std::find(leftOut.begin(), leftOut.end(), int(i)) == leftOut.end())
+                t += active.points[a][i].torque - relaxed.points[a][i].torque;
+        torque.push_back(t);
+    }
+    return torque;
+}
+
+SteadyMvcCurve calcRelaxedCurve(const std::vector<MuscleSpec>& muscles, const MvcGeometry& g) {
+    return calcSteadyMvcCurve(muscles, g, MuscleGroup::Flexor, SubjectEffort{0, 0});
+}
+
+// The effort of a condition at level l: agonists l VA, antagonists l CC.
+SubjectEffort makeEffort(double level, double voluntaryActivation, double coContraction) {
+    SubjectEffort e;
+    e.voluntaryActivation = level * voluntaryActivation;
+    e.coContraction = level * coContraction;
+    return e;
+}
+
+std::vector<int> findMuscles(const ArmSetup& setup, const std::vector<std::string>& names, const char* what) {
+    std::vector<int> out;
+    for (const std::string& n : names) {
+        try {
+            out.push_back(setup.findMuscle(n));
+        } catch (const InputError& e) {
+            throw InputError(std::string("synergist-aware identifier: ") + what + ": " + e.what());
+        }
+    }
+    return out;
+}
+
+// Relative torque sd pooled over the conditions' repetitions (NaN without repetitions) and its degrees
+// of freedom.
+std::pair<double, int> estimateNoiseLevel(const std::vector<TorqueObservation>& data) {
+    std::map<std::tuple<double, int, double>, std::vector<double>> byCondition;
+    for (const TorqueObservation& o : data) byCondition[{o.flexionDeg, int(o.effort), o.level}].push_back(o.torque);
+    double ss = 0;
+    int dof = 0;
+    for (const auto& [condition, v] : byCondition) {
+        if (v.size() < 2) continue;
+        double m = 0;
+        for (double x : v) m += x;
+        m /= double(v.size());
+        for (double x : v) ss += (x / m - 1) * (x / m - 1);
+        dof += int(v.size()) - 1;
+    }
+    return {dof > 0 ? std::sqrt(ss / dof) : NAN, dof};
+}
+
+}  // namespace
+
+std::vector<double> calcTaredSteadyTorque(const ArmSetup& setup, const SubjectEffort& effort,
+                                          const std::vector<double>& flexionDeg, MuscleGroup group) {
+    const MvcGeometry g = calcMvcGeometry(setup, flexionDeg);
+    return calcTaredTorque(setup.muscles, g, group, effort, calcRelaxedCurve(setup.muscles, g));
+}
+
+SynergistModel::SynergistModel(const Population& prior, const SynergistOptions& options,
+                               const std::vector<TorqueCondition>& conditions)
+    : base_(&prior.base) {
+    const ArmSetup& base = prior.base;
+    biceps_ = findMuscles(base, options.biceps, "biceps");
+    synergists_ = findMuscles(base, options.synergists, "synergists");
+    if (!options.includeSynergists) leftOut_ = synergists_;
+    for (int i = 0; i < base.getNumMuscles(); ++i)
+        if (base.muscles[i].group == MuscleGroup::Extensor) extensors_.push_back(i);
+    if (std::find(biceps_.begin(), biceps_.end(), base.primary) == biceps_.end())
+        throw InputError("synergist-aware identifier: the primary muscle '" + base.muscles[base.primary].params.name +
+                         "' is not in the biceps group");
+    std::vector<double> angles;
+    for (const TorqueCondition& c : conditions) {
+        auto it = std::find(angles.begin(), angles.end(), c.flexionDeg);
+        angleOf_.push_back(int(it - angles.begin()));
+        if (it == angles.end()) angles.push_back(c.flexionDeg);
+        auto kt = std::find_if(kinds_.begin(), kinds_.end(),
+                               [&](const EffortKind& k) { return k.group == c.effort && k.level == c.level; });
+        kindOf_.push_back(int(kt - kinds_.begin()));
+        if (kt == kinds_.end()) kinds_.push_back({c.effort, c.level});
+    }
+    geometry_ = calcMvcGeometry(base, angles);
+
+    const int n = getNumParameters();
+    const double s2 = prior.strengthSubjectSd * prior.strengthSubjectSd;
+    const double m2 = prior.strengthMuscleSd * prior.strengthMuscleSd;
+    auto uniformSd = [](const UniformRange& r) { return std::max((r.max - r.min) / std::sqrt(12.0), 1e-4); };
+    priorCovariance_.assign(n, std::vector<double>(n, 0.0));
+    auto& cov = priorCovariance_;
+    std::vector<int> masses = {kExtensorMass};
+    for (int a = kFirstMass; a < n; ++a) masses.push_back(a);
+    for (int a : masses)
+        for (int b : masses) cov[a][b] = s2;
+    cov[kBicepsSlow][kBicepsSlow] = cov[kSynergistSlow][kSynergistSlow] = std::pow(prior.slowFractionSd, 2);
+    cov[kExtensorMass][kExtensorMass] += m2 / double(std::max<std::size_t>(extensors_.size(), 1));
+    for (int a = kFirstMass; a < n; ++a) cov[a][a] += m2;
+    cov[kTendon][kTendon] = cov[kSynergistTendon][kSynergistTendon] = std::pow(prior.tendonLengthSd, 2);
+    cov[kFascicle][kFascicle] = cov[kSynergistFascicle][kSynergistFascicle] = std::pow(prior.fascicleLengthSd, 2);
+    cov[kActivation][kActivation] = std::pow(uniformSd(prior.voluntaryActivation), 2);
+    cov[kCoContraction][kCoContraction] = std::pow(uniformSd(prior.coContraction), 2);
+    for (int j = 0; j < n; ++j) cov[j][j] = std::max(cov[j][j], 1e-10);  // a zero spread: the value is known
+    priorMean_.assign(n, 0.0);
+    priorMean_[kActivation] = 0.5 * (prior.voluntaryActivation.min + prior.voluntaryActivation.max);
+    priorMean_[kCoContraction] = 0.5 * (prior.coContraction.min + prior.coContraction.max);
+    const double lnLo = std::log(0.25), lnHi = std::log(4.0), lenLo = std::log(0.6), lenHi = std::log(1.4);
+    lower_.assign(n, lnLo);
+    upper_.assign(n, lnHi);
+    for (int j : {kTendon, kFascicle, kSynergistTendon, kSynergistFascicle}) {
+        lower_[j] = lenLo;
+        upper_[j] = lenHi;
+    }
+    // Activations stay 1e-5 inside [0, 1], so the Jacobian's difference probes (relative step 1e-6) do
+    // not cross the model's domain; a range of zero width holds the value fixed.
+    auto inside = [](double v) { return std::clamp(v, 1e-5, 1 - 1e-5); };
+    for (int j : {kBicepsSlow, kSynergistSlow}) {
+        lower_[j] = options.freeSlowFraction ? -0.3 : 0.0;
+        upper_[j] = options.freeSlowFraction ? 0.3 : 0.0;
+    }
+    lower_[kActivation] = inside(prior.voluntaryActivation.min);
+    upper_[kActivation] = inside(prior.voluntaryActivation.max);
+    lower_[kCoContraction] = inside(prior.coContraction.min);
+    upper_[kCoContraction] = inside(prior.coContraction.max);
+    for (int j : {kActivation, kCoContraction}) priorMean_[j] = std::clamp(priorMean_[j], lower_[j], upper_[j]);
+}
+
+std::vector<std::string> SynergistModel::getParameterNames() const {
+    std::vector<std::string> names = {"ln_biceps_tendon_scale", "voluntary_activation", "co_contraction",
+                                      "ln_biceps_fascicle_scale", "ln_synergist_tendon_scale",
+                                      "ln_synergist_fascicle_scale", "ln_extensor_mass_scale",
+                                      "biceps_slow_fraction_shift", "synergist_slow_fraction_shift"};
+    for (int i : biceps_) names.push_back("ln_" + base_->muscles[i].params.name + "_mass_scale");
+    for (int i : synergists_) names.push_back("ln_" + base_->muscles[i].params.name + "_mass_scale");
+    return names;
+}
+
+int SynergistModel::findMassIndex(int muscle) const {
+    for (std::size_t k = 0; k < biceps_.size(); ++k)
+        if (biceps_[k] == muscle) return kFirstMass + int(k);
+    for (std::size_t k = 0; k < synergists_.size(); ++k)
+        if (synergists_[k] == muscle) return kFirstMass + int(biceps_.size() + k);
+    return -1;
+}
+
+int SynergistModel::getMassIndex() const { return findMassIndex(base_->primary); }
+
+std::vector<int> SynergistModel::getFlexorMassIndices() const {
+    std::vector<int> out;
+    for (std::size_t k = 0; k < biceps_.size() + synergists_.size(); ++k) out.push_back(kFirstMass + int(k));
+    return out;
+}
+
+std::vector<MuscleSpec> SynergistModel::makeMuscles(const double* x) const {
+    std::vector<MuscleSpec> m = base_->muscles;
+    for (std::size_t k = 0; k < biceps_.size(); ++k) {
+        MuscleParameters& q = m[biceps_[k]].params;
+        q.mass *= std::exp(x[kFirstMass + k]);
+        q.optimalTendonLength *= std::exp(x[kTendon]);
+        q.optimalFascicleLength *= std::exp(x[kFascicle]);
+        q.slowFraction = std::clamp(q.slowFraction + x[kBicepsSlow], 0.05, 0.95);
+    }
+    for (std::size_t k = 0; k < synergists_.size(); ++k) {
+        MuscleParameters& q = m[synergists_[k]].params;
+        q.mass *= std::exp(x[kFirstMass + biceps_.size() + k]);
+        q.optimalTendonLength *= std::exp(x[kSynergistTendon]);
+        q.optimalFascicleLength *= std::exp(x[kSynergistFascicle]);
+        q.slowFraction = std::clamp(q.slowFraction + x[kSynergistSlow], 0.05, 0.95);
+    }
+    for (int i : extensors_) m[i].params.mass *= std::exp(x[kExtensorMass]);
+    return m;
+}
+
+std::vector<double> SynergistModel::calcTorques(const double* x) const {
+    // Guard: the bounds keep difference probes inside [0, 1].
+    const double va = std::clamp(x[kActivation], 0.0, 1.0), cc = std::clamp(x[kCoContraction], 0.0, 1.0);
+    const std::vector<MuscleSpec> muscles = makeMuscles(x);
+    const SteadyMvcCurve relaxed = calcRelaxedCurve(muscles, geometry_);
+    std::vector<std::vector<double>> byKind;
+    for (const EffortKind& k : kinds_)
+        byKind.push_back(calcTaredTorque(muscles, geometry_, k.group, makeEffort(k.level, va, cc), relaxed, leftOut_));
+    std::vector<double> t;
+    for (std::size_t c = 0; c < angleOf_.size(); ++c) t.push_back(byKind[kindOf_[c]][angleOf_[c]]);
+    return t;
+}
+
+MuscleEstimate identifySynergistAware(const Population& prior, const std::vector<TorqueObservation>& data,
+                                      const SynergistOptions& options) {
+    if (data.empty()) throw InputError("synergist-aware identifier: no observations");
+    const bool measured = std::isfinite(options.measuredActivation);
+    if (measured) {
+        checkField("measured voluntary activation", options.measuredActivation, Bound::closed(0, 1));
+        checkField("activation sd", options.activationSd, Bound::positive());
+    }
+    // One condition per observation: the model computes each distinct angle and effort kind once.
+    std::vector<TorqueCondition> conditions;
+    std::vector<double> torque;
+    for (const TorqueObservation& o : data) {
+        conditions.push_back({o.flexionDeg, o.effort, o.level, 1});
+        torque.push_back(o.torque);
+    }
+    const SynergistModel model(prior, options, conditions);
+
+    MuscleEstimate est;
+    est.method = measured ? "synergist-va" : "synergist";
+    std::tie(est.noiseLevel, est.noiseDegreesOfFreedom) = estimateNoiseLevel(data);
+    if (std::isfinite(options.noiseLevel)) {
+        checkField("noise level", options.noiseLevel, Bound{0, 0.5, true, true, "relative sd"});
+        est.noiseLevel = options.noiseLevel;
+        est.noiseDegreesOfFreedom = 0;
+    } else if (!std::isfinite(est.noiseLevel)) {
+        est.noiseLevel = prior.transducerNoise;
+        est.noiseDegreesOfFreedom = 0;
+    }
+    est.noiseLevel = std::max(est.noiseLevel, 0.002);  // floor: the scatter of few repetitions can be ~0
+    std::vector<double> sd;
+    for (double t : torque) sd.push_back(est.noiseLevel * std::max(std::abs(t), 1.0));
+
+    using P = SynergistModel;
+    MapProblem map;
+    map.priorMean = model.getPriorMean();
+    map.priorCovariance = model.getPriorCovariance();
+    map.lower = model.getLower();
+    map.upper = model.getUpper();
+    map.numResiduals = int(torque.size()) + (measured ? 1 : 0);
+    map.residuals = [&](const double* x, double* r) {
+        if (measured) r[torque.size()] = (x[P::kActivation] - options.measuredActivation) / options.activationSd;
+        std::vector<double> t;
+        try {
+            t = model.calcTorques(x);
+        } catch (const std::exception&) {
+            return false;
+        }
+        for (std::size_t k = 0; k < torque.size(); ++k) r[k] = (t[k] - torque[k]) / sd[k];
+        return true;
+    };
+    const MapResult m = calcMapEstimate(map);
+    const std::vector<double>& x = m.x;
+    est.converged = m.converged;
+    est.message = m.message;
+    est.iterations = m.iterations;
+    if (m.failed) return est;  // no estimate: mass and tendon length stay NaN
+
+    const ArmSetup& base = prior.base;
+    const MuscleParameters& b = base.muscles[base.primary].params;
+    const int im = model.getMassIndex();
+    est.numParameters = model.getNumParameters();
+    est.mass = b.mass * std::exp(x[im]);
+    est.tendonLength = b.optimalTendonLength * std::exp(x[P::kTendon]);
+    est.nuisanceNames = {"voluntary_activation", "co_contraction", "biceps_fascicle_scale", "synergist_tendon_scale",
+                         "synergist_fascicle_scale", "extensor_mass_scale"};
+    est.nuisance = {x[P::kActivation], x[P::kCoContraction], std::exp(x[P::kFascicle]),
+                    std::exp(x[P::kSynergistTendon]), std::exp(x[P::kSynergistFascicle]), std::exp(x[P::kExtensorMass])};
+    if (options.freeSlowFraction) {
+        est.nuisanceNames.insert(est.nuisanceNames.end(), {"biceps_slow_fraction_shift", "synergist_slow_fraction_shift"});
+        est.nuisance.insert(est.nuisance.end(), {x[P::kBicepsSlow], x[P::kSynergistSlow]});
+    }
+    for (int i = 0; i < base.getNumMuscles(); ++i) {
+        const int k = model.findMassIndex(i);
+        if (k < 0 || i == base.primary) continue;
+        est.nuisanceNames.push_back(base.muscles[i].params.name + "_mass_scale");
+        est.nuisance.push_back(std::exp(x[k]));
+    }
+    try {
+        const std::vector<double> t = model.calcTorques(x.data());
+        double ss = 0;
+        for (std::size_t k = 0; k < torque.size(); ++k) {
+            est.predictedTorque.push_back(t[k]);
+            ss += std::pow(t[k] - torque[k], 2);
+        }
+        est.rmsResidual = std::sqrt(ss / double(torque.size()));
+    } catch (const std::exception& e) {
+        est.converged = false;
+        est.message += "; no steady state at the estimate: " + std::string(e.what());
+        return est;
+    }
+    if (!m.covariance.empty()) {
+        const double quantile = est.noiseDegreesOfFreedom > 0 ? calcStudentTQuantile(0.975, est.noiseDegreesOfFreedom)
+                                                          : calcNormalQuantile(0.975);
+        const double sm = std::sqrt(m.covariance[im][im]), st = std::sqrt(m.covariance[P::kTendon][P::kTendon]);
+        est.massLower = b.mass * std::exp(x[im] - quantile * sm);
+        est.massUpper = b.mass * std::exp(x[im] + quantile * sm);
+        est.tendonLower = b.optimalTendonLength * std::exp(x[P::kTendon] - quantile * st);
+        est.tendonUpper = b.optimalTendonLength * std::exp(x[P::kTendon] + quantile * st);
+        est.massTendonCorrelation = m.covariance[im][P::kTendon] / (sm * st);
+    }
+    return est;
+}
+
+double measureVoluntaryActivation(const std::vector<TorqueObservation>& data, double sd, unsigned seed) {
+    checkField("activation sd", sd, Bound::nonNegative());
+    PortableRandom rng{seed};
+    double mean = 0;
+    int n = 0;
+    for (const TorqueObservation& o : data)
+        if (o.level == 1) mean += o.activation, ++n;
+    if (n == 0) throw InputError("measureVoluntaryActivation: no maximal efforts (twitch interpolation needs MVCs)");
+    mean /= n;
+    return std::clamp(mean + sd * rng.drawNormal(), 0.0, 1.0);
+}
+
+
+}  // namespace armsim

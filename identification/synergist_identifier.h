@@ -1,0 +1,107 @@
+// The synergist-aware identifier: a maximum a posteriori fit of the net tared joint torque predicted
+// by the whole model (every muscle at its steady state), with the population as prior. Free: a log
+// mass scale per biceps head and per synergist, one for the extensors, the biceps heads' tendon and
+// fascicle length scales, the synergists' tendon and fascicle scales, voluntary activation VA and
+// co-contraction CC (and optionally the flexors' slow-fibre fractions). Data residuals are weighted by
+// a relative noise level estimated from the repetitions' scatter; the posterior covariance is the
+// Laplace approximation; 95 % intervals are symmetric in the log scales (Student-t quantile with the
+// noise estimate's degrees of freedom), so the M and L0T intervals are exp-transformed. With VA
+// measured by twitch interpolation it has one more residual ("synergist-va").
+#pragma once
+
+#include "experiments/torque_protocol.h"
+#include "identification/torque_estimate.h"
+#include "model/mvc_curve.h"
+
+#include <string>
+#include <vector>
+
+namespace armsim {
+
+/// The synergist-aware identifier's model and extra measurements.
+struct SynergistOptions {
+    /// Which muscles the model groups (names in the population's base model).
+    std::vector<std::string> biceps = {"BIClong", "BICshort"};  ///< share s_b and t_b
+    std::vector<std::string> synergists = {"BRA", "BRD"};       ///< share s_s
+    /// false: the synergists are left out of the identifier's model (no torque from them): the
+    /// ablation that shows what they are for.
+    bool includeSynergists = true;
+    // Every extensor shares s_e.
+    /// The subject's voluntary activation measured by twitch interpolation (superimposed stimulation
+    /// during the MVCs) [1]; NaN: not measured. Adds the residual (VA - measured) / activationSd.
+    double measuredActivation = 0.0 / 0.0;
+    double activationSd = 0.02;  ///< sd of that measurement [1] (an assumption, see measureVoluntaryActivation)
+    /// Free the flexors' slow-fibre fractions (one shift for the biceps heads, one for the synergists;
+    /// prior sd the population's): submaximal efforts depend on them.
+    bool freeSlowFraction = false;
+    /// Relative sd of one trial's torque [1]; NaN: estimated from the repetitions (pooled over the
+    /// conditions), or the population's transducer noise when nothing is repeated.
+    double noiseLevel = 0.0 / 0.0;
+};
+
+/// The synergist-aware identifier's model: its parameters x, their prior and bounds, and the tared
+/// steady torque it predicts for a list of effort conditions (also used by experiment design).
+/// x = [ln t_b, VA, CC, ln f_b, ln t_s, ln f_s, ln s_e, d_b, d_s, then ln s_m for every biceps head and
+/// synergist m]: t tendon, f fascicle length and s mass scales; b the biceps heads (one tendon and one
+/// fascicle scale), s the synergists, e the extensors (one mass scale); d the change of the slow-fibre
+/// fraction F_slow (added, biceps heads and synergists; held at 0 unless freeSlowFraction). Prior: every mass scale shares the
+/// person-level variance (the extensors' one scale averages their muscle terms); lengths and effort
+/// independent, effort uniform ranges as their mean and sd.
+class SynergistModel {
+public:
+    /// Throws InputError for muscle names not in the population's model or a primary muscle that is
+    /// not in the biceps group. Conditions may repeat (each distinct angle and effort kind is computed
+    /// once); their repetitions are ignored.
+    SynergistModel(const Population& prior, const SynergistOptions& options,
+                   const std::vector<TorqueCondition>& conditions);
+    int getNumParameters() const { return kFirstMass + int(biceps_.size() + synergists_.size()); }
+    std::vector<std::string> getParameterNames() const;
+    int getMassIndex() const;                 ///< ln M of the primary muscle
+    std::vector<int> getFlexorMassIndices() const;  ///< the biceps heads' and synergists' ln mass scales
+    static constexpr int getTendonIndex() { return kTendon; }          ///< ln t_b
+    static constexpr int getActivationIndex() { return kActivation; }  ///< VA
+    const std::vector<double>& getPriorMean() const { return priorMean_; }
+    const std::vector<std::vector<double>>& getPriorCovariance() const { return priorCovariance_; }
+    const std::vector<double>& getLower() const { return lower_; }
+    const std::vector<double>& getUpper() const { return upper_; }
+    /// Tared torque of every condition at x [N m]; throws SimulationError where a muscle has no steady state.
+    std::vector<double> calcTorques(const double* x) const;
+    /// The population's model with x's muscles.
+    std::vector<MuscleSpec> makeMuscles(const double* x) const;
+
+private:
+    static constexpr int kTendon = 0, kActivation = 1, kCoContraction = 2, kFascicle = 3, kSynergistTendon = 4,
+                         kSynergistFascicle = 5, kExtensorMass = 6, kBicepsSlow = 7, kSynergistSlow = 8,
+                         kFirstMass = 9;
+    struct EffortKind {
+        MuscleGroup group;
+        double level;
+    };
+    int findMassIndex(int muscle) const;
+    const ArmSetup* base_;
+    std::vector<int> biceps_, synergists_, extensors_, leftOut_;
+    MvcGeometry geometry_;
+    std::vector<EffortKind> kinds_;
+    std::vector<int> angleOf_, kindOf_;       // condition -> angle index, effort kind
+    std::vector<double> priorMean_, lower_, upper_;
+    std::vector<std::vector<double>> priorCovariance_;
+    friend MuscleEstimate identifySynergistAware(const Population&, const std::vector<TorqueObservation>&,
+                                                 const SynergistOptions&);
+};
+
+/// The synergist-aware MAP identifier with the population as prior.
+MuscleEstimate identifySynergistAware(const Population& prior, const std::vector<TorqueObservation>& data,
+                                      const SynergistOptions& options = {});
+
+/// A twitch-interpolation measurement of the subject's voluntary activation: the mean activation of
+/// the efforts actually produced, plus N(0, sd^2) measurement error, within [0, 1]. The default sd
+/// 0.02 is an assumption for a practised lab, not a cited value.
+double measureVoluntaryActivation(const std::vector<TorqueObservation>& data, double sd, unsigned seed);
+
+/// Net tared steady torque of `setup` at the angles [N m]: every muscle at its steady state with the
+/// agonists of `group` at `effort`'s voluntary activation and the antagonists at its co-contraction,
+/// less the same with every muscle relaxed (what a tared transducer reads at the plateau of an effort).
+std::vector<double> calcTaredSteadyTorque(const ArmSetup& setup, const SubjectEffort& effort,
+                                          const std::vector<double>& flexionDeg, MuscleGroup group = MuscleGroup::Flexor);
+
+}  // namespace armsim

@@ -1,0 +1,32 @@
+// An identifier's estimate of the primary muscle's mass and optimal tendon length, with intervals and
+// the nuisance parameters: the result every torque-data identifier returns.
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace armsim {
+
+/// An identifier's estimate of the primary muscle (the biceps long head).
+struct MuscleEstimate {
+    std::string method;                  ///< "thesis", "synergist" or "synergist-va"
+    bool converged = false;
+    std::string message;                 ///< solver summary or why it failed
+    double mass = 0.0 / 0.0;             ///< M [kg]
+    double tendonLength = 0.0 / 0.0;     ///< L0T [m]
+    double massLower = 0.0 / 0.0, massUpper = 0.0 / 0.0;        ///< 95 % interval [kg]
+    double tendonLower = 0.0 / 0.0, tendonUpper = 0.0 / 0.0;    ///< 95 % interval [m]
+    double noiseLevel = 0.0 / 0.0;       ///< relative torque sd used to weight the data [1]
+    int noiseDegreesOfFreedom = 0;       ///< of that sd's estimate (repetitions); 0: taken as known
+    std::vector<std::string> nuisanceNames;    ///< synergist: activation, co-contraction, length and mass scales
+    std::vector<double> nuisance;              ///< their estimates
+    double massTendonCorrelation = 0.0 / 0.0;  ///< posterior correlation of ln M and ln L0T
+    double rmsResidual = 0.0 / 0.0;            ///< of the torque [N m] (thesis: of the force [N])
+    /// Per observation: the torque the method predicts at the estimate [N m] (thesis: the fitted biceps
+    /// force x the biceps moment arm, flexion MVCs only; NaN elsewhere).
+    std::vector<double> predictedTorque;
+    int numParameters = 0;                     ///< free parameters of the fit
+    int iterations = 0;                        ///< solver iterations
+};
+
+}  // namespace armsim

@@ -1,0 +1,125 @@
+#include "identification/torque_identification.h"
+
+#include "basics/bound.h"
+#include "basics/csv.h"
+#include "estimation/statistics.h"
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+
+namespace armsim {
+
+const std::vector<std::string>& getElbowMethodKinds() {
+    static const std::vector<std::string> kinds = {"thesis", "synergist", "synergist-va"};
+    return kinds;
+}
+
+MuscleEstimate identifyElbowMethod(const ElbowMethod& method, const Population& population,
+                                   const std::vector<TorqueObservation>& data, unsigned seed, int subject) {
+    MuscleEstimate e;
+    if (method.kind == "thesis") {
+        e = identifyThesisMethod(population.base, data);
+    } else if (method.kind == "synergist") {
+        SynergistOptions o = method.options;
+        o.measuredActivation = 0.0 / 0.0;
+        e = identifySynergistAware(population, data, o);
+    } else if (method.kind == "synergist-va") {
+        SynergistOptions o = method.options;
+        checkField("activation_sd", o.activationSd, Bound{0, 0.5, true, false});
+        o.measuredActivation = measureVoluntaryActivation(data, o.activationSd, seed + 7919u * unsigned(subject));
+        e = identifySynergistAware(population, data, o);
+    } else {
+        throw InputError("identifier '" + method.kind + "': expected thesis, synergist or synergist-va");
+    }
+    e.method = method.label.empty() ? method.kind : method.label;
+    return e;
+}
+
+std::string formatTorqueEstimatesCsv(const std::vector<TorqueObservation>& data,
+                                     const std::vector<MuscleEstimate>& estimates, double noiseLevel) {
+    CsvText csv({"method", "converged", "mass_kg", "mass_lower_kg", "mass_upper_kg", "tendon_length_m",
+                 "tendon_lower_m", "tendon_upper_m", "rms_residual_Nm", "chi_square", "dof", "p_value", "noise_level"});
+    for (const MuscleEstimate& e : estimates) {
+        const TorqueResidualCheck c = checkTorqueResiduals(data, e, noiseLevel);
+        CsvRow row;
+        row.addText(e.method).addInteger(e.converged ? 1 : 0).addNumber(e.mass).addNumber(e.massLower);
+        row.addNumber(e.massUpper).addNumber(e.tendonLength).addNumber(e.tendonLower).addNumber(e.tendonUpper);
+        row.addNumber(c.rms).addNumber(c.chiSquare).addInteger(c.dof).addNumber(c.p).addNumber(noiseLevel);
+        csv.addRow(row);
+    }
+    return csv.getText();
+}
+
+std::string formatTorquePredictionsCsv(const std::vector<TorqueObservation>& data,
+                                       const std::vector<MuscleEstimate>& estimates) {
+    std::vector<std::string> header = {"flexion_deg", "effort", "level", "repetition", "torque_Nm"};
+    for (const MuscleEstimate& e : estimates) header.push_back(e.method + "_Nm");
+    CsvText csv(header);
+    for (std::size_t k = 0; k < data.size(); ++k) {
+        const TorqueObservation& d = data[k];
+        CsvRow row;
+        row.addNumber(d.flexionDeg).addInteger(d.effort == MuscleGroup::Flexor ? 1 : -1).addNumber(d.level);
+        row.addInteger(d.repetition).addNumber(d.torque);
+        for (const MuscleEstimate& e : estimates) row.addNumber(e.predictedTorque[k]);
+        csv.addRow(row);
+    }
+    return csv.getText();
+}
+
+void TorqueIdentificationOptions::validate() const {
+    if (!std::isnan(noiseLevel)) checkField("noise_level", noiseLevel, Bound::closed(1e-4, 0.5));
+    if (!std::isnan(activation)) checkField("activation", activation, Bound::closed(0, 1));
+    checkField("activation_sd", activationSd, Bound::closed(1e-4, 0.5));
+}
+
+std::vector<MuscleEstimate> identifyTorqueData(const Population& prior, const std::vector<TorqueObservation>& data,
+                                               const TorqueIdentificationOptions& o, std::string* skipped) {
+    o.validate();
+    std::vector<MuscleEstimate> estimates;
+    std::set<double> mvcAngles;
+    for (const TorqueObservation& d : data)
+        if (d.isFlexionMvc()) mvcAngles.insert(d.flexionDeg);
+    if (skipped) skipped->clear();
+    if (mvcAngles.size() >= 2)
+        estimates.push_back(identifyThesisMethod(prior.base, data));
+    else if (skipped)
+        *skipped = "thesis method: skipped (it fits flexion MVCs at >= 2 angles; these data have " +
+                   std::to_string(mvcAngles.size()) + ")";
+    SynergistOptions so;
+    so.noiseLevel = o.noiseLevel;
+    estimates.push_back(identifySynergistAware(prior, data, so));
+    if (std::isfinite(o.activation)) {
+        so.measuredActivation = o.activation;
+        so.activationSd = o.activationSd;
+        estimates.push_back(identifySynergistAware(prior, data, so));
+    }
+    return estimates;
+}
+
+double findJudgingNoiseLevel(const TorqueIdentificationOptions& o, const std::vector<MuscleEstimate>& estimates) {
+    if (std::isfinite(o.noiseLevel) || estimates.empty()) return o.noiseLevel;
+    return estimates.back().noiseLevel;
+}
+
+TorqueResidualCheck checkTorqueResiduals(const std::vector<TorqueObservation>& data, const MuscleEstimate& e,
+                                         double noise) {
+    TorqueResidualCheck c;
+    double sum = 0, chi = 0;
+    for (std::size_t k = 0; k < data.size() && k < e.predictedTorque.size(); ++k) {
+        if (!std::isfinite(e.predictedTorque[k])) continue;
+        const double residual = e.predictedTorque[k] - data[k].torque;
+        const double sd = noise * std::max(std::abs(data[k].torque), 1.0);
+        sum += residual * residual;
+        chi += std::pow(residual / sd, 2);
+        ++c.n;
+    }
+    c.rms = std::sqrt(sum / std::max(c.n, 1));
+    c.chiSquare = chi;
+    c.dof = std::max(1, c.n - (e.method == "thesis" ? e.numParameters : 0));
+    c.p = calcChiSquareSurvival(c.chiSquare, c.dof);
+    return c;
+}
+
+
+}  // namespace armsim

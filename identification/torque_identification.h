@@ -1,0 +1,70 @@
+// Identification from one person's joint torque data (`armsim identify-torque`, validations and
+// studies): the identifiers by name, the set run on a lab's data, residual checks and the CSV tables.
+#pragma once
+
+#include "identification/synergist_identifier.h"
+#include "identification/thesis_method.h"
+
+#include <string>
+#include <vector>
+
+namespace armsim {
+
+/// Which identifiers identifyTorqueData runs on one person's torque data (as `armsim identify-torque`).
+struct TorqueIdentificationOptions {
+    double noiseLevel = 0.0 / 0.0;   ///< relative sd of one trial's torque [1]; NaN: estimated from repetitions
+    double activation = 0.0 / 0.0;   ///< measured voluntary activation [1]; NaN: not measured (no synergist-va)
+    double activationSd = 0.02;      ///< sd of that measurement [1]
+    /// InputError naming the field (noise_level in [1e-4, 0.5], activation in [0, 1], activation_sd
+    /// in [1e-4, 0.5]).
+    void validate() const;
+};
+
+/// Runs "thesis" (when the data hold flexion MVCs at two or more angles; otherwise *skipped says why),
+/// "synergist" and, with a measured activation, "synergist-va", each with the prior population.
+std::vector<MuscleEstimate> identifyTorqueData(const Population& prior, const std::vector<TorqueObservation>& data,
+                                               const TorqueIdentificationOptions& options = {},
+                                               std::string* skipped = nullptr);
+
+/// An estimate's torque residuals judged against a relative noise level: chi-square with
+/// sd_k = noise * max(|torque_k|, 1 N m). The thesis method's two free parameters are subtracted from
+/// the degrees of freedom; the MAP fits' are not (their prior keeps the effective count lower: a
+/// conservative test for them).
+struct TorqueResidualCheck {
+    double rms = 0.0 / 0.0;      ///< of predicted - measured [N m], over the observations it predicts
+    double chiSquare = 0.0 / 0.0;
+    int n = 0, dof = 0;
+    double p = 0.0 / 0.0;        ///< chi-square tail probability; >= 0.05: consistent with the noise
+};
+TorqueResidualCheck checkTorqueResiduals(const std::vector<TorqueObservation>& data, const MuscleEstimate& estimate,
+                                         double noiseLevel);
+/// torque_estimates.csv of `armsim identify-torque`: per estimate its interval, its residual check against
+/// noiseLevel (checkTorqueResiduals) and the noise level.
+std::string formatTorqueEstimatesCsv(const std::vector<TorqueObservation>& data,
+                                     const std::vector<MuscleEstimate>& estimates, double noiseLevel);
+/// torque_predictions.csv: every observation with each estimate's predicted torque (empty where none).
+std::string formatTorquePredictionsCsv(const std::vector<TorqueObservation>& data,
+                                       const std::vector<MuscleEstimate>& estimates);
+/// The noise level residuals are judged against: the given one, or else the last (synergist) fit's
+/// estimate from the repetitions.
+double findJudgingNoiseLevel(const TorqueIdentificationOptions& options, const std::vector<MuscleEstimate>& estimates);
+
+/// One identifier of a validation or a study, with its options.
+struct ElbowMethod {
+    std::string label;           ///< its name in results (default: the kind)
+    std::string kind = "synergist";  ///< "thesis", "synergist" or "synergist-va"
+    /// synergist kinds: freeSlowFraction, includeSynergists, noiseLevel; synergist-va also activationSd
+    /// (the twitch-interpolation measurement's sd, drawn per subject by measureVoluntaryActivation).
+    SynergistOptions options;
+};
+/// The kinds ElbowMethod::kind may name.
+const std::vector<std::string>& getElbowMethodKinds();
+
+/// Identifies `data` of person `subject` with `method` (population as the synergist prior, its base
+/// model as the thesis method's assumed model). seed: of the study or validation (the VA measurement's
+/// seed derives from it and the subject). Throws what the identifier throws.
+MuscleEstimate identifyElbowMethod(const ElbowMethod& method, const Population& population,
+                                   const std::vector<TorqueObservation>& data, unsigned seed, int subject);
+
+
+}  // namespace armsim

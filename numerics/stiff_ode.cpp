@@ -1,0 +1,329 @@
+#include "numerics/stiff_ode.h"
+
+#include "basics/bound.h"
+#include "numerics/cpodes_c.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <stdexcept>
+#include <regex>
+#include <sstream>
+
+namespace armsim {
+
+void IntegrationSettings::validate() const {
+    checkField("accuracy", accuracy, Bound::open(0, 1));
+    checkField("max_step", maxStepSize, Bound::nonNegative("s"));
+    if (maxStepSize > 0 && maxStepSize < kMinStepSize)
+        checkField("max_step", maxStepSize, Bound{kMinStepSize, 1e300, false, false, "s, 0 or at least the 1e-12 s minimum step"});
+}
+
+long calcNumSamples(double duration, double sampleRate) {
+    const double n = std::round(duration * sampleRate) + 1;
+    if (!(n <= kMaxSamples))
+        throw InputError("duration " + formatNumber(duration) + " s x sample_rate " + formatNumber(sampleRate) +
+                         " Hz = " + formatNumber(n) + " samples: expected at most " + formatNumber(kMaxSamples) +
+                         " (lower the sample rate or the duration)");
+    return long(n);
+}
+
+namespace detail {
+
+SampledRun::SampledRun(double t0, double duration, double sampleRate, const std::vector<double>& breakpoints,
+                       int size)
+    : t0_(t0), tEnd_(t0 + duration), rate_(sampleRate), eps_(1e-9 / sampleRate),
+      numSamples_(calcNumSamples(duration, sampleRate)), ya_(size), yda_(size), y_(size) {
+    for (double b : breakpoints)
+        if (b > t0 + eps_ && b < tEnd_ - eps_) cuts_.push_back(b);
+    std::sort(cuts_.begin(), cuts_.end());
+    cuts_.erase(std::unique(cuts_.begin(), cuts_.end()), cuts_.end());
+    cuts_.push_back(tEnd_);
+}
+
+void SampledRun::restart(double ta, const double* ya, const double* yda) {
+    ta_ = ta;
+    std::copy(ya, ya + ya_.size(), ya_.begin());
+    std::copy(yda, yda + yda_.size(), yda_.begin());
+}
+
+void SampledRun::advance(double tb, const double* yb, const double* ydb, bool atBreakpoint, const OdeVisitor& emit) {
+    const double h = tb - ta_;
+    const std::size_t n = y_.size();
+    while (next_ < numSamples_ && sampleTime(next_) <= tb + eps_) {
+        const double t = std::min(sampleTime(next_), tb);
+        const double s = h > 0 ? (t - ta_) / h : 1.0;
+        double c0, c1, c2, c3;  // weights of ya, h*yda, yb, h*ydb
+        if (!atBreakpoint) {
+            c0 = (1 + 2 * s) * (1 - s) * (1 - s);
+            c1 = s * (1 - s) * (1 - s);
+            c2 = s * s * (3 - 2 * s);
+            c3 = s * s * (s - 1);
+        } else {
+            c0 = 1 - s * s;
+            c1 = s * (1 - s);
+            c2 = s * s;
+            c3 = 0;
+        }
+        for (std::size_t i = 0; i < n; ++i) y_[i] = c0 * ya_[i] + c1 * h * yda_[i] + c2 * yb[i] + c3 * h * ydb[i];
+        emit(t, y_.data());
+        ++next_;
+    }
+    restart(tb, yb, ydb);
+}
+
+}  // namespace detail
+
+namespace {
+
+void checkFinite(double t, const double* y, int n) {
+    for (int i = 0; i < n; ++i)
+        if (!std::isfinite(y[i])) {
+            std::ostringstream msg;
+            msg << "t = " << t << " s: state y[" << i << "] is " << y[i] << " (not finite)";
+            throw SimulationError(msg.str());
+        }
+}
+
+// What CPODES calls back: f, counted, and its diagnostics. A throwing f becomes a recoverable error
+// (CPODES cuts the step), as in Simbody's CPodesIntegrator; the last message is kept for the report
+// if CPODES gives up. With blocks, a call that differs from the last full evaluation (same t) in one
+// block evaluates only that block.
+class RhsContext {
+public:
+    RhsContext(const OdeRhs& f, const OdeBlocks* blocks, int n) : f_(f), blocks_(blocks) {
+        if (blocks_) {
+            baseY_.resize(n);
+            baseYdot_.resize(n);
+        }
+    }
+    int getNumEvaluations() const { return count_; }
+    int getNumPartialEvaluations() const { return partial_; }
+    const std::string& getLastError() const { return lastError_; }
+    void clearLastError() { lastError_.clear(); }
+    const std::string& getSolverMessage() const { return solverMessage_; }
+    /// f(t, y, ydot); throws SimulationError naming t if f fails.
+    void evaluate(double t, const double* y, double* ydot) {
+        if (calc(t, y, ydot) != 0) throw SimulationError("t = " + formatNumber(t) + " s: " + lastError_);
+    }
+    static int calcRhs(double t, cpodes::NVector y, cpodes::NVector ydot, void* context) {
+        return static_cast<RhsContext*>(context)->calc(t, cpodes::ArrayVector::updData(y),
+                                                       cpodes::ArrayVector::updData(ydot));
+    }
+    // CPODES' own diagnostics: kept for the exception rather than printed to stderr. Its messages
+    // start "At t = <t>" glued to the text; the time is reported by the caller.
+    static void handleError(int, const char*, const char*, char* msg, void* context) {
+        static const std::regex timePrefix("^At t = [-+0-9.eE]+,? *");
+        static_cast<RhsContext*>(context)->solverMessage_ = std::regex_replace(std::string(msg), timePrefix, "");
+    }
+
+private:
+    int calc(double t, const double* y, double* ydot) {
+        ++count_;
+        try {
+            if (!blocks_) {
+                f_(t, y, ydot);
+            } else if (!calcFromBase(t, y, ydot)) {
+                hasBase_ = false;
+                f_(t, y, ydot);
+                baseT_ = t;
+                std::copy(y, y + baseY_.size(), baseY_.begin());
+                std::copy(ydot, ydot + baseYdot_.size(), baseYdot_.begin());
+                hasBase_ = true;
+            }
+        } catch (const std::exception& e) {
+            lastError_ = e.what();
+            return 1;  // recoverable
+        } catch (...) {
+            lastError_ = "unknown exception";
+            return 1;
+        }
+        return 0;
+    }
+    // ydot from the last full evaluation and at most one block, if y differs from it in at most one
+    // block at the same t (bitwise: a block function may tell -0 from +0).
+    bool calcFromBase(double t, const double* y, double* ydot) {
+        if (!hasBase_ || t != baseT_) return false;
+        int changed = -1;
+        for (int b = 0; b < int(blocks_->first.size()); ++b) {
+            const std::size_t first = std::size_t(blocks_->first[b]), bytes = sizeof(double) * blocks_->size[b];
+            if (std::memcmp(y + first, &baseY_[first], bytes) == 0) continue;
+            if (changed >= 0) return false;
+            changed = b;
+        }
+        std::copy(baseYdot_.begin(), baseYdot_.end(), ydot);
+        if (changed >= 0) blocks_->calcBlock(changed, t, y, ydot);
+        ++partial_;
+        return true;
+    }
+    const OdeRhs& f_;
+    const OdeBlocks* blocks_;
+    int count_ = 0, partial_ = 0;
+    bool hasBase_ = false;
+    double baseT_ = 0;
+    std::vector<double> baseY_, baseYdot_;  // the last full evaluation
+    std::string lastError_, solverMessage_;
+};
+
+// One CPODES run (a segment between breakpoints), configured as Simbody's CPodesIntegrator configures
+// its CPodes: BDF, Newton, dense LAPACK Jacobian by CPODES' difference quotients.
+class Cpodes {
+public:
+    Cpodes(RhsContext& context, double t0, std::vector<double>& y0, std::vector<double>& yp0, double relTol,
+           double absTol, const IntegrationSettings& settings)
+        : mem_(cpodes::CPodeCreate(cpodes::CP_EXPL, cpodes::CP_BDF, cpodes::CP_NEWTON)), absTol_(absTol) {
+        if (!mem_) throw std::bad_alloc();
+        try {
+            const int n = int(y0.size());
+            cpodes::ArrayVector y(n, y0.data()), yp(n, yp0.data());
+            check(cpodes::CPodeInit(mem_, reinterpret_cast<void*>(&RhsContext::calcRhs), &context, t0, &y, &yp,
+                                    cpodes::CP_SS, relTol, &absTol_),
+                  "CPodeInit", t0);
+            check(cpodes::CPodeSetErrHandlerFn(mem_, &RhsContext::handleError, &context), "CPodeSetErrHandlerFn",
+                  t0);
+            check(cpodes::CPLapackDense(mem_, n), "CPLapackDense", t0);
+            check(cpodes::CPodeSetNonlinConvCoef(mem_, 0.01), "CPodeSetNonlinConvCoef", t0);
+            check(cpodes::CPodeSetMinStep(mem_, IntegrationSettings::kMinStepSize), "CPodeSetMinStep", t0);
+            if (settings.maxStepSize > 0)
+                check(cpodes::CPodeSetMaxStep(mem_, settings.maxStepSize), "CPodeSetMaxStep", t0);
+        } catch (...) {
+            cpodes::CPodeFree(&mem_);
+            throw;
+        }
+    }
+    Cpodes(const Cpodes&) = delete;
+    Cpodes& operator=(const Cpodes&) = delete;
+    ~Cpodes() { cpodes::CPodeFree(&mem_); }
+    /// One internal step towards tout; CPODES' flag.
+    int step(double tout, double* tret, std::vector<double>& y, std::vector<double>& yp) {
+        cpodes::ArrayVector yv(long(y.size()), y.data()), ypv(long(yp.size()), yp.data());
+        return cpodes::CPode(mem_, tout, tret, &yv, &ypv, cpodes::CP_ONE_STEP);
+    }
+    /// y(t) from CPODES' interpolant over the last step.
+    void calcInterpolated(double t, std::vector<double>& y) {
+        cpodes::ArrayVector yv(long(y.size()), y.data());
+        check(cpodes::CPodeGetDky(mem_, t, 0, &yv), "CPodeGetDky", t);
+    }
+    int getNumSteps() const {
+        long steps = 0;
+        cpodes::CPodeGetNumSteps(mem_, &steps);
+        return int(steps);
+    }
+
+private:
+    static void check(int flag, const char* call, double t) {
+        if (flag != cpodes::CP_SUCCESS)
+            throw SimulationError("t = " + formatNumber(t) + " s: " + call + " failed (CPodes flag " +
+                                  std::to_string(flag) + ")");
+    }
+    void* mem_;
+    double absTol_;
+};
+
+// The N_Vector layout declared in cpodes_c.h, checked once against the loaded library.
+void checkCpodesLayout() {
+    static const std::string mismatch = cpodes::findCpodesLayoutMismatch();
+    if (!mismatch.empty())
+        throw SimulationError("the CPodes C interface of the loaded libSimTKmath differs from the one armsim was "
+                              "written for (Simbody 3.7): " + mismatch);
+}
+
+// integrateSampled for f, whose blocks (if any) are `blocks`.
+IntegrationStats integrate(const OdeRhs& f, const OdeBlocks* blocks, double t0, std::vector<double>& y,
+                           double duration, double sampleRate, const std::vector<double>& breakpoints,
+                           const IntegrationSettings& settings, const OdeVisitor& sample, const OdeVisitor& check) {
+    settings.validate();
+    checkField("duration", duration, Bound::nonNegative("s"));
+    checkField("sample_rate", sampleRate, Bound::positive("Hz"));
+    checkCpodesLayout();
+    const int n = int(y.size());
+    detail::SampledRun run(t0, duration, sampleRate, breakpoints, n);
+    IntegrationStats stats;
+    RhsContext context(f, blocks, n);
+
+    if (check) check(t0, y.data());
+    checkFinite(t0, y.data(), n);
+    sample(t0, y.data());
+    run.start();
+    const double relTol = settings.accuracy, absTol = settings.accuracy / 10;  // CPodesIntegrator's choice
+    double t = t0;
+    std::vector<double> yv = y, ydot(n), yout(n), ypout(n);
+    for (double segmentEnd : run.getSegmentEnds()) {
+        context.evaluate(t, yv.data(), ydot.data());
+        run.restart(t, yv.data(), ydot.data());
+        Cpodes cpodes(context, t, yv, ydot, relTol, absTol, settings);
+        ++stats.restarts;
+        while (t < segmentEnd - run.getEpsilon()) {
+            checkInterruption();  // a long trial stops within a step of Ctrl-C
+            double tret = t;
+            context.clearLastError();  // report only this step's model errors
+            int res = cpodes.step(segmentEnd, &tret, yout, ypout);
+            if (res == cpodes::CP_TOO_CLOSE) {  // segment shorter than CPodes can step: treat as reached
+                tret = segmentEnd;
+                yout = yv;
+                res = cpodes::CP_SUCCESS;
+            }
+            if (res < 0) {
+                std::ostringstream msg;
+                msg << "t = " << t << " s: the integrator failed";
+                if (!context.getSolverMessage().empty()) msg << ": " << context.getSolverMessage();
+                msg << " (CPodes flag " << res << ")";
+                if (!context.getLastError().empty()) msg << "; last model error: " << context.getLastError();
+                throw SimulationError(msg.str());
+            }
+            if (tret > segmentEnd) {  // overshot: CPodes' own interpolant at the segment end
+                cpodes.calcInterpolated(segmentEnd, yout);
+                tret = segmentEnd;
+            }
+            t = tret;
+            yv.swap(yout);
+            if (check) check(t, yv.data());
+            checkFinite(t, yv.data(), n);
+            context.evaluate(t, yv.data(), ydot.data());
+            run.advance(t, yv.data(), ydot.data(), run.isBreakpoint(t, segmentEnd), sample);
+        }
+        stats.steps += cpodes.getNumSteps();
+    }
+    stats.restarts -= 1;
+    stats.realizations = context.getNumEvaluations();
+    stats.partialEvaluations = context.getNumPartialEvaluations();
+    y = yv;
+    return stats;
+}
+
+}  // namespace
+
+IntegrationStats integrateSampled(const OdeRhs& f, double t0, std::vector<double>& y, double duration,
+                                  double sampleRate, const std::vector<double>& breakpoints,
+                                  const IntegrationSettings& settings, const OdeVisitor& sample,
+                                  const OdeVisitor& check) {
+    return integrate(f, nullptr, t0, y, duration, sampleRate, breakpoints, settings, sample, check);
+}
+
+IntegrationStats integrateSampled(const OdeBlocks& f, double t0, std::vector<double>& y, double duration,
+                                  double sampleRate, const std::vector<double>& breakpoints,
+                                  const IntegrationSettings& settings, const OdeVisitor& sample,
+                                  const OdeVisitor& check) {
+    const std::size_t numBlocks = f.first.size();
+    if (f.size.size() != numBlocks || !f.calcBlock)
+        throw std::invalid_argument("integrateSampled: blocks need a first state, a size and calcBlock");
+    std::vector<int> owner(y.size(), -1);
+    for (std::size_t b = 0; b < numBlocks; ++b) {
+        if (f.size[b] <= 0)
+            throw std::invalid_argument("integrateSampled: block " + std::to_string(b) + " is empty");
+        for (int i = f.first[b]; i < f.first[b] + f.size[b]; ++i) {
+            if (i < 0 || i >= int(y.size()) || owner[i] >= 0)
+                throw std::invalid_argument("integrateSampled: block " + std::to_string(b) +
+                                            " is outside y or overlaps another block");
+            owner[i] = int(b);
+        }
+    }
+    if (std::count(owner.begin(), owner.end(), -1) > 0)
+        throw std::invalid_argument("integrateSampled: the blocks do not cover y");
+    const OdeRhs whole = [&f, numBlocks](double t, const double* yIn, double* ydot) {
+        for (std::size_t b = 0; b < numBlocks; ++b) f.calcBlock(int(b), t, yIn, ydot);
+    };
+    return integrate(whole, &f, t0, y, duration, sampleRate, breakpoints, settings, sample, check);
+}
+
+}  // namespace armsim

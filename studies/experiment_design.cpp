@@ -1,0 +1,306 @@
+#include "studies/experiment_design.h"
+
+#include "basics/bound.h"
+#include "basics/csv.h"
+#include "basics/parallel.h"
+#include "basics/portable_random.h"
+
+#include <fmt/format.h>
+
+#include <Eigen/Dense>
+
+#include <algorithm>
+#include <cmath>
+
+namespace armsim {
+
+namespace {
+
+constexpr double kMassGoal = 0.10;     // issue 11: mass RMSE <= 10 %
+constexpr double kTendonGoal = 0.010;  // issue 11: tendon-length RMSE <= 1 cm [m]
+constexpr double kStep = 1e-4;         // central-difference step in x (ln scales and activations)
+
+Eigen::MatrixXd toMatrix(const std::vector<std::vector<double>>& rows) {
+    Eigen::MatrixXd m(int(rows.size()), rows.empty() ? 0 : int(rows.front().size()));
+    for (int a = 0; a < m.rows(); ++a)
+        for (int b = 0; b < m.cols(); ++b) m(a, b) = rows[a][b];
+    return m;
+}
+
+// Tared torques of every candidate condition and their gradients at one prior draw.
+struct DrawSensitivity {
+    bool ok = false;
+    std::vector<double> torque;    // [condition]
+    Eigen::MatrixXd jacobian;      // [condition][parameter]
+};
+
+struct Sensitivities {
+    std::vector<std::string> names;
+    int massIndex = 0, tendonIndex = 0, activationIndex = 0;
+    Eigen::VectorXd flexorMean;    // weights of the mean of the flexors' ln mass scales
+    Eigen::MatrixXd priorPrecision;
+    double priorMassSd = 0, priorTendonSd = 0, priorFlexorStrengthSd = 0, baseTendonLength = 0;
+    double relativeSd = 0;         // sigma: relative sd of one trial's torque
+    double activationSd = 0;
+    std::vector<DrawSensitivity> draws;
+};
+
+}  // namespace
+
+std::vector<std::vector<double>> drawFromPrior(const SynergistModel& model, unsigned seed, int draws) {
+    const int n = model.getNumParameters();
+    // Only the free coordinates are drawn (held ones stay at their mean), so the draws do not depend on
+    // which held parameters the model carries.
+    std::vector<int> free;
+    for (int j = 0; j < n; ++j)
+        if (model.getLower()[j] + 2 * kStep < model.getUpper()[j] - 2 * kStep) free.push_back(j);
+    const Eigen::MatrixXd sigma = toMatrix(model.getPriorCovariance());
+    Eigen::MatrixXd freeSigma(free.size(), free.size());
+    for (std::size_t a = 0; a < free.size(); ++a)
+        for (std::size_t b = 0; b < free.size(); ++b) freeSigma(a, b) = sigma(free[a], free[b]);
+    const Eigen::MatrixXd L = Eigen::LLT<Eigen::MatrixXd>(freeSigma).matrixL();
+    std::vector<std::vector<double>> out;
+    for (int d = 0; d < draws; ++d) {
+        PortableRandom rng{seed, 0x5EED1u, unsigned(d)};
+        Eigen::VectorXd z(free.size());
+        for (int j = 0; j < z.size(); ++j) z(j) = rng.drawNormal();
+        const Eigen::VectorXd v = L * z;
+        std::vector<double> x = model.getPriorMean();
+        for (std::size_t k = 0; k < free.size(); ++k) {
+            const int j = free[k];  // kept inside the bounds by more than the difference step
+            x[j] = std::clamp(x[j] + v(k), model.getLower()[j] + 2 * kStep, model.getUpper()[j] - 2 * kStep);
+        }
+        out.push_back(x);
+    }
+    return out;
+}
+
+namespace {
+
+Sensitivities calcSensitivities(const Population& prior, const std::vector<TorqueCondition>& conditions,
+                                const DesignSettings& settings, const std::function<void(int, int)>& progress) {
+    SynergistOptions options;
+    options.freeSlowFraction = settings.freeSlowFraction;
+    const SynergistModel model(prior, options, conditions);
+    const int n = model.getNumParameters();
+    Sensitivities s;
+    s.names = model.getParameterNames();
+    s.massIndex = model.getMassIndex();
+    s.tendonIndex = SynergistModel::getTendonIndex();
+    s.activationIndex = SynergistModel::getActivationIndex();
+    const Eigen::MatrixXd sigma = toMatrix(model.getPriorCovariance());
+    s.priorPrecision = sigma.inverse();
+    s.flexorMean = Eigen::VectorXd::Zero(n);
+    const std::vector<int> flexors = model.getFlexorMassIndices();
+    for (int j : flexors) s.flexorMean(j) = 1.0 / double(flexors.size());
+    s.priorFlexorStrengthSd = std::sqrt(s.flexorMean.dot(sigma * s.flexorMean));
+    s.baseTendonLength = prior.base.muscles[prior.base.primary].params.optimalTendonLength;
+    s.priorMassSd = std::sqrt(sigma(s.massIndex, s.massIndex));
+    s.priorTendonSd = s.baseTendonLength * std::sqrt(sigma(s.tendonIndex, s.tendonIndex));
+    s.relativeSd = std::hypot(prior.transducerNoise, prior.trialCv);
+    s.activationSd = settings.activationSd;
+
+    const std::vector<std::vector<double>> xs = drawFromPrior(model, settings.seed, settings.draws);
+    s.draws.resize(xs.size());
+    runParallel(int(xs.size()), settings.jobs, [&](int d) {
+        DrawSensitivity& out = s.draws[d];
+        try {
+            std::vector<double> x = xs[d];
+            out.torque = model.calcTorques(x.data());
+            out.jacobian.resize(int(conditions.size()), n);
+            for (int j = 0; j < n; ++j) {
+                const double x0 = x[j];
+                if (model.getLower()[j] == model.getUpper()[j]) {  // held fixed
+                    out.jacobian.col(j).setZero();
+                    continue;
+                }
+                x[j] = x0 + kStep;
+                const std::vector<double> up = model.calcTorques(x.data());
+                x[j] = x0 - kStep;
+                const std::vector<double> down = model.calcTorques(x.data());
+                x[j] = x0;
+                for (std::size_t c = 0; c < conditions.size(); ++c)
+                    out.jacobian(int(c), j) = (up[c] - down[c]) / (2 * kStep);
+            }
+            out.ok = true;
+        } catch (const SimulationError&) {
+            out.ok = false;  // no steady state for this draw: left out of the averages
+        }
+    }, progress);
+    return s;
+}
+
+// Posterior covariance at draw d with `counts[c]` trials of condition c.
+Eigen::MatrixXd calcPosterior(const Sensitivities& s, int d, const std::vector<int>& counts) {
+    const DrawSensitivity& ds = s.draws[d];
+    Eigen::MatrixXd precision = s.priorPrecision;
+    for (std::size_t c = 0; c < counts.size(); ++c) {
+        if (counts[c] == 0) continue;
+        const double sd = s.relativeSd * std::max(std::abs(ds.torque[c]), 1.0);
+        const Eigen::RowVectorXd g = ds.jacobian.row(int(c));
+        precision += double(counts[c]) * g.transpose() * g / (sd * sd);
+    }
+    if (s.activationSd > 0) precision(s.activationIndex, s.activationIndex) += 1 / (s.activationSd * s.activationSd);
+    return precision.inverse();
+}
+
+ProtocolPrediction evaluate(const Sensitivities& s, const std::vector<int>& counts, const std::string& name) {
+    ProtocolPrediction p;
+    p.name = name;
+    for (int c : counts) p.trials += c;
+    p.parameterNames = s.names;
+    p.priorMassSd = s.priorMassSd;
+    p.priorTendonSd = s.priorTendonSd;
+    const int n = int(s.names.size());
+    p.massCorrelation.assign(n, 0.0);
+    p.posteriorSd.assign(n, 0.0);
+    const double gT = kTendonGoal / s.baseTendonLength;
+    double crit = 0, vm = 0, vt = 0, vf = 0;
+    int used = 0;
+    for (std::size_t d = 0; d < s.draws.size(); ++d) {
+        if (!s.draws[d].ok) continue;
+        const Eigen::MatrixXd C = calcPosterior(s, int(d), counts);
+        const double cm = C(s.massIndex, s.massIndex), ct = C(s.tendonIndex, s.tendonIndex);
+        crit += cm / (kMassGoal * kMassGoal) + ct / (gT * gT);
+        vm += cm;
+        vt += ct;
+        vf += s.flexorMean.dot(C * s.flexorMean);
+        for (int j = 0; j < n; ++j) {
+            p.massCorrelation[j] += C(s.massIndex, j) / std::sqrt(cm * C(j, j));
+            p.posteriorSd[j] += std::sqrt(C(j, j));
+        }
+        ++used;
+    }
+    if (used == 0) throw SimulationError("experiment design: no prior draw has a steady state at every condition");
+    p.drawsUsed = used;
+    p.criterion = crit / used;
+    p.massSd = std::sqrt(vm / used);
+    p.tendonSd = s.baseTendonLength * std::sqrt(vt / used);
+    p.flexorStrengthSd = std::sqrt(vf / used);
+    p.priorFlexorStrengthSd = s.priorFlexorStrengthSd;
+    for (int j = 0; j < n; ++j) {
+        p.massCorrelation[j] /= used;
+        p.posteriorSd[j] /= used;
+    }
+    return p;
+}
+
+std::vector<int> countTrials(const std::vector<TorqueCondition>& conditions) {
+    std::vector<int> counts;
+    for (const TorqueCondition& c : conditions) counts.push_back(c.repetitions);
+    return counts;
+}
+
+}  // namespace
+
+void DesignSettings::validate() const {
+    if (flexionDeg.empty()) throw FieldError("angles", "no angles: expected at least one");
+    for (double q : flexionDeg) checkField("angles", q, Bound::closed(0, 180, "deg, 0 = extended"));
+    for (double l : levels) checkField("levels", l, Bound::open(0, 1, "fraction of maximal, in (0, 1)"));
+    checkField("repetitions", repetitions, Bound::closed(1, 100));
+    checkField("trials", trials, Bound{double(repetitions), 10000, false, false, "at least one block of repetitions"});
+    checkField("draws", draws, Bound::closed(1, 100000));
+    checkField("activation_sd", activationSd, Bound::closed(0, 0.5));
+    checkField("jobs", jobs, Bound::closed(1, 1024));
+}
+
+ProtocolPrediction predictProtocol(const Population& prior, const TorqueProtocol& protocol,
+                                   const DesignSettings& settings) {
+    protocol.validate();
+    settings.validate();
+    const Sensitivities s = calcSensitivities(prior, protocol.conditions, settings, {});
+    return evaluate(s, countTrials(protocol.conditions), protocol.name);
+}
+
+DesignResult designProtocol(const Population& prior, const DesignSettings& settings, const TorqueProtocol& reference,
+                            const std::function<void(int, int)>& progress) {
+    reference.validate();
+    settings.validate();
+    prior.validate();
+    DesignResult result;
+    std::vector<double> levels = {1.0};
+    levels.insert(levels.end(), settings.levels.begin(), settings.levels.end());
+    for (MuscleGroup effort : {MuscleGroup::Flexor, MuscleGroup::Extensor}) {
+        if (effort == MuscleGroup::Extensor && !settings.extension) continue;
+        for (double level : levels)
+            for (double q : settings.flexionDeg) result.candidates.push_back({q, effort, level, 1});
+    }
+    const int picks = settings.trials / settings.repetitions;
+    const int total = 2 * settings.draws + picks;
+    Sensitivities s = calcSensitivities(prior, result.candidates, settings, [&](int done, int) {
+        if (progress) progress(done, total);
+    });
+    Sensitivities r = calcSensitivities(prior, reference.conditions, settings, [&](int done, int) {
+        if (progress) progress(settings.draws + done, total);
+    });
+    for (std::size_t d = 0; d < s.draws.size(); ++d) s.draws[d].ok = r.draws[d].ok = s.draws[d].ok && r.draws[d].ok;
+    result.reference = evaluate(r, countTrials(reference.conditions), reference.name);
+
+    std::vector<int> counts(result.candidates.size(), 0);
+    for (int k = 0; k < picks; ++k) {
+        int best = -1;
+        double bestCriterion = INFINITY;
+        for (std::size_t c = 0; c < counts.size(); ++c) {
+            counts[c] += settings.repetitions;
+            const double v = evaluate(s, counts, "").criterion;
+            counts[c] -= settings.repetitions;
+            if (v < bestCriterion) bestCriterion = v, best = int(c);
+        }
+        counts[best] += settings.repetitions;
+        TorqueCondition picked = result.candidates[best];
+        picked.repetitions = settings.repetitions;
+        result.steps.push_back({picked, bestCriterion});
+        if (progress) progress(2 * settings.draws + k + 1, total);
+    }
+
+    TorqueProtocol& p = result.protocol;
+    p.name = "designed";
+    p.conditions.clear();
+    for (std::size_t c = 0; c < counts.size(); ++c)
+        if (counts[c] > 0) {
+            TorqueCondition tc = result.candidates[c];
+            tc.repetitions = counts[c];
+            p.conditions.push_back(tc);
+        }
+    result.predicted = evaluate(s, counts, p.name);
+    p.description = fmt::format(
+        "designed by armsim design: {} trials, {} prior draws (seed {}); predicted posterior sd of ln M {:.1f} %, of "
+        "L0T {:.1f} mm",
+        result.predicted.trials, settings.draws, settings.seed, 100 * result.predicted.massSd,
+        1000 * result.predicted.tendonSd);
+    return result;
+}
+
+std::string formatDesignStepsCsv(const DesignResult& result) {
+    CsvText csv({"step", "effort", "flexion_deg", "level", "repetitions", "criterion"});
+    for (std::size_t k = 0; k < result.steps.size(); ++k) {
+        const DesignStep& s = result.steps[k];
+        CsvRow row;
+        row.addInteger(long(k) + 1).addText(getEffortName(s.condition.effort)).addNumber(s.condition.flexionDeg);
+        row.addNumber(s.condition.level).addInteger(s.condition.repetitions).addNumber(s.criterion);
+        csv.addRow(row);
+    }
+    return csv.getText();
+}
+
+std::string formatPredictionsCsv(const std::vector<ProtocolPrediction>& predictions) {
+    if (predictions.empty()) return "";
+    std::vector<std::string> header = {"protocol", "trials", "draws_used", "criterion", "mass_sd_pct", "tendon_sd_mm",
+                                       "flexor_strength_sd_pct", "prior_mass_sd_pct", "prior_tendon_sd_mm",
+                                       "prior_flexor_strength_sd_pct"};
+    for (const std::string& n : predictions.front().parameterNames) header.push_back("corr_lnM_" + n);
+    for (const std::string& n : predictions.front().parameterNames) header.push_back("sd_" + n);
+    CsvText csv(header);
+    for (const ProtocolPrediction& p : predictions) {
+        CsvRow row;
+        row.addText(p.name).addInteger(p.trials).addInteger(p.drawsUsed).addNumber(p.criterion);
+        row.addNumber(100 * p.massSd).addNumber(1000 * p.tendonSd).addNumber(100 * p.flexorStrengthSd);
+        row.addNumber(100 * p.priorMassSd).addNumber(1000 * p.priorTendonSd).addNumber(100 * p.priorFlexorStrengthSd);
+        for (double v : p.massCorrelation) row.addNumber(v);
+        for (double v : p.posteriorSd) row.addNumber(v);
+        csv.addRow(row);
+    }
+    return csv.getText();
+}
+
+}  // namespace armsim

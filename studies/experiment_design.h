@@ -1,0 +1,102 @@
+// Bayesian experiment design for the synergist-aware identifier (issue 11, `armsim design`).
+//
+// A protocol's expected posterior uncertainty is computed with the Laplace approximation the identifier
+// itself reports: for a parameter vector x, the posterior covariance is
+//     C(x) = (Sigma^{-1} + sum_i n_i J_i(x)^T J_i(x) / s_i(x)^2 [+ e_VA e_VA^T / sd_VA^2])^{-1},
+// with Sigma the identifier's prior covariance (identification/synergist_identifier.h, SynergistModel),
+// J_i the gradient of condition i's tared torque T_i (central differences), n_i its repetitions and
+// s_i = sigma |T_i| its sd (sigma^2 = transducer noise^2 + trial cv^2: each trial's torque varies with
+// the effort and the sensor), and the last term when voluntary activation is measured by twitch
+// interpolation. The expectation is over `draws` parameter vectors drawn from the identifier's prior
+// (Gaussian, clipped to its bounds, seeded).
+//
+// Criterion (minimised): mean over draws of var(ln M) / g_M^2 + var(ln L0T) / g_T^2 with the issue's
+// goals g_M = 10 % (mass RMSE) and g_T = 1 cm / L0T (tendon RMSE): each width counts relative to its goal.
+// Design: greedy, a block of `repetitions` trials of the candidate condition that lowers the criterion
+// most, until the trial budget is spent (information adds over trials, so this is the usual greedy
+// approximation to the optimal exact design); a condition picked twice gets twice the repetitions.
+#pragma once
+
+#include "identification/torque_identification.h"
+
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace armsim {
+
+/// What an experimenter may do.
+struct DesignSettings {
+    std::vector<double> flexionDeg = {15, 30, 45, 60, 75, 90, 105, 120, 135};  ///< allowed angles [deg]
+    bool extension = true;               ///< extension MVCs allowed
+    /// Submaximal levels allowed (EMG feedback: the agonists' EMG held at that fraction of its MVC
+    /// value; needs surface EMG), fractions in (0, 1); empty: maximal efforts only.
+    std::vector<double> levels;
+    int trials = 15;                     ///< budget: total trials (thesis: 5 angles x 3)
+    int repetitions = 3;                 ///< trials per pick (>= 2: the identifier estimates its noise from repeats)
+    int draws = 32;                      ///< prior draws the criterion averages over
+    unsigned seed = 1;
+    double activationSd = 0.02;          ///< > 0: VA measured by twitch interpolation to this sd; 0: not
+    bool freeSlowFraction = false;       ///< the identifier frees the slow fractions (SynergistOptions)
+    int jobs = 2;                        ///< threads (over draws)
+    /// FieldError naming the field for values out of range.
+    void validate() const;
+};
+
+/// A protocol's predicted uncertainty (averages over the prior draws).
+struct ProtocolPrediction {
+    std::string name;
+    int trials = 0;
+    int drawsUsed = 0;                   ///< prior draws with a steady state at every condition
+    double criterion = 0.0 / 0.0;        ///< as minimised (1 = both widths at their goals) [1]
+    double massSd = 0.0 / 0.0;           ///< RMS over draws of the posterior sd of ln M [1] (~ relative sd of M)
+    double tendonSd = 0.0 / 0.0;         ///< RMS over draws of the posterior sd of L0T [m]
+    /// RMS posterior sd of the mean of the flexors' ln mass scales (total flexor strength) [1]: small
+    /// when the data pin the flexors' sum while massSd stays near the per-muscle prior sd (the split).
+    double flexorStrengthSd = 0.0 / 0.0;
+    double priorFlexorStrengthSd = 0.0 / 0.0;  ///< its prior sd [1]
+    double priorMassSd = 0.0 / 0.0;      ///< the prior's sd of ln M [1]
+    double priorTendonSd = 0.0 / 0.0;    ///< the prior's sd of L0T [m]
+    std::vector<std::string> parameterNames;
+    /// Mean over draws of the posterior correlation of ln M with each parameter.
+    std::vector<double> massCorrelation;
+    /// Mean over draws of the posterior sd of each parameter (its own units: ln scale or activation).
+    std::vector<double> posteriorSd;
+};
+
+/// One greedy pick.
+struct DesignStep {
+    TorqueCondition condition;           ///< with repetitions = the block
+    double criterion = 0;                ///< after the pick
+};
+
+struct DesignResult {
+    TorqueProtocol protocol;             ///< the design (name "designed")
+    ProtocolPrediction predicted;        ///< its prediction
+    ProtocolPrediction reference;        ///< the reference protocol's, on the same prior draws
+    std::vector<DesignStep> steps;
+    std::vector<TorqueCondition> candidates;  ///< every condition considered
+};
+
+/// design_steps.csv: step, effort, flexion_deg, level, repetitions, criterion after the pick.
+std::string formatDesignStepsCsv(const DesignResult& result);
+
+/// `draws` parameter vectors of the identifier's prior (Gaussian, clipped to its bounds), seeded by
+/// (seed, draw): the draws the predictions average over.
+std::vector<std::vector<double>> drawFromPrior(const SynergistModel& model, unsigned seed, int draws);
+
+/// Predicted uncertainty of the synergist-aware identifier with this protocol.
+ProtocolPrediction predictProtocol(const Population& prior, const TorqueProtocol& protocol,
+                                   const DesignSettings& settings);
+
+/// The greedy design within the settings' budget and options, and the reference protocol's
+/// prediction on the same draws (a draw without a steady state at some condition of either is left out
+/// of both). progress(done, total) over the sensitivities (the expensive part) and the picks.
+DesignResult designProtocol(const Population& prior, const DesignSettings& settings, const TorqueProtocol& reference,
+                            const std::function<void(int, int)>& progress = {});
+
+/// CSV: one row per protocol: name, trials, criterion, mass_sd_pct, tendon_sd_mm, prior sds, and the
+/// mean posterior correlation of ln M with every parameter.
+std::string formatPredictionsCsv(const std::vector<ProtocolPrediction>& predictions);
+
+}  // namespace armsim

@@ -1,0 +1,378 @@
+#include "studies/study.h"
+
+#include "basics/format.h"
+#include "basics/csv.h"
+#include "basics/files.h"
+#include "basics/param_node.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <charconv>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <map>
+#include <sstream>
+
+namespace armsim {
+
+namespace {
+
+constexpr long kMaxTasks = 1000000000L;
+// Changes whenever a result's meaning or format changes, so old journals are not resumed into new files.
+constexpr const char* kResultsVersion = "armsim-study-results-1";
+
+std::uint64_t hashFnv1a(const std::string& text, std::uint64_t h = 1469598103934665603ULL) {
+    for (unsigned char c : text) h = (h ^ c) * 1099511628211ULL;
+    return h;
+}
+
+std::string toHex(std::uint64_t v) { return fmt::format("{:016x}", v); }
+
+bool parseDouble(const std::string& s, double& v) {
+    if (s.empty()) {
+        v = 0.0 / 0.0;
+        return true;
+    }
+    const char* b = s.data();
+    const auto r = std::from_chars(b, b + s.size(), v);
+    return r.ec == std::errc() && r.ptr == b + s.size();
+}
+
+bool parseLong(const std::string& s, long& v) {
+    const char* b = s.data();
+    const auto r = std::from_chars(b, b + s.size(), v);
+    return !s.empty() && r.ec == std::errc() && r.ptr == b + s.size();
+}
+
+// Resolves a file named in the study: relative to the study file's folder, then as given.
+std::string resolveStudyFile(const ParamNode& n, const std::string& field, const std::string& value, const char* what) {
+    namespace fs = std::filesystem;
+    const fs::path p(value);
+    if (p.is_relative() && !n.getDirectory().empty()) {
+        const fs::path beside = fs::path(n.getDirectory()) / p;
+        if (isRegularFile(beside.string())) return beside.string();
+    }
+    if (isRegularFile(p.string())) return p.string();
+    throw InputError(n.where(field) + ": field '" + field + "' = '" + value + "': no such " + what +
+                     " (looked beside the study file and in the working directory)");
+}
+
+}  // namespace
+
+void Study::validate() const {
+    population.validate();
+    checkField("subjects", subjects, Bound::closed(1, 1e7));
+    if (protocols.empty()) throw FieldError("protocols", "is empty: expected at least one protocol");
+    if (noiseLevels.empty()) throw FieldError("noise_levels", "is empty: expected at least one noise level");
+    if (methods.empty()) throw FieldError("methods", "is empty: expected at least one identifier");
+    for (std::size_t i = 0; i < noiseLevels.size(); ++i)
+        checkField("noise_levels[" + std::to_string(i) + "]", noiseLevels[i], Bound{0, 0.5, false, true, "relative sd"});
+    for (std::size_t i = 0; i < protocols.size(); ++i) {
+        protocols[i].protocol.validate();
+        for (std::size_t j = 0; j < i; ++j)
+            if (protocols[j].protocol.name == protocols[i].protocol.name)
+                throw FieldError("protocols[" + std::to_string(i) + "]",
+                                 "= '" + protocols[i].reference + "': its name '" + protocols[i].protocol.name +
+                                     "' is also protocols[" + std::to_string(j) + "]'s: expected unique protocol names");
+    }
+    // Names go into CSV cells and journal lines: no control characters (they would not round-trip).
+    auto checkName = [](const std::string& field, const std::string& name) {
+        for (unsigned char c : name)
+            if (c < 0x20 || c == 0x7f)
+                throw FieldError(field, "= '" + name + "': expected a name without tabs, newlines or control characters");
+    };
+    for (std::size_t i = 0; i < protocols.size(); ++i)
+        checkName("protocols[" + std::to_string(i) + "].name", protocols[i].protocol.name);
+    for (std::size_t i = 0; i < methods.size(); ++i) checkName("methods[" + std::to_string(i) + "].label", methods[i].label);
+    const auto& kinds = getElbowMethodKinds();
+    for (std::size_t i = 0; i < methods.size(); ++i) {
+        const std::string f = "methods[" + std::to_string(i) + "]";
+        if (std::find(kinds.begin(), kinds.end(), methods[i].kind) == kinds.end())
+            throw FieldError(f + ".method", "= '" + methods[i].kind + "': expected thesis, synergist or synergist-va");
+        if (methods[i].label.empty()) throw FieldError(f + ".label", "is empty: expected a name");
+        for (std::size_t j = 0; j < i; ++j)
+            if (methods[j].label == methods[i].label)
+                throw FieldError(f + ".label", "= '" + methods[i].label + "': also methods[" + std::to_string(j) +
+                                                   "]'s label: expected unique labels");
+        checkField(f + ".activation_sd", methods[i].options.activationSd, Bound{0, 0.5, true, false});
+        if (std::isfinite(methods[i].options.noiseLevel))
+            checkField(f + ".noise_level", methods[i].options.noiseLevel, Bound{0, 0.5, true, false});
+    }
+    if (getNumTasks() > kMaxTasks)
+        throw FieldError("subjects", "x protocols x noise levels x methods = " + std::to_string(getNumTasks()) +
+                                         " tasks: expected at most " + std::to_string(kMaxTasks));
+}
+
+Study readStudy(const std::string& path) {
+    const ParamNode n = ParamNode::loadFile(path);
+    Study s;
+    s.file = path;
+    if (n.getString("kind", "") != "study")
+        throw InputError(n.where("kind") + ": field 'kind' = '" + n.getString("kind", "") +
+                         "': expected 'study' (a study file starts with `kind: study`)");
+    s.name = n.getString("name", std::filesystem::path(path).stem().string());
+    s.description = n.getString("description", "");
+    s.populationReference = n.getString("population", "default");
+    s.population = s.populationReference == "default"
+                       ? loadDefaultPopulation()
+                       : loadPopulation(resolveStudyFile(n, "population", s.populationReference, "population file"));
+    s.subjects = n.getInt("subjects", 1, 10000000);
+    s.seed = unsigned(n.getInt("seed", 0, 2147483647, 1));
+    const std::vector<std::string> protocols = n.getStrings("protocols");
+    for (std::size_t i = 0; i < protocols.size(); ++i) {
+        StudyProtocol p;
+        p.reference = protocols[i];
+        if (p.reference != "thesis")
+            p.protocol = readTorqueProtocol(
+                resolveStudyFile(n, "protocols", p.reference, ("protocol file (protocols[" + std::to_string(i) + "])").c_str()));
+        s.protocols.push_back(p);
+    }
+    s.noiseLevels = n.has("noise_levels") ? n.getNumbers("noise_levels", Bound{0, 0.5, false, true, "relative sd"})
+                                          : std::vector<double>{s.population.transducerNoise};
+    for (const ParamNode& m : n.children("methods")) {
+        ElbowMethod e;
+        e.kind = m.getChoice("method", getElbowMethodKinds(), "");
+        e.label = m.getString("label", e.kind);
+        e.options.activationSd = m.getNumber("activation_sd", Bound{0, 0.5, true, false}, 0.02);
+        e.options.freeSlowFraction = m.getBool("free_slow_fraction", false);
+        e.options.includeSynergists = m.getBool("include_synergists", true);
+        if (m.has("noise_level")) e.options.noiseLevel = m.getNumber("noise_level", Bound{0, 0.5, true, false});
+        m.finish();
+        s.methods.push_back(e);
+    }
+    s.output = n.getString("output", "out/study/" + s.name);
+    n.finish();
+    n.rethrowWithLocation([&] { s.validate(); });
+    return s;
+}
+
+std::string calcStudyFingerprint(const Study& s) {
+    std::ostringstream t;
+    t << kResultsVersion << "\nsubjects " << s.subjects << "\nseed " << s.seed << "\nnoise";
+    for (double v : s.noiseLevels) t << ' ' << formatNumber(v);
+    for (const ElbowMethod& m : s.methods)
+        t << "\nmethod " << m.label << ' ' << m.kind << ' ' << formatNumber(m.options.activationSd) << ' '
+          << m.options.freeSlowFraction << ' ' << m.options.includeSynergists << ' '
+          << (std::isfinite(m.options.noiseLevel) ? formatNumber(m.options.noiseLevel) : "");
+    for (const StudyProtocol& p : s.protocols) t << "\nprotocol\n" << formatTorqueProtocol(p.protocol);
+    if (!s.population.file.empty()) t << "\npopulation\n" << readFileText(s.population.file);
+    if (!s.population.base.file.empty()) t << "\nmodel\n" << readFileText(s.population.base.file);
+    for (const MuscleSpec& m : s.population.base.muscles) {
+        const MuscleParameters& p = m.params;
+        t << "\nmuscle " << p.name << ' ' << formatNumber(p.mass) << ' ' << formatNumber(p.optimalFascicleLength) << ' '
+          << formatNumber(p.optimalTendonLength) << ' ' << formatNumber(p.maxPathLength) << ' '
+          << formatNumber(p.slowFraction) << ' ' << p.numSlowUnits << ' ' << p.numFastUnits;
+    }
+    return toHex(hashFnv1a(t.str()));
+}
+
+StudyTask getStudyTask(const Study& s, long index) {
+    if (index < 0 || index >= s.getNumTasks())
+        throw std::out_of_range("study task " + std::to_string(index) + " of " + std::to_string(s.getNumTasks()));
+    StudyTask t;
+    t.index = index;
+    const long K = long(s.methods.size()), N = long(s.noiseLevels.size()), P = long(s.protocols.size());
+    t.method = int(index % K);
+    index /= K;
+    t.noise = int(index % N);
+    index /= N;
+    t.protocol = int(index % P);
+    t.subject = int(index / P);
+    return t;
+}
+
+std::vector<StudyResult> runStudyGroup(const Study& study, long group, const std::vector<long>& tasks, int rank) {
+    checkInterruption();
+    using Clock = std::chrono::steady_clock;
+    const int P = int(study.protocols.size());
+    const int subject = int(group / P), protocol = int(group % P);
+    const TorqueProtocol& pr = study.protocols[protocol].protocol;
+    const auto t0 = Clock::now();
+    VirtualSubject v;
+    std::vector<TorqueObservation> clean;
+    std::string synthesisError;
+    try {
+        v = drawSubject(study.population, study.seed, subject);
+        clean = synthesizeTorqueData(v, pr, study.seed, 1);
+    } catch (const InterruptedError&) {
+        throw;  // not a failed task: the study stops and resumes later
+    } catch (const std::exception& e) {
+        synthesisError = std::string("synthesis: ") + e.what();
+    }
+    const double synthesisShare = std::chrono::duration<double>(Clock::now() - t0).count() / double(tasks.size());
+
+    std::vector<StudyResult> out;
+    std::map<int, std::vector<TorqueObservation>> noisy;  // by noise level
+    for (long index : tasks) {
+        const StudyTask t = getStudyTask(study, index);
+        if (t.getGroup(study) != group) throw std::logic_error("runStudyGroup: task outside the group");
+        const ElbowMethod& m = study.methods[t.method];
+        const double level = study.noiseLevels[t.noise];
+        const auto t1 = Clock::now();
+        MuscleEstimate e;
+        e.method = m.label;
+        std::string error = synthesisError;
+        if (error.empty()) {
+            try {
+                auto it = noisy.find(t.noise);
+                if (it == noisy.end()) it = noisy.emplace(t.noise, setTransducerNoise(clean, level)).first;
+                e = identifyElbowMethod(m, study.population, it->second, study.seed, subject);
+            } catch (const InterruptedError&) {
+                throw;
+            } catch (const std::exception& x) {
+                error = x.what();
+            }
+        }
+        StudyResult r;
+        r.task = index;
+        r.protocol = pr.name;
+        r.rank = rank;
+        r.synthesisTime = synthesisShare;
+        if (!error.empty()) {
+            e = MuscleEstimate();
+            e.method = m.label;
+            r.status = "failed";
+            r.reason = error;
+        } else {
+            r.status = e.converged ? "ok" : std::isfinite(e.mass) ? "not-converged" : "failed";
+            if (!e.converged) r.reason = e.message;
+        }
+        if (synthesisError.empty()) {
+            try {
+                r.row = makeElbowValidationRow(study.population, v, level, m.label, e);
+            } catch (const std::exception& x) {
+                r.status = "failed";
+                r.reason = std::string("recording: ") + x.what();
+                r.row.subject = subject;
+                r.row.noise = level;
+                r.row.method = m.label;
+                r.row.estimate = e;
+            }
+        } else {  // no subject: no truth
+            r.row.subject = subject;
+            r.row.noise = level;
+            r.row.method = m.label;
+            r.row.estimate = e;
+            r.row.trueMass = r.row.trueTendonLength = r.row.voluntaryActivation = r.row.coContraction =
+                r.row.strengthLevel = 0.0 / 0.0;
+        }
+        r.identificationTime = std::chrono::duration<double>(Clock::now() - t1).count();
+        out.push_back(std::move(r));
+    }
+    return out;
+}
+
+std::string getStudyResultsHeader() {
+    return "task,subject,protocol,method,noise,status,true_mass_kg,mass_kg,mass_lower_kg,mass_upper_kg,mass_error,"
+           "mass_covered,true_tendon_length_m,tendon_length_m,tendon_lower_m,tendon_upper_m,tendon_error_m,"
+           "tendon_covered,noise_estimate,rms_residual_Nm,iterations,parameters,mass_tendon_correlation,"
+           "voluntary_activation,co_contraction,strength_level,biceps_short_scale,synergist_scale,reason";
+}
+
+std::string formatStudyResult(const StudyResult& r) {
+    const ElbowValidationRow& w = r.row;
+    const MuscleEstimate& e = w.estimate;
+    auto flag = [](CsvRow& row, int c) -> CsvRow& { return c < 0 ? row.addEmpty() : row.addInteger(c); };
+    CsvRow row;
+    row.addInteger(r.task).addInteger(w.subject).addText(r.protocol).addText(w.method).addNumber(w.noise);
+    row.addText(r.status).addNumber(w.trueMass).addNumber(e.mass).addNumber(e.massLower).addNumber(e.massUpper);
+    flag(row.addNumber(w.massError), w.massCovered).addNumber(w.trueTendonLength).addNumber(e.tendonLength);
+    row.addNumber(e.tendonLower).addNumber(e.tendonUpper);
+    flag(row.addNumber(w.tendonError), w.tendonCovered).addNumber(e.noiseLevel).addNumber(e.rmsResidual);
+    row.addInteger(e.iterations).addInteger(e.numParameters).addNumber(e.massTendonCorrelation);
+    row.addNumber(w.voluntaryActivation).addNumber(w.coContraction).addNumber(w.strengthLevel);
+    row.addNumber(w.bicepsShortScale).addNumber(w.synergistScale).addText(r.reason);
+    return row.getText();
+}
+
+std::string formatStudyJournalLine(const StudyResult& r) {
+    const std::string body = formatStudyResult(r) + '\t' + formatNumber(r.synthesisTime) + ',' +
+                             formatNumber(r.identificationTime) + ',' + std::to_string(r.rank);
+    return toHex(hashFnv1a(body)) + ' ' + body;
+}
+
+bool parseStudyJournalLine(const std::string& line, StudyResult& r) {
+    if (line.size() < 18 || line[16] != ' ') return false;
+    const std::string body = line.substr(17);
+    if (toHex(hashFnv1a(body)) != line.substr(0, 16)) return false;
+    const std::size_t tab = body.find('\t');
+    if (tab == std::string::npos) return false;
+    const std::vector<std::string> c = splitCsvRecord(body.substr(0, tab)),
+                                   timing = splitCsvRecord(body.substr(tab + 1));
+    if (c.size() != 29 || timing.size() != 3) return false;
+    r = StudyResult();
+    ElbowValidationRow& w = r.row;
+    MuscleEstimate& e = w.estimate;
+    long subject = 0, iterations = 0, parameters = 0, rank = 0;
+    auto flag = [](const std::string& s, int& v) {
+        if (s.empty()) return v = -1, true;
+        if (s != "0" && s != "1") return false;
+        return v = s == "1", true;
+    };
+    bool ok = parseLong(c[0], r.task) && parseLong(c[1], subject) && parseDouble(c[4], w.noise) &&
+              parseDouble(c[6], w.trueMass) && parseDouble(c[7], e.mass) && parseDouble(c[8], e.massLower) &&
+              parseDouble(c[9], e.massUpper) && parseDouble(c[10], w.massError) && flag(c[11], w.massCovered) &&
+              parseDouble(c[12], w.trueTendonLength) && parseDouble(c[13], e.tendonLength) &&
+              parseDouble(c[14], e.tendonLower) && parseDouble(c[15], e.tendonUpper) &&
+              parseDouble(c[16], w.tendonError) && flag(c[17], w.tendonCovered) && parseDouble(c[18], e.noiseLevel) &&
+              parseDouble(c[19], e.rmsResidual) && parseLong(c[20], iterations) && parseLong(c[21], parameters) &&
+              parseDouble(c[22], e.massTendonCorrelation) && parseDouble(c[23], w.voluntaryActivation) &&
+              parseDouble(c[24], w.coContraction) && parseDouble(c[25], w.strengthLevel) &&
+              parseDouble(c[26], w.bicepsShortScale) && parseDouble(c[27], w.synergistScale) &&
+              parseDouble(timing[0], r.synthesisTime) && parseDouble(timing[1], r.identificationTime) &&
+              parseLong(timing[2], rank);
+    if (!ok) return false;
+    w.subject = int(subject);
+    r.protocol = c[2];
+    w.method = e.method = c[3];
+    r.status = c[5];
+    r.reason = c[28];
+    e.converged = r.status == "ok";
+    e.iterations = int(iterations);
+    e.numParameters = int(parameters);
+    r.rank = int(rank);
+    return r.status == "ok" || r.status == "not-converged" || r.status == "failed";
+}
+
+std::vector<StudySummaryRow> summarizeStudy(const Study& study, const std::vector<StudyResult>& results) {
+    std::vector<StudySummaryRow> out;
+    for (const StudyProtocol& p : study.protocols) {
+        std::vector<ElbowValidationRow> rows;
+        for (const StudyResult& r : results) {
+            if (r.protocol != p.protocol.name) continue;
+            rows.push_back(r.row);
+            if (r.status == "failed") rows.back().massError = rows.back().tendonError = 0.0 / 0.0;
+        }
+        for (const ElbowValidationSummary& x : summarizeElbowValidation(rows)) {
+            StudySummaryRow row{p.protocol.name, x};
+            for (const StudyResult& r : results)
+                if (r.protocol == p.protocol.name && r.row.method == x.method && r.row.noise == x.noise) {
+                    row.notConverged += r.status == "not-converged";
+                    row.failed += r.status == "failed";
+                }
+            out.push_back(row);
+        }
+    }
+    return out;
+}
+
+std::string formatStudySummaryCsv(const std::vector<StudySummaryRow>& rows) {
+    CsvText csv({"protocol", "method", "noise", "tasks", "ok", "not_converged", "failed", "mass_bias", "mass_rmse",
+                 "mass_coverage", "mass_interval_width", "tendon_bias_m", "tendon_rmse_m", "tendon_coverage",
+                 "tendon_interval_width_m"});
+    for (const StudySummaryRow& r : rows) {
+        const ElbowValidationSummary& x = r.stats;
+        CsvRow row;
+        row.addText(r.protocol).addText(x.method).addNumber(x.noise).addInteger(x.subjects).addInteger(x.converged);
+        row.addInteger(r.notConverged).addInteger(r.failed).addNumber(x.massBias).addNumber(x.massRmse);
+        row.addNumber(x.massCoverage).addNumber(x.massIntervalWidth).addNumber(x.tendonBias).addNumber(x.tendonRmse);
+        row.addNumber(x.tendonCoverage).addNumber(x.tendonIntervalWidth);
+        csv.addRow(row);
+    }
+    return csv.getText();
+}
+
+}  // namespace armsim

@@ -1,0 +1,172 @@
+// Population studies (issue 13): Monte Carlo over virtual subjects. A study file names the truth (a
+// population of virtual subjects around a model), the protocols, the identifiers with their options,
+// the transducer noise levels, the number of subjects, the seed and the output folder. Every
+// (subject, protocol, noise, method) cell is one task: the subject's data are synthesized, read at the
+// noise level and identified; the estimate, the truth, the 95 % intervals, the residual, the iterations
+// and a status are recorded. The cells of one (subject, protocol) share one synthesis, so they are
+// scheduled together as a group; each cell is still recorded (and resumed) on its own.
+//
+// Results are a function of the study alone: a cell depends only on (seed, subject, protocol, noise,
+// method), numbers are written in shortest round-trip form and the table is sorted by task, so the
+// result files are byte-identical for any number of ranks or threads and any completion order. Times
+// (which are not) go to timing.csv.
+//
+// Resume: finished cells are appended to OUT/journal.log as they complete (one line per cell with a
+// checksum, flushed per group). A run that finds a journal of the same study (same fingerprint: the
+// study, its protocols and its population) computes only the cells the journal lacks; a torn last line
+// (a kill mid-write) fails its checksum and is dropped. A task that throws is recorded as failed with
+// the reason and never stops the study.
+#pragma once
+
+#include "studies/torque_validation.h"
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace armsim {
+
+/// A protocol of a study: "thesis" (the thesis's five flexion MVCs x 3) or a torque protocol file.
+struct StudyProtocol {
+    std::string reference;     ///< as written in the study file
+    TorqueProtocol protocol;   ///< its conditions; protocol.name labels its results
+};
+
+/// A study (units SI; noise levels relative).
+struct Study {
+    std::string name;                       ///< labels outputs
+    std::string description;
+    std::string file;                       ///< the study file ("" when built in code)
+    std::string populationReference = "default";  ///< "default" or the population file as written
+    Population population;                  ///< the truth: subjects are drawn from it
+    int subjects = 20;                      ///< persons 0 .. subjects-1 of the population
+    unsigned seed = 1;                      ///< population, synthesis noise and VA-measurement seed
+    std::vector<StudyProtocol> protocols;   ///< at least one
+    std::vector<double> noiseLevels;        ///< transducer noise (relative sd) [1]; at least one
+    std::vector<ElbowMethod> methods;       ///< identifiers (unique labels); at least one
+    std::string output;                     ///< output folder (relative to the working directory)
+
+    long getNumGroups() const { return long(subjects) * long(protocols.size()); }
+    int getCellsPerGroup() const { return int(noiseLevels.size() * methods.size()); }
+    long getNumTasks() const { return getNumGroups() * getCellsPerGroup(); }
+    /// FieldError naming the field for an empty list, a duplicate label or a value out of range.
+    void validate() const;
+};
+
+/// Reads a study file (`kind: study`) strictly: unknown keys, values out of range, missing protocol or
+/// population files are InputErrors naming the file, line, field and value. Protocol and population
+/// files are resolved relative to the study file, then to the working directory.
+Study readStudy(const std::string& path);
+
+/// A 16-hex-digit fingerprint of everything that decides the results: the study's settings (not its
+/// output folder), every protocol's conditions and the population's distributions and base model.
+std::string calcStudyFingerprint(const Study& study);
+
+/// One cell. Tasks are numbered subject-major: ((subject x P + protocol) x N + noise) x K + method.
+struct StudyTask {
+    long index = 0;
+    int subject = 0, protocol = 0, noise = 0, method = 0;
+    long getGroup(const Study& study) const { return long(subject) * long(study.protocols.size()) + protocol; }
+};
+StudyTask getStudyTask(const Study& study, long index);
+
+/// What one task recorded.
+struct StudyResult {
+    long task = 0;
+    std::string protocol;          ///< the protocol's name
+    std::string status;            ///< "ok", "not-converged" or "failed"
+    std::string reason;            ///< why not ok (the solver's report or the error); "" when ok
+    ElbowValidationRow row;        ///< truth, estimate, intervals, coverage (row.method: the method's label)
+    // Not part of the deterministic results (timing.csv):
+    double synthesisTime = 0;      ///< [s] this cell's share of its group's synthesis
+    double identificationTime = 0; ///< [s]
+    int rank = 0;                  ///< MPI rank that computed it
+};
+
+/// Computes the listed tasks (all of group `group`): draws the subject, synthesizes the protocol once,
+/// identifies at every listed (noise, method). Never throws for a task's failure: a synthesis or
+/// identification error is that task's "failed" result with the message.
+std::vector<StudyResult> runStudyGroup(const Study& study, long group, const std::vector<long>& tasks, int rank = 0);
+
+/// Column names of results.csv.
+std::string getStudyResultsHeader();
+/// One results.csv line (no newline); every number in shortest round-trip form.
+std::string formatStudyResult(const StudyResult& result);
+/// A journal line: checksum, result, timing (no newline). parseStudyJournalLine reads it back exactly
+/// and returns false for a torn or altered line.
+std::string formatStudyJournalLine(const StudyResult& result);
+bool parseStudyJournalLine(const std::string& line, StudyResult& result);
+
+/// One cell of the summary: a protocol, method and noise level over the subjects.
+struct StudySummaryRow {
+    std::string protocol;
+    ElbowValidationSummary stats;  ///< bias, RMSE, coverage over the tasks with an estimate (ok, not-converged)
+    int notConverged = 0, failed = 0;
+};
+/// Per (protocol, method, noise), in the study's order.
+std::vector<StudySummaryRow> summarizeStudy(const Study& study, const std::vector<StudyResult>& results);
+/// summary.csv: counts by status, bias, RMSE, coverage and interval width.
+std::string formatStudySummaryCsv(const std::vector<StudySummaryRow>& rows);
+
+/// Progress of a run, reported by the coordinator (rank 0).
+struct StudyProgress {
+    long total = 0;       ///< tasks in the study
+    long resumed = 0;     ///< found done in the journal at the start
+    long done = 0;        ///< done in all (resumed included)
+    long failed = 0;      ///< of done
+    double elapsed = 0;   ///< [s] since this run started
+    double rate = 0;      ///< tasks per second in this run
+    double remaining = 0; ///< [s] estimated; NaN before the first task
+};
+
+struct StudyRunOptions {
+    std::string output;          ///< "" : the study's
+    int threads = 0;             ///< worker threads of this process; 0: every core
+    bool restart = false;        ///< discard a journal (of this or another study) and start over
+    std::function<void(const StudyProgress&)> progress;  ///< about once a second and at the end
+};
+
+/// What a finished run did and wrote.
+struct StudyOutcome {
+    std::string output;                ///< the folder
+    long total = 0, resumed = 0, computed = 0, failed = 0, notConverged = 0;
+    double wallTime = 0;               ///< [s] this run
+    double taskTime = 0;               ///< [s] summed over the tasks computed in this run (all ranks)
+    double synthesisTime = 0;          ///< [s] of taskTime
+    int ranks = 1, threads = 1;        ///< workers: ranks x threads per rank
+    std::vector<std::string> files;    ///< written, in the folder
+};
+
+/// Byte transport from the coordinator to worker ranks (MPI in study_mpi.cpp).
+class StudyCoordinatorLink {
+public:
+    virtual ~StudyCoordinatorLink() = default;
+    virtual int getNumWorkers() const = 0;          ///< worker ranks (numbered 1 .. n)
+    /// A worker's message if one has arrived (does not block).
+    virtual bool receive(int& worker, std::string& message) = 0;
+    virtual void send(int worker, const std::string& message) = 0;
+};
+/// Byte transport from a worker rank to the coordinator.
+class StudyWorkerLink {
+public:
+    virtual ~StudyWorkerLink() = default;
+    virtual int getRank() const = 0;
+    /// Sends message to the coordinator and waits for its reply.
+    virtual std::string exchange(const std::string& message) = 0;
+};
+
+/// Runs the study's missing tasks on this process's threads (and on the workers behind `link`, which
+/// ask for groups as their threads free up: dynamic load balancing), journals each result as it
+/// arrives, and writes results.csv, timing.csv, summary.csv, study.yaml and plots to the output folder
+/// (each whole or not at all). Throws InputError for an output folder that cannot be used, one that
+/// holds another study's journal (unless restart), or one another run is using.
+StudyOutcome runStudy(const Study& study, const StudyRunOptions& options, StudyCoordinatorLink* link = nullptr);
+/// A worker rank's part: asks the coordinator for groups, computes them on `threads` threads, sends
+/// the results back, until the coordinator has no more.
+void runStudyWorker(const Study& study, int threads, StudyWorkerLink& link);
+
+/// true when this process was started by mpirun/mpiexec/srun (OpenMPI, PMIx or PMI environment).
+bool isLaunchedByMpi();
+
+}  // namespace armsim

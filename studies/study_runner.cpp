@@ -1,0 +1,431 @@
+// The study's machinery: the output folder (lock, journal, final files), the worker threads of one
+// process, the coordinator (rank 0) and the worker-rank loop. The numbers come from runStudyGroup.
+#include "basics/errors.h"
+#include "basics/files.h"
+#include "basics/format.h"
+#include "basics/plot.h"
+#include "studies/study.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <condition_variable>
+#include <cstdio>
+#include <cstdlib>
+#include <deque>
+#include <exception>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <sstream>
+#include <thread>
+
+#include <fcntl.h>
+#include <sys/file.h>
+#include <unistd.h>
+
+namespace armsim {
+
+namespace {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+// Cells of one (subject, protocol) still to compute.
+struct GroupWork {
+    long group = 0;
+    std::vector<long> tasks;
+};
+
+std::string formatWork(const std::vector<GroupWork>& work, bool noMore) {
+    std::ostringstream s;
+    s << "W " << (noMore ? 1 : 0) << '\n';
+    for (const GroupWork& w : work) {
+        s << w.group;
+        for (long t : w.tasks) s << ' ' << t;
+        s << '\n';
+    }
+    return s.str();
+}
+
+std::vector<GroupWork> parseWork(const std::string& text, bool& noMore) {
+    std::istringstream in(text);
+    std::string tag, line;
+    int flag = 0;
+    if (!(in >> tag >> flag) || tag != "W") throw std::logic_error("study: malformed work message");
+    noMore = flag != 0;
+    std::getline(in, line);
+    std::vector<GroupWork> out;
+    while (std::getline(in, line)) {
+        std::istringstream l(line);
+        GroupWork w;
+        l >> w.group;
+        for (long t; l >> t;) w.tasks.push_back(t);
+        out.push_back(w);
+    }
+    return out;
+}
+
+// A request carries the worker's study fingerprint: every rank must have read the same study.
+std::string formatRequest(int want, const std::string& fingerprint, const std::vector<StudyResult>& results) {
+    std::string s = "R " + std::to_string(want) + ' ' + fingerprint + '\n';
+    for (const StudyResult& r : results) s += formatStudyJournalLine(r) + '\n';
+    return s;
+}
+
+std::vector<StudyResult> parseRequest(const std::string& text, int& want, std::string& fingerprint) {
+    std::istringstream in(text);
+    std::string tag, line;
+    if (!(in >> tag >> want >> fingerprint) || tag != "R") throw std::logic_error("study: malformed request message");
+    std::getline(in, line);
+    std::vector<StudyResult> out;
+    while (std::getline(in, line)) {
+        StudyResult r;
+        if (!parseStudyJournalLine(line, r)) throw std::logic_error("study: corrupt result in a worker's message");
+        out.push_back(std::move(r));
+    }
+    return out;
+}
+
+// The threads of one process: groups in, results out.
+class LocalWorkers {
+public:
+    LocalWorkers(const Study& study, int threads, int rank) {
+        try {
+            start(study, threads, rank);
+        } catch (...) {  // a thread could not be created: stop the ones that were
+            stop();
+            throw;
+        }
+    }
+    ~LocalWorkers() { stop(); }
+    int getNumThreads() const { return int(threads_.size()); }
+    void add(GroupWork w) {
+        std::lock_guard<std::mutex> lock(mutex_);
+        work_.push_back(std::move(w));
+        workReady_.notify_one();
+    }
+    // Finished groups (waits up to `wait` for the first); the number of groups they came from via `groups`.
+    std::vector<StudyResult> take(std::chrono::milliseconds wait, int& groups) {
+        std::unique_lock<std::mutex> lock(mutex_);
+        resultReady_.wait_for(lock, wait, [this] { return !results_.empty() || error_; });
+        if (error_) std::rethrow_exception(error_);
+        std::vector<StudyResult> out;
+        groups = int(results_.size());
+        for (auto& r : results_) out.insert(out.end(), std::make_move_iterator(r.begin()), std::make_move_iterator(r.end()));
+        results_.clear();
+        return out;
+    }
+
+private:
+    void start(const Study& study, int threads, int rank) {
+        for (int i = 0; i < threads; ++i)
+            threads_.emplace_back([this, &study, rank] { work(study, rank); });
+    }
+    void stop() {
+        {
+            std::lock_guard<std::mutex> lock(mutex_);
+            closed_ = true;
+            work_.clear();
+        }
+        workReady_.notify_all();
+        for (std::thread& t : threads_) t.join();
+        threads_.clear();
+    }
+    void work(const Study& study, int rank) {
+        for (;;) {
+            GroupWork w;
+            {
+                std::unique_lock<std::mutex> lock(mutex_);
+                workReady_.wait(lock, [this] { return closed_ || !work_.empty(); });
+                if (work_.empty()) return;
+                w = std::move(work_.front());
+                work_.pop_front();
+            }
+            std::vector<StudyResult> r;
+            std::exception_ptr error;
+            try {
+                r = runStudyGroup(study, w.group, w.tasks, rank);
+            } catch (...) {
+                error = std::current_exception();
+            }
+            std::lock_guard<std::mutex> lock(mutex_);
+            if (error && !error_) error_ = error;
+            results_.push_back(std::move(r));
+            resultReady_.notify_all();
+        }
+    }
+
+    std::mutex mutex_;
+    std::condition_variable workReady_, resultReady_;
+    std::deque<GroupWork> work_;
+    std::deque<std::vector<StudyResult>> results_;
+    std::exception_ptr error_;
+    bool closed_ = false;
+    std::vector<std::thread> threads_;
+};
+
+// The output folder: an exclusive lock for this run (released by the kernel when the process dies) and
+// the journal of finished cells.
+class StudyFolder {
+public:
+    StudyFolder(const std::string& dir, const std::string& fingerprint, const Study& study, bool restart) : dir_(dir) {
+        std::error_code ec;
+        fs::create_directories(dir_, ec);
+        if (ec || !fs::is_directory(dir_, ec))
+            throw InputError("study output '" + dir_ + "': cannot create the folder" + (ec ? ": " + ec.message() : ""));
+        lock_.fd = ::open((dir_ + "/.lock").c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+        if (lock_.fd < 0) throw InputError("study output '" + dir_ + "': cannot write in the folder");
+        if (::flock(lock_.fd, LOCK_EX | LOCK_NB) != 0)
+            throw InputError("study output '" + dir_ + "': another armsim study is running in this folder");
+        journalPath_ = dir_ + "/journal.log";
+        const std::string header = "# armsim study journal; fingerprint " + fingerprint + "; study " + study.name;
+        std::string kept = header + '\n';
+        if (doesPathExist(journalPath_) && !restart) {
+            std::ifstream in(journalPath_, std::ios::binary);
+            std::string first, line;
+            std::getline(in, first);
+            if (first.rfind("# armsim study journal", 0) != 0 || first.find(fingerprint) == std::string::npos)
+                throw InputError("study output '" + dir_ + "': journal.log holds results of another study or of a " +
+                                 "changed study file, protocol or population (fingerprint " + fingerprint +
+                                 " expected); use another output folder or --restart to discard them");
+            while (std::getline(in, line)) {
+                StudyResult r;
+                if (in.eof() || !parseStudyJournalLine(line, r) || r.task < 0 || r.task >= study.getNumTasks()) {
+                    ++dropped_;  // a torn last line (no newline) or a damaged one: recomputed
+                    continue;
+                }
+                if (done_.emplace(r.task, r).second) kept += line + '\n';
+            }
+        }
+        writeFileAtomically(journalPath_, kept);  // compacted: valid lines only, so appends start on a clean line
+        journal_.reset(std::fopen(journalPath_.c_str(), "ab"));
+        if (!journal_) throw InputError("study output '" + dir_ + "': cannot append to journal.log");
+    }
+    const std::map<long, StudyResult>& getDone() const { return done_; }
+    int getDropped() const { return dropped_; }
+    // Journals results (one write and flush: a kill leaves at most one torn line).
+    void append(const std::vector<StudyResult>& results) {
+        std::string text;
+        for (const StudyResult& r : results) {
+            text += formatStudyJournalLine(r) + '\n';
+            done_.emplace(r.task, r);
+        }
+        if (std::fwrite(text.data(), 1, text.size(), journal_.get()) != text.size() || std::fflush(journal_.get()) != 0)
+            throw InputError("study output '" + dir_ + "': cannot append to journal.log");
+    }
+
+private:
+    struct Lock {  // closing the descriptor releases the lock, also when the constructor throws
+        int fd = -1;
+        ~Lock() {
+            if (fd >= 0) ::close(fd);
+        }
+    };
+    std::string dir_, journalPath_;
+    Lock lock_;
+    std::unique_ptr<std::FILE, int (*)(std::FILE*)> journal_{nullptr, std::fclose};
+    std::map<long, StudyResult> done_;
+    int dropped_ = 0;
+};
+
+// Per (protocol, method): a statistic of the summary against the noise level.
+void writeNoisePlot(const std::string& path, const std::string& title, const std::string& yLabel,
+                    const std::vector<StudySummaryRow>& summary, double (*statistic)(const ElbowValidationSummary&)) {
+    PlotSpec spec;
+    spec.title = title;
+    spec.xLabel = "transducer noise (% of the torque)";
+    spec.yLabel = yLabel;
+    std::map<std::string, std::size_t> seriesOf;
+    for (const StudySummaryRow& r : summary) {
+        const double y = statistic(r.stats);
+        if (!std::isfinite(y)) continue;
+        const std::string key = r.protocol + " / " + r.stats.method;
+        if (!seriesOf.count(key)) {
+            seriesOf[key] = spec.series.size();
+            spec.series.push_back({key, {}, {}, false, int(spec.series.size() % 8)});
+        }
+        PlotSeries& s = spec.series[seriesOf[key]];
+        s.x.push_back(100 * r.stats.noise);
+        s.y.push_back(y);
+    }
+    if (spec.series.empty()) return;
+    for (PlotSeries& s : spec.series) s.markers = s.x.size() == 1;
+    writePlotPng(path, spec);
+}
+
+std::vector<std::string> writeStudyFiles(const Study& study, const std::string& dir,
+                                         const std::map<long, StudyResult>& done) {
+    std::vector<StudyResult> results;
+    results.reserve(done.size());
+    std::string table = getStudyResultsHeader() + '\n', timing = "task,rank,synthesis_s,identification_s\n";
+    for (const auto& [task, r] : done) {
+        table += formatStudyResult(r) + '\n';
+        timing += std::to_string(task) + ',' + std::to_string(r.rank) + ',' + formatNumber(r.synthesisTime) + ',' +
+                  formatNumber(r.identificationTime) + '\n';
+        results.push_back(r);
+    }
+    const std::vector<StudySummaryRow> summary = summarizeStudy(study, results);
+    writeFileAtomically(dir + "/results.csv", table);
+    writeFileAtomically(dir + "/timing.csv", timing);
+    writeFileAtomically(dir + "/summary.csv", formatStudySummaryCsv(summary));
+    std::vector<std::string> files = {"results.csv", "summary.csv", "timing.csv"};
+    if (!study.file.empty()) {
+        writeFileAtomically(dir + "/study.yaml", readFileText(study.file));
+        files.push_back("study.yaml");
+    }
+    const struct {
+        const char* file;
+        const char* title;
+        const char* yLabel;
+        double (*statistic)(const ElbowValidationSummary&);
+    } plots[] = {
+        {"mass_rmse_vs_noise.png", "Biceps long-head mass: RMSE of the identified mass", "mass RMSE (%)",
+         [](const ElbowValidationSummary& x) { return 100 * x.massRmse; }},
+        {"mass_coverage_vs_noise.png", "Biceps long-head mass: coverage of the 95 % interval", "coverage of the true mass",
+         [](const ElbowValidationSummary& x) { return x.massCoverage; }},
+        {"tendon_rmse_vs_noise.png", "Optimal tendon length: RMSE", "L0T RMSE (mm)",
+         [](const ElbowValidationSummary& x) { return 1000 * x.tendonRmse; }},
+    };
+    for (const auto& p : plots) {
+        writeNoisePlot(dir + "/" + p.file, p.title, p.yLabel, summary, p.statistic);
+        if (doesPathExist(dir + "/" + p.file)) files.push_back(p.file);
+    }
+    return files;
+}
+
+int defaultThreads() { return std::max(1u, std::thread::hardware_concurrency()); }
+
+}  // namespace
+
+StudyOutcome runStudy(const Study& study, const StudyRunOptions& options, StudyCoordinatorLink* link) {
+    study.validate();
+    const auto start = Clock::now();
+    StudyOutcome outcome;
+    outcome.output = options.output.empty() ? study.output : options.output;
+    if (outcome.output.empty()) throw InputError("study: no output folder (set `output:` or --out)");
+    const std::string fingerprint = calcStudyFingerprint(study);
+    StudyFolder folder(outcome.output, fingerprint, study, options.restart);
+
+    // Missing cells, grouped, in task order.
+    std::deque<GroupWork> pending;
+    const int cells = study.getCellsPerGroup();
+    for (long g = 0; g < study.getNumGroups(); ++g) {
+        GroupWork w{g, {}};
+        for (long t = g * cells; t < (g + 1) * cells; ++t)
+            if (!folder.getDone().count(t)) w.tasks.push_back(t);
+        if (!w.tasks.empty()) pending.push_back(std::move(w));
+    }
+    outcome.total = study.getNumTasks();
+    outcome.resumed = long(folder.getDone().size());
+
+    StudyProgress progress;
+    progress.total = outcome.total;
+    progress.resumed = progress.done = outcome.resumed;
+    for (const auto& [task, r] : folder.getDone()) progress.failed += r.status == "failed";
+    auto record = [&](const std::vector<StudyResult>& results) {
+        if (results.empty()) return;
+        folder.append(results);
+        for (const StudyResult& r : results) {
+            ++progress.done;
+            ++outcome.computed;
+            progress.failed += r.status == "failed";
+            outcome.taskTime += r.synthesisTime + r.identificationTime;
+            outcome.synthesisTime += r.synthesisTime;
+        }
+    };
+    auto report = [&] {
+        if (!options.progress) return;
+        progress.elapsed = std::chrono::duration<double>(Clock::now() - start).count();
+        const long computed = progress.done - progress.resumed;
+        progress.rate = progress.elapsed > 0 ? double(computed) / progress.elapsed : 0;
+        progress.remaining = computed > 0 ? double(progress.total - progress.done) / progress.rate : 0.0 / 0.0;
+        options.progress(progress);
+    };
+
+    const int threads = options.threads > 0 ? options.threads : defaultThreads();
+    outcome.threads = threads;
+    outcome.ranks = 1 + (link ? link->getNumWorkers() : 0);
+    {
+        LocalWorkers local(study, pending.empty() ? 0 : threads, 0);
+        int localInFlight = 0, stopped = 0;
+        const int workers = link ? link->getNumWorkers() : 0;
+        std::vector<bool> told(workers + 1, false);
+        auto lastReport = Clock::now();
+        report();
+        while (progress.done < progress.total || stopped < workers) {
+            while (localInFlight < local.getNumThreads() && !pending.empty()) {
+                local.add(std::move(pending.front()));
+                pending.pop_front();
+                ++localInFlight;
+            }
+            int worker = 0;
+            std::string message;
+            while (link && link->receive(worker, message)) {
+                int want = 0;
+                std::string theirs;
+                const std::vector<StudyResult> results = parseRequest(message, want, theirs);
+                if (theirs != fingerprint)
+                    throw InputError("rank " + std::to_string(worker) + " read a different study (fingerprint " + theirs +
+                                     ", rank 0: " + fingerprint + "): the study, protocol and population files must "
+                                     "be the same on every node");
+                record(results);
+                std::vector<GroupWork> give;
+                while (int(give.size()) < want && !pending.empty()) {
+                    give.push_back(std::move(pending.front()));
+                    pending.pop_front();
+                }
+                link->send(worker, formatWork(give, pending.empty()));
+                if (pending.empty() && !told[worker]) told[worker] = true, ++stopped;
+            }
+            int groups = 0;
+            record(local.take(std::chrono::milliseconds(link ? 1 : 200), groups));
+            localInFlight -= groups;
+            if (Clock::now() - lastReport > std::chrono::seconds(1)) {
+                report();
+                lastReport = Clock::now();
+            }
+        }
+    }
+    report();
+
+    outcome.files = writeStudyFiles(study, outcome.output, folder.getDone());
+    for (const auto& [task, r] : folder.getDone()) {
+        outcome.failed += r.status == "failed";
+        outcome.notConverged += r.status == "not-converged";
+    }
+    outcome.wallTime = std::chrono::duration<double>(Clock::now() - start).count();
+    return outcome;
+}
+
+bool isLaunchedByMpi() {
+    return std::getenv("OMPI_COMM_WORLD_SIZE") || std::getenv("PMIX_RANK") || std::getenv("PMI_RANK");
+}
+
+void runStudyWorker(const Study& study, int threads, StudyWorkerLink& link) {
+    study.validate();
+    threads = threads > 0 ? threads : defaultThreads();
+    const std::string fingerprint = calcStudyFingerprint(study);
+    LocalWorkers local(study, threads, link.getRank());
+    const int capacity = threads;  // no prefetch: a queued group could leave another rank idle at the end
+    int inFlight = 0;
+    bool noMore = false;
+    std::vector<StudyResult> finished;
+    for (;;) {
+        const int want = noMore ? 0 : capacity - inFlight;
+        if (want > 0 || !finished.empty()) {
+            const std::vector<GroupWork> work = parseWork(link.exchange(formatRequest(want, fingerprint, finished)), noMore);
+            finished.clear();
+            for (const GroupWork& w : work) local.add(w);
+            inFlight += int(work.size());
+        }
+        if (noMore && inFlight == 0) return;
+        int groups = 0;
+        finished = local.take(std::chrono::milliseconds(200), groups);
+        inFlight -= groups;
+    }
+}
+
+}  // namespace armsim

@@ -1,0 +1,166 @@
+#include "studies/torque_validation.h"
+
+#include "basics/bound.h"
+#include "basics/csv.h"
+#include "basics/parallel.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace armsim {
+
+ElbowValidationRow makeElbowValidationRow(const Population& population, const VirtualSubject& v, double noise,
+                                          const std::string& method, const MuscleEstimate& e) {
+    const int primary = population.base.primary;
+    ElbowValidationRow row;
+    row.subject = v.index;
+    row.noise = noise;
+    row.method = method;
+    row.trueMass = v.setup.muscles[primary].params.mass;
+    row.trueTendonLength = v.setup.muscles[primary].params.optimalTendonLength;
+    row.estimate = e;
+    row.massError = e.mass / row.trueMass - 1;
+    row.tendonError = e.tendonLength - row.trueTendonLength;
+    if (std::isfinite(e.massLower)) row.massCovered = row.trueMass >= e.massLower && row.trueMass <= e.massUpper;
+    if (std::isfinite(e.tendonLower))
+        row.tendonCovered = row.trueTendonLength >= e.tendonLower && row.trueTendonLength <= e.tendonUpper;
+    row.voluntaryActivation = v.setup.effort.voluntaryActivation;
+    row.coContraction = v.setup.effort.coContraction;
+    row.strengthLevel = v.strengthLevel;
+    // Nuisance truths of the muscles the model has (a model without them leaves NaN).
+    auto present = [&](const std::vector<std::string>& names) {
+        std::vector<int> out;
+        for (const std::string& n : names)
+            for (int i = 0; i < population.base.getNumMuscles(); ++i)
+                if (population.base.muscles[i].params.name == n) out.push_back(i);
+        return out;
+    };
+    for (int i : present(SynergistOptions().biceps))
+        if (i != primary) row.bicepsShortScale = v.massScale[i] / v.massScale[primary];
+    const std::vector<int> synergists = present(SynergistOptions().synergists);
+    double syn = 0;
+    for (int i : synergists) syn += v.massScale[i];
+    if (!synergists.empty()) row.synergistScale = syn / double(synergists.size()) / v.massScale[primary];
+    return row;
+}
+
+std::vector<ElbowValidationRow> runElbowValidation(const Population& population, const ElbowValidationSettings& settings,
+                                                   const std::function<void(int, int)>& progress) {
+    population.validate();
+    settings.protocol.validate();
+    checkField("subjects", settings.subjects, Bound::closed(1, 1e6));
+    checkField("activation_sd", settings.activationSd, Bound::closed(0, 0.5));
+    std::vector<double> levels = settings.noiseLevels;
+    if (levels.empty()) levels.push_back(population.transducerNoise);
+    for (double v : levels) checkField("noise", v, Bound{0, 0.5, false, true, "relative sd"});
+    std::vector<ElbowMethod> methods(settings.activationSd > 0 ? 3 : 2);
+    for (std::size_t k = 0; k < methods.size(); ++k) {
+        methods[k].kind = getElbowMethodKinds()[k];
+        methods[k].options.freeSlowFraction = settings.freeSlowFraction;
+        methods[k].options.activationSd = settings.activationSd;
+    }
+
+    std::vector<std::vector<ElbowValidationRow>> perSubject(settings.subjects);
+    runParallel(settings.subjects, settings.jobs, [&](int s) {
+        const VirtualSubject v = drawSubject(population, settings.seed, s);
+        const std::vector<TorqueObservation> clean = synthesizeTorqueData(v, settings.protocol, settings.seed, 1);
+        for (double level : levels) {
+            const std::vector<TorqueObservation> data = setTransducerNoise(clean, level);
+            for (const ElbowMethod& m : methods) {
+                // A method that cannot use these data (the thesis method with fewer flexion-MVC angles
+                // than unknowns) is recorded as failed, not fatal.
+                MuscleEstimate e;
+                try {
+                    e = identifyElbowMethod(m, population, data, settings.seed, s);
+                } catch (const std::exception& x) {
+                    e.method = m.kind;
+                    e.message = x.what();
+                }
+                perSubject[s].push_back(makeElbowValidationRow(population, v, level, m.kind, e));
+            }
+        }
+    }, progress);
+    std::vector<ElbowValidationRow> rows;
+    for (auto& r : perSubject) rows.insert(rows.end(), r.begin(), r.end());
+    return rows;
+}
+
+std::vector<ElbowValidationSummary> summarizeElbowValidation(const std::vector<ElbowValidationRow>& rows) {
+    std::vector<ElbowValidationSummary> out;
+    for (const ElbowValidationRow& r : rows) {
+        auto it = std::find_if(out.begin(), out.end(),
+                               [&](const ElbowValidationSummary& s) { return s.method == r.method && s.noise == r.noise; });
+        if (it == out.end()) {
+            out.push_back({});
+            it = out.end() - 1;
+            it->method = r.method;
+            it->noise = r.noise;
+        }
+        ++it->subjects;
+    }
+    for (ElbowValidationSummary& s : out) {
+        double mb = 0, mm = 0, tb = 0, tm = 0, mw = 0, tw = 0;
+        int mc = 0, mn = 0, tc = 0, tn = 0, n = 0;
+        for (const ElbowValidationRow& r : rows) {
+            if (r.method != s.method || r.noise != s.noise) continue;
+            if (r.estimate.converged) ++s.converged;
+            if (!std::isfinite(r.massError) || !std::isfinite(r.tendonError)) continue;
+            ++n;
+            mb += r.massError, mm += r.massError * r.massError;
+            tb += r.tendonError, tm += r.tendonError * r.tendonError;
+            if (r.massCovered >= 0) {
+                ++mn, mc += r.massCovered;
+                mw += (r.estimate.massUpper - r.estimate.massLower) / r.estimate.mass;
+            }
+            if (r.tendonCovered >= 0) {
+                ++tn, tc += r.tendonCovered;
+                tw += r.estimate.tendonUpper - r.estimate.tendonLower;
+            }
+        }
+        s.massBias = s.massRmse = s.tendonBias = s.tendonRmse = 0.0 / 0.0;  // no estimate
+        if (n > 0) {
+            s.massBias = mb / n, s.massRmse = std::sqrt(mm / n);
+            s.tendonBias = tb / n, s.tendonRmse = std::sqrt(tm / n);
+        }
+        if (mn > 0) s.massCoverage = double(mc) / mn, s.massIntervalWidth = mw / mn;
+        if (tn > 0) s.tendonCoverage = double(tc) / tn, s.tendonIntervalWidth = tw / tn;
+    }
+    return out;
+}
+
+std::string formatElbowValidationCsv(const std::vector<ElbowValidationRow>& rows) {
+    CsvText csv({"subject", "noise", "method", "converged", "true_mass_kg", "mass_kg", "mass_lower_kg", "mass_upper_kg",
+                 "mass_error_pct", "mass_covered", "true_tendon_length_m", "tendon_length_m", "tendon_lower_m",
+                 "tendon_upper_m", "tendon_error_mm", "tendon_covered", "voluntary_activation", "co_contraction",
+                 "strength_level", "biceps_short_scale", "synergist_scale", "noise_level_used", "rms_residual"});
+    auto flag = [](CsvRow& row, int c) -> CsvRow& { return c < 0 ? row.addEmpty() : row.addInteger(c); };
+    for (const ElbowValidationRow& r : rows) {
+        const MuscleEstimate& e = r.estimate;
+        CsvRow row;
+        row.addInteger(r.subject).addNumber(r.noise).addText(r.method).addInteger(e.converged ? 1 : 0);
+        row.addNumber(r.trueMass).addNumber(e.mass).addNumber(e.massLower).addNumber(e.massUpper);
+        flag(row.addNumber(100 * r.massError), r.massCovered);
+        row.addNumber(r.trueTendonLength).addNumber(e.tendonLength).addNumber(e.tendonLower).addNumber(e.tendonUpper);
+        flag(row.addNumber(1000 * r.tendonError), r.tendonCovered);
+        row.addNumber(r.voluntaryActivation).addNumber(r.coContraction).addNumber(r.strengthLevel);
+        row.addNumber(r.bicepsShortScale).addNumber(r.synergistScale).addNumber(e.noiseLevel).addNumber(e.rmsResidual);
+        csv.addRow(row);
+    }
+    return csv.getText();
+}
+
+std::string formatElbowValidationSummaryCsv(const std::vector<ElbowValidationSummary>& summaries) {
+    CsvText csv({"method", "noise", "subjects", "converged", "mass_bias_pct", "mass_rmse_pct", "mass_coverage",
+                 "tendon_bias_mm", "tendon_rmse_mm", "tendon_coverage"});
+    for (const ElbowValidationSummary& s : summaries) {
+        CsvRow row;
+        row.addText(s.method).addNumber(s.noise).addInteger(s.subjects).addInteger(s.converged);
+        row.addNumber(100 * s.massBias).addNumber(100 * s.massRmse).addNumber(s.massCoverage);
+        row.addNumber(1000 * s.tendonBias).addNumber(1000 * s.tendonRmse).addNumber(s.tendonCoverage);
+        csv.addRow(row);
+    }
+    return csv.getText();
+}
+
+
+}  // namespace armsim

@@ -1,0 +1,69 @@
+// Validation of the torque-data identifiers on virtual subjects: each subject drawn from a population,
+// its data synthesized through a protocol, identified with every method, truth beside estimate.
+#pragma once
+
+#include "identification/torque_identification.h"
+
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace armsim {
+
+/// One identification in a validation: truth, estimate, coverage.
+struct ElbowValidationRow {
+    int subject = 0;
+    double noise = 0;                  ///< transducer noise used [1]
+    std::string method;
+    double trueMass = 0, trueTendonLength = 0;   ///< the subject's primary muscle [kg], [m]
+    MuscleEstimate estimate;
+    double massError = 0.0 / 0.0;      ///< estimate / truth - 1 [1]
+    double tendonError = 0.0 / 0.0;    ///< estimate - truth [m]
+    int massCovered = -1;              ///< 1/0: truth inside/outside the interval; -1: no interval
+    int tendonCovered = -1;
+    // Nuisance truths, for error-vs-nuisance plots.
+    double voluntaryActivation = 0, coContraction = 0, strengthLevel = 0;
+    double bicepsShortScale = 0.0 / 0.0;  ///< second biceps head's mass scale / primary's [1]
+    double synergistScale = 0.0 / 0.0;    ///< mean mass scale of the synergists / primary's [1]
+};
+
+/// A validation row: the subject's truth beside the estimate.
+ElbowValidationRow makeElbowValidationRow(const Population& population, const VirtualSubject& subject, double noise,
+                                          const std::string& method, const MuscleEstimate& estimate);
+
+/// Bias, RMSE and coverage of one method at one noise level.
+struct ElbowValidationSummary {
+    std::string method;
+    double noise = 0;
+    int subjects = 0, converged = 0;
+    double massBias = 0, massRmse = 0;        ///< relative [1]; NaN when no subject has an estimate
+    double tendonBias = 0, tendonRmse = 0;    ///< [m]
+    double massCoverage = 0.0 / 0.0, tendonCoverage = 0.0 / 0.0;  ///< fraction of subjects [1]
+    double massIntervalWidth = 0.0 / 0.0;     ///< mean 95 % interval width / estimate [1]
+    double tendonIntervalWidth = 0.0 / 0.0;   ///< mean 95 % interval width [m]
+};
+
+/// Settings of runElbowValidation.
+struct ElbowValidationSettings {
+    int subjects = 200;
+    unsigned seed = 1;                        ///< population and noise seed
+    std::vector<double> noiseLevels;          ///< transducer noise levels; empty: the population's
+    /// > 0: also run "synergist-va", the synergist-aware identifier with voluntary activation measured
+    /// by twitch interpolation to this sd [1]; 0: not.
+    double activationSd = 0.02;
+    TorqueProtocol protocol;
+    bool freeSlowFraction = false;            ///< the synergist identifiers free the slow fractions (SynergistOptions)
+    int jobs = 2;                             ///< threads (over subjects)
+};
+
+/// Draws subjects 0..subjects-1, synthesizes each one's data once per noise level (common random
+/// numbers across levels), identifies with both methods. progress(done, total) per subject.
+std::vector<ElbowValidationRow> runElbowValidation(const Population& population, const ElbowValidationSettings& settings,
+                                                   const std::function<void(int, int)>& progress = {});
+std::vector<ElbowValidationSummary> summarizeElbowValidation(const std::vector<ElbowValidationRow>& rows);
+/// One CSV line per row: truth, estimate, 95 % interval, coverage, nuisance truths (SI units, errors in %).
+std::string formatElbowValidationCsv(const std::vector<ElbowValidationRow>& rows);
+/// Per method and noise level: bias, RMSE, coverage (CSV).
+std::string formatElbowValidationSummaryCsv(const std::vector<ElbowValidationSummary>& summaries);
+
+}  // namespace armsim

@@ -1,0 +1,128 @@
+// The synergist-aware identifier: the tared steady torque two ways, and the thesis and synergist-aware
+// identifiers on a seeded population with the elbow as truth.
+#include "basics/parallel.h"
+#include "identification/torque_identification.h"
+#include "model/geometry.h"
+#include "model/mvc_curve.h"
+#include "model/trial.h"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <random>
+
+using namespace armsim;
+
+namespace {
+
+const Population& population() {
+    static const Population p = loadDefaultPopulation();
+    return p;
+}
+
+}  // namespace
+
+// The identifier's prediction two ways: the steady MVC curves of model/ (active minus relaxed), and
+// the time-integrated, tared MVC trial at the end of a 3 s hold.
+TEST(ElbowIdentification, TaredSteadyTorqueEqualsTheMvcCurvesAndTheIntegratedTrial) {
+    constexpr double kTrialRelTol = 0.01;  // slow activation dynamics: the 3 s plateau is within 1 %
+    const VirtualSubject v = drawSubject(population(), 3, 2);
+    const std::vector<double> flexion = {30, 90, 135};
+    const std::vector<double> t = calcTaredSteadyTorque(v.setup, v.setup.effort, flexion);
+    const SteadyMvcCurve active = calcSteadyMvcCurve(v.setup, MuscleGroup::Flexor, v.setup.effort, flexion);
+    const SteadyMvcCurve relaxed = calcSteadyMvcCurve(v.setup, MuscleGroup::Flexor, SubjectEffort{0, 0}, flexion);
+    for (std::size_t a = 0; a < flexion.size(); ++a) {
+        EXPECT_NEAR(t[a], active.totalTorque[a] - relaxed.totalTorque[a], 1e-9 * std::abs(t[a]));
+        IsometricTrialSettings s;
+        s.elbowAngle = degToRad(180 - flexion[a]);
+        s.activation = v.setup.effort.voluntaryActivation;
+        s.antagonistActivation = v.setup.effort.coContraction;
+        s.averagingWindow = 0.2;
+        const double trial = runIsometricTrial(v.setup, s).summary.meanMuscleTorque;
+        EXPECT_NEAR(trial, t[a], kTrialRelTol * std::abs(t[a])) << flexion[a] << " deg";
+    }
+}
+
+// Issue 11: with the elbow as truth (20 seeded subjects, five angles x 3 efforts, 2 % transducer
+// noise), the synergist-aware identifier's biceps mass bias is within 10 % and its tendon-length
+// RMSE within 15 mm, while the thesis method is off by more than +50 % (the flexors' torque lands on
+// the biceps). Leaving the synergists out of the identifier's model breaks the bias bound: the
+// test fails if the synergists are dropped.
+TEST(ElbowIdentification, SynergistAwareIdentifierMeetsItsBiasBoundWhereTheThesisMethodFails) {
+    constexpr int kSubjects = 20;
+    constexpr double kMassBiasBound = 0.10, kTendonRmseBound = 0.015;
+    constexpr int kMinCovered = 15;  // of 20: a 95 % interval may miss ~1; mismatch the prior lacks costs more
+    TorqueProtocol protocol;
+    protocol.holdDuration = 2.0;
+    std::vector<std::vector<TorqueObservation>> data(kSubjects);
+    std::vector<VirtualSubject> subjects(kSubjects);
+    runParallel(kSubjects, 2, [&](int s) {
+        subjects[s] = drawSubject(population(), 1, s);
+        data[s] = synthesizeTorqueData(subjects[s], protocol, 1);
+    });
+    SynergistOptions dropped;
+    dropped.includeSynergists = false;
+    std::vector<std::array<MuscleEstimate, 4>> estimates(kSubjects);
+    runParallel(kSubjects, 2, [&](int s) {
+        SynergistOptions withVa;
+        withVa.measuredActivation = measureVoluntaryActivation(data[s], withVa.activationSd, unsigned(s));
+        estimates[s] = {identifySynergistAware(population(), data[s]), identifyThesisMethod(population().base, data[s]),
+                        identifySynergistAware(population(), data[s], dropped),
+                        identifySynergistAware(population(), data[s], withVa)};
+    });
+    double bias[4] = {0, 0, 0, 0}, massSq[4] = {0, 0, 0, 0}, tendonSq = 0;
+    int converged = 0, covered = 0;
+    for (int s = 0; s < kSubjects; ++s) {
+        const MuscleParameters& truth = subjects[s].setup.biceps();
+        const auto& e = estimates[s];
+        for (int m = 0; m < 4; ++m) {
+            bias[m] += (e[m].mass / truth.mass - 1) / kSubjects;
+            massSq[m] += std::pow(e[m].mass / truth.mass - 1, 2) / kSubjects;
+        }
+        tendonSq += std::pow(e[0].tendonLength - truth.optimalTendonLength, 2) / kSubjects;
+        converged += e[0].converged;
+        if (!e[0].converged) {
+            std::printf("subject %d: %s; mass %g tendon %g;", s, e[0].message.c_str(), e[0].mass, e[0].tendonLength);
+            for (std::size_t k = 0; k < e[0].nuisance.size(); ++k) std::printf(" %s %g", e[0].nuisanceNames[k].c_str(), e[0].nuisance[k]);
+            std::printf("\n");
+        }
+        covered += truth.mass >= e[0].massLower && truth.mass <= e[0].massUpper;
+    }
+    std::printf("mass bias: synergist-aware %+.1f %%, thesis %+.1f %%, synergists dropped %+.1f %%, with measured "
+                "activation %+.1f %%; mass RMSE %.1f %% / %.1f %% with measured activation; tendon RMSE %.1f mm; "
+                "mass coverage %d/%d\n",
+                100 * bias[0], 100 * bias[1], 100 * bias[2], 100 * bias[3], 100 * std::sqrt(massSq[0]),
+                100 * std::sqrt(massSq[3]), 1000 * std::sqrt(tendonSq), covered, kSubjects);
+    EXPECT_EQ(converged, kSubjects);
+    EXPECT_LE(std::abs(bias[0]), kMassBiasBound);
+    EXPECT_LE(std::sqrt(tendonSq), kTendonRmseBound);
+    EXPECT_GT(bias[1], 0.5);
+    EXPECT_GT(std::abs(bias[2]), kMassBiasBound);  // the ablation fails the bound the full model meets
+    EXPECT_GE(covered, kMinCovered);
+    // A measured activation removes the activation-strength confound: a smaller mass RMSE.
+    EXPECT_LT(massSq[3], massSq[0]);
+}
+
+// A population whose effort is exactly known (zero-width ranges: VA = 1, no co-contraction) holds
+// those values fixed in the fit instead of probing outside [0, 1].
+TEST(ElbowIdentification, ZeroWidthEffortRangesAreHeldFixed) {
+    Population known = population();
+    known.voluntaryActivation = {1.0, 1.0};
+    known.coContraction = {0.0, 0.0};
+    TorqueProtocol protocol;
+    protocol.holdDuration = 1.5;
+    protocol.averagingWindow = 0.5;
+    const VirtualSubject v = drawSubject(known, 4, 0);
+    const std::vector<TorqueObservation> data = synthesizeTorqueData(v, protocol, 4, 2);
+    const MuscleEstimate e = identifySynergistAware(known, data);
+    ASSERT_TRUE(std::isfinite(e.mass)) << e.message;
+    EXPECT_TRUE(e.converged) << e.message;
+    EXPECT_NEAR(e.nuisance[0], 1.0, 1e-5);  // voluntary_activation, within the probe margin
+    EXPECT_NEAR(e.nuisance[1], 0.0, 1e-5);  // co_contraction
+    EXPECT_LT(e.massLower, e.mass);
+    EXPECT_GT(e.massUpper, e.mass);
+}

@@ -1,0 +1,273 @@
+// Population studies (issue 13): task numbering, the journal line format, a study cell against the
+// validation's own computation (a second path to the same numbers), failures recorded, resume from a
+// partial and torn journal, thread-count independence, and bad study files.
+#include "basics/errors.h"
+#include "basics/files.h"
+#include "studies/study.h"
+#include "tests/support/temp_files.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+#include <unistd.h>
+
+using namespace armsim;
+namespace fs = std::filesystem;
+
+namespace {
+
+fs::path freshDir(const std::string& name) { return armsim::testing::makeFreshDir("study", name); }
+std::string readText(const fs::path& p) { return armsim::testing::readFileText(p); }
+
+// 3 subjects x {thesis, one angle} x {1 %, 5 %} x {thesis, synergist-va}: the thesis method cannot
+// identify two unknowns from one angle, so 6 of its cells fail by design.
+Study makeSmallStudy() {
+    Study s;
+    s.name = "small";
+    s.population = loadDefaultPopulation();
+    s.subjects = 3;
+    s.seed = 5;
+    StudyProtocol thesis{"thesis", TorqueProtocol()};
+    StudyProtocol one{"one_angle.yaml", TorqueProtocol()};
+    one.protocol.name = "one_angle";
+    one.protocol.conditions = TorqueProtocol::makeFlexionMvcs({90}, 3);
+    s.protocols = {thesis, one};
+    s.noiseLevels = {0.01, 0.05};
+    ElbowMethod a, b;
+    a.kind = a.label = "thesis";
+    b.kind = b.label = "synergist-va";
+    s.methods = {a, b};
+    return s;
+}
+
+const Study& smallStudy() {
+    static const Study s = makeSmallStudy();
+    return s;
+}
+
+// The uninterrupted run on two threads, computed once for the tests that compare against it.
+const std::string& referenceResults() {
+    static const std::string text = [] {
+        const fs::path d = freshDir("reference");
+        StudyRunOptions o;
+        o.output = d.string();
+        o.threads = 2;
+        runStudy(smallStudy(), o);
+        return readText(d / "results.csv") + readText(d / "summary.csv");
+    }();
+    return text;
+}
+
+}  // namespace
+
+TEST(Study, TasksAreNumberedSubjectMajorAndGroupedBySubjectAndProtocol) {
+    const Study& s = smallStudy();
+    ASSERT_EQ(s.getNumTasks(), 3 * 2 * 2 * 2);
+    std::set<std::tuple<int, int, int, int>> seen;
+    for (long i = 0; i < s.getNumTasks(); ++i) {
+        const StudyTask t = getStudyTask(s, i);
+        EXPECT_EQ(((long(t.subject) * 2 + t.protocol) * 2 + t.noise) * 2 + t.method, i);
+        EXPECT_EQ(t.getGroup(s), i / s.getCellsPerGroup());
+        seen.insert({t.subject, t.protocol, t.noise, t.method});
+    }
+    EXPECT_EQ(long(seen.size()), s.getNumTasks());  // every cell exactly once
+    EXPECT_THROW(getStudyTask(s, s.getNumTasks()), std::out_of_range);
+}
+
+// The study's cells are the validation's identifications: same subject, data, noise and method give the
+// same numbers through runStudyGroup as through runElbowValidation (which shares only the identifier).
+TEST(Study, CellsEqualTheElbowValidationOfTheSameSubjects) {
+    const Study& s = smallStudy();
+    ElbowValidationSettings v;
+    v.subjects = 2;
+    v.seed = s.seed;
+    v.noiseLevels = s.noiseLevels;
+    v.activationSd = 0.02;
+    v.jobs = 2;
+    const std::vector<ElbowValidationRow> rows = runElbowValidation(s.population, v);
+    int compared = 0;
+    for (int subject = 0; subject < 2; ++subject) {
+        const long group = long(subject) * 2;  // the thesis protocol
+        std::vector<long> tasks;
+        for (long t = group * 4; t < group * 4 + 4; ++t) tasks.push_back(t);
+        for (const StudyResult& r : runStudyGroup(s, group, tasks)) {
+            for (const ElbowValidationRow& w : rows) {
+                if (w.subject != subject || w.noise != r.row.noise || w.method != r.row.method) continue;
+                EXPECT_EQ(r.row.estimate.mass, w.estimate.mass) << r.row.method;  // bitwise: same computation
+                EXPECT_EQ(r.row.estimate.tendonLength, w.estimate.tendonLength);
+                EXPECT_EQ(r.row.trueMass, w.trueMass);
+                EXPECT_EQ(r.row.massCovered, w.massCovered);
+                EXPECT_EQ(r.status == "ok", w.estimate.converged);
+                ++compared;
+            }
+        }
+    }
+    EXPECT_EQ(compared, 2 * 2 * 2);
+}
+
+TEST(Study, JournalLinesRoundTripExactlyAndRejectTornOrAlteredLines) {
+    const Study& s = smallStudy();
+    const std::vector<StudyResult> results = runStudyGroup(s, 1, {4, 5, 6, 7}, 3);  // subject 0, one angle
+    ASSERT_EQ(results.size(), 4u);
+    for (const StudyResult& r : results) {
+        const std::string line = formatStudyJournalLine(r);
+        StudyResult back;
+        ASSERT_TRUE(parseStudyJournalLine(line, back)) << line;
+        EXPECT_EQ(formatStudyJournalLine(back), line);
+        EXPECT_EQ(formatStudyResult(back), formatStudyResult(r));
+        EXPECT_EQ(back.rank, 3);
+        for (std::size_t cut : {line.size() - 1, line.size() / 2, std::size_t(20)})
+            EXPECT_FALSE(parseStudyJournalLine(line.substr(0, cut), back)) << "torn at " << cut;
+        std::string altered = line;
+        altered[line.size() / 2] = altered[line.size() / 2] == '1' ? '2' : '1';
+        EXPECT_FALSE(parseStudyJournalLine(altered, back));
+    }
+}
+
+// The thesis method on one angle fails (two unknowns, one distinct point): recorded with its reason;
+// every other cell completes.
+TEST(Study, AFailingTaskIsRecordedWithItsReasonAndTheOthersComplete) {
+    const fs::path d = freshDir("failing");
+    StudyRunOptions o;
+    o.output = d.string();
+    o.threads = 2;
+    const StudyOutcome out = runStudy(smallStudy(), o);
+    EXPECT_EQ(out.computed, 24);
+    EXPECT_EQ(out.failed, 6);
+    std::istringstream in(readText(d / "results.csv"));
+    std::string line;
+    std::getline(in, line);
+    EXPECT_EQ(line, getStudyResultsHeader());
+    int failed = 0, ok = 0;
+    long previous = -1;
+    while (std::getline(in, line)) {
+        const long task = std::stol(line.substr(0, line.find(',')));
+        EXPECT_EQ(task, previous + 1);  // sorted, none dropped
+        previous = task;
+        if (line.find(",failed,") != std::string::npos) {
+            ++failed;
+            EXPECT_NE(line.find(",one_angle,thesis,"), std::string::npos) << line;
+            EXPECT_NE(line.find("expected at least as many distinct points as unknowns"), std::string::npos) << line;
+        } else {
+            ++ok;
+        }
+    }
+    EXPECT_EQ(failed, 6);
+    EXPECT_EQ(ok, 18);
+    EXPECT_NE(readText(d / "summary.csv").find("one_angle,thesis,0.01,3,0,0,3,,"), std::string::npos);
+    for (const char* f : {"timing.csv", "mass_rmse_vs_noise.png", "mass_coverage_vs_noise.png"})
+        EXPECT_TRUE(fs::exists(d / f)) << f;
+}
+
+TEST(Study, ResultsDoNotDependOnTheThreadCount) {
+    const fs::path d = freshDir("one_thread");
+    StudyRunOptions o;
+    o.output = d.string();
+    o.threads = 1;
+    runStudy(smallStudy(), o);
+    EXPECT_EQ(readText(d / "results.csv") + readText(d / "summary.csv"), referenceResults());
+}
+
+// A run killed after some groups leaves a journal with complete lines and maybe one torn line; the
+// next run computes only what is missing and writes the same files as an uninterrupted run.
+TEST(Study, ResumeFromAPartialJournalWithATornLineGivesTheUninterruptedResults) {
+    const fs::path full = freshDir("full"), partial = freshDir("partial");
+    StudyRunOptions o;
+    o.output = full.string();
+    o.threads = 2;
+    runStudy(smallStudy(), o);
+    std::istringstream journal(readText(full / "journal.log"));
+    std::string header, line, kept;
+    std::getline(journal, header);
+    int lines = 0;
+    while (std::getline(journal, line))
+        if (++lines <= 10) kept += line + '\n';
+    ASSERT_EQ(lines, 24);
+    std::getline(std::istringstream(readText(full / "journal.log")).ignore(1 << 20, '\n'), line);
+    std::ofstream(partial / "journal.log", std::ios::binary) << header << '\n' << kept << line.substr(0, 40);
+
+    o.output = partial.string();
+    const StudyOutcome resumed = runStudy(smallStudy(), o);
+    EXPECT_EQ(resumed.resumed, 10);
+    EXPECT_EQ(resumed.computed, 14);  // the torn line's task is computed again
+    EXPECT_EQ(readText(partial / "results.csv") + readText(partial / "summary.csv"), referenceResults());
+
+    const StudyOutcome again = runStudy(smallStudy(), o);  // finished: nothing left to compute
+    EXPECT_EQ(again.computed, 0);
+    EXPECT_EQ(readText(partial / "results.csv") + readText(partial / "summary.csv"), referenceResults());
+}
+
+TEST(Study, AJournalOfAnotherStudyIsRefusedUnlessRestarted) {
+    const fs::path d = freshDir("other");
+    Study a = smallStudy();
+    a.subjects = 1;
+    a.protocols.resize(1);
+    a.methods.resize(1);
+    a.noiseLevels.resize(1);
+    StudyRunOptions o;
+    o.output = d.string();
+    o.threads = 1;
+    runStudy(a, o);
+    Study b = a;
+    b.seed = 6;
+    try {
+        runStudy(b, o);
+        FAIL() << "another study's journal was accepted";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("--restart"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find(d.string()), std::string::npos) << e.what();
+    }
+    o.restart = true;
+    EXPECT_EQ(runStudy(b, o).computed, 1);
+}
+
+TEST(Study, ReadsAStudyFileAndNamesTheFileLineAndFieldOfEveryError) {
+    const fs::path d = freshDir("files");
+    std::ofstream(d / "one.yaml") << "kind: torque\nname: one\nconditions:\n  - {flexion_deg: 90}\n";
+    const std::string good = "kind: study\nname: s\nsubjects: 2\nprotocols: [thesis, one.yaml]\nnoise_levels: [0.02]\n"
+                             "methods:\n  - {method: thesis}\n  - {method: synergist-va, label: va, activation_sd: 0.03}\n";
+    std::ofstream(d / "good.yaml") << good;
+    const Study s = readStudy((d / "good.yaml").string());
+    EXPECT_EQ(s.subjects, 2);
+    ASSERT_EQ(s.protocols.size(), 2u);
+    EXPECT_EQ(s.protocols[1].protocol.name, "one");
+    ASSERT_EQ(s.methods.size(), 2u);
+    EXPECT_EQ(s.methods[1].label, "va");
+    EXPECT_EQ(s.methods[1].options.activationSd, 0.03);
+    EXPECT_EQ(s.output, "out/study/s");
+    EXPECT_EQ(calcStudyFingerprint(s), calcStudyFingerprint(readStudy((d / "good.yaml").string())));
+
+    struct Case {
+        std::string text, expected;
+    };
+    const std::vector<Case> cases = {
+        {"kind: torque\n", "expected 'study'"},
+        {good + "subject: 3\n", "subject"},                                       // unknown key
+        {"kind: study\nsubjects: 0\nprotocols: [thesis]\nmethods:\n  - {method: thesis}\n", "subjects"},
+        {"kind: study\nsubjects: 2\nprotocols: [missing.yaml]\nmethods:\n  - {method: thesis}\n", "missing.yaml"},
+        {"kind: study\nsubjects: 2\nprotocols: [thesis]\nmethods:\n  - {method: lm}\n", "methods[0].method"},
+        {"kind: study\nsubjects: 2\nprotocols: [thesis]\nmethods:\n  - {method: thesis}\n  - {method: thesis}\n",
+         "expected unique labels"},
+        {"kind: study\nsubjects: 2\nprotocols: [thesis]\nnoise_levels: [0.7]\nmethods:\n  - {method: thesis}\n",
+         "noise_levels[0]"},
+        {"kind: study\nsubjects: 2\nprotocols: [thesis, thesis]\nmethods:\n  - {method: thesis}\n",
+         "expected unique protocol names"},
+        {"kind: study\nsubjects: 2\nprotocols: []\nmethods:\n  - {method: thesis}\n", "protocols"},
+        {"kind: study\nsubjects: 2\nprotocols: [thesis]\nmethods:\n  - {method: thesis, label: \"a\\tb\"}\n",
+         "methods[0].label"},
+    };
+    for (std::size_t i = 0; i < cases.size(); ++i) {
+        const fs::path p = d / ("bad" + std::to_string(i) + ".yaml");
+        std::ofstream(p) << cases[i].text;
+        try {
+            readStudy(p.string());
+            ADD_FAILURE() << "accepted: " << cases[i].text;
+        } catch (const InputError& e) {
+            EXPECT_NE(std::string(e.what()).find(p.string()), std::string::npos) << e.what();
+            EXPECT_NE(std::string(e.what()).find(cases[i].expected), std::string::npos) << e.what();
+        }
+    }
+}
