@@ -1,10 +1,14 @@
 // armsim model: list the shipped models, show one (muscle table, moment arms, steady MVC torque-angle
-// curves as CSV + PNG), calibrate a model's muscle strength to the elbow target curves.
+// curves as CSV + PNG), score it against anatomy targets, calibrate a model's muscle strength to the elbow
+// target curves.
 #include "basics/errors.h"
+#include "basics/format.h"
 #include "cli/commands.h"
+#include "experiments/model_check.h"
 #include "experiments/model_report.h"
-#include "identification/strength_calibration.h"
+#include "model/strength_calibration.h"
 
+#include <cmath>
 #include <cstdio>
 #include <memory>
 
@@ -36,8 +40,24 @@ void showModel(const ArmSetup& setup, const std::string& out, double step, const
     for (const std::string& f : r.files) std::printf("wrote %s\n", f.c_str());
 }
 
+// Writes the scorecard to out and prints the per-kind summary and every failed target.
+void checkModel(const ArmSetup& setup, const std::vector<AnatomyTarget>& targets, const std::string& out) {
+    const ModelCheckResult r = writeModelCheck(setup, targets, out);
+    std::printf("model %s against %zu targets:\n", setup.name.c_str(), targets.size());
+    for (const ScoreSummary& s : r.summary)
+        std::printf("  %-14s %-9s %3d of %3d pass\n", getTargetKindName(s.kind), s.muscle.empty() ? "all" : s.muscle.c_str(),
+                    s.passed, s.scored);
+    for (const TargetScore& s : r.scores)
+        if (!s.pass)
+            std::printf("  fail: %s %s%s%s: %g outside [%g, %g] +/- %g (SI units; %s)\n", getTargetKindName(s.target.kind),
+                        s.muscle.c_str(), s.target.kind == TargetKind::Mvc ? (s.target.direction == MuscleGroup::Flexor ? "flexion" : "extension") : "",
+                        std::isfinite(s.target.flexionDeg) ? (" at " + formatNumber(s.target.flexionDeg) + " deg").c_str() : "",
+                        s.value, s.target.lower, s.target.upper, s.target.tolerance, s.target.where.c_str());
+    for (const std::string& f : r.files) std::printf("wrote %s\n", f.c_str());
+}
+
 void addModelCommands(CLI::App& app) {
-    CLI::App* model = app.add_subcommand("model", "model files: list, show, calibrate");
+    CLI::App* model = app.add_subcommand("model", "model files: list, show, check, calibrate");
     model->require_subcommand(1);
 
     model->add_subcommand("list", "names of the shipped models (assets/models/)")->callback([] {
@@ -63,6 +83,18 @@ void addModelCommands(CLI::App& app) {
             const ElbowReference ref = reference->empty() ? loadDefaultElbowReference() : loadElbowReference(*reference);
             showModel(loadModel(*name), *out, *step, ref);
         });
+    }
+
+    {
+        auto name = std::make_shared<std::string>("elbow");
+        auto out = std::make_shared<std::string>("out/model_check");
+        auto targets = std::make_shared<std::string>();
+        CLI::App* c = model->add_subcommand(
+            "check", "score a model against anatomy targets: scorecard.csv, score_summary.csv, plots with the bands");
+        c->add_option("--model", *name, "model name or file")->capture_default_str();
+        c->add_option("--targets", *targets, "target file (default assets/reference/elbow_targets.yaml)");
+        c->add_option("--out", *out, "output directory")->capture_default_str();
+        c->callback([=] { checkModel(loadModel(*name), targets->empty() ? loadDefaultAnatomyTargets() : loadAnatomyTargets(*targets), *out); });
     }
 
     {

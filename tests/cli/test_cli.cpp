@@ -1,4 +1,5 @@
 // The armsim command end to end: exit codes, messages, and files written whole or not at all.
+#include "basics/csv.h"
 #include "basics/table.h"
 #include "tests/support/run_armsim.h"
 #include "tests/support/temp_files.h"
@@ -156,6 +157,36 @@ TEST(Cli, TrialWritesTheSeriesAndRejectsBadSettings) {
 
 // armsim model show: the files it promises, the summary it prints, and CSV numbers that agree with
 // each other (net torque = sum of muscle torques; moment arm table at 90 deg = the MVC table's arm).
+// model check: one scorecard row per target and muscle, as many as the summary counts; a target file
+// with an error is named with its line.
+TEST(Cli, ModelCheckWritesTheScorecardItsSummaryCountsAndPlots) {
+    const fs::path d = freshDir("model_check");
+    const CommandResult r = runArmsim("model check --model elbow --out " + d.string());
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    for (const char* f : {"scorecard.csv", "score_summary.csv", "check_moment_arms.png", "check_mvc.png"})
+        EXPECT_TRUE(fs::exists(d / f)) << f;
+    std::ifstream card(d / "scorecard.csv"), summary(d / "score_summary.csv");
+    std::string line;
+    int rows = -1, passed = 0;
+    while (std::getline(card, line)) ++rows;
+    int scoredAll = 0;
+    std::getline(summary, line);
+    while (std::getline(summary, line)) {
+        const std::vector<std::string> c = armsim::splitCsvRecord(line);
+        if (c.at(1).empty()) scoredAll += std::stoi(c.at(3)), passed += std::stoi(c.at(2));
+    }
+    EXPECT_GT(rows, 40);
+    EXPECT_EQ(rows, scoredAll);
+    EXPECT_NE(r.output.find("moment_arm     all        " ), std::string::npos) << r.output;
+    EXPECT_GT(passed, 0);
+    const fs::path bad = d / "bad.yaml";
+    std::ofstream(bad) << "targets:\n  - {kind: mvc, direction: sideways, flexion_deg: 90, lower: 1, upper: 2, source: x}\n";
+    const CommandResult b = runArmsim("model check --targets " + bad.string() + " --out " + (d / "b").string());
+    EXPECT_EQ(b.exitCode, 2) << b.output;
+    EXPECT_NE(b.output.find("bad.yaml:2"), std::string::npos) << b.output;
+    EXPECT_NE(b.output.find("sideways"), std::string::npos) << b.output;
+}
+
 TEST(Cli, ModelShowWritesTablesAndPlots) {
     constexpr double kSumTol = 1e-6;  // N m, CSV digits
     const fs::path d = freshDir("model_show");

@@ -1,0 +1,124 @@
+#include "experiments/model_check.h"
+
+#include "basics/csv.h"
+#include "basics/files.h"
+#include "basics/plot.h"
+#include "model/mvc_curve.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+namespace armsim {
+
+namespace {
+
+// The file unit of a kind and its factor from SI (the scorecard keeps SI; plots use these).
+const char* getSiUnit(TargetKind k) {
+    switch (k) {
+    case TargetKind::MomentArm: return "m";
+    case TargetKind::Mvc: return "N m";
+    case TargetKind::Volume: return "m^3";
+    case TargetKind::Share: return "1";
+    case TargetKind::OptimumAngle: return "deg";
+    }
+    return "";
+}
+
+std::vector<double> sweepAngles(const ArmSetup& setup) {
+    std::vector<double> a;
+    for (double d = setup.arm.getMinFlexionDeg(); d <= setup.arm.getMaxFlexionDeg() + 1e-9; d += 2) a.push_back(d);
+    return a;
+}
+
+// Band edges (with tolerance) of the targets of one kind, as two marker series.
+void addBands(PlotSpec& spec, const std::vector<TargetScore>& scores, TargetKind kind, const std::string& muscle,
+              MuscleGroup direction, double scale, int color, const std::string& label) {
+    PlotSeries lo{label, {}, {}, true, color}, hi{"", {}, {}, true, color};
+    std::map<double, bool> seen;
+    for (const TargetScore& s : scores) {
+        const AnatomyTarget& t = s.target;
+        if (t.kind != kind || (kind == TargetKind::MomentArm && s.muscle != muscle) ||
+            (kind == TargetKind::Mvc && t.direction != direction) || seen[t.flexionDeg])
+            continue;
+        seen[t.flexionDeg] = true;
+        lo.x.push_back(t.flexionDeg), lo.y.push_back(scale * (t.lower - t.tolerance));
+        hi.x.push_back(t.flexionDeg), hi.y.push_back(scale * (t.upper + t.tolerance));
+    }
+    if (lo.x.empty()) return;
+    spec.series.push_back(lo);
+    spec.series.push_back(hi);
+}
+
+}  // namespace
+
+ModelCheckResult writeModelCheck(const ArmSetup& setup, const std::vector<AnatomyTarget>& targets,
+                                 const std::string& outDir) {
+    ModelCheckResult r;
+    r.scores = scoreAnatomy(setup, targets);
+    r.summary = summarizeScores(r.scores);
+    createFolder(outDir);
+    auto path = [&](const std::string& f) { return outDir + "/" + f; };
+
+    CsvText card({"kind", "muscle", "direction", "flexion_deg", "value", "lower", "upper", "tolerance", "unit", "pass",
+                  "source", "where"});
+    for (const TargetScore& s : r.scores) {
+        const AnatomyTarget& t = s.target;
+        CsvRow row;
+        row.addText(getTargetKindName(t.kind)).addText(s.muscle);
+        row.addText(t.kind == TargetKind::Mvc ? (t.direction == MuscleGroup::Flexor ? "flexion" : "extension") : "");
+        row.addNumber(t.flexionDeg).addNumber(s.value).addNumber(t.lower).addNumber(t.upper).addNumber(t.tolerance);
+        row.addText(getSiUnit(t.kind)).addInteger(s.pass ? 1 : 0).addText(t.source).addText(t.where);
+        card.addRow(row);
+    }
+    writeFileAtomically(path("scorecard.csv"), card.getText());
+    CsvText summary({"kind", "muscle", "passed", "scored", "fraction"});
+    for (const ScoreSummary& s : r.summary) {
+        CsvRow row;
+        row.addText(getTargetKindName(s.kind)).addText(s.muscle).addInteger(s.passed).addInteger(s.scored);
+        row.addNumber(double(s.passed) / s.scored);
+        summary.addRow(row);
+    }
+    writeFileAtomically(path("score_summary.csv"), summary.getText());
+    r.files = {path("scorecard.csv"), path("score_summary.csv")};
+
+    // Moment arms: every muscle's curve, the bands of its targets in the same colour.
+    const std::vector<double> angles = sweepAngles(setup);
+    const MvcGeometry g = calcMvcGeometry(setup, angles);
+    PlotSpec arms;
+    arms.title = "Moment arms; markers: published band +/- tolerance";
+    arms.xLabel = "elbow flexion (deg)";
+    arms.yLabel = "moment arm (mm), + = flexor";
+    arms.legend = PlotSpec::Legend::TopLeft;  // above the curves: the y range is raised to leave it room
+    for (int m = 0; m < setup.getNumMuscles(); ++m) {
+        PlotSeries c{setup.muscles[m].params.name, angles, {}, false, m % 8};
+        for (std::size_t a = 0; a < angles.size(); ++a) c.y.push_back(1000 * g.momentArm[a][m]);
+        arms.series.push_back(c);
+        addBands(arms, r.scores, TargetKind::MomentArm, setup.muscles[m].params.name, MuscleGroup::Flexor, 1000, m % 8, "");
+    }
+    double top = 0;
+    for (const PlotSeries& c : arms.series)
+        for (double y : c.y) top = std::max(top, y);
+    arms.yMax = 2 * top;
+    writePlotPng(path("check_moment_arms.png"), arms);
+
+    PlotSpec mvc;
+    mvc.title = "Steady MVC torque; markers: published band +/- tolerance";
+    mvc.xLabel = "elbow flexion (deg)";
+    mvc.yLabel = "net torque magnitude (N m)";
+    mvc.legend = PlotSpec::Legend::BottomRight;
+    const MuscleGroup groups[2] = {MuscleGroup::Flexor, MuscleGroup::Extensor};
+    for (int k = 0; k < 2; ++k) {
+        const SteadyMvcCurve c = calcSteadyMvcCurve(setup.muscles, g, groups[k], setup.effort);
+        PlotSeries s{std::string(k == 0 ? "flexion" : "extension") + " MVC (model)", angles, {}, false, k};
+        for (double t : c.totalTorque) s.y.push_back(std::abs(t));
+        mvc.series.push_back(s);
+        addBands(mvc, r.scores, TargetKind::Mvc, "", groups[k], 1, k, k == 0 ? "flexion band" : "extension band");
+    }
+    writePlotPng(path("check_mvc.png"), mvc);
+    r.files.push_back(path("check_moment_arms.png"));
+    r.files.push_back(path("check_mvc.png"));
+    return r;
+}
+
+}  // namespace armsim

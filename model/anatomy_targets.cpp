@@ -1,0 +1,181 @@
+#include "model/anatomy_targets.h"
+
+#include "basics/errors.h"
+#include "basics/format.h"
+#include "basics/param_node.h"
+#include "model/mvc_curve.h"
+#include "muscles/muscle_file.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+namespace armsim {
+
+namespace {
+
+const std::vector<std::string> kKindNames = {"moment_arm", "mvc", "volume", "share", "optimum_angle"};
+
+// Band units per kind: the file's unit and its factor to SI.
+struct Unit {
+    const char* name;
+    double toSi;
+};
+Unit getFileUnit(TargetKind k) {
+    switch (k) {
+    case TargetKind::MomentArm: return {"mm", 1e-3};
+    case TargetKind::Mvc: return {"N m", 1};
+    case TargetKind::Volume: return {"cm^3", 1e-6};
+    case TargetKind::Share: return {"1", 1};
+    case TargetKind::OptimumAngle: return {"deg", 1};
+    }
+    return {"", 1};
+}
+
+bool covers(const std::string& family, const std::string& muscle) {
+    return muscle.compare(0, family.size(), family) == 0;
+}
+
+std::vector<int> findCovered(const ArmSetup& setup, const std::string& family) {
+    std::vector<int> out;
+    for (int i = 0; i < setup.getNumMuscles(); ++i)
+        if (covers(family, setup.muscles[i].params.name)) out.push_back(i);
+    return out;
+}
+
+// Flexion angle where the fibre length crosses 1 going along the samples (linear interpolation); NaN
+// when it does not.
+double findOptimumAngle(const SteadyMvcCurve& c, int m) {
+    for (std::size_t a = 1; a < c.flexionDeg.size(); ++a) {
+        const double l0 = c.points[a - 1][m].fibreLength - 1, l1 = c.points[a][m].fibreLength - 1;
+        if (l0 == 0) return c.flexionDeg[a - 1];
+        if ((l0 < 0) != (l1 < 0))
+            return c.flexionDeg[a - 1] + (c.flexionDeg[a] - c.flexionDeg[a - 1]) * l0 / (l0 - l1);
+    }
+    return NAN;
+}
+
+}  // namespace
+
+const char* getTargetKindName(TargetKind k) { return kKindNames[int(k)].c_str(); }
+
+std::vector<AnatomyTarget> loadAnatomyTargets(const std::string& path) {
+    const ParamNode root = ParamNode::loadFile(path);
+    std::vector<AnatomyTarget> out;
+    for (const ParamNode& n : root.children("targets")) {
+        AnatomyTarget t;
+        t.where = n.where();
+        const std::string kind = n.getChoice("kind", kKindNames, "");
+        t.kind = TargetKind(std::find(kKindNames.begin(), kKindNames.end(), kind) - kKindNames.begin());
+        const Unit u = getFileUnit(t.kind);
+        if (t.kind != TargetKind::Mvc) t.muscle = n.getString("muscle");
+        if (t.kind == TargetKind::Mvc)
+            t.direction = n.getChoice("direction", {"flexion", "extension"}, "") == "flexion" ? MuscleGroup::Flexor
+                                                                                             : MuscleGroup::Extensor;
+        if (t.kind == TargetKind::MomentArm || t.kind == TargetKind::Mvc || t.kind == TargetKind::Share)
+            t.flexionDeg = n.getNumber("flexion_deg", Bound::closed(0, 180, "deg"));
+        const Bound band = t.kind == TargetKind::Share ? Bound::closed(0, 1)
+                           : t.kind == TargetKind::OptimumAngle ? Bound::closed(0, 180, "deg")
+                           : t.kind == TargetKind::MomentArm ? Bound::closed(-200, 200, "mm")
+                           : t.kind == TargetKind::Mvc ? Bound::closed(0, 1000, "N m")
+                                                       : Bound::closed(0, 1e5, "cm^3");
+        t.lower = n.getNumber("lower", band) * u.toSi;
+        t.upper = n.getNumber("upper", band) * u.toSi;
+        if (t.lower > t.upper)
+            throw InputError(n.where("upper") + ": field 'upper' = " + formatNumber(t.upper / u.toSi) + " " +
+                             u.name + ": expected >= lower = " + formatNumber(t.lower / u.toSi) + " " + u.name);
+        t.tolerance = n.getNumber("tolerance", Bound::closed(0, 1e5, u.name), 0.0) * u.toSi;
+        t.weight = n.getNumber("weight", Bound::closed(0, 1e3), 1.0);
+        t.source = n.getString("source");
+        n.finish();
+        out.push_back(t);
+    }
+    root.finish();
+    return out;
+}
+
+std::vector<AnatomyTarget> loadDefaultAnatomyTargets() {
+    return loadAnatomyTargets(getAssetDirectory() + "/reference/elbow_targets.yaml");
+}
+
+std::vector<TargetScore> scoreAnatomy(const ArmSetup& setup, const std::vector<AnatomyTarget>& targets) {
+    // Every angle any target names, plus a 1-deg sweep of the elbow's range for the optimum angles.
+    const double maxFlexion = setup.arm.getMaxFlexionDeg(), minFlexion = setup.arm.getMinFlexionDeg();
+    std::vector<double> angles;
+    for (double a = minFlexion; a <= maxFlexion + 1e-9; a += 1) angles.push_back(a);
+    for (const AnatomyTarget& t : targets)
+        if (std::isfinite(t.flexionDeg) && t.flexionDeg >= minFlexion && t.flexionDeg <= maxFlexion)
+            angles.push_back(t.flexionDeg);
+    std::sort(angles.begin(), angles.end());
+    angles.erase(std::unique(angles.begin(), angles.end()), angles.end());
+    auto indexOf = [&](double deg) {
+        return int(std::lower_bound(angles.begin(), angles.end(), deg) - angles.begin());
+    };
+    const MvcGeometry geometry = calcMvcGeometry(setup, angles);
+    const SteadyMvcCurve flexion = calcSteadyMvcCurve(setup.muscles, geometry, MuscleGroup::Flexor, setup.effort);
+    const SteadyMvcCurve extension = calcSteadyMvcCurve(setup.muscles, geometry, MuscleGroup::Extensor, setup.effort);
+    const SteadyMvcCurve full = calcSteadyMvcCurve(setup.muscles, geometry, MuscleGroup::Flexor, SubjectEffort{1, 0});
+
+    std::vector<TargetScore> out;
+    auto add = [&](const AnatomyTarget& t, const std::string& muscle, double value) {
+        TargetScore s;
+        s.target = t;
+        s.muscle = muscle;
+        s.value = value;
+        s.pass = std::isfinite(value) && value >= t.lower - t.tolerance && value <= t.upper + t.tolerance;
+        out.push_back(s);
+    };
+    for (const AnatomyTarget& t : targets) {
+        const bool inRange = !std::isfinite(t.flexionDeg) || (t.flexionDeg >= minFlexion && t.flexionDeg <= maxFlexion);
+        if (!inRange) continue;
+        if (t.kind == TargetKind::Mvc) {
+            const SteadyMvcCurve& c = t.direction == MuscleGroup::Flexor ? flexion : extension;
+            add(t, "", std::abs(c.totalTorque[indexOf(t.flexionDeg)]));
+            continue;
+        }
+        const std::vector<int> covered = findCovered(setup, t.muscle);
+        if (covered.empty()) continue;
+        switch (t.kind) {
+        case TargetKind::MomentArm:
+            for (int m : covered) add(t, setup.muscles[m].params.name, geometry.momentArm[indexOf(t.flexionDeg)][m]);
+            break;
+        case TargetKind::OptimumAngle:
+            for (int m : covered) add(t, setup.muscles[m].params.name, findOptimumAngle(full, m));
+            break;
+        case TargetKind::Volume: {
+            double v = 0;
+            for (int m : covered) v += setup.muscles[m].params.mass / setup.muscles[m].params.coefficients.density;
+            add(t, t.muscle, v);
+            break;
+        }
+        case TargetKind::Share: {
+            double s = 0;
+            for (int m : covered) s += flexion.calcFlexorShare(indexOf(t.flexionDeg), m);
+            add(t, t.muscle, s);
+            break;
+        }
+        case TargetKind::Mvc: break;
+        }
+    }
+    return out;
+}
+
+std::vector<ScoreSummary> summarizeScores(const std::vector<TargetScore>& scores) {
+    std::vector<ScoreSummary> out;
+    auto bump = [&](TargetKind k, const std::string& muscle, bool pass) {
+        auto it = std::find_if(out.begin(), out.end(), [&](const ScoreSummary& s) { return s.kind == k && s.muscle == muscle; });
+        if (it == out.end()) {
+            out.push_back({k, muscle});
+            it = out.end() - 1;
+        }
+        ++it->scored;
+        it->passed += pass;
+    };
+    for (const TargetScore& s : scores) {
+        bump(s.target.kind, "", s.pass);
+        if (s.target.kind == TargetKind::MomentArm || s.target.kind == TargetKind::OptimumAngle) bump(s.target.kind, s.muscle, s.pass);
+    }
+    return out;
+}
+
+}  // namespace armsim

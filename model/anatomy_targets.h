@@ -1,0 +1,62 @@
+// Anatomy targets (assets/reference/elbow_targets.yaml) and a model's score against them: moment arms
+// vs angle, net MVC torque vs angle, muscle volumes, flexor torque shares and the angle at which each
+// muscle works at its optimal fibre length. What `armsim model check` reports and what a calibration
+// to anatomy fits.
+#pragma once
+
+#include "model/model_file.h"
+
+#include <string>
+#include <vector>
+
+namespace armsim {
+
+/// What a target measures.
+enum class TargetKind { MomentArm, Mvc, Volume, Share, OptimumAngle };
+const char* getTargetKindName(TargetKind k);
+
+/// One published value with its band. Family names cover model muscles by prefix ("BIC" covers
+/// BIClong and BICshort); moment-arm and optimum-angle targets score each covered muscle, volume and
+/// share targets the family's sum.
+struct AnatomyTarget {
+    TargetKind kind = TargetKind::MomentArm;
+    std::string muscle;           ///< family or muscle name; empty for mvc
+    MuscleGroup direction = MuscleGroup::Flexor;   ///< mvc: flexion or extension effort
+    double flexionDeg = 0.0 / 0.0;///< angle [deg] (moment_arm, mvc, share); NaN for volume, optimum_angle
+    double lower = 0, upper = 0;  ///< published band, SI (m, N m, m^3, 1, deg)
+    double tolerance = 0;         ///< added on both sides of the band before judging (SI, as the band)
+    double weight = 1;            ///< in a calibration's objective [1]
+    std::string source;           ///< where the band comes from
+    std::string where;            ///< "file:line" of the entry
+};
+
+/// Reads a target file; errors name file, line, field, value and what was expected.
+std::vector<AnatomyTarget> loadAnatomyTargets(const std::string& path);
+/// assets/reference/elbow_targets.yaml.
+std::vector<AnatomyTarget> loadDefaultAnatomyTargets();
+
+/// The model's value for one target (and one muscle of it where the target scores each).
+struct TargetScore {
+    AnatomyTarget target;
+    std::string muscle;           ///< the model muscle (or family) scored
+    double value = 0.0 / 0.0;     ///< model value, SI; NaN when the model has none (e.g. no optimum in range)
+    bool pass = false;            ///< value within [lower - tolerance, upper + tolerance]
+};
+
+/// Scores `setup` against every target. Moment arms from virtual work at the angle, MVC torque from the
+/// steady MVC curve at the model's subject effort (the magnitude for extension), volume = mass / density,
+/// share = the family's part of the flexors' torque at a flexion MVC, optimum angle = the flexion angle
+/// where the muscle's steady fibre length at a full flexion MVC crosses L0 (NaN: it does not within the
+/// elbow's range). Targets naming no model muscle are skipped.
+std::vector<TargetScore> scoreAnatomy(const ArmSetup& setup, const std::vector<AnatomyTarget>& targets);
+
+/// Passed and scored counts of one kind (and muscle, when not empty).
+struct ScoreSummary {
+    TargetKind kind;
+    std::string muscle;
+    int passed = 0, scored = 0;
+};
+/// Per kind, and per muscle for moment arms and optimum angles.
+std::vector<ScoreSummary> summarizeScores(const std::vector<TargetScore>& scores);
+
+}  // namespace armsim

@@ -1,0 +1,84 @@
+// Anatomy targets: the loader's errors, and each kind of score checked a second way (path-length
+// differences for moment arms, mass / density for volumes, the steady fibre length at the optimum angle).
+#include "basics/errors.h"
+#include "model/anatomy_targets.h"
+#include "model/mvc_curve.h"
+#include "tests/support/temp_files.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+
+using namespace armsim;
+
+namespace {
+
+constexpr double kMomentArmTol = 1e-6;   // m: virtual-work moment arm vs central difference of the path
+constexpr double kFibreLengthTol = 2e-3; // L/L0 at the reported optimum angle (linear interpolation over 1 deg)
+
+std::string writeTargets(const std::string& body) {
+    const auto dir = armsim::testing::makeFreshDir("anatomy_targets", ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    const std::string path = (dir / "targets.yaml").string();
+    std::ofstream(path) << "targets:\n" << body;
+    return path;
+}
+
+const ArmSetup& elbow() {
+    static const ArmSetup s = loadModel("elbow");
+    return s;
+}
+
+}  // namespace
+
+TEST(AnatomyTargets, LoaderNamesFileLineFieldAndValue) {
+    try {
+        loadAnatomyTargets(writeTargets("  - {kind: moment_arm, muscle: BRA, flexion_deg: 90, lower: 30, upper: 20, source: x}\n"));
+        FAIL() << "lower > upper accepted";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("targets.yaml:2"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("'upper' = 20 mm"), std::string::npos) << e.what();
+    }
+    EXPECT_THROW(loadAnatomyTargets(writeTargets("  - {kind: moment, muscle: BRA, flexion_deg: 90, lower: 1, upper: 2, source: x}\n")), InputError);
+    EXPECT_THROW(loadAnatomyTargets(writeTargets("  - {kind: volume, muscle: BRA, lower: 1, upper: 2, sourse: x}\n")), InputError);
+    EXPECT_NO_THROW(loadDefaultAnatomyTargets());
+}
+
+TEST(AnatomyTargets, ScoresEqualASecondMethodAndBandsDecidePass) {
+    const ArmSetup& s = elbow();
+    const int bra = s.findMuscle("BRA");
+    // Moment arm: virtual work vs -dP/dtheta (central difference, 0.01 deg).
+    const double h = 0.01;
+    const MvcGeometry g = calcMvcGeometry(s, {90 - h, 90, 90 + h});
+    const double fd = (g.pathLength[0][bra] - g.pathLength[2][bra]) / (2 * h * M_PI / 180);
+    const double value = g.momentArm[1][bra];
+    EXPECT_NEAR(value, fd, kMomentArmTol);
+    // A band around the value passes, one beside it fails; tolerance widens it.
+    const std::string mm = std::to_string(1000 * value);
+    const auto scores = scoreAnatomy(s, loadAnatomyTargets(writeTargets(
+        "  - {kind: moment_arm, muscle: BRA, flexion_deg: 90, lower: " + std::to_string(1000 * value - 0.1) +
+        ", upper: " + std::to_string(1000 * value + 0.1) + ", source: a}\n"
+        "  - {kind: moment_arm, muscle: BRA, flexion_deg: 90, lower: " + std::to_string(1000 * value + 1) +
+        ", upper: " + std::to_string(1000 * value + 2) + ", source: b}\n"
+        "  - {kind: moment_arm, muscle: BRA, flexion_deg: 90, lower: " + std::to_string(1000 * value + 1) +
+        ", upper: " + std::to_string(1000 * value + 2) + ", tolerance: 1.5, source: c}\n"
+        "  - {kind: volume, muscle: BIC, lower: 1, upper: 1e5, source: d}\n"
+        "  - {kind: optimum_angle, muscle: BICshort, lower: 0, upper: 180, source: e}\n"
+        "  - {kind: moment_arm, muscle: XYZ, flexion_deg: 90, lower: 0, upper: 1, source: f}\n")));
+    ASSERT_EQ(scores.size(), 5u);  // the target naming no model muscle is skipped
+    EXPECT_NEAR(scores[0].value, value, 1e-12);
+    EXPECT_TRUE(scores[0].pass);
+    EXPECT_FALSE(scores[1].pass);
+    EXPECT_TRUE(scores[2].pass);
+    // Volume: both biceps heads' mass / density.
+    double v = 0;
+    for (const char* m : {"BIClong", "BICshort"}) {
+        const MuscleParameters& p = s.muscles[s.findMuscle(m)].params;
+        v += p.mass / p.coefficients.density;
+    }
+    EXPECT_NEAR(scores[3].value, v, 1e-12 * v);
+    // Optimum angle: the steady fibre length at a full flexion MVC is L0 there.
+    ASSERT_TRUE(std::isfinite(scores[4].value));
+    const SteadyMvcCurve c = calcSteadyMvcCurve(s, MuscleGroup::Flexor, SubjectEffort{1, 0}, {scores[4].value});
+    EXPECT_NEAR(c.points[0][s.findMuscle("BICshort")].fibreLength, 1.0, kFibreLengthTol);
+}
