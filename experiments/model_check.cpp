@@ -13,18 +13,6 @@ namespace armsim {
 
 namespace {
 
-// The file unit of a kind and its factor from SI (the scorecard keeps SI; plots use these).
-const char* getSiUnit(TargetKind k) {
-    switch (k) {
-    case TargetKind::MomentArm: return "m";
-    case TargetKind::Mvc: return "N m";
-    case TargetKind::Volume: return "m^3";
-    case TargetKind::Share: return "1";
-    case TargetKind::OptimumAngle: return "deg";
-    }
-    return "";
-}
-
 std::vector<double> sweepAngles(const ArmSetup& setup) {
     std::vector<double> a;
     for (double d = setup.arm.getMinFlexionDeg(); d <= setup.arm.getMaxFlexionDeg() + 1e-9; d += 2) a.push_back(d);
@@ -68,7 +56,7 @@ ModelCheckResult writeModelCheck(const ArmSetup& setup, const std::vector<Anatom
         row.addText(getTargetKindName(t.kind)).addText(s.muscle);
         row.addText(t.kind == TargetKind::Mvc ? (t.direction == MuscleGroup::Flexor ? "flexion" : "extension") : "");
         row.addNumber(t.flexionDeg).addNumber(s.value).addNumber(t.lower).addNumber(t.upper).addNumber(t.tolerance);
-        row.addText(getSiUnit(t.kind)).addInteger(s.pass ? 1 : 0).addText(t.source).addText(t.where);
+        row.addText(getTargetSiUnit(t.kind)).addInteger(s.pass ? 1 : 0).addText(t.source).addText(t.where);
         card.addRow(row);
     }
     writeFileAtomically(path("scorecard.csv"), card.getText());

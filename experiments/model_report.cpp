@@ -3,6 +3,7 @@
 #include "basics/files.h"
 #include "basics/param_node.h"
 #include "basics/plot.h"
+#include "model/anatomy_targets.h"
 #include "model/geometry.h"
 #include "model/muscle_arm.h"
 #include "muscles/muscle_file.h"
@@ -75,10 +76,6 @@ ElbowReference loadElbowReference(const std::string& path) {
 
 ElbowReference loadDefaultElbowReference() {
     return loadElbowReference(getAssetDirectory() + "/measured/elbow_reference.yaml");
-}
-
-bool referenceCoversMuscle(const std::string& referenceMuscle, const std::string& modelMuscle) {
-    return modelMuscle.compare(0, referenceMuscle.size(), referenceMuscle) == 0;
 }
 
 Table calcMuscleTable(const ArmSetup& setup) {
@@ -197,7 +194,7 @@ ModelReportFiles writeModelReport(const ArmSetup& setup, const std::string& outD
     refs.color = 7;
     for (const MomentArmReference& r : reference.momentArms) {
         bool covered = false;
-        for (const MuscleSpec& m : setup.muscles) covered = covered || referenceCoversMuscle(r.muscle, m.params.name);
+        for (const MuscleSpec& m : setup.muscles) covered = covered || doesFamilyCoverMuscle(r.muscle, m.params.name);
         if (!covered) continue;
         for (double v : {r.min, r.max}) {
             refs.x.push_back(r.flexionDeg);

@@ -38,8 +38,6 @@ ElbowReference loadElbowReference(const std::string& path);
 /// assets/measured/elbow_reference.yaml.
 ElbowReference loadDefaultElbowReference();
 
-/// True when a reference muscle name covers a model muscle ("BIC" covers "BIClong"; "TRI" "TRImed").
-bool referenceCoversMuscle(const std::string& referenceMuscle, const std::string& modelMuscle);
 
 /// Muscle table: one row per muscle (F0, L0, L0T, mass, P_max, slow fraction, calibration scales).
 /// Columns are numbers; muscle i is row i (names from setup).

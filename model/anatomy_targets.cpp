@@ -16,30 +16,18 @@ namespace {
 
 const std::vector<std::string> kKindNames = {"moment_arm", "mvc", "volume", "share", "optimum_angle"};
 
-// Band units per kind: the file's unit and its factor to SI.
+// Band units per kind: the file's unit, SI's, and the factor between them.
 struct Unit {
-    const char* name;
+    const char* file;
+    const char* si;
     double toSi;
 };
-Unit getFileUnit(TargetKind k) {
-    switch (k) {
-    case TargetKind::MomentArm: return {"mm", 1e-3};
-    case TargetKind::Mvc: return {"N m", 1};
-    case TargetKind::Volume: return {"cm^3", 1e-6};
-    case TargetKind::Share: return {"1", 1};
-    case TargetKind::OptimumAngle: return {"deg", 1};
-    }
-    return {"", 1};
-}
-
-bool covers(const std::string& family, const std::string& muscle) {
-    return muscle.compare(0, family.size(), family) == 0;
-}
+const Unit kUnits[] = {{"mm", "m", 1e-3}, {"N m", "N m", 1}, {"cm^3", "m^3", 1e-6}, {"1", "1", 1}, {"deg", "deg", 1}};
 
 std::vector<int> findCovered(const ArmSetup& setup, const std::string& family) {
     std::vector<int> out;
     for (int i = 0; i < setup.getNumMuscles(); ++i)
-        if (covers(family, setup.muscles[i].params.name)) out.push_back(i);
+        if (doesFamilyCoverMuscle(family, setup.muscles[i].params.name)) out.push_back(i);
     return out;
 }
 
@@ -58,6 +46,13 @@ double findOptimumAngle(const SteadyMvcCurve& c, int m) {
 }  // namespace
 
 const char* getTargetKindName(TargetKind k) { return kKindNames[int(k)].c_str(); }
+const char* getTargetFileUnit(TargetKind k) { return kUnits[int(k)].file; }
+const char* getTargetSiUnit(TargetKind k) { return kUnits[int(k)].si; }
+double getTargetFileToSi(TargetKind k) { return kUnits[int(k)].toSi; }
+
+bool doesFamilyCoverMuscle(const std::string& family, const std::string& muscle) {
+    return muscle.compare(0, family.size(), family) == 0;
+}
 
 std::vector<AnatomyTarget> loadAnatomyTargets(const std::string& path) {
     const ParamNode root = ParamNode::loadFile(path);
@@ -67,7 +62,7 @@ std::vector<AnatomyTarget> loadAnatomyTargets(const std::string& path) {
         t.where = n.where();
         const std::string kind = n.getChoice("kind", kKindNames, "");
         t.kind = TargetKind(std::find(kKindNames.begin(), kKindNames.end(), kind) - kKindNames.begin());
-        const Unit u = getFileUnit(t.kind);
+        const Unit& u = kUnits[int(t.kind)];
         if (t.kind != TargetKind::Mvc) t.muscle = n.getString("muscle");
         if (t.kind == TargetKind::Mvc)
             t.direction = n.getChoice("direction", {"flexion", "extension"}, "") == "flexion" ? MuscleGroup::Flexor
@@ -83,8 +78,8 @@ std::vector<AnatomyTarget> loadAnatomyTargets(const std::string& path) {
         t.upper = n.getNumber("upper", band) * u.toSi;
         if (t.lower > t.upper)
             throw InputError(n.where("upper") + ": field 'upper' = " + formatNumber(t.upper / u.toSi) + " " +
-                             u.name + ": expected >= lower = " + formatNumber(t.lower / u.toSi) + " " + u.name);
-        t.tolerance = n.getNumber("tolerance", Bound::closed(0, 1e5, u.name), 0.0) * u.toSi;
+                             u.file + ": expected >= lower = " + formatNumber(t.lower / u.toSi) + " " + u.file);
+        t.tolerance = n.getNumber("tolerance", Bound::closed(0, 1e5, u.file), 0.0) * u.toSi;
         t.weight = n.getNumber("weight", Bound::closed(0, 1e3), 1.0);
         t.source = n.getString("source");
         n.finish();

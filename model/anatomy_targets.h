@@ -14,6 +14,15 @@ namespace armsim {
 /// What a target measures.
 enum class TargetKind { MomentArm, Mvc, Volume, Share, OptimumAngle };
 const char* getTargetKindName(TargetKind k);
+/// The unit a target file gives a kind's bands in ("mm", "N m", "cm^3", "1", "deg").
+const char* getTargetFileUnit(TargetKind k);
+/// The SI unit of a kind's bands and values ("m", "N m", "m^3", "1", "deg").
+const char* getTargetSiUnit(TargetKind k);
+/// Factor from the file unit to SI (1e-3 for mm).
+double getTargetFileToSi(TargetKind k);
+
+/// True when a family name covers a model muscle: a prefix ("BIC" covers "BIClong", "TRI" "TRImed").
+bool doesFamilyCoverMuscle(const std::string& family, const std::string& muscle);
 
 /// One published value with its band. Family names cover model muscles by prefix ("BIC" covers
 /// BIClong and BICshort); moment-arm and optimum-angle targets score each covered muscle, volume and
