@@ -103,7 +103,7 @@ PathElementSpec readViaElement(const ParamNode& n, int index) {
     return e;
 }
 
-MuscleSpec readMuscle(const ParamNode& n) {
+MuscleSpec readMuscle(const ParamNode& n, double specificTension) {
     MuscleSpec m;
     const std::string name = n.getString("name");
     if (!std::regex_match(name, std::regex("[A-Za-z][A-Za-z0-9_]*")))
@@ -122,13 +122,13 @@ MuscleSpec readMuscle(const ParamNode& n) {
                              (alternative ? std::string(" or '") + n.path(alternative) + "'" : std::string()) +
                              " (or a 'parameters' muscle file)");
         };
-        require("mass", "max_isometric_force");
+        if (!n.has("volume")) require("mass", "max_isometric_force");
         require("optimal_fascicle_length", nullptr);
         require("optimal_tendon_length", "tendon_slack_length");
         require("fibre_fractions", nullptr);
         require("fibre_types", nullptr);
     }
-    readMuscleFields(n, m.params, false);
+    readMuscleFields(n, m.params, false, specificTension);
     m.maxPathFromRange = !n.has("max_path_length");
     m.params.name = name;
     m.sourceParams = m.params;
@@ -306,7 +306,9 @@ ArmSetup loadModelFile(const std::string& file) {
         subj.rethrowWithLocation([&] { s.effort.validate(); });
     }
 
-    for (const ParamNode& m : root.children("muscles")) s.muscles.push_back(readMuscle(m));
+    if (root.has("specific_tension"))
+        s.specificTension = root.getNumber("specific_tension", getSpecificTensionBound());
+    for (const ParamNode& m : root.children("muscles")) s.muscles.push_back(readMuscle(m, s.specificTension));
     if (s.muscles.empty()) throw InputError(root.where("muscles") + ": field 'muscles' is empty: expected at least one muscle");
     if (root.has("primary")) {
         const std::string primary = root.getString("primary");

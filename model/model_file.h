@@ -11,16 +11,21 @@
 //                                        distances from the elbow centre.
 //   subject:                             voluntary_activation, co_contraction, trial_cv, fatigue
 //                                        (defaults of the virtual subject's effort, see SubjectEffort)
+//   specific_tension: SIGMA              [N/m^2] every muscle's sigma unless the muscle gives its own
+//                                        (default: the fibre-type file's, Virtual Muscle's 31.8 N/cm^2)
 //   primary: NAME                        the muscle the thesis calls "the biceps": the transducer
 //                                        estimate and the identification address it (default: first)
 //   muscles: [...]                       each: name, group (flexor|extensor), Virtual Muscle
 //                                        parameters (a `parameters:` muscle file and/or the fields of a
-//                                        muscle file; `max_isometric_force` [N] may stand for `mass` and
-//                                        `tendon_slack_length` [m] for `optimal_tendon_length`), and a
+//                                        muscle file; `max_isometric_force` [N] or `volume` [m^3] may
+//                                        stand for `mass` and `tendon_slack_length` [m] for
+//                                        `optimal_tendon_length`; `specific_tension` [N/m^2]), and a
 //                                        path: origin, via (points, cylinders, spheres), insertion.
+//                                        A `parameters:` file's mass stays as that file gives it.
 //
 // Conversions from OpenSim (Holzbaur et al. 2005) parameters, stated once here:
-//   mass = F0 L0 rho / sigma              (spec 1: F0 = sigma M / (rho L0))
+//   mass = F0 L0 rho / sigma              (spec 1: F0 = sigma M / (rho L0)), sigma the muscle's
+//   mass = rho V                          from an MRI volume V; F0 = sigma V / L0 then follows sigma
 //   L0T  = tendon_slack_length / LrT      the VM series-elastic force is F0 cT (LT - LrT) on its linear
 //                                         part, so LrT L0T is the length where the tendon's linear force
 //                                         extrapolates to zero: the slack length of a Hill tendon. The
@@ -98,6 +103,8 @@ struct ArmSetup {
     std::string file;                     ///< the model file it came from ("" when built in code)
     std::string description;
     ArmParameters arm;                    ///< segments, elbow range, transducer (and the thesis's A, B)
+    /// The model file's specific_tension [N/m^2]; 0: none given (each muscle's fibre-type file's sigma).
+    double specificTension = 0;
     SubjectEffort effort;                 ///< defaults of the subject's effort
     std::vector<MuscleSpec> muscles;
     int primary = 0;                      ///< index of the thesis's "biceps"

@@ -96,7 +96,9 @@ void loadFibreTypes(const std::string& path, FibreType& slow, FibreType& fast, M
     root.finish();
 }
 
-void readMuscleFields(const ParamNode& root, MuscleParameters& p, bool required) {
+Bound getSpecificTensionBound() { return Bound::closed(1e4, 2e6, "N/m^2 (1-200 N/cm^2)"); }
+
+void readMuscleFields(const ParamNode& root, MuscleParameters& p, bool required, double specificTension) {
     const Bound any = Bound::any();
     auto number = [&](const std::string& key, double& field) {
         if (required || root.has(key)) field = root.getNumber(key, any);
@@ -107,7 +109,12 @@ void readMuscleFields(const ParamNode& root, MuscleParameters& p, bool required)
         if (root.has(key))
             throw InputError(root.where(converted) + ": give either '" + key + "' or '" + converted + "', not both");
     };
-    numberOrConverted("mass", "max_isometric_force", p.mass);
+    const int sizeKeys = int(root.has("mass")) + int(root.has("max_isometric_force")) + int(root.has("volume"));
+    if (sizeKeys > 1)
+        throw InputError(root.where() + ": give one of 'mass', 'max_isometric_force' and 'volume', not " +
+                         std::to_string(sizeKeys));
+    if (required && !root.has("max_isometric_force") && !root.has("volume")) number("mass", p.mass);
+    if (!required && root.has("mass")) number("mass", p.mass);
     number("optimal_fascicle_length", p.optimalFascicleLength);
     numberOrConverted("optimal_tendon_length", "tendon_slack_length", p.optimalTendonLength);
     if (root.has("max_path_length") || required) number("max_path_length", p.maxPathLength);
@@ -135,7 +142,13 @@ void readMuscleFields(const ParamNode& root, MuscleParameters& p, bool required)
         const std::string typesFile = root.findFile("fibre_types", "fibre-type file");
         loadFibreTypes(typesFile, p.slow, p.fast, p.coefficients);
     }
+    // The model's specific tension, then the muscle's own, replace the fibre-type file's.
+    if (specificTension > 0) p.coefficients.sigma = specificTension;
+    if (root.has("specific_tension"))
+        p.coefficients.sigma = root.getNumber("specific_tension", getSpecificTensionBound());
     // Conversions need the coefficients (sigma, rho, LrT), so they come last.
+    if (root.has("volume"))
+        p.mass = root.getNumber("volume", Bound{0, 0.01, false, true, "m^3"}) * p.coefficients.density;
     if (root.has("max_isometric_force")) {
         const double F0 = root.getNumber("max_isometric_force", Bound::positive("N"));
         p.mass = F0 * p.optimalFascicleLength * p.coefficients.density / p.coefficients.sigma;
@@ -151,7 +164,7 @@ MuscleParameters loadMuscleParameters(const std::string& path) {
     MuscleParameters p;
     p.name = root.getString("name");
     root.getString("source", "");
-    readMuscleFields(root, p, true);
+    readMuscleFields(root, p, true, 0);
     root.finish();
     root.rethrowWithLocation([&] { p.validate(); });
     return p;

@@ -1,6 +1,7 @@
 // Reading muscle parameter files (assets/muscles/*.yaml). Framework-free.
 #pragma once
 
+#include "basics/bound.h"
 #include "muscles/virtual_muscle.h"
 
 #include <string>
@@ -21,10 +22,16 @@ void loadFibreTypes(const std::string& path, FibreType& slow, FibreType& fast, M
 MuscleParameters loadMuscleParameters(const std::string& path);
 
 class ParamNode;
-/// Reads the fields of a muscle file present in root into p (all of them when required): mass or
-/// max_isometric_force [N] (mass = F0 L0 rho / sigma), optimal_fascicle_length, optimal_tendon_length
-/// or tendon_slack_length [m] (L0T = slack / LrT, see model/model_file.h), max_path_length,
-/// pennation_angle (informative), fibre_fractions, motor_units, fibre_types. Does not validate.
-void readMuscleFields(const ParamNode& root, MuscleParameters& p, bool required);
+/// Reads the fields of a muscle file present in root into p (all of them when required): one of mass
+/// [kg], max_isometric_force [N] (mass = F0 L0 rho / sigma) and volume [m^3] (mass = rho V, so
+/// F0 = sigma V / L0), optimal_fascicle_length, optimal_tendon_length or tendon_slack_length [m]
+/// (L0T = slack / LrT, see model/model_file.h), max_path_length, pennation_angle (informative),
+/// fibre_fractions, motor_units, fibre_types, specific_tension [N/m^2]. sigma is, in order of
+/// precedence: the muscle's specific_tension, specificTension when > 0 (a model's), the fibre-type
+/// file's. Does not validate.
+void readMuscleFields(const ParamNode& root, MuscleParameters& p, bool required, double specificTension);
+/// Plausible specific tension [N/m^2]: 1-200 N/cm^2 (in vivo 25-30, Virtual Muscle 31.8; model files
+/// fitted to strong subjects imply up to ~140).
+Bound getSpecificTensionBound();
 
 }  // namespace armsim

@@ -289,6 +289,48 @@ TEST(ModelFile, BadFilesNameTheFileLineAndKey) {
     EXPECT_NE(msg.find("elbow"), std::string::npos) << msg;  // lists the shipped models
 }
 
+// Strength apart from size (issue 28): sigma from the model file or the muscle, mass from a volume,
+// F0 = sigma V / L0 following sigma; a muscle given by max_isometric_force keeps F0 whatever sigma.
+TEST(ModelFile, SpecificTensionAndVolumeSetF0AndMass) {
+    const std::string types = std::string(ARMSIM_ASSET_DIR) + "/muscles/human_fibre_types.yaml";
+    auto muscle = [&](const std::string& name, const std::string& fields) {
+        return "  - name: " + name + "\n" + fields +
+               "    optimal_fascicle_length: 0.12\n    tendon_slack_length: 0.2\n"
+               "    fibre_types: " + types + "\n    fibre_fractions: {slow: 0.5, fast: 0.5}\n"
+               "    path:\n      origin: {body: upper_arm, location: [0, 0.3, 0]}\n"
+               "      insertion: {body: forearm, location: [0, -0.05, 0]}\n";
+    };
+    const double sigma = 250000, own = 400000, V = 80e-6, F0 = 600, L0 = 0.12;
+    const std::string text = "name: sigma\narm: arm/default_male.yaml\nspecific_tension: 250000\nmuscles:\n" +
+                             muscle("byVolume", "    volume: 80.0e-6\n") +
+                             muscle("ownSigma", "    volume: 80.0e-6\n    specific_tension: 400000\n") +
+                             muscle("byForce", "    max_isometric_force: 600\n");
+    const ArmSetup s = loadModel(writeTemp("sigma.yaml", text));
+    EXPECT_EQ(s.specificTension, sigma);
+    const double rho = s.muscles[0].params.coefficients.density;
+    const VirtualMuscle a(s.calcMuscleParameters(0)), b(s.calcMuscleParameters(1)), c(s.calcMuscleParameters(2));
+    EXPECT_NEAR(a.getParameters().mass, rho * V, 1e-15);
+    EXPECT_NEAR(a.getF0(), sigma * V / L0, 1e-9);
+    EXPECT_NEAR(b.getParameters().mass, rho * V, 1e-15);
+    EXPECT_NEAR(b.getF0(), own * V / L0, 1e-9);
+    EXPECT_NEAR(c.getF0(), F0, 1e-9);
+    EXPECT_NEAR(c.getParameters().mass, F0 * L0 * rho / sigma, 1e-15);
+    // Without specific_tension: Virtual Muscle's 31.8 N/cm^2 from the fibre-type file.
+    const ArmSetup thesis = loadModel("thesis");
+    EXPECT_EQ(thesis.specificTension, 0);
+    EXPECT_EQ(thesis.biceps().coefficients.sigma, 318000);
+
+    std::string msg = messageOf(writeTemp("sigma_bad.yaml", "name: sigma\narm: arm/default_male.yaml\n"
+                                                            "specific_tension: 25\nmuscles:\n" +
+                                                                muscle("m", "    volume: 80.0e-6\n")));
+    EXPECT_NE(msg.find("sigma_bad.yaml:3"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("specific_tension"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("N/cm^2"), std::string::npos) << msg;
+    msg = messageOf(writeTemp("sigma_two.yaml", "name: sigma\narm: arm/default_male.yaml\nmuscles:\n" +
+                                                    muscle("m", "    volume: 80.0e-6\n    mass: 0.1\n")));
+    EXPECT_NE(msg.find("not 2"), std::string::npos) << msg;
+}
+
 // loadModel reuses a model while its files are unchanged: the reused model equals a fresh load, and an
 // edit of a file the model only refers to (its muscle file) is seen by the next load.
 TEST(ModelFile, AReloadSeesAnEditedMuscleFile) {
