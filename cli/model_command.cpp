@@ -6,6 +6,7 @@
 #include "cli/commands.h"
 #include "experiments/model_check.h"
 #include "experiments/model_report.h"
+#include "model/anatomy_calibration.h"
 #include "model/strength_calibration.h"
 
 #include <cmath>
@@ -99,24 +100,59 @@ void addModelCommands(CLI::App& app) {
 
     {
         auto name = std::make_shared<std::string>("elbow");
+        auto targets = std::make_shared<std::string>();
         CLI::App* c = model->add_subcommand(
-            "calibrate", "fit muscle strength scales to the elbow's target MVC curves; prints calibration lines");
-        c->add_option("--model", *name, "model name or file (its present calibration is the start)")->capture_default_str();
+            "calibrate", "fit muscle scales: to a target file (--targets: MVC, shares, optimum angles, volumes, "
+                         "with priors) or, without it, strength to the elbow's target MVC curves; prints calibration lines");
+        c->add_option("--model", *name, "model name or file")->capture_default_str();
+        c->add_option("--targets", *targets, "anatomy target file (e.g. assets/reference/elbow_targets.yaml)");
         c->callback([=] {
             ArmSetup setup = loadModel(*name);
-            for (const MvcTorqueTarget& target : {getElbowFlexionTarget(), getElbowExtensionTarget()}) {
-                std::printf("fitting the %s muscles to: %s\n", getMuscleGroupName(target.effort), target.source.c_str());
+            if (!targets->empty()) {
+                const std::vector<AnatomyTarget> t = loadAnatomyTargets(*targets);
+                std::printf("fitting model %s to %s (specific tension, volume and fascicle length per group, "
+                            "tendon length per muscle; priors: model/anatomy_calibration.h)\n",
+                            setup.name.c_str(), targets->c_str());
                 std::fflush(stdout);
-                StrengthCalibrationResult r = calibrateStrength(setup, target);
-                std::printf("  %s\n  torque error: rms %.2f N m, max %.2f N m\n", r.report.c_str(), r.rmsTorqueError,
-                            r.maxTorqueError);
+                const AnatomyCalibrationResult r = calibrateToAnatomy(setup, t);
+                auto passed = [](const std::vector<TargetScore>& s) {
+                    int n = 0;
+                    for (const TargetScore& x : s) n += x.pass;
+                    return n;
+                };
+                std::printf("  %s\n  targets passed: %d of %d as given, %d after\n", r.report.c_str(),
+                            passed(r.before), int(r.before.size()), passed(r.after));
+                for (const GroupScales& g : r.groups)
+                    std::printf("  %-8s specific tension x%.3f, volume x%.3f, fascicle length x%.3f\n",
+                                getMuscleGroupName(g.group), g.specificTension, g.volume, g.fascicleLength);
+                for (const TargetScore& x : r.after) {
+                    if (x.pass) continue;
+                    const double u = getTargetFileToSi(x.target.kind);
+                    std::printf("  fails: %s %s%s%s: %.4g, band %.4g..%.4g +/- %.4g %s (%s)\n", getTargetKindName(x.target.kind),
+                                x.muscle.c_str(), x.target.kind == TargetKind::Mvc ? (x.target.direction == MuscleGroup::Flexor ? "flexion" : "extension") : "",
+                                std::isfinite(x.target.flexionDeg) ? (" at " + formatNumber(x.target.flexionDeg) + " deg").c_str() : "",
+                                x.value / u, x.target.lower / u, x.target.upper / u, x.target.tolerance / u,
+                                getTargetFileUnit(x.target.kind), x.target.where.c_str());
+                }
                 setup = applyCalibration(setup, r.muscles);
+            } else {
+                for (const MvcTorqueTarget& target : {getElbowFlexionTarget(), getElbowExtensionTarget()}) {
+                    std::printf("fitting the %s muscles to: %s\n", getMuscleGroupName(target.effort), target.source.c_str());
+                    std::fflush(stdout);
+                    StrengthCalibrationResult r = calibrateStrength(setup, target);
+                    std::printf("  %s\n  torque error: rms %.2f N m, max %.2f N m\n", r.report.c_str(), r.rmsTorqueError,
+                                r.maxTorqueError);
+                    setup = applyCalibration(setup, r.muscles);
+                }
             }
             std::printf("calibration lines for the model file:\n");
-            for (const MuscleSpec& m : setup.muscles)
-                std::printf("  %-9s calibration: {force_scale: %.4f, fascicle_length_scale: %.4f, tendon_length_scale: %.4f}\n",
-                            m.params.name.c_str(), m.calibration.forceScale, m.calibration.fascicleLengthScale,
-                            m.calibration.tendonLengthScale);
+            for (const MuscleSpec& m : setup.muscles) {
+                const MuscleCalibration& k = m.calibration;
+                std::printf("  %-9s calibration: {force_scale: %.6f, fascicle_length_scale: %.6f, tendon_length_scale: %.6f",
+                            m.params.name.c_str(), k.forceScale, k.fascicleLengthScale, k.tendonLengthScale);
+                if (k.specificTensionScale != 1) std::printf(", specific_tension_scale: %.6f", k.specificTensionScale);
+                std::printf("}\n");
+            }
         });
     }
 }

@@ -93,20 +93,35 @@ std::vector<AnatomyTarget> loadDefaultAnatomyTargets() {
     return loadAnatomyTargets(getAssetDirectory() + "/reference/elbow_targets.yaml");
 }
 
-std::vector<TargetScore> scoreAnatomy(const ArmSetup& setup, const std::vector<AnatomyTarget>& targets) {
-    // Every angle any target names, plus a 1-deg sweep of the elbow's range for the optimum angles.
+AnatomySweep calcAnatomySweep(const ArmSetup& setup, const std::vector<AnatomyTarget>& targets) {
     const double maxFlexion = setup.arm.getMaxFlexionDeg(), minFlexion = setup.arm.getMinFlexionDeg();
-    std::vector<double> angles;
-    for (double a = minFlexion; a <= maxFlexion + 1e-9; a += 1) angles.push_back(a);
+    AnatomySweep sweep;
+    std::vector<double>& angles = sweep.flexionDeg;
+    const bool optimumAngles = std::any_of(targets.begin(), targets.end(),
+                                           [](const AnatomyTarget& t) { return t.kind == TargetKind::OptimumAngle; });
+    if (optimumAngles)
+        for (double a = minFlexion; a <= maxFlexion + 1e-9; a += 1) angles.push_back(a);
     for (const AnatomyTarget& t : targets)
         if (std::isfinite(t.flexionDeg) && t.flexionDeg >= minFlexion && t.flexionDeg <= maxFlexion)
             angles.push_back(t.flexionDeg);
     std::sort(angles.begin(), angles.end());
     angles.erase(std::unique(angles.begin(), angles.end()), angles.end());
+    sweep.geometry = calcMvcGeometry(setup, angles);
+    return sweep;
+}
+
+std::vector<TargetScore> scoreAnatomy(const ArmSetup& setup, const std::vector<AnatomyTarget>& targets) {
+    return scoreAnatomy(setup, targets, calcAnatomySweep(setup, targets));
+}
+
+std::vector<TargetScore> scoreAnatomy(const ArmSetup& setup, const std::vector<AnatomyTarget>& targets,
+                                      const AnatomySweep& sweep) {
+    const double maxFlexion = setup.arm.getMaxFlexionDeg(), minFlexion = setup.arm.getMinFlexionDeg();
+    const std::vector<double>& angles = sweep.flexionDeg;
     auto indexOf = [&](double deg) {
         return int(std::lower_bound(angles.begin(), angles.end(), deg) - angles.begin());
     };
-    const MvcGeometry geometry = calcMvcGeometry(setup, angles);
+    const MvcGeometry& geometry = sweep.geometry;
     const SteadyMvcCurve flexion = calcSteadyMvcCurve(setup.muscles, geometry, MuscleGroup::Flexor, setup.effort);
     const SteadyMvcCurve extension = calcSteadyMvcCurve(setup.muscles, geometry, MuscleGroup::Extensor, setup.effort);
     const SteadyMvcCurve full = calcSteadyMvcCurve(setup.muscles, geometry, MuscleGroup::Flexor, SubjectEffort{1, 0});

@@ -5,6 +5,7 @@
 #pragma once
 
 #include "model/model_file.h"
+#include "model/mvc_curve.h"
 
 #include <string>
 #include <vector>
@@ -58,6 +59,18 @@ struct TargetScore {
 /// where the muscle's steady fibre length at a full flexion MVC crosses L0 (NaN: it does not within the
 /// elbow's range). Targets naming no model muscle are skipped.
 std::vector<TargetScore> scoreAnatomy(const ArmSetup& setup, const std::vector<AnatomyTarget>& targets);
+
+/// The angles scoreAnatomy evaluates a model at (each target's angle, and every 1 deg of the elbow's range
+/// when an optimum_angle target needs the fibre-length crossing)
+/// and the geometry there. Scales of a calibration change no geometry, so a fit computes it once.
+struct AnatomySweep {
+    std::vector<double> flexionDeg;   ///< sorted, unique [deg]
+    MvcGeometry geometry;
+};
+AnatomySweep calcAnatomySweep(const ArmSetup& setup, const std::vector<AnatomyTarget>& targets);
+/// scoreAnatomy on a sweep made for this model's geometry.
+std::vector<TargetScore> scoreAnatomy(const ArmSetup& setup, const std::vector<AnatomyTarget>& targets,
+                                      const AnatomySweep& sweep);
 
 /// Passed and scored counts of one kind (and muscle, when not empty).
 struct ScoreSummary {

@@ -139,6 +139,7 @@ MuscleSpec readMuscle(const ParamNode& n, double specificTension) {
         cal.forceScale = c.getNumber("force_scale", scale, 1.0);
         cal.fascicleLengthScale = c.getNumber("fascicle_length_scale", scale, 1.0);
         cal.tendonLengthScale = c.getNumber("tendon_length_scale", scale, 1.0);
+        cal.specificTensionScale = c.getNumber("specific_tension_scale", scale, 1.0);
         c.getString("source", "");
         c.finish();
         m.setCalibration(cal);
@@ -179,6 +180,7 @@ void MuscleCalibration::validate() const {
     checkField("calibration.force_scale", forceScale, scale);
     checkField("calibration.fascicle_length_scale", fascicleLengthScale, scale);
     checkField("calibration.tendon_length_scale", tendonLengthScale, scale);
+    checkField("calibration.specific_tension_scale", specificTensionScale, scale);
 }
 
 void MuscleSpec::setCalibration(const MuscleCalibration& c) {
@@ -190,6 +192,7 @@ void MuscleSpec::setCalibration(const MuscleCalibration& c) {
     params.optimalFascicleLength *= c.fascicleLengthScale;
     params.mass *= c.forceScale * c.fascicleLengthScale;
     params.optimalTendonLength *= c.tendonLengthScale;
+    params.coefficients.sigma *= c.specificTensionScale;
 }
 
 ArmSetup applyCalibration(const ArmSetup& setup, const std::vector<MuscleCalibration>& calibration) {

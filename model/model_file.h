@@ -62,13 +62,17 @@ struct PathElementSpec {
     std::string label;                  ///< "origin", "via 1", "cylinder 2", "insertion"
 };
 
-/// Scales fitted to a subject's measured strength (a model file's per-muscle `calibration:`), applied to
-/// the source parameters: F0' = k F0, L0' = f L0, L0T' = t L0T (mass = F0' L0' rho / sigma).
+/// Scales fitted to a subject's measured strength or to anatomy targets (a model file's per-muscle
+/// `calibration:`), applied to the source parameters: F0' = k s F0, L0' = f L0, L0T' = t L0T,
+/// mass' = k f mass, sigma' = s sigma (so a muscle given by its volume V has volume k f V).
 struct MuscleCalibration {
-    double forceScale = 1;            ///< k, on the maximal isometric force F0 [1]
-    double fascicleLengthScale = 1;   ///< f, on the optimal fascicle length L0 [1]
-    double tendonLengthScale = 1;     ///< t, on the optimal tendon length L0T [1]
-    bool isIdentity() const { return forceScale == 1 && fascicleLengthScale == 1 && tendonLengthScale == 1; }
+    double forceScale = 1;             ///< k, on the maximal isometric force F0 [1]
+    double fascicleLengthScale = 1;    ///< f, on the optimal fascicle length L0 [1]
+    double tendonLengthScale = 1;      ///< t, on the optimal tendon length L0T [1]
+    double specificTensionScale = 1;   ///< s, on the specific tension sigma (F0 without mass) [1]
+    bool isIdentity() const {
+        return forceScale == 1 && fascicleLengthScale == 1 && tendonLengthScale == 1 && specificTensionScale == 1;
+    }
     /// Throws FieldError naming the field unless every scale is in [0.2, 5].
     void validate() const;
 };

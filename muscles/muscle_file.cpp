@@ -148,7 +148,7 @@ void readMuscleFields(const ParamNode& root, MuscleParameters& p, bool required,
         p.coefficients.sigma = root.getNumber("specific_tension", getSpecificTensionBound());
     // Conversions need the coefficients (sigma, rho, LrT), so they come last.
     if (root.has("volume"))
-        p.mass = root.getNumber("volume", Bound{0, 0.01, false, true, "m^3"}) * p.coefficients.density;
+        p.mass = root.getNumber("volume", Bound{0, 0.01, true, false, "m^3"}) * p.coefficients.density;
     if (root.has("max_isometric_force")) {
         const double F0 = root.getNumber("max_isometric_force", Bound::positive("N"));
         p.mass = F0 * p.optimalFascicleLength * p.coefficients.density / p.coefficients.sigma;

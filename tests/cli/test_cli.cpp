@@ -187,6 +187,29 @@ TEST(Cli, ModelCheckWritesTheScorecardItsSummaryCountsAndPlots) {
     EXPECT_NE(b.output.find("sideways"), std::string::npos) << b.output;
 }
 
+// model calibrate --targets: volume targets alone pin each group's volume scale (printed, and k f in the
+// calibration lines); the fit reports the targets it passes before and after.
+TEST(Cli, ModelCalibrateToTargetsFitsTheVolumesItIsGiven) {
+    constexpr double kScaleTol = 0.01;   // the band is +/- 0.5 %, the prior pulls towards 1
+    const fs::path d = freshDir("model_calibrate");
+    const fs::path targets = d / "volumes.yaml";
+    std::ofstream(targets) << "targets:\n"
+                              "  - {kind: volume, muscle: BIC, lower: 199, upper: 201, source: test}\n"
+                              "  - {kind: volume, muscle: TRI, lower: 398, upper: 402, source: test}\n";
+    const CommandResult r = runArmsim("model calibrate --model twin --targets " + targets.string());
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    EXPECT_NE(r.output.find("targets passed: 0 of 2 as given, 2 after"), std::string::npos) << r.output;
+    // twin.yaml: biceps 80.2 + 63.8 = 144 cm^3, triceps 159.8 + 2 x 106.1 = 372 cm^3.
+    const std::size_t line = r.output.find("BICshort  calibration: {force_scale: ");
+    ASSERT_NE(line, std::string::npos) << r.output;
+    const double k = std::stod(r.output.substr(line + 37));
+    const double f = std::stod(r.output.substr(r.output.find("fascicle_length_scale: ", line) + 23));
+    EXPECT_NEAR(k * f, 200.0 / 144.0, kScaleTol * 200.0 / 144.0) << r.output;
+    const CommandResult b = runArmsim("model calibrate --model twin --targets " + (d / "none.yaml").string());
+    EXPECT_EQ(b.exitCode, 2) << b.output;
+    EXPECT_NE(b.output.find("none.yaml"), std::string::npos) << b.output;
+}
+
 TEST(Cli, ModelShowWritesTablesAndPlots) {
     constexpr double kSumTol = 1e-6;  // N m, CSV digits
     const fs::path d = freshDir("model_show");

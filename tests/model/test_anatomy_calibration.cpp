@@ -1,0 +1,112 @@
+// Calibration to anatomy (model/anatomy_calibration.h): a model with known scales makes the targets;
+// the fit recovers its volumes and predicts its torque where it was not fitted (identified vs true);
+// the twin's file read back two ways.
+#include "basics/errors.h"
+#include "model/anatomy_calibration.h"
+#include "model/mvc_curve.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+using namespace armsim;
+
+namespace {
+
+constexpr double kBandHalfWidth = 0.005;    // targets made from the truth: +/- 0.5 %
+constexpr double kVolumeScaleTol = 0.01;    // relative: volumes are pinned by their own targets
+constexpr double kHeldOutTorqueTol = 0.02;  // relative: flexion MVC at angles between the targets' ones
+constexpr double kExactTol = 1e-9;
+
+AnatomyTarget makeTarget(TargetKind kind, const std::string& muscle, MuscleGroup direction, double deg, double value) {
+    AnatomyTarget t;
+    t.kind = kind;
+    t.muscle = muscle;
+    t.direction = direction;
+    t.flexionDeg = deg;
+    t.lower = value * (1 - kBandHalfWidth);
+    t.upper = value * (1 + kBandHalfWidth);
+    t.source = "truth model";
+    return t;
+}
+
+}  // namespace
+
+TEST(AnatomyCalibration, RecoversTheScalesOfAModelThatMadeTheTargets) {
+    const ArmSetup twin = loadModel("twin");
+    const std::vector<MuscleCalibration> identity(twin.muscles.size());
+    const ArmSetup source = applyCalibration(twin, identity);
+    // The truth: flexors 1.4x stronger per area and 1.3x larger, extensors 1.2x and 1.1x.
+    std::vector<MuscleCalibration> truthScales(twin.muscles.size());
+    for (std::size_t m = 0; m < truthScales.size(); ++m) {
+        const bool flexor = twin.muscles[m].group == MuscleGroup::Flexor;
+        truthScales[m].specificTensionScale = flexor ? 1.4 : 1.2;
+        truthScales[m].forceScale = flexor ? 1.3 : 1.1;  // f = 1: k = v
+    }
+    const ArmSetup truth = applyCalibration(twin, truthScales);
+    std::vector<AnatomyTarget> targets;
+    const std::vector<double> angles = {60, 90, 110};
+    const SteadyMvcCurve flexion = calcSteadyMvcCurve(truth, MuscleGroup::Flexor, truth.effort, angles);
+    for (std::size_t a = 0; a < angles.size(); ++a)
+        targets.push_back(makeTarget(TargetKind::Mvc, "", MuscleGroup::Flexor, angles[a], flexion.totalTorque[a]));
+    const SteadyMvcCurve extension = calcSteadyMvcCurve(truth, MuscleGroup::Extensor, truth.effort, {90});
+    targets.push_back(makeTarget(TargetKind::Mvc, "", MuscleGroup::Extensor, 90, -extension.totalTorque[0]));
+    for (const char* family : {"BIC", "BRA", "BRD", "TRI"}) {
+        double v = 0;
+        for (const MuscleSpec& m : truth.muscles)
+            if (doesFamilyCoverMuscle(family, m.params.name)) v += m.params.mass / m.params.coefficients.density;
+        targets.push_back(makeTarget(TargetKind::Volume, family, MuscleGroup::Flexor, NAN, v));
+    }
+
+    const AnatomyCalibrationResult r = calibrateToAnatomy(source, targets);
+    int passedBefore = 0, passedAfter = 0;
+    for (const TargetScore& s : r.before) passedBefore += s.pass;
+    for (const TargetScore& s : r.after) passedAfter += s.pass;
+    EXPECT_LT(passedBefore, int(targets.size()));   // the source model misses them
+    EXPECT_EQ(passedAfter, int(targets.size())) << r.report;
+    ASSERT_EQ(r.groups.size(), 2u);
+    for (const GroupScales& g : r.groups) {
+        const bool flexor = g.group == MuscleGroup::Flexor;
+        EXPECT_NEAR(g.volume, flexor ? 1.3 : 1.1, kVolumeScaleTol * (flexor ? 1.3 : 1.1)) << getMuscleGroupName(g.group);
+    }
+    // s, f and t trade against each other in the torque (only volumes pin v): judge the fitted model by
+    // the truth's torque at angles it was not fitted to.
+    const ArmSetup fitted = applyCalibration(twin, r.muscles);
+    const std::vector<double> heldOut = {75, 100};
+    const SteadyMvcCurve a = calcSteadyMvcCurve(fitted, MuscleGroup::Flexor, fitted.effort, heldOut);
+    const SteadyMvcCurve b = calcSteadyMvcCurve(truth, MuscleGroup::Flexor, truth.effort, heldOut);
+    for (std::size_t i = 0; i < heldOut.size(); ++i)
+        EXPECT_NEAR(a.totalTorque[i], b.totalTorque[i], kHeldOutTorqueTol * b.totalTorque[i]) << heldOut[i] << " deg";
+    // The result's calibration is the groups' scales: k = v / f.
+    for (std::size_t m = 0; m < r.muscles.size(); ++m) {
+        const GroupScales& g = r.groups[twin.muscles[m].group == r.groups[0].group ? 0 : 1];
+        EXPECT_NEAR(r.muscles[m].forceScale * r.muscles[m].fascicleLengthScale, g.volume, kExactTol);
+        EXPECT_NEAR(r.muscles[m].specificTensionScale, g.specificTension, kExactTol);
+    }
+}
+
+// The twin's file: F0 = s sigma V' / L0' with V' = k f V (its calibration applied to the MRI volume)
+// against the Virtual Muscle's own F0 = sigma M / (rho L0).
+TEST(AnatomyCalibration, TwinForceFollowsVolumeAndSpecificTension) {
+    const ArmSetup twin = loadModel("twin");
+    ASSERT_EQ(twin.getNumMuscles(), 7);
+    EXPECT_EQ(twin.specificTension, 300000);
+    for (int m = 0; m < twin.getNumMuscles(); ++m) {
+        const MuscleSpec& spec = twin.muscles[m];
+        const MuscleCalibration& c = spec.calibration;
+        const double V = spec.sourceParams.mass / spec.sourceParams.coefficients.density;   // the file's volume
+        const double L0 = spec.params.optimalFascicleLength;
+        const double expected = c.specificTensionScale * 300000 * (c.forceScale * c.fascicleLengthScale * V) / L0;
+        EXPECT_NEAR(VirtualMuscle(twin.calcMuscleParameters(m)).getF0(), expected, 1e-9 * expected) << spec.params.name;
+        EXPECT_NEAR(L0, c.fascicleLengthScale * spec.sourceParams.optimalFascicleLength, 1e-15);
+    }
+}
+
+TEST(AnatomyCalibration, RejectsTargetsThatNameNoMuscleOfTheModel) {
+    const ArmSetup twin = loadModel("twin");
+    AnatomyTarget t = makeTarget(TargetKind::Volume, "DELT", MuscleGroup::Flexor, NAN, 1e-4);
+    EXPECT_THROW(calibrateToAnatomy(twin, {t}), InputError);
+    AnatomyCalibrationOptions bad;
+    bad.volumeSd = 0;
+    EXPECT_THROW(calibrateToAnatomy(twin, {t}, bad), FieldError);
+}
