@@ -222,6 +222,8 @@ struct ValidateOptions {
     std::string out = "out/validate";
     std::string truth = "thesis";
     std::string population;
+    std::string truthPopulation;   // out of family: subjects drawn from here ...
+    std::string prior;             // ... identified with this prior (both default to --population)
     int subjects = 200;
     double activationSd = 0.02;
     std::vector<double> angles;  // flexion angles [deg] of the elbow protocol; empty: the thesis's five
@@ -269,7 +271,10 @@ void addElbowValidationPlots(const std::vector<ElbowValidationRow>& rows, Output
 }
 
 void runElbowValidate(const ValidateOptions& o) {
-    const Population population = o.population.empty() ? loadDefaultPopulation() : loadPopulation(o.population);
+    const Population family = o.population.empty() ? loadDefaultPopulation() : loadPopulation(o.population);
+    const Population population = o.truthPopulation.empty() ? family : loadPopulation(o.truthPopulation);
+    const Population prior = o.prior.empty() ? family : loadPopulation(o.prior);
+    const bool inFamily = o.truthPopulation.empty() && o.prior.empty();
     ElbowValidationSettings s;
     s.subjects = o.subjects;
     s.seed = o.seed;
@@ -284,6 +289,10 @@ void runElbowValidate(const ValidateOptions& o) {
     }
     if (o.noiseGiven)
         for (double pct : o.noise) s.noiseLevels.push_back(pct / 100.0);
+    if (!inFamily)
+        std::printf("out of family: truth population '%s' (%s, model %s), identifiers' prior '%s' (%s, model %s)\n",
+                    population.name.c_str(), population.file.c_str(), population.base.name.c_str(), prior.name.c_str(),
+                    prior.file.c_str(), prior.base.name.c_str());
     std::printf("validation on the elbow model as truth: population '%s' (%s), %d subjects, seed %u; protocol "
                 "'%s' (%d trials: %s); identifiers: thesis (biceps only), synergist-aware (MAP) and, with "
                 "--activation-sd > 0, synergist-aware with voluntary activation measured by twitch interpolation "
@@ -292,7 +301,7 @@ void runElbowValidate(const ValidateOptions& o) {
                 s.protocol.getNumTrials(), describeConditions(s.protocol).c_str());
     std::fflush(stdout);
     const std::vector<ElbowValidationRow> rows =
-        runElbowValidation(population, s, [](int d, int n) { printProgress("subjects", d, n); });
+        runElbowValidation(population, prior, s, [](int d, int n) { printProgress("subjects", d, n); });
     const std::vector<ElbowValidationSummary> summary = summarizeElbowValidation(rows);
     std::printf("%-13s %6s %9s %14s %14s %9s %15s %15s %9s\n", "method", "noise", "converged", "mass bias",
                 "mass RMSE", "coverage", "L0T bias", "L0T RMSE", "coverage");
@@ -364,6 +373,12 @@ void addValidateCommand(CLI::App& app) {
         ->check(CLI::IsMember({"thesis", "elbow"}));
     c->add_option("--population", o->population,
                   "population file for --truth elbow (default assets/subjects/default_population.yaml)");
+    c->add_option("--truth-population", o->truthPopulation,
+                  "--truth elbow: draw the subjects from this population file instead (out of family; e.g. "
+                  "assets/subjects/mismatch/stronger.yaml)");
+    c->add_option("--prior", o->prior,
+                  "--truth elbow: population file the identifiers take as their prior and model (default: "
+                  "--population, or the default population)");
     c->add_option("--activation-sd", o->activationSd,
                   "--truth elbow: sd of a twitch-interpolation measurement of voluntary activation for the "
                   "synergist-va identifier (0: leave it out)")
@@ -383,7 +398,11 @@ void addValidateCommand(CLI::App& app) {
         o->noiseGiven = c->count("--noise") > 0;
         if (c->count("--protocol") && (c->count("--angles") || c->count("--repetitions")))
             throw InputError("--protocol replaces --angles and --repetitions: give one or the other");
-        for (const char* option : {"--population", "--subjects", "--activation-sd", "--angles", "--repetitions", "--protocol"})
+        if (c->count("--population") && c->count("--truth-population") && c->count("--prior"))
+            throw InputError("--population is both the truth and the prior: with --truth-population and --prior "
+                             "it has nothing left to do; give two of the three");
+        for (const char* option : {"--population", "--truth-population", "--prior", "--subjects", "--activation-sd",
+                                   "--angles", "--repetitions", "--protocol"})
             if (o->truth != "elbow" && c->count(option))
                 throw InputError(std::string(option) + " needs --truth elbow");
         if (o->truth == "elbow")

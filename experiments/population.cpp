@@ -38,12 +38,37 @@ double drawTruncatedNormal(PortableRandom& rng) {
 
 }  // namespace
 
+void scaleGeometry(ArmSetup& setup, double g) {
+    checkField("geometry scale", g, Bound::closed(0.25, 4));
+    ArmParameters& a = setup.arm;
+    for (double* x : {&a.upperArmLength, &a.forearmLength, &a.handLength, &a.originDistance, &a.insertionDistance,
+                      &a.strapDistance})
+        *x *= g;
+    for (MuscleSpec& m : setup.muscles) {
+        for (PathElementSpec& e : m.path) {
+            for (double& c : e.location) c *= g;
+            e.radius *= g;
+        }
+        for (MuscleParameters* p : {&m.params, &m.sourceParams}) {
+            p->optimalFascicleLength *= g;
+            p->optimalTendonLength *= g;
+            p->maxPathLength *= g;
+        }
+    }
+}
+
 void Population::validate() const {
+    checkField("strength.mean_scale", strengthMeanScale, Bound::closed(0.25, 4));
     checkField("strength.subject_sd", strengthSubjectSd, Bound::closed(0, 1));
     checkField("strength.muscle_sd", strengthMuscleSd, Bound::closed(0, 1));
     checkField("tendon_length.sd", tendonLengthSd, Bound{0, 1.0 / 3, false, true, "relative sd, < 1/3"});
     checkField("fascicle_length.sd", fascicleLengthSd, Bound{0, 1.0 / 3, false, true, "relative sd, < 1/3"});
     checkField("slow_fraction.sd", slowFractionSd, Bound::closed(0, 0.5));
+    checkField("slow_fraction.mean_shift", slowFractionMeanShift, Bound::closed(-0.5, 0.5));
+    checkField("specific_tension.mean_scale", specificTensionMeanScale, Bound::closed(0.25, 4));
+    checkField("specific_tension.sd", specificTensionSd, Bound::closed(0, 1));
+    checkField("geometry.mean_scale", geometryMeanScale, Bound::closed(0.5, 2));
+    checkField("geometry.scale_sd", geometryScaleSd, Bound::closed(0, 0.2));
     checkRange("voluntary_activation", voluntaryActivation, Bound{0, 1, true, false, "in (0, 1]"});
     checkRange("co_contraction", coContraction, Bound::closed(0, 1));
     checkField("trial_cv", trialCv, Bound::closed(0, 0.5));
@@ -65,6 +90,7 @@ Population loadPopulation(const std::string& path) {
     }
     if (root.has("strength")) {
         const ParamNode s = root.child("strength");
+        p.strengthMeanScale = s.getNumber("mean_scale", Bound::any(), p.strengthMeanScale);
         p.strengthSubjectSd = s.getNumber("subject_sd", Bound::any(), p.strengthSubjectSd);
         p.strengthMuscleSd = s.getNumber("muscle_sd", Bound::any(), p.strengthMuscleSd);
         s.finish();
@@ -77,7 +103,24 @@ Population loadPopulation(const std::string& path) {
     };
     readSd("tendon_length", p.tendonLengthSd);
     readSd("fascicle_length", p.fascicleLengthSd);
-    readSd("slow_fraction", p.slowFractionSd);
+    if (root.has("slow_fraction")) {
+        const ParamNode n = root.child("slow_fraction");
+        p.slowFractionSd = n.getNumber("sd", Bound::any(), p.slowFractionSd);
+        p.slowFractionMeanShift = n.getNumber("mean_shift", Bound::any(), p.slowFractionMeanShift);
+        n.finish();
+    }
+    if (root.has("specific_tension")) {
+        const ParamNode n = root.child("specific_tension");
+        p.specificTensionMeanScale = n.getNumber("mean_scale", Bound::any(), p.specificTensionMeanScale);
+        p.specificTensionSd = n.getNumber("sd", Bound::any(), p.specificTensionSd);
+        n.finish();
+    }
+    if (root.has("geometry")) {
+        const ParamNode n = root.child("geometry");
+        p.geometryMeanScale = n.getNumber("mean_scale", Bound::any(), p.geometryMeanScale);
+        p.geometryScaleSd = n.getNumber("scale_sd", Bound::any(), p.geometryScaleSd);
+        n.finish();
+    }
     p.voluntaryActivation = readRange(root, "voluntary_activation", p.voluntaryActivation);
     p.coContraction = readRange(root, "co_contraction", p.coContraction);
     p.trialCv = root.getNumber("trial_cv", Bound::any(), p.trialCv);
@@ -104,7 +147,14 @@ VirtualSubject drawSubject(const Population& population, unsigned seed, int inde
     v.seed = seed;
     v.setup = population.base;
     v.transducerNoise = population.transducerNoise;
-    v.strengthLevel = population.strengthSubjectSd * rng.drawNormal();
+    v.strengthLevel = std::log(population.strengthMeanScale) + population.strengthSubjectSd * rng.drawNormal();
+    // Person-level sigma and size, from their own stream (see population.h).
+    PortableRandom person{seed, unsigned(index), 1u};
+    v.specificTensionScale = population.specificTensionMeanScale * std::exp(population.specificTensionSd * person.drawNormal());
+    v.geometryScale = population.geometryMeanScale * std::exp(population.geometryScaleSd * drawTruncatedNormal(person));
+    if (v.geometryScale != 1) scaleGeometry(v.setup, v.geometryScale);
+    if (v.specificTensionScale != 1)
+        for (MuscleSpec& m : v.setup.muscles) m.params.coefficients.sigma *= v.specificTensionScale;
     for (MuscleSpec& m : v.setup.muscles) {
         const MuscleParameters base = m.params;
         const double mass = std::exp(v.strengthLevel + population.strengthMuscleSd * rng.drawNormal());
@@ -119,7 +169,7 @@ VirtualSubject drawSubject(const Population& population, unsigned seed, int inde
             m.params.mass *= mass;
             m.params.optimalTendonLength *= tendon;
             m.params.optimalFascicleLength *= fascicle;
-            m.params.slowFraction = std::clamp(base.slowFraction + slow, 0.05, 0.95);
+            m.params.slowFraction = std::clamp(base.slowFraction + population.slowFractionMeanShift + slow, 0.05, 0.95);
             const VirtualMuscle muscle(m.params);
             const SteadyState relaxed = muscle.calcSteadyState(m.params.maxPathLength, 0.0);
             if (relaxed.converged && relaxed.states[VirtualMuscle::kL] < kMaxRelaxedStretch * muscle.getNfLimit()) break;

@@ -127,6 +127,8 @@ SynergistModel::SynergistModel(const Population& prior, const SynergistOptions& 
     cov[kCoContraction][kCoContraction] = std::pow(uniformSd(prior.coContraction), 2);
     for (int j = 0; j < n; ++j) cov[j][j] = std::max(cov[j][j], 1e-10);  // a zero spread: the value is known
     priorMean_.assign(n, 0.0);
+    for (int a : masses) priorMean_[a] = std::log(prior.strengthMeanScale);
+    priorMean_[kBicepsSlow] = priorMean_[kSynergistSlow] = prior.slowFractionMeanShift;
     priorMean_[kActivation] = 0.5 * (prior.voluntaryActivation.min + prior.voluntaryActivation.max);
     priorMean_[kCoContraction] = 0.5 * (prior.coContraction.min + prior.coContraction.max);
     const double lnLo = std::log(0.25), lnHi = std::log(4.0), lenLo = std::log(0.6), lenHi = std::log(1.4);
@@ -140,8 +142,8 @@ SynergistModel::SynergistModel(const Population& prior, const SynergistOptions& 
     // not cross the model's domain; a range of zero width holds the value fixed.
     auto inside = [](double v) { return std::clamp(v, 1e-5, 1 - 1e-5); };
     for (int j : {kBicepsSlow, kSynergistSlow}) {
-        lower_[j] = options.freeSlowFraction ? -0.3 : 0.0;
-        upper_[j] = options.freeSlowFraction ? 0.3 : 0.0;
+        lower_[j] = options.freeSlowFraction ? prior.slowFractionMeanShift - 0.3 : prior.slowFractionMeanShift;
+        upper_[j] = options.freeSlowFraction ? prior.slowFractionMeanShift + 0.3 : prior.slowFractionMeanShift;
     }
     lower_[kActivation] = inside(prior.voluntaryActivation.min);
     upper_[kActivation] = inside(prior.voluntaryActivation.max);

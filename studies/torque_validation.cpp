@@ -46,7 +46,20 @@ ElbowValidationRow makeElbowValidationRow(const Population& population, const Vi
 
 std::vector<ElbowValidationRow> runElbowValidation(const Population& population, const ElbowValidationSettings& settings,
                                                    const std::function<void(int, int)>& progress) {
+    return runElbowValidation(population, population, settings, progress);
+}
+
+std::vector<ElbowValidationRow> runElbowValidation(const Population& population, const Population& prior,
+                                                   const ElbowValidationSettings& settings,
+                                                   const std::function<void(int, int)>& progress) {
     population.validate();
+    prior.validate();
+    const std::string& truthPrimary = population.base.muscles[population.base.primary].params.name;
+    const std::string& priorPrimary = prior.base.muscles[prior.base.primary].params.name;
+    if (truthPrimary != priorPrimary)
+        throw InputError("the prior's model '" + prior.base.name + "' identifies muscle '" + priorPrimary +
+                         "', the truth's model '" + population.base.name + "' has '" + truthPrimary +
+                         "' as its primary muscle: expected the same muscle");
     settings.protocol.validate();
     checkField("subjects", settings.subjects, Bound::closed(1, 1e6));
     checkField("activation_sd", settings.activationSd, Bound::closed(0, 0.5));
@@ -71,7 +84,7 @@ std::vector<ElbowValidationRow> runElbowValidation(const Population& population,
                 // than unknowns) is recorded as failed, not fatal.
                 MuscleEstimate e;
                 try {
-                    e = identifyElbowMethod(m, population, data, settings.seed, s);
+                    e = identifyElbowMethod(m, prior, data, settings.seed, s);
                 } catch (const std::exception& x) {
                     e.method = m.kind;
                     e.message = x.what();

@@ -56,8 +56,14 @@ struct ElbowValidationSettings {
     int jobs = 2;                             ///< threads (over subjects)
 };
 
-/// Draws subjects 0..subjects-1, synthesizes each one's data once per noise level (common random
-/// numbers across levels), identifies with both methods. progress(done, total) per subject.
+/// Draws subjects 0..subjects-1 from `truth`, synthesizes each one's data once per noise level (common
+/// random numbers across levels), identifies with every method using `prior` as the identifiers' prior
+/// and model (out of family when the two differ). Throws InputError unless the two models' primary
+/// muscles have the same name. progress(done, total) per subject.
+std::vector<ElbowValidationRow> runElbowValidation(const Population& truth, const Population& prior,
+                                                   const ElbowValidationSettings& settings,
+                                                   const std::function<void(int, int)>& progress = {});
+/// In family: the truth population is the prior.
 std::vector<ElbowValidationRow> runElbowValidation(const Population& population, const ElbowValidationSettings& settings,
                                                    const std::function<void(int, int)>& progress = {});
 std::vector<ElbowValidationSummary> summarizeElbowValidation(const std::vector<ElbowValidationRow>& rows);

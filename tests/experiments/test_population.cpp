@@ -2,10 +2,13 @@
 // population files read strictly.
 #include "basics/errors.h"
 #include "experiments/population.h"
+#include "model/geometry.h"
+#include "model/muscle_arm.h"
 #include "model/mvc_curve.h"
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -106,4 +109,45 @@ TEST(Population, BadFilesNameTheFileLineAndField) {
     e = errorOf("name: x\nmodel: elbw\n");
     EXPECT_NE(e.find(":2"), std::string::npos) << e;
     EXPECT_NE(e.find("elbw"), std::string::npos) << e;
+}
+
+// Issue 31: means and person-level scales. Each mismatch field moves exactly what it names; the new
+// person-level draws come from their own stream, so masses and lengths are those of the same people
+// without them.
+TEST(Population, MeanScalesAndPersonLevelScalesMoveWhatTheyName) {
+    constexpr double kExact = 1e-12;   // relative: scaling is exact arithmetic
+    const Population& base = population();
+    Population p = base;
+    p.strengthMeanScale = 1.26;
+    p.slowFractionMeanShift = 0.1;
+    p.specificTensionMeanScale = 1.2;
+    p.specificTensionSd = 0.16;
+    p.geometryMeanScale = 1.15;
+    p.geometryScaleSd = 0.05;
+    ArmGeometry g0(base.base);
+    g0.setElbowAngle(elbowAngleFromFlexion(degToRad(90)));
+    double sigmaLog = 0;
+    constexpr int kPeople = 400;
+    for (int i = 0; i < kPeople; ++i) {
+        const VirtualSubject a = drawSubject(base, 3, i), b = drawSubject(p, 3, i);
+        for (int m = 0; m < a.setup.getNumMuscles(); ++m) {
+            EXPECT_NEAR(b.massScale[m], 1.26 * a.massScale[m], kExact * b.massScale[m]);
+            EXPECT_EQ(b.tendonLengthScale[m], a.tendonLengthScale[m]);
+            const MuscleParameters &pa = a.setup.muscles[m].params, &pb = b.setup.muscles[m].params;
+            EXPECT_NEAR(pb.coefficients.sigma, b.specificTensionScale * pa.coefficients.sigma, kExact * pb.coefficients.sigma);
+            EXPECT_NEAR(pb.optimalFascicleLength, b.geometryScale * pa.optimalFascicleLength, kExact);
+            EXPECT_NEAR(pb.maxPathLength, b.geometryScale * pa.maxPathLength, kExact);
+            EXPECT_NEAR(pb.slowFraction, std::clamp(pa.slowFraction + 0.1, 0.05, 0.95), kExact);
+        }
+        sigmaLog += std::log(b.specificTensionScale / 1.2);
+        if (i < 3) {  // moment arms scale with the person's size (path geometry, virtual work)
+            ArmGeometry g(b.setup);
+            g.setElbowAngle(elbowAngleFromFlexion(degToRad(90)));
+            for (int m = 0; m < g.getNumMuscles(); ++m)
+                EXPECT_NEAR(g.calcMomentArm(m), b.geometryScale * g0.calcMomentArm(m), 1e-9) << m;
+        }
+    }
+    // The sigma scale is ln-normal around its median 1.2 (mean of ln within 4 standard errors).
+    EXPECT_NEAR(sigmaLog / kPeople, 0.0, 4 * 0.16 / std::sqrt(double(kPeople)));
+    EXPECT_NE(errorOf("name: x\nmodel: elbow\ngeometry: {mean_scale: 3}\n").find("geometry.mean_scale"), std::string::npos);
 }

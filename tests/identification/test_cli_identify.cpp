@@ -201,6 +201,14 @@ TEST(CliValidate, ElbowTruthWritesPerSubjectAndSummaryFilesAndPlots) {
         EXPECT_EQ(bad.exitCode, kInputErrorExit) << bad.output;
         EXPECT_NE(bad.output.find("needs --truth elbow"), std::string::npos) << bad.output;
     }
+    // Out of family: the stronger mismatch population as the truth, the default population as the prior.
+    const fs::path o = freshDir("elbow_validate_out_of_family");
+    const CommandResult oof = runArmsim("validate --truth elbow --truth-population " + std::string(ARMSIM_ASSET_DIR) +
+                                        "/subjects/mismatch/stronger.yaml --subjects 1 --jobs 2 --out " + o.string());
+    ASSERT_EQ(oof.exitCode, 0) << oof.output;
+    EXPECT_NE(oof.output.find("out of family: truth population 'stronger'"), std::string::npos) << oof.output;
+    EXPECT_NE(oof.output.find("prior 'default'"), std::string::npos) << oof.output;
+    EXPECT_EQ(readLines(o / "elbow_validation.csv").size(), 4u);
     const CommandResult outside = runArmsim("validate --truth elbow --subjects 1 --angles 30,170 --out " + d.string());
     EXPECT_EQ(outside.exitCode, kInputErrorExit) << outside.output;
     EXPECT_NE(outside.output.find("170"), std::string::npos) << outside.output;

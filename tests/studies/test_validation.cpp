@@ -1,6 +1,7 @@
 // Validation of the thesis identifiers against a known truth: a tiny run recovers the thesis truth and
 // writes one row per method and noise level.
 #include "basics/errors.h"
+#include "studies/torque_validation.h"
 #include "studies/validation.h"
 #include "tests/identification/test_support.h"
 
@@ -34,4 +35,37 @@ TEST(Validation, TinyRunRecoversTheThesisTruthAndWritesOneRowPerMethodAndNoiseLe
     EXPECT_NE(formatValidationTable(rows).find("lm"), std::string::npos);
     s.noiseLevels = {0.6};
     EXPECT_THROW(runValidation(setup.arm, base, s), InputError);
+}
+
+// Out of family (issue 31): subjects come from the truth population, the identifiers use the prior.
+// With the prior equal to the truth the run is the in-family run; a stronger truth makes the same people
+// 1.26x heavier while the identifiers' answers are computed against the default prior.
+TEST(Validation, OutOfFamilyDrawsFromTheTruthAndIdentifiesWithThePrior) {
+    const Population prior = loadDefaultPopulation();
+    Population truth = prior;
+    truth.strengthMeanScale = 1.26;
+    ElbowValidationSettings v;
+    v.subjects = 2;
+    v.noiseLevels = {0.02};
+    v.activationSd = 0;
+    v.jobs = 2;
+    const std::vector<ElbowValidationRow> inFamily = runElbowValidation(prior, v);
+    const std::vector<ElbowValidationRow> same = runElbowValidation(prior, prior, v);
+    const std::vector<ElbowValidationRow> stronger = runElbowValidation(truth, prior, v);
+    ASSERT_EQ(inFamily.size(), same.size());
+    ASSERT_EQ(inFamily.size(), stronger.size());
+    for (std::size_t k = 0; k < inFamily.size(); ++k) {
+        EXPECT_EQ(same[k].estimate.mass, inFamily[k].estimate.mass);   // bitwise: the same computation
+        EXPECT_NEAR(stronger[k].trueMass, 1.26 * inFamily[k].trueMass, 1e-12);
+        const VirtualSubject person = drawSubject(truth, v.seed, stronger[k].subject);
+        EXPECT_EQ(stronger[k].trueMass, person.setup.muscles[person.setup.primary].params.mass);
+    }
+    Population other = prior;
+    other.base.primary = other.base.findMuscle("BRA");
+    try {
+        runElbowValidation(other, prior, v);
+        FAIL() << "a truth whose primary muscle is not the prior's was accepted";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("'BRA'"), std::string::npos) << e.what();
+    }
 }
