@@ -110,6 +110,30 @@ Table calcMomentArmTable(const ArmSetup& setup, double stepDeg) {
     return t;
 }
 
+Table calcForearmMomentArmTable(const ArmSetup& setup, double flexionDeg, double stepDeg) {
+    const ArmParameters::ForearmRotation& rot = setup.arm.forearmRotation;
+    if (!rot.enabled) throw InputError("model '" + setup.name + "' has no forearm rotation");
+    std::vector<std::string> cols = {"rotation_deg"};
+    for (const MuscleSpec& m : setup.muscles) cols.push_back("forearm_moment_arm_" + m.params.name + "_m");
+    for (const MuscleSpec& m : setup.muscles) cols.push_back("moment_arm_" + m.params.name + "_m");
+    Table t(cols);
+    ArmGeometry g(setup);
+    g.setElbowAngle(elbowAngleFromFlexion(degToRad(flexionDeg)));
+    std::vector<double> phis;
+    for (double phi = rot.minDeg; phi < rot.maxDeg - 1e-9; phi += stepDeg) phis.push_back(phi);
+    phis.push_back(rot.maxDeg);
+    for (double phi : phis) {
+        g.setForearmRotation(degToRad(phi));
+        std::vector<double> row = {phi};
+        std::vector<PathGeometry> paths;
+        for (int i = 0; i < g.getNumMuscles(); ++i) paths.push_back(g.calcPathGeometry(i));
+        for (const PathGeometry& p : paths) row.push_back(g.calcForearmMomentArm(p));
+        for (const PathGeometry& p : paths) row.push_back(g.calcMomentArm(p));
+        t.appendRow(row);
+    }
+    return t;
+}
+
 Table formatMvcCurve(const ArmSetup& setup, const SteadyMvcCurve& curve) {
     std::vector<std::string> cols = {"flexion_deg", "elbow_angle_deg", "torque_total_Nm"};
     for (const std::string& m : curve.muscles) cols.push_back("torque_" + m + "_Nm");
@@ -209,6 +233,33 @@ ModelReportFiles writeModelReport(const ArmSetup& setup, const std::string& outD
     armPlot.yMax = hi + 1.0 * (hi - lo);  // room for the legend above the curves
     writePlotPng(path("moment_arms.png"), armPlot);
     out.files.push_back(path("moment_arms.png"));
+
+    if (setup.arm.forearmRotation.enabled) {
+        constexpr double kForearmFlexionDeg = 90;  // the usual forearm-rotation test posture (elbow at a right angle)
+        const Table fa = calcForearmMomentArmTable(setup, kForearmFlexionDeg, stepDeg);
+        fa.writeCsv(path("forearm_moment_arms.csv"));
+        out.files.push_back(path("forearm_moment_arms.csv"));
+        PlotSpec plot;
+        plot.title = "Forearm-rotation moment arms at 90 deg flexion, model " + setup.name + " (virtual work)";
+        plot.xLabel = "forearm rotation (deg, - pronated, + supinated)";
+        plot.yLabel = "moment arm (cm, + = supination)";
+        plot.legend = PlotSpec::Legend::TopLeft;
+        const std::vector<double> phi = fa.getColumn("rotation_deg");
+        double lo = 0, hi = 0;
+        int color = 0;
+        for (int i = 0; i < setup.getNumMuscles(); ++i) {  // the muscles that act on the rotation
+            PlotSeries ps{setup.muscles[i].params.name, phi, {}, false, color % 8};
+            for (double h : fa.getColumn("forearm_moment_arm_" + ps.label + "_m")) ps.y.push_back(100 * h);
+            if (std::all_of(ps.y.begin(), ps.y.end(), [](double v) { return v == 0; })) continue;
+            for (double v : ps.y) lo = std::min(lo, v), hi = std::max(hi, v);
+            plot.series.push_back(ps);
+            ++color;
+        }
+        plot.yMin = lo - 0.05 * (hi - lo);
+        plot.yMax = hi + 1.0 * (hi - lo);
+        writePlotPng(path("forearm_moment_arms.png"), plot);
+        out.files.push_back(path("forearm_moment_arms.png"));
+    }
 
     const std::vector<double> angles = calcAngles(setup, stepDeg);
     for (MuscleGroup g : {MuscleGroup::Flexor, MuscleGroup::Extensor}) {

@@ -45,6 +45,10 @@ Table calcMuscleTable(const ArmSetup& setup);
 /// Path lengths and moment arms (virtual work) every stepDeg over the elbow's range: flexion_deg,
 /// elbow_angle_deg, then path_<m>_m and moment_arm_<m>_m per muscle.
 Table calcMomentArmTable(const ArmSetup& setup, double stepDeg);
+/// Moment arms over the forearm rotation's range at one flexion angle [deg]: rotation_deg (every stepDeg
+/// from the most pronated, + = supinated), forearm_moment_arm_<m>_m (+ = supinates) and moment_arm_<m>_m
+/// (elbow, + = flexes) per muscle. Throws InputError for a model without a forearm rotation.
+Table calcForearmMomentArmTable(const ArmSetup& setup, double flexionDeg, double stepDeg);
 /// Steady MVC curve as a table: flexion_deg, elbow_angle_deg, torque_total_Nm, then torque_<m>_Nm,
 /// force_<m>_N, fibre_length_<m> (L/L0) per muscle, and for a flexion effort the primary muscle's share
 /// of the flexors' torque (primary_share).

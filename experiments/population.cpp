@@ -44,6 +44,7 @@ void scaleGeometry(ArmSetup& setup, double g) {
     for (double* x : {&a.upperArmLength, &a.forearmLength, &a.handLength, &a.originDistance, &a.insertionDistance,
                       &a.strapDistance})
         *x *= g;
+    for (double& c : a.forearmRotation.axisPoint) c *= g;
     for (MuscleSpec& m : setup.muscles) {
         for (PathElementSpec& e : m.path) {
             for (double& c : e.location) c *= g;

@@ -38,6 +38,11 @@ MassProperties segmentMassProperties(double m, const Vec3& com, double k, double
     return MassProperties(m, com, central.shiftFromMassCenter(-com, m));
 }
 
+MassProperties scaleMassProperties(const MassProperties& m, double share) {
+    if (share == 1) return m;
+    return MassProperties(share * m.getMass(), m.getMassCenter(), m.getUnitInertia());
+}
+
 }  // namespace
 
 ArmModel::ArmModel(const ArmParameters& params)
@@ -60,8 +65,19 @@ ArmModel::ArmModel(const ArmParameters& params)
     upperArm_ = MobilizedBody::Weld(matter_.updGround(), Transform(), upperBody, Transform());
 
     // Forearm + hand on a pin about Z at the elbow centre; q = flexion angle.
-    Body::Rigid foreBody(calcForearmMassProperties());
+    const ArmParameters::ForearmRotation& rot = p.forearmRotation;
+    const double foreShare = rot.enabled ? 1 - rot.massFraction : 1;
+    Body::Rigid foreBody(scaleMassProperties(calcForearmMassProperties(), foreShare));
     forearm_ = MobilizedBody::Pin(upperArm_, Transform(), foreBody, Transform());
+    if (rot.enabled) {
+        // The pin's Z axis along the rotation axis, in both frames: the radius frame is the forearm's at 0.
+        const Vec3 d(rot.axisDirection[0], rot.axisDirection[1], rot.axisDirection[2]);
+        const Transform X(Rotation(UnitVec3(d), ZAxis), Vec3(rot.axisPoint[0], rot.axisPoint[1], rot.axisPoint[2]));
+        Body::Rigid radiusBody(scaleMassProperties(calcForearmMassProperties(), rot.massFraction));
+        radius_ = MobilizedBody::Pin(forearm_, X, radiusBody, X);
+        Force::MobilityLinearStop(forces_, radius_, MobilizerQIndex(0), p.stopStiffness, p.stopDissipation,
+                                  degToRad(rot.minDeg), degToRad(rot.maxDeg));
+    }
 
     // Soft stops on q = pi - theta: theta in [min, max] <=> q in [pi - max, pi - min].
     elbowStop_ = Force::MobilityLinearStop(forces_, forearm_, MobilizerQIndex(0), p.stopStiffness,
@@ -123,6 +139,7 @@ const State& ArmModel::finalize() {
     requireNotFinalized("finalize");
     defaultState_ = system_.realizeTopology();
     system_.realizeModel(defaultState_);
+    if (params_.forearmRotation.enabled) radius_.lockAt(defaultState_, degToRad(params_.forearmRotation.postureDeg));
     finalized_ = true;
     return defaultState_;
 }
@@ -151,6 +168,26 @@ void ArmModel::lockElbow(State& state, double theta) const {
 }
 
 void ArmModel::unlockElbow(State& state) const { forearm_.unlock(state); }
+
+void ArmModel::lockForearmRotation(State& state, double phi) const {
+    if (!hasForearmRotation()) throw std::logic_error("ArmModel::lockForearmRotation: the arm has no forearm rotation");
+    radius_.lockAt(state, phi);
+}
+
+double ArmModel::getForearmRotation(const State& state) const {
+    if (!hasForearmRotation()) throw std::logic_error("ArmModel::getForearmRotation: the arm has no forearm rotation");
+    return radius_.getQ(state);
+}
+
+double ArmModel::calcForearmHoldingTorque(const State& state) const {
+    if (!hasForearmRotation() || !radius_.isLocked(state))
+        throw std::logic_error("ArmModel::calcForearmHoldingTorque: no locked forearm rotation");
+    if (state.getSystemStage() < Stage::Acceleration)
+        throw std::logic_error("ArmModel::calcForearmHoldingTorque: realize the state to Stage::Acceleration first");
+    Vector motionForces;
+    matter_.findMotionForces(state, motionForces);
+    return -motionForces[radius_.getFirstUIndex(state)];
+}
 
 double ArmModel::calcPathLength(const State& state) const {
     return (upperArm_.findStationLocationInGround(state, origin_) -

@@ -9,6 +9,9 @@
 //   Forearm frame: origin at the elbow centre, forearm axis along -Y, elbow pin about +Z.
 //   Pin coordinate q = flexion angle = pi - theta: q = 0 fully extended (forearm hanging along -Y),
 //   q = pi/2 forearm horizontal along +X. Positive pin torque flexes the elbow.
+//   Radius frame (arms with a forearm rotation): coincides with the forearm frame at phi = 0 and turns
+//   by phi about the rotation axis (+ = supination); the radius carries the given fraction of the
+//   forearm + hand mass properties, the forearm the rest (the same sum at phi = 0).
 // Angles are radians here; theta is the included elbow angle (geometry.h).
 #pragma once
 
@@ -50,6 +53,10 @@ public:
     const SimTK::GeneralForceSubsystem& getForces() const { return forces_; }
     const SimTK::MobilizedBody::Weld& getUpperArm() const { return upperArm_; }
     const SimTK::MobilizedBody::Pin& getForearm() const { return forearm_; }
+    /// The radius (and hand) on its pronation-supination pin; an empty handle unless the arm has a
+    /// forearm rotation (ArmParameters::forearmRotation).
+    const SimTK::MobilizedBody::Pin& getRadius() const { return radius_; }
+    bool hasForearmRotation() const { return params_.forearmRotation.enabled; }
     const SimTK::Force::Gravity& getGravity() const { return gravity_; }
     const SimTK::Force::MobilityLinearStop& getElbowStop() const { return elbowStop_; }
     /// @}
@@ -82,6 +89,17 @@ public:
     bool isElbowLocked(const SimTK::State& state) const { return forearm_.isLocked(state); }
     /// @}
 
+    /// @name Forearm rotation (phi, rad: + = supination, 0 = neutral); only with hasForearmRotation()
+    /// @{
+    /// Locks the radius at phi (the default state holds the posture of the parameters); lowers the
+    /// state to Stage::Model. Throws std::logic_error without a forearm rotation.
+    void lockForearmRotation(SimTK::State& state, double phi) const;
+    double getForearmRotation(const SimTK::State& state) const;
+    /// Torque [N m] the forearm lock applies about the rotation axis, + = supination (as
+    /// calcHoldingTorque: the state locked and realized to Stage::Acceleration).
+    double calcForearmHoldingTorque(const SimTK::State& state) const;
+    /// @}
+
     /// @name Measurements
     /// @{
     /// Biceps path length |origin - insertion| [m] from the Simbody station positions.
@@ -110,6 +128,7 @@ private:
     SimTK::Force::Gravity gravity_;
     SimTK::MobilizedBody::Weld upperArm_;
     SimTK::MobilizedBody::Pin forearm_;
+    SimTK::MobilizedBody::Pin radius_;
     SimTK::Force::MobilityLinearStop elbowStop_;
     SimTK::Vec3 origin_, insertion_, strap_, hand_;
     SimTK::State defaultState_;

@@ -2,6 +2,8 @@
 
 #include "basics/param_node.h"
 
+#include <cmath>
+
 namespace armsim {
 
 void ArmParameters::validate() const {
@@ -37,6 +39,17 @@ void ArmParameters::validate() const {
     checkField("elbow.stop_stiffness", stopStiffness, Bound::positive("N m/rad"));
     checkField("elbow.stop_dissipation", stopDissipation, Bound::nonNegative("s/rad"));
 
+    if (forearmRotation.enabled) {
+        const ForearmRotation& r = forearmRotation;
+        checkField("forearm_rotation.min_deg", r.minDeg, Bound::closed(-120, 0, "deg"));
+        checkField("forearm_rotation.max_deg", r.maxDeg, Bound::closed(0, 120, "deg"));
+        checkField("forearm_rotation.posture_deg", r.postureDeg, Bound::closed(r.minDeg, r.maxDeg, "deg"));
+        checkField("forearm_rotation.mass_fraction", r.massFraction, Bound{0, 1, true, true, "of the forearm + hand mass"});
+        const auto& d = r.axisDirection;
+        checkField("forearm_rotation.axis_direction (length)", std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]),
+                   Bound{0, 1e3, true, false, "a direction"});
+        for (double c : r.axisPoint) checkField("forearm_rotation.axis_point", c, Bound::closed(-1, 1, "m"));
+    }
     checkField("gravity", gravity, Bound::nonNegative("m/s^2"));
     checkField("hand_load", handLoad, Bound::nonNegative("kg"));
 }
@@ -54,6 +67,7 @@ ArmParameters ArmParameters::scaled(double newBodyMass, double newBodyHeight) co
     p.originDistance *= s;
     p.insertionDistance *= s;
     p.strapDistance *= s;
+    for (double& c : p.forearmRotation.axisPoint) c *= s;
     return p;
 }
 
@@ -111,6 +125,26 @@ bool readArmParameters(const ParamNode& root, ArmParameters& p, bool requireBice
     p.stopDissipation = elbow.getNumber("stop_dissipation", any);
     elbow.finish();
 
+    if (root.has("forearm_rotation")) {
+        const ParamNode r = root.child("forearm_rotation");
+        ArmParameters::ForearmRotation& f = p.forearmRotation;
+        f.enabled = true;
+        auto vec3 = [&](const char* key) {
+            const std::vector<double> v = r.getNumbers(key, any);
+            if (v.size() != 3)
+                throw InputError(r.where(key) + ": field '" + r.path(key) + "' has " + std::to_string(v.size()) +
+                                 " numbers: expected 3 (x, y, z in the forearm frame)");
+            return std::array<double, 3>{v[0], v[1], v[2]};
+        };
+        f.axisPoint = vec3("axis_point");
+        f.axisDirection = vec3("axis_direction");
+        f.minDeg = r.getNumber("min_deg", any, f.minDeg);
+        f.maxDeg = r.getNumber("max_deg", any, f.maxDeg);
+        f.postureDeg = r.getNumber("posture_deg", any, f.postureDeg);
+        f.massFraction = r.getNumber("mass_fraction", any, f.massFraction);
+        r.getString("source", "");
+        r.finish();
+    }
     p.gravity = root.getNumber("gravity", any);
     p.handLoad = root.getNumber("hand_load", any);
     return hasBiceps;

@@ -13,6 +13,7 @@
 //    40..180 deg elbow range: the thesis, sections 5.2.1, 5.2.2, 5.3.2 and 6.1.2.
 #pragma once
 
+#include <array>
 #include <string>
 
 namespace armsim {
@@ -53,6 +54,19 @@ struct ArmParameters {
     double maxElbowAngleDeg = 180;   ///< [deg] most extended included angle (180 = straight); thesis Fig. 5.1
     double stopStiffness = 2000;     ///< [N m/rad] joint-stop stiffness; model choice (the forearm's weight sags 0.08 deg into the extension stop)
     double stopDissipation = 0.1;    ///< [s/rad] Hunt-Crossley stop dissipation (0 = elastic); model choice
+
+    /// Forearm rotation (pronation-supination): the radius, carrying the hand, turns on a pin about an
+    /// axis fixed in the forearm (ulna) frame. Off unless the arm has a `forearm_rotation` section; the
+    /// angle is locked at the posture in every trial (an isometric transducer holds the hand).
+    struct ForearmRotation {
+        bool enabled = false;
+        std::array<double, 3> axisPoint{0, 0, 0};      ///< [m] a point of the axis in the forearm frame (the radial head)
+        std::array<double, 3> axisDirection{0, -1, 0}; ///< [1] positive rotation about it (right-hand rule) is supination
+        double minDeg = -90;      ///< [deg] most pronated; 0 = neutral (thumb up at 90 deg flexion)
+        double maxDeg = 90;       ///< [deg] most supinated
+        double postureDeg = 0;    ///< [deg] the posture trials hold
+        double massFraction = 0.1;  ///< [1] of the forearm + hand mass carried by the radius body (model choice; no trial moves it)
+    } forearmRotation;
 
     double gravity = 9.80665;  ///< [m/s^2] magnitude of gravity, along -Y; standard gravity
     double handLoad = 0;       ///< [kg] point mass held in the hand, at the hand COM; 0 = none

@@ -15,8 +15,12 @@
 
 namespace armsim {
 
-const char* getMuscleGroupName(MuscleGroup g) { return g == MuscleGroup::Flexor ? "flexor" : "extensor"; }
-const char* getArmBodyName(ArmBody b) { return b == ArmBody::UpperArm ? "upper_arm" : "forearm"; }
+const char* getMuscleGroupName(MuscleGroup g) {
+    return g == MuscleGroup::Flexor ? "flexor" : g == MuscleGroup::Extensor ? "extensor" : "forearm";
+}
+const char* getArmBodyName(ArmBody b) {
+    return b == ArmBody::UpperArm ? "upper_arm" : b == ArmBody::Forearm ? "forearm" : "radius";
+}
 
 void SubjectEffort::validate() const {
     checkField("subject.voluntary_activation", voluntaryActivation, Bound{0, 1, true, false});
@@ -67,7 +71,8 @@ std::array<double, 3> readVec3(const ParamNode& n, const std::string& key, const
 }
 
 ArmBody readBody(const ParamNode& n) {
-    return n.getChoice("body", {"upper_arm", "forearm"}, "") == "upper_arm" ? ArmBody::UpperArm : ArmBody::Forearm;
+    const std::string b = n.getChoice("body", {"upper_arm", "forearm", "radius"}, "");
+    return b == "upper_arm" ? ArmBody::UpperArm : b == "forearm" ? ArmBody::Forearm : ArmBody::Radius;
 }
 
 PathElementSpec readPoint(const ParamNode& n, const std::string& label) {
@@ -110,8 +115,8 @@ MuscleSpec readMuscle(const ParamNode& n, double specificTension) {
         throw InputError(n.where("name") + ": field '" + n.path("name") + "' = '" + name +
                          "': expected a name of letters, digits and _ (it names CSV columns)");
     m.source = n.getString("source", "");
-    m.group = n.getChoice("group", {"flexor", "extensor"}, "flexor") == "flexor" ? MuscleGroup::Flexor
-                                                                                : MuscleGroup::Extensor;
+    const std::string group = n.getChoice("group", {"flexor", "extensor", "forearm"}, "flexor");
+    m.group = group == "flexor" ? MuscleGroup::Flexor : group == "extensor" ? MuscleGroup::Extensor : MuscleGroup::Forearm;
     const bool fromFile = n.has("parameters");
     if (fromFile) {
         m.params = loadMuscleParameters(n.findFile("parameters", "muscle file"));
@@ -322,6 +327,12 @@ ArmSetup loadModelFile(const std::string& file) {
         }
     }
     root.finish();
+    if (!s.arm.forearmRotation.enabled)
+        for (const MuscleSpec& m : s.muscles)
+            for (const PathElementSpec& e : m.path)
+                if (e.body == ArmBody::Radius)
+                    throw InputError(file + ": muscle '" + m.params.name + "' " + e.label +
+                                     ": body 'radius' needs the arm's forearm_rotation section");
     if (!hasBiceps) deriveThesisGeometry(s);
     root.rethrowWithLocation([&] { s.arm.validate(); });
     resolveMaxPathLengths(s);

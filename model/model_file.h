@@ -15,7 +15,7 @@
 //                                        (default: the fibre-type file's, Virtual Muscle's 31.8 N/cm^2)
 //   primary: NAME                        the muscle the thesis calls "the biceps": the transducer
 //                                        estimate and the identification address it (default: first)
-//   muscles: [...]                       each: name, group (flexor|extensor), Virtual Muscle
+//   muscles: [...]                       each: name, group (flexor|extensor|forearm), Virtual Muscle
 //                                        parameters (a `parameters:` muscle file and/or the fields of a
 //                                        muscle file; `max_isometric_force` [N] or `volume` [m^3] may
 //                                        stand for `mass` and `tendon_slack_length` [m] for
@@ -42,12 +42,14 @@
 
 namespace armsim {
 
-/// Which effort recruits a muscle: an elbow flexion or an extension MVC.
-enum class MuscleGroup { Flexor, Extensor };
+/// Which elbow effort recruits a muscle: a flexion or an extension MVC; Forearm: neither (a forearm
+/// rotator: it acts at the co-contraction level in elbow efforts). As an effort direction only Flexor
+/// (flexion) and Extensor (extension) are used.
+enum class MuscleGroup { Flexor, Extensor, Forearm };
 const char* getMuscleGroupName(MuscleGroup g);
 
-/// The two bodies a path element can sit on.
-enum class ArmBody { UpperArm, Forearm };
+/// The bodies a path element can sit on (the radius only in arms with a forearm rotation).
+enum class ArmBody { UpperArm, Forearm, Radius };
 const char* getArmBodyName(ArmBody b);
 
 /// One element of a muscle path in a model file (body frame, metres; frames in model/arm.h).

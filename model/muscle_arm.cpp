@@ -22,7 +22,9 @@ MusclePath buildMusclePath(const ArmModel& arm, const MuscleSpec& muscle) {
         e.kind = s.kind == PathElementSpec::Kind::Point      ? PathElement::Kind::Point
                  : s.kind == PathElementSpec::Kind::Cylinder ? PathElement::Kind::Cylinder
                                                              : PathElement::Kind::Sphere;
-        e.body = s.body == ArmBody::UpperArm ? MobilizedBody(arm.getUpperArm()) : MobilizedBody(arm.getForearm());
+        e.body = s.body == ArmBody::UpperArm ? MobilizedBody(arm.getUpperArm())
+                 : s.body == ArmBody::Forearm ? MobilizedBody(arm.getForearm())
+                                              : MobilizedBody(arm.getRadius());
         e.location = toVec3(s.location);
         e.axis = UnitVec3(toVec3(s.axis));
         e.radius = s.radius;
@@ -68,6 +70,11 @@ double MuscleArm::calcPathLength(const State& s, int i) const { return forces_.a
 
 double MuscleArm::calcMomentArm(const State& s, int i) const {
     return calcPathMomentArm(arm_->getMatter(), arm_->getForearm(), s, forces_.at(i).calcPathGeometry(s));
+}
+
+double MuscleArm::calcForearmMomentArm(const State& s, int i) const {
+    if (!arm_->hasForearmRotation()) return 0;
+    return calcPathMomentArm(arm_->getMatter(), arm_->getRadius(), s, forces_.at(i).calcPathGeometry(s));
 }
 
 void MuscleArm::setSteadyMuscleStates(State& s) const {
@@ -121,6 +128,7 @@ ArmGeometry::ArmGeometry(const ArmSetup& setup) : arm_(setup.arm) {
         names_.push_back(m.params.name);
     }
     state_ = arm_.finalize();
+    arm_.getSystem().realize(state_, Stage::Position);
 }
 
 void ArmGeometry::setElbowAngle(double theta) {
@@ -134,6 +142,16 @@ double ArmGeometry::calcMomentArm(const PathGeometry& g) const {
     return calcPathMomentArm(arm_.getMatter(), arm_.getForearm(), state_, g);
 }
 
+void ArmGeometry::setForearmRotation(double phi) {
+    arm_.lockForearmRotation(state_, phi);
+    arm_.getSystem().realize(state_, Stage::Position);
+}
+
+double ArmGeometry::calcForearmMomentArm(const PathGeometry& g) const {
+    if (!arm_.hasForearmRotation()) return 0;
+    return calcPathMomentArm(arm_.getMatter(), arm_.getRadius(), state_, g);
+}
+
 void resolveMaxPathLengths(ArmSetup& setup) {
     bool any = false;
     for (const MuscleSpec& m : setup.muscles) any = any || m.maxPathFromRange;
@@ -145,26 +163,38 @@ void resolveMaxPathLengths(ArmSetup& setup) {
         geometry.setElbowAngle(theta);
         return geometry.calcPathLength(i);
     };
-    for (int i = 0; i < setup.getNumMuscles(); ++i) {
-        if (!setup.muscles[i].maxPathFromRange) continue;
-        int best = 0;
-        double bestLength = -1;
-        for (int k = 0; k < n; ++k) {
-            const double len = lengthAt(i, k + 1 == n ? hi : lo + k * (hi - lo) / (n - 1));
-            if (len > bestLength) bestLength = len, best = k;
+    // With a forearm rotation: the longest over the elbow's range at each end of the rotation's range
+    // and at the posture (the longest of the three).
+    std::vector<double> postures = {0};
+    const ArmParameters::ForearmRotation& rot = setup.arm.forearmRotation;
+    if (rot.enabled) postures = {degToRad(rot.minDeg), degToRad(rot.postureDeg), degToRad(rot.maxDeg)};
+    std::vector<double> longest(setup.muscles.size(), -1);
+    for (double phi : postures) {
+        if (rot.enabled) geometry.setForearmRotation(phi);
+        for (int i = 0; i < setup.getNumMuscles(); ++i) {
+            if (!setup.muscles[i].maxPathFromRange) continue;
+            int best = 0;
+            double bestLength = -1;
+            for (int k = 0; k < n; ++k) {
+                const double len = lengthAt(i, k + 1 == n ? hi : lo + k * (hi - lo) / (n - 1));
+                if (len > bestLength) bestLength = len, best = k;
+            }
+            // Golden-section refinement around the best sample (the maximum may be inside the range).
+            double a = lo + std::max(0, best - 1) * (hi - lo) / (n - 1);
+            double b = best + 1 >= n ? hi : lo + (best + 1) * (hi - lo) / (n - 1);
+            const double g = (std::sqrt(5.0) - 1) / 2;
+            double c = b - g * (b - a), d = a + g * (b - a);
+            double fc = lengthAt(i, c), fd = lengthAt(i, d);
+            while (b - a > 1e-10) {
+                if (fc > fd) { b = d; d = c; fd = fc; c = b - g * (b - a); fc = lengthAt(i, c); }
+                else { a = c; c = d; fc = fd; d = a + g * (b - a); fd = lengthAt(i, d); }
+            }
+            longest[i] = std::max({longest[i], bestLength, fc, fd});
         }
-        // Golden-section refinement around the best sample (the maximum may be inside the range).
-        double a = lo + std::max(0, best - 1) * (hi - lo) / (n - 1);
-        double b = best + 1 >= n ? hi : lo + (best + 1) * (hi - lo) / (n - 1);
-        const double g = (std::sqrt(5.0) - 1) / 2;
-        double c = b - g * (b - a), d = a + g * (b - a);
-        double fc = lengthAt(i, c), fd = lengthAt(i, d);
-        while (b - a > 1e-10) {
-            if (fc > fd) { b = d; d = c; fd = fc; c = b - g * (b - a); fc = lengthAt(i, c); }
-            else { a = c; c = d; fc = fd; d = a + g * (b - a); fd = lengthAt(i, d); }
-        }
-        setup.muscles[i].params.maxPathLength = std::max({bestLength, fc, fd});
     }
+    for (int i = 0; i < setup.getNumMuscles(); ++i)
+        if (setup.muscles[i].maxPathFromRange) setup.muscles[i].params.maxPathLength = longest[i];
+    if (rot.enabled) geometry.setForearmRotation(degToRad(rot.postureDeg));
 }
 
 }  // namespace armsim

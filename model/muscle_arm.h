@@ -46,6 +46,8 @@ public:
     /// Moment arm of muscle i about the elbow [m], + = flexes: the elbow torque of a unit tension along
     /// its path, through Simbody's system Jacobian (virtual work). Equals -dP/dq. Stage::Position.
     double calcMomentArm(const SimTK::State& s, int i) const;
+    /// Moment arm of muscle i about the forearm rotation axis [m], + = supinates; 0 without one.
+    double calcForearmMomentArm(const SimTK::State& s, int i) const;
 
     /// Every muscle at its steady isometric state for the present path and activation; throws
     /// SimulationError naming the muscle when one has no equilibrium.
@@ -84,6 +86,12 @@ public:
     /// Moment arm by virtual work [m] (as MuscleArm::calcMomentArm) of a path geometry at the present angle.
     double calcMomentArm(const PathGeometry& g) const;
     double calcMomentArm(int i) const { return calcMomentArm(calcPathGeometry(i)); }
+    /// Locks the forearm rotation at phi [rad] (+ = supination) and realizes positions; the arm must
+    /// have a forearm rotation (std::logic_error otherwise).
+    void setForearmRotation(double phi);
+    /// Moment arm about the forearm rotation axis by virtual work [m], + = supinates; 0 without one.
+    double calcForearmMomentArm(const PathGeometry& g) const;
+    double calcForearmMomentArm(int i) const { return calcForearmMomentArm(calcPathGeometry(i)); }
     const ArmModel& getArm() const { return arm_; }
     const SimTK::State& getState() const { return state_; }
     const MusclePath& getPath(int i) const { return paths_.at(i); }

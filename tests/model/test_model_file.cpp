@@ -407,3 +407,53 @@ TEST(ModelFile, LinksInTwoFoldersAreTwoModels) {
     EXPECT_EQ(loadModel((dir / "a" / "model.yaml").string()).muscles.at(0).params.mass, 0.3);
     fs::remove_all(dir);
 }
+
+// The forearm rotation (issue 28): the twin's radius turns about MoBL-ARMS's pro_sup axis. Its moment
+// arms two ways (virtual work through Simbody's Jacobian vs -dP/dphi by central differences), the
+// rotators' signs, and the lock.
+TEST(ForearmRotation, TwinMomentArmsTwoWaysAndTheRotatorsSigns) {
+    const ArmSetup twin = loadModel("twin");
+    ASSERT_TRUE(twin.arm.forearmRotation.enabled);
+    ArmGeometry g(twin);
+    EXPECT_NEAR(g.getArm().getForearmRotation(g.getState()), 0.0, kExactTol);   // the posture of the file
+    for (double flexion : {30.0, 90.0})
+        for (double phiDeg : {-60.0, 0.0, 45.0}) {
+            g.setElbowAngle(elbowAngleFromFlexion(degToRad(flexion)));
+            const double phi = degToRad(phiDeg);
+            for (int i = 0; i < g.getNumMuscles(); ++i) {
+                g.setForearmRotation(phi + kDerivativeStep);
+                const double up = g.calcPathLength(i);
+                g.setForearmRotation(phi - kDerivativeStep);
+                const double down = g.calcPathLength(i);
+                g.setForearmRotation(phi);
+                const double byDerivative = -(up - down) / (2 * kDerivativeStep);
+                EXPECT_NEAR(g.calcForearmMomentArm(i), byDerivative, kMomentArmRelTol * std::abs(byDerivative) + 1e-9)
+                    << twin.muscles[i].params.name << " at " << flexion << " deg flexion, " << phiDeg << " deg rotation";
+            }
+        }
+    // At 90 deg flexion and neutral: the biceps and the supinator supinate, the pronators pronate, and
+    // muscles on the upper arm and ulna alone (BRA, triceps) have no forearm moment arm.
+    g.setElbowAngle(elbowAngleFromFlexion(kPi / 2));
+    g.setForearmRotation(0);
+    EXPECT_GT(g.calcForearmMomentArm(twin.findMuscle("BIClong")), 0.005);
+    EXPECT_GT(g.calcForearmMomentArm(twin.findMuscle("SUP")), 0.003);
+    EXPECT_LT(g.calcForearmMomentArm(twin.findMuscle("PT")), -0.005);
+    EXPECT_LT(g.calcForearmMomentArm(twin.findMuscle("PQ")), -0.003);
+    EXPECT_EQ(g.calcForearmMomentArm(twin.findMuscle("BRA")), 0.0);
+    EXPECT_EQ(g.calcForearmMomentArm(twin.findMuscle("TRIlong")), 0.0);
+    // The brachioradialis turns the forearm towards neutral: a supinator when pronated, a pronator when supinated.
+    g.setForearmRotation(degToRad(-80));
+    EXPECT_GT(g.calcForearmMomentArm(twin.findMuscle("BRD")), 0.005);
+    g.setForearmRotation(degToRad(80));
+    EXPECT_LT(g.calcForearmMomentArm(twin.findMuscle("BRD")), -0.005);
+    // The elbow model has no forearm rotation and no radius.
+    EXPECT_FALSE(elbow().arm.forearmRotation.enabled);
+    ArmGeometry e(elbow());
+    EXPECT_THROW(e.setForearmRotation(0.1), std::logic_error);
+    EXPECT_EQ(e.calcForearmMomentArm(0), 0.0);
+    const std::string bad = messageOf(writeTemp("radius_without_rotation.yaml",
+        "name: bad\narm: arm/default_male.yaml\nmuscles:\n  - name: m\n    parameters: " + std::string(ARMSIM_ASSET_DIR) +
+        "/muscles/biceps_long_head.yaml\n    path:\n      origin: {body: upper_arm, location: [0, 0.3, 0]}\n"
+        "      insertion: {body: radius, location: [0, -0.05, 0]}\n"));
+    EXPECT_NE(bad.find("forearm_rotation"), std::string::npos) << bad;
+}
