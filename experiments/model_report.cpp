@@ -110,6 +110,19 @@ Table calcMomentArmTable(const ArmSetup& setup, double stepDeg) {
     return t;
 }
 
+namespace {
+
+// y range over every series and 0, with the upper half left free for a legend above the curves.
+void setRangeWithLegendRoom(PlotSpec& plot) {
+    double lo = 0, hi = 0;
+    for (const PlotSeries& ps : plot.series)
+        for (double v : ps.y) lo = std::min(lo, v), hi = std::max(hi, v);
+    plot.yMin = lo - 0.05 * (hi - lo);
+    plot.yMax = hi + 1.0 * (hi - lo);
+}
+
+}  // namespace
+
 Table calcForearmMomentArmTable(const ArmSetup& setup, double flexionDeg, double stepDeg) {
     const ArmParameters::ForearmRotation& rot = setup.arm.forearmRotation;
     if (!rot.enabled) throw InputError("model '" + setup.name + "' has no forearm rotation");
@@ -226,11 +239,7 @@ ModelReportFiles writeModelReport(const ArmSetup& setup, const std::string& outD
         }
     }
     if (!refs.x.empty()) armPlot.series.push_back(refs);
-    double lo = 0, hi = 0;
-    for (const PlotSeries& ps : armPlot.series)
-        for (double v : ps.y) lo = std::min(lo, v), hi = std::max(hi, v);
-    armPlot.yMin = lo - 0.05 * (hi - lo);
-    armPlot.yMax = hi + 1.0 * (hi - lo);  // room for the legend above the curves
+    setRangeWithLegendRoom(armPlot);
     writePlotPng(path("moment_arms.png"), armPlot);
     out.files.push_back(path("moment_arms.png"));
 
@@ -245,18 +254,15 @@ ModelReportFiles writeModelReport(const ArmSetup& setup, const std::string& outD
         plot.yLabel = "moment arm (cm, + = supination)";
         plot.legend = PlotSpec::Legend::TopLeft;
         const std::vector<double> phi = fa.getColumn("rotation_deg");
-        double lo = 0, hi = 0;
         int color = 0;
         for (int i = 0; i < setup.getNumMuscles(); ++i) {  // the muscles that act on the rotation
             PlotSeries ps{setup.muscles[i].params.name, phi, {}, false, color % 8};
             for (double h : fa.getColumn("forearm_moment_arm_" + ps.label + "_m")) ps.y.push_back(100 * h);
             if (std::all_of(ps.y.begin(), ps.y.end(), [](double v) { return v == 0; })) continue;
-            for (double v : ps.y) lo = std::min(lo, v), hi = std::max(hi, v);
             plot.series.push_back(ps);
             ++color;
         }
-        plot.yMin = lo - 0.05 * (hi - lo);
-        plot.yMax = hi + 1.0 * (hi - lo);
+        setRangeWithLegendRoom(plot);
         writePlotPng(path("forearm_moment_arms.png"), plot);
         out.files.push_back(path("forearm_moment_arms.png"));
     }
