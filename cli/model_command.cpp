@@ -51,7 +51,7 @@ void checkModel(const ArmSetup& setup, const std::vector<AnatomyTarget>& targets
     for (const TargetScore& s : r.scores)
         if (!s.pass)
             std::printf("  fail: %s %s%s%s: %g outside [%g, %g] +/- %g (SI units; %s)\n", getTargetKindName(s.target.kind),
-                        s.muscle.c_str(), s.target.kind == TargetKind::Mvc ? (s.target.direction == MuscleGroup::Flexor ? "flexion" : "extension") : "",
+                        s.muscle.c_str(), describeTargetCondition(s.target).c_str(),
                         std::isfinite(s.target.flexionDeg) ? (" at " + formatNumber(s.target.flexionDeg) + " deg").c_str() : "",
                         s.value, s.target.lower, s.target.upper, s.target.tolerance, s.target.where.c_str());
     for (const std::string& f : r.files) std::printf("wrote %s\n", f.c_str());
@@ -129,7 +129,7 @@ void addModelCommands(CLI::App& app) {
                     if (x.pass) continue;
                     const double u = getTargetFileToSi(x.target.kind);
                     std::printf("  fails: %s %s%s%s: %.4g, band %.4g..%.4g +/- %.4g %s (%s)\n", getTargetKindName(x.target.kind),
-                                x.muscle.c_str(), x.target.kind == TargetKind::Mvc ? (x.target.direction == MuscleGroup::Flexor ? "flexion" : "extension") : "",
+                                x.muscle.c_str(), describeTargetCondition(x.target).c_str(),
                                 std::isfinite(x.target.flexionDeg) ? (" at " + formatNumber(x.target.flexionDeg) + " deg").c_str() : "",
                                 x.value / u, x.target.lower / u, x.target.upper / u, x.target.tolerance / u,
                                 getTargetFileUnit(x.target.kind), x.target.where.c_str());

@@ -54,7 +54,7 @@ ModelCheckResult writeModelCheck(const ArmSetup& setup, const std::vector<Anatom
         const AnatomyTarget& t = s.target;
         CsvRow row;
         row.addText(getTargetKindName(t.kind)).addText(s.muscle);
-        row.addText(t.kind == TargetKind::Mvc ? (t.direction == MuscleGroup::Flexor ? "flexion" : "extension") : "");
+        row.addText(describeTargetCondition(t));
         row.addNumber(t.flexionDeg).addNumber(s.value).addNumber(t.lower).addNumber(t.upper).addNumber(t.tolerance);
         row.addText(getTargetSiUnit(t.kind)).addInteger(s.pass ? 1 : 0).addText(t.source).addText(t.where);
         card.addRow(row);

@@ -30,7 +30,8 @@ void AnatomyCalibrationOptions::validate() const {
 namespace {
 
 bool isFitted(TargetKind k) {
-    return k == TargetKind::Mvc || k == TargetKind::Share || k == TargetKind::OptimumAngle || k == TargetKind::Volume;
+    return k == TargetKind::Mvc || k == TargetKind::Share || k == TargetKind::OptimumAngle || k == TargetKind::Volume ||
+           k == TargetKind::ForearmMvc || k == TargetKind::PostureRatio;
 }
 
 constexpr double kMissingResidual = 3;

@@ -14,7 +14,8 @@ namespace armsim {
 
 namespace {
 
-const std::vector<std::string> kKindNames = {"moment_arm", "mvc", "volume", "share", "optimum_angle"};
+const std::vector<std::string> kKindNames = {"moment_arm", "mvc", "volume", "share", "optimum_angle", "forearm_mvc",
+                                             "posture_ratio"};
 
 // Band units per kind: the file's unit, SI's, and the factor between them.
 struct Unit {
@@ -22,7 +23,8 @@ struct Unit {
     const char* si;
     double toSi;
 };
-const Unit kUnits[] = {{"mm", "m", 1e-3}, {"N m", "N m", 1}, {"cm^3", "m^3", 1e-6}, {"1", "1", 1}, {"deg", "deg", 1}};
+const Unit kUnits[] = {{"mm", "m", 1e-3}, {"N m", "N m", 1}, {"cm^3", "m^3", 1e-6}, {"1", "1", 1},
+                       {"deg", "deg", 1},  {"N m", "N m", 1}, {"1", "1", 1}};
 
 std::vector<int> findCovered(const ArmSetup& setup, const std::string& family) {
     std::vector<int> out;
@@ -50,6 +52,17 @@ const char* getTargetFileUnit(TargetKind k) { return kUnits[int(k)].file; }
 const char* getTargetSiUnit(TargetKind k) { return kUnits[int(k)].si; }
 double getTargetFileToSi(TargetKind k) { return kUnits[int(k)].toSi; }
 
+std::string describeTargetCondition(const AnatomyTarget& t) {
+    switch (t.kind) {
+    case TargetKind::Mvc: return t.direction == MuscleGroup::Flexor ? "flexion" : "extension";
+    case TargetKind::ForearmMvc:
+        return std::string(t.forearmEffort == ForearmEffort::Supination ? "supination" : "pronation") +
+               " at rotation " + formatNumber(t.rotationDeg) + " deg";
+    case TargetKind::PostureRatio: return "flexion at rotation " + formatNumber(t.rotationDeg) + " deg / neutral";
+    default: return "";
+    }
+}
+
 bool doesFamilyCoverMuscle(const std::string& family, const std::string& muscle) {
     return muscle.compare(0, family.size(), family) == 0;
 }
@@ -63,13 +76,20 @@ std::vector<AnatomyTarget> loadAnatomyTargets(const std::string& path) {
         const std::string kind = n.getChoice("kind", kKindNames, "");
         t.kind = TargetKind(std::find(kKindNames.begin(), kKindNames.end(), kind) - kKindNames.begin());
         const Unit& u = kUnits[int(t.kind)];
-        if (t.kind != TargetKind::Mvc) t.muscle = n.getString("muscle");
+        const bool forearm = t.kind == TargetKind::ForearmMvc || t.kind == TargetKind::PostureRatio;
+        if (t.kind != TargetKind::Mvc && !forearm) t.muscle = n.getString("muscle");
+        if (t.kind == TargetKind::ForearmMvc)
+            t.forearmEffort = n.getChoice("direction", {"supination", "pronation"}, "") == "supination"
+                                  ? ForearmEffort::Supination : ForearmEffort::Pronation;
+        if (forearm) t.rotationDeg = n.getNumber("rotation_deg", Bound::closed(-120, 120, "deg"));
         if (t.kind == TargetKind::Mvc)
             t.direction = n.getChoice("direction", {"flexion", "extension"}, "") == "flexion" ? MuscleGroup::Flexor
                                                                                              : MuscleGroup::Extensor;
-        if (t.kind == TargetKind::MomentArm || t.kind == TargetKind::Mvc || t.kind == TargetKind::Share)
+        if (t.kind == TargetKind::MomentArm || t.kind == TargetKind::Mvc || t.kind == TargetKind::Share || forearm)
             t.flexionDeg = n.getNumber("flexion_deg", Bound::closed(0, 180, "deg"));
         const Bound band = t.kind == TargetKind::Share ? Bound::closed(0, 1)
+                           : t.kind == TargetKind::PostureRatio ? Bound::closed(0, 5)
+                           : t.kind == TargetKind::ForearmMvc ? Bound::closed(0, 1000, "N m")
                            : t.kind == TargetKind::OptimumAngle ? Bound::closed(0, 180, "deg")
                            : t.kind == TargetKind::MomentArm ? Bound::closed(-200, 200, "mm")
                            : t.kind == TargetKind::Mvc ? Bound::closed(0, 1000, "N m")
@@ -135,9 +155,24 @@ std::vector<TargetScore> scoreAnatomy(const ArmSetup& setup, const std::vector<A
         s.pass = std::isfinite(value) && value >= t.lower - t.tolerance && value <= t.upper + t.tolerance;
         out.push_back(s);
     };
+    const ArmParameters::ForearmRotation& rot = setup.arm.forearmRotation;
     for (const AnatomyTarget& t : targets) {
         const bool inRange = !std::isfinite(t.flexionDeg) || (t.flexionDeg >= minFlexion && t.flexionDeg <= maxFlexion);
         if (!inRange) continue;
+        if (t.kind == TargetKind::ForearmMvc || t.kind == TargetKind::PostureRatio) {
+            if (!rot.enabled || t.rotationDeg < rot.minDeg || t.rotationDeg > rot.maxDeg) continue;
+            const MvcGeometry g = calcMvcGeometry(setup, {t.flexionDeg}, t.rotationDeg);
+            if (t.kind == TargetKind::ForearmMvc) {
+                const SteadyMvcCurve c = calcSteadyForearmMvc(setup.muscles, g, t.forearmEffort, setup.effort);
+                add(t, "", std::abs(c.totalForearmTorque[0]));
+            } else {
+                const MvcGeometry neutral = calcMvcGeometry(setup, {t.flexionDeg}, 0.0);
+                const double at = calcSteadyMvcCurve(setup.muscles, g, MuscleGroup::Flexor, setup.effort).totalTorque[0];
+                const double ref = calcSteadyMvcCurve(setup.muscles, neutral, MuscleGroup::Flexor, setup.effort).totalTorque[0];
+                add(t, "", ref > 0 ? at / ref : NAN);
+            }
+            continue;
+        }
         if (t.kind == TargetKind::Mvc) {
             const SteadyMvcCurve& c = t.direction == MuscleGroup::Flexor ? flexion : extension;
             add(t, "", std::abs(c.totalTorque[indexOf(t.flexionDeg)]));
@@ -164,7 +199,9 @@ std::vector<TargetScore> scoreAnatomy(const ArmSetup& setup, const std::vector<A
             add(t, t.muscle, s);
             break;
         }
-        case TargetKind::Mvc: break;
+        case TargetKind::Mvc:
+        case TargetKind::ForearmMvc:
+        case TargetKind::PostureRatio: break;
         }
     }
     return out;

@@ -13,9 +13,9 @@
 namespace armsim {
 
 /// What a target measures.
-enum class TargetKind { MomentArm, Mvc, Volume, Share, OptimumAngle };
+enum class TargetKind { MomentArm, Mvc, Volume, Share, OptimumAngle, ForearmMvc, PostureRatio };
 const char* getTargetKindName(TargetKind k);
-/// The unit a target file gives a kind's bands in ("mm", "N m", "cm^3", "1", "deg").
+/// The unit a target file gives a kind's bands in ("mm", "N m", "cm^3", "1", "deg", "N m", "1").
 const char* getTargetFileUnit(TargetKind k);
 /// The SI unit of a kind's bands and values ("m", "N m", "m^3", "1", "deg").
 const char* getTargetSiUnit(TargetKind k);
@@ -32,6 +32,8 @@ struct AnatomyTarget {
     TargetKind kind = TargetKind::MomentArm;
     std::string muscle;           ///< family or muscle name; empty for mvc
     MuscleGroup direction = MuscleGroup::Flexor;   ///< mvc: flexion or extension effort
+    ForearmEffort forearmEffort = ForearmEffort::Supination;   ///< forearm_mvc: supination or pronation
+    double rotationDeg = 0;       ///< forearm posture [deg] (forearm_mvc, posture_ratio; + = supinated)
     double flexionDeg = 0.0 / 0.0;///< angle [deg] (moment_arm, mvc, share); NaN for volume, optimum_angle
     double lower = 0, upper = 0;  ///< published band, SI (m, N m, m^3, 1, deg)
     double tolerance = 0;         ///< added on both sides of the band before judging (SI, as the band)
@@ -39,6 +41,10 @@ struct AnatomyTarget {
     std::string source;           ///< where the band comes from
     std::string where;            ///< "file:line" of the entry
 };
+
+/// What a target's effort or posture is, for reports: "flexion", "extension", "supination at rotation -45 deg",
+/// "flexion at rotation 60 deg / neutral"; "" for kinds without one.
+std::string describeTargetCondition(const AnatomyTarget& t);
 
 /// Reads a target file; errors name file, line, field, value and what was expected.
 std::vector<AnatomyTarget> loadAnatomyTargets(const std::string& path);
@@ -54,7 +60,10 @@ struct TargetScore {
 };
 
 /// Scores `setup` against every target. Moment arms from virtual work at the angle, MVC torque from the
-/// steady MVC curve at the model's subject effort (the magnitude for extension), volume = mass / density,
+/// steady MVC curve at the model's subject effort (the magnitude for extension), forearm_mvc the
+/// magnitude of the steady forearm torque of a supination or pronation MVC at the angle and posture,
+/// posture_ratio the flexion MVC at the posture over that in neutral (both skipped for a model without a
+/// forearm rotation), volume = mass / density,
 /// share = the family's part of the flexors' torque at a flexion MVC, optimum angle = the flexion angle
 /// where the muscle's steady fibre length at a full flexion MVC crosses L0 (NaN: it does not within the
 /// elbow's range). Targets naming no model muscle are skipped.

@@ -15,34 +15,48 @@ double SteadyMvcCurve::calcFlexorShare(int a, int m) const {
     return flexion > 0 ? std::max(0.0, t) / flexion : 0.0;
 }
 
-MvcGeometry calcMvcGeometry(const ArmSetup& setup, const std::vector<double>& flexionDeg) {
+MvcGeometry calcMvcGeometry(const ArmSetup& setup, const std::vector<double>& flexionDeg, double rotationDeg) {
     MvcGeometry g;
     g.flexionDeg = flexionDeg;
     ArmGeometry geometry(setup);
+    const ArmParameters::ForearmRotation& rot = setup.arm.forearmRotation;
+    if (rot.enabled) {
+        g.rotationDeg = std::isnan(rotationDeg) ? rot.postureDeg : rotationDeg;
+        if (!(g.rotationDeg >= rot.minDeg - 1e-9 && g.rotationDeg <= rot.maxDeg + 1e-9))
+            throw InputError("forearm rotation " + formatNumber(g.rotationDeg) + " deg is outside the range [" +
+                             formatNumber(rot.minDeg) + ", " + formatNumber(rot.maxDeg) + "] deg of model '" +
+                             setup.name + "'");
+        geometry.setForearmRotation(degToRad(g.rotationDeg));
+    }
     const double lo = setup.arm.getMinFlexionDeg(), hi = setup.arm.getMaxFlexionDeg();
     for (double q : flexionDeg) {
         if (!(q >= lo - 1e-9 && q <= hi + 1e-9))
             throw InputError("flexion angle " + formatNumber(q) + " deg is outside the elbow's range [" +
                              formatNumber(lo) + ", " + formatNumber(hi) + "] deg of model '" + setup.name + "'");
         geometry.setElbowAngle(elbowAngleFromFlexion(degToRad(q)));
-        std::vector<double> P, h;
+        std::vector<double> P, h, r;
         for (int i = 0; i < setup.getNumMuscles(); ++i) {
             const PathGeometry path = geometry.calcPathGeometry(i);
             P.push_back(path.length);
             h.push_back(geometry.calcMomentArm(path));
+            r.push_back(geometry.calcForearmMomentArm(path));
         }
         g.pathLength.push_back(std::move(P));
         g.momentArm.push_back(std::move(h));
+        g.forearmMomentArm.push_back(std::move(r));
     }
     return g;
 }
 
-SteadyMvcCurve calcSteadyMvcCurve(const std::vector<MuscleSpec>& muscles, const MvcGeometry& geometry,
-                                  MuscleGroup effort, const SubjectEffort& subject) {
+namespace {
+
+// Every muscle at its steady state at each angle, at the activation agonist(a, i) ? VA : CC.
+template <class IsAgonist>
+SteadyMvcCurve calcSteadyCurve(const std::vector<MuscleSpec>& muscles, const MvcGeometry& geometry,
+                               const SubjectEffort& subject, IsAgonist isAgonist) {
     checkField("voluntary activation", subject.voluntaryActivation, Bound::closed(0, 1));
     checkField("co-contraction", subject.coContraction, Bound::closed(0, 1));
     SteadyMvcCurve curve;
-    curve.effort = effort;
     curve.flexionDeg = geometry.flexionDeg;
     std::vector<VirtualMuscle> vm;
     for (const MuscleSpec& m : muscles) {
@@ -51,12 +65,13 @@ SteadyMvcCurve calcSteadyMvcCurve(const std::vector<MuscleSpec>& muscles, const 
     }
     for (std::size_t a = 0; a < geometry.flexionDeg.size(); ++a) {
         std::vector<SteadyMusclePoint> row;
-        double total = 0;
+        double total = 0, forearm = 0;
         for (std::size_t i = 0; i < muscles.size(); ++i) {
             SteadyMusclePoint p;
             p.pathLength = geometry.pathLength[a][i];
             p.momentArm = geometry.momentArm[a][i];
-            p.activation = muscles[i].group == effort ? subject.voluntaryActivation : subject.coContraction;
+            p.forearmMomentArm = geometry.forearmMomentArm.empty() ? 0.0 : geometry.forearmMomentArm[a][i];
+            p.activation = isAgonist(a, i) ? subject.voluntaryActivation : subject.coContraction;
             const SteadyState st = vm[i].calcSteadyState(p.pathLength, p.activation);
             if (!st.converged)
                 throw SimulationError("muscle '" + curve.muscles[i] + "' at " + formatNumber(geometry.flexionDeg[a]) +
@@ -64,13 +79,36 @@ SteadyMvcCurve calcSteadyMvcCurve(const std::vector<MuscleSpec>& muscles, const 
             p.fibreLength = st.L;
             p.force = st.force;
             p.torque = p.momentArm * p.force;
+            p.forearmTorque = p.forearmMomentArm * p.force;
             total += p.torque;
+            forearm += p.forearmTorque;
             row.push_back(p);
         }
         curve.points.push_back(std::move(row));
         curve.totalTorque.push_back(total);
+        curve.totalForearmTorque.push_back(forearm);
     }
     return curve;
+}
+
+}  // namespace
+
+SteadyMvcCurve calcSteadyMvcCurve(const std::vector<MuscleSpec>& muscles, const MvcGeometry& geometry,
+                                  MuscleGroup effort, const SubjectEffort& subject) {
+    SteadyMvcCurve c = calcSteadyCurve(muscles, geometry, subject,
+                                       [&](std::size_t, std::size_t i) { return muscles[i].group == effort; });
+    c.effort = effort;
+    return c;
+}
+
+SteadyMvcCurve calcSteadyForearmMvc(const std::vector<MuscleSpec>& muscles, const MvcGeometry& geometry,
+                                    ForearmEffort effort, const SubjectEffort& subject) {
+    const double sign = effort == ForearmEffort::Supination ? 1.0 : -1.0;
+    SteadyMvcCurve c = calcSteadyCurve(muscles, geometry, subject, [&](std::size_t a, std::size_t i) {
+        return !geometry.forearmMomentArm.empty() && sign * geometry.forearmMomentArm[a][i] > kForearmAgonistMomentArm;
+    });
+    c.effort = MuscleGroup::Forearm;
+    return c;
 }
 
 SteadyMvcCurve calcSteadyMvcCurve(const ArmSetup& setup, MuscleGroup effort, const SubjectEffort& subject,

@@ -17,6 +17,8 @@ struct SteadyMusclePoint {
     double fibreLength = 0;  ///< L / L0 at the steady state [1]
     double force = 0;        ///< tendon force Fse [N]
     double torque = 0;       ///< h Fse, + = flexion [N m]
+    double forearmMomentArm = 0;  ///< about the forearm rotation axis, + = supinates [m] (0 without one)
+    double forearmTorque = 0;     ///< forearmMomentArm Fse, + = supination [N m]
 };
 
 /// The steady MVC torque-angle curve of a model: rows = angles, columns = muscles.
@@ -26,6 +28,7 @@ struct SteadyMvcCurve {
     std::vector<double> flexionDeg;                       ///< 0 = full extension
     std::vector<std::vector<SteadyMusclePoint>> points;   ///< [angle][muscle]
     std::vector<double> totalTorque;                      ///< sum of muscle torques, + = flexion [N m]
+    std::vector<double> totalForearmTorque;               ///< sum about the forearm axis, + = supination [N m]
     /// Share of the flexion torque of the flexors that muscle m gives at angle a [1].
     double calcFlexorShare(int a, int m) const;
 };
@@ -36,11 +39,15 @@ struct MvcGeometry {
     std::vector<double> flexionDeg;                     ///< 0 = full extension
     std::vector<std::vector<double>> pathLength;        ///< [angle][muscle] P [m]
     std::vector<std::vector<double>> momentArm;         ///< [angle][muscle] h, + = flexes [m] (virtual work)
+    std::vector<std::vector<double>> forearmMomentArm;  ///< [angle][muscle] + = supinates [m]; 0 without a forearm rotation
+    double rotationDeg = 0;                             ///< forearm posture [deg] (0 without a forearm rotation)
 };
 
-/// The geometry of `setup` at the flexion angles [deg]. Throws InputError for an angle outside the
-/// elbow's range.
-MvcGeometry calcMvcGeometry(const ArmSetup& setup, const std::vector<double>& flexionDeg);
+/// The geometry of `setup` at the flexion angles [deg], in forearm posture rotationDeg (NaN: the model's
+/// posture; ignored without a forearm rotation). Throws InputError for an angle outside the elbow's or
+/// the rotation's range.
+MvcGeometry calcMvcGeometry(const ArmSetup& setup, const std::vector<double>& flexionDeg,
+                            double rotationDeg = 0.0 / 0.0);
 
 /// The curve of `muscles` (setup.muscles, or the same muscles with other parameters) on a geometry
 /// computed for them; as calcSteadyMvcCurve below.
@@ -55,5 +62,17 @@ SteadyMvcCurve calcSteadyMvcCurve(const std::vector<MuscleSpec>& muscles, const 
 /// equilibrium.
 SteadyMvcCurve calcSteadyMvcCurve(const ArmSetup& setup, MuscleGroup effort, const SubjectEffort& subject,
                                   const std::vector<double>& flexionDeg);
+
+/// A maximal forearm-rotation effort.
+enum class ForearmEffort { Supination, Pronation };
+/// Smallest moment arm about the forearm axis that makes a muscle an agonist of a rotation effort [m].
+inline constexpr double kForearmAgonistMomentArm = 1e-3;
+
+/// The steady state of every muscle during a maximal forearm-rotation effort at each angle of the
+/// geometry: agonists (muscles whose forearm moment arm there turns the way of the effort by more than
+/// kForearmAgonistMomentArm) at subject.voluntaryActivation, the others at subject.coContraction. The
+/// curve's effort is MuscleGroup::Forearm; totalForearmTorque is the effort's torque (+ = supination).
+SteadyMvcCurve calcSteadyForearmMvc(const std::vector<MuscleSpec>& muscles, const MvcGeometry& geometry,
+                                    ForearmEffort effort, const SubjectEffort& subject);
 
 }  // namespace armsim

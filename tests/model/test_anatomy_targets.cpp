@@ -3,6 +3,8 @@
 #include "basics/errors.h"
 #include "model/anatomy_targets.h"
 #include "model/mvc_curve.h"
+#include "model/geometry.h"
+#include "model/muscle_arm.h"
 #include "tests/support/temp_files.h"
 
 #include <gtest/gtest.h>
@@ -81,4 +83,43 @@ TEST(AnatomyTargets, ScoresEqualASecondMethodAndBandsDecidePass) {
     ASSERT_TRUE(std::isfinite(scores[4].value));
     const SteadyMvcCurve c = calcSteadyMvcCurve(s, MuscleGroup::Flexor, SubjectEffort{1, 0}, {scores[4].value});
     EXPECT_NEAR(c.points[0][s.findMuscle("BICshort")].fibreLength, 1.0, kFibreLengthTol);
+}
+
+// Forearm efforts two ways (issue 28): the steady curve's supination torque (sum of forearm moment arm x
+// tendon force) against the torque Simbody's forearm lock must apply to hold the radius still with every
+// muscle at that steady state (gravity off), and the posture ratio against two flexion curves.
+TEST(AnatomyTargets, ForearmTorqueEqualsTheForearmLockReaction) {
+    constexpr double kReactionTol = 1e-6;   // relative: two computations of one torque
+    ArmSetup twin = loadModel("twin");
+    twin.arm.gravity = 0;
+    const double flexion = 90;
+    for (const auto& [effort, rotation] : {std::pair{ForearmEffort::Supination, -67.5}, std::pair{ForearmEffort::Pronation, 0.0}}) {
+        const MvcGeometry g = calcMvcGeometry(twin, {flexion}, rotation);
+        const SteadyMvcCurve c = calcSteadyForearmMvc(twin.muscles, g, effort, twin.effort);
+        std::vector<ActivationProfile> U;
+        for (const SteadyMusclePoint& p : c.points[0]) U.push_back(ActivationProfile::constant(p.activation));
+        MuscleArm arm(twin, U);
+        SimTK::State s = arm.getDefaultState();
+        arm.getArm().lockElbow(s, elbowAngleFromFlexion(degToRad(flexion)));
+        arm.getArm().lockForearmRotation(s, degToRad(rotation));
+        arm.getSystem().realize(s, SimTK::Stage::Position);
+        arm.setSteadyMuscleStates(s);
+        arm.getSystem().realize(s, SimTK::Stage::Acceleration);
+        const double reaction = arm.getArm().calcForearmHoldingTorque(s);
+        EXPECT_NEAR(-reaction, c.totalForearmTorque[0], kReactionTol * std::abs(c.totalForearmTorque[0]));
+        EXPECT_GT((effort == ForearmEffort::Supination ? 1 : -1) * c.totalForearmTorque[0], 1.0);
+        for (const SteadyMusclePoint& p : c.points[0])   // agonists at the subject's voluntary activation
+            EXPECT_EQ(p.activation, (effort == ForearmEffort::Supination ? 1 : -1) * p.forearmMomentArm > kForearmAgonistMomentArm
+                                        ? twin.effort.voluntaryActivation : twin.effort.coContraction);
+    }
+    AnatomyTarget ratio;
+    ratio.kind = TargetKind::PostureRatio;
+    ratio.flexionDeg = 90;
+    ratio.rotationDeg = -90;
+    const std::vector<TargetScore> scores = scoreAnatomy(twin, {ratio});
+    ASSERT_EQ(scores.size(), 1u);
+    const double pronated = calcSteadyMvcCurve(twin.muscles, calcMvcGeometry(twin, {90}, -90), MuscleGroup::Flexor, twin.effort).totalTorque[0];
+    const double neutral = calcSteadyMvcCurve(twin, MuscleGroup::Flexor, twin.effort, {90}).totalTorque[0];
+    EXPECT_NEAR(scores[0].value, pronated / neutral, 1e-12);
+    EXPECT_TRUE(scoreAnatomy(loadModel("elbow"), {ratio}).empty());   // no forearm rotation: not scored
 }
