@@ -74,6 +74,16 @@ void BM_ElbowMvcTrial(benchmark::State& state) {
 }
 BENCHMARK(BM_ElbowMvcTrial)->Arg(1000)->Arg(100)->Unit(benchmark::kMillisecond);
 
+// Issue 28: the same trial on the twin (ten muscles, the forearm rotation locked at neutral).
+void BM_TwinMvcTrial(benchmark::State& state) {
+    static const ArmSetup twin = loadShippedModel("twin");
+    IsometricTrialSettings s;
+    s.activation = twin.effort.voluntaryActivation;
+    s.antagonistActivation = twin.effort.coContraction;
+    measureIsometricTrial(state, twin, s);
+}
+BENCHMARK(BM_TwinMvcTrial)->Arg(1000)->Arg(100)->Unit(benchmark::kMillisecond);
+
 // Issue 14's floor: one right-hand side of the locked elbow is every muscle's state derivative at its
 // fixed path (90 deg flexion; agonists 0.95, antagonists 0.10); arg 0 = thesis arm, 1 = elbow.
 void BM_LockedArmDerivative(benchmark::State& state) {
