@@ -381,8 +381,10 @@ py::tuple validateElbowPy(const py::object& population, int subjects, unsigned s
                           const std::optional<std::vector<double>>& noise, double activationSd,
                           const std::optional<std::vector<double>>& angles, const std::optional<int>& repetitions,
                           const py::object& protocol,
-                          bool freeSlowFraction, int jobs) {
-    const Population pop = toPopulation(population);
+                          bool freeSlowFraction, int jobs, const py::object& truthPopulation, const py::object& prior) {
+    const Population family = toPopulation(population);
+    const Population pop = truthPopulation.is_none() ? family : toPopulation(truthPopulation);
+    const Population priorPop = prior.is_none() ? family : toPopulation(prior);
     ElbowValidationSettings s;
     s.subjects = subjects;
     s.seed = seed;
@@ -405,7 +407,7 @@ py::tuple validateElbowPy(const py::object& population, int subjects, unsigned s
     std::vector<ElbowValidationRow> rows;
     {
         py::gil_scoped_release release;
-        rows = runElbowValidation(pop, s);
+        rows = runElbowValidation(pop, priorPop, s);
     }
     Columns c;
     for (const ElbowValidationRow& r : rows) {
@@ -608,8 +610,11 @@ stop_reason, iterations, evaluations, wall_time [s].)");
     mod.def("validate_elbow", &validateElbowPy, "population"_a = py::none(), "subjects"_a = 200, "seed"_a = 1u,
             "noise"_a = py::none(), "activation_sd"_a = 0.02, "angles"_a = py::none(), "repetitions"_a = py::none(),
             "protocol"_a = py::none(), "free_slow_fraction"_a = false, "jobs"_a = 2,
+            "truth_population"_a = py::none(), "prior"_a = py::none(),
             R"(Validation on virtual subjects of the seven-muscle elbow (as `armsim validate --truth elbow`):
 `subjects` people drawn from the population (default assets/subjects/default_population.yaml),
+or out of family from `truth_population` with `prior` as the identifiers' prior (each defaults to
+`population`; as --truth-population and --prior),
 MVC torque data synthesized per noise level (fractions; default the population's), identified by
 the thesis, synergist and (activation_sd > 0) synergist-va methods. The protocol: flexion MVCs at
 `angles` [deg flexion, default 135, 120, 90, 60, 30] x repetitions, or a torque protocol file.

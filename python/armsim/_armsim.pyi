@@ -49,7 +49,8 @@ def validate_elbow(population: Optional[Union[str, "os.PathLike[str]"]] = None, 
                    noise: Optional[Sequence[float]] = None, activation_sd: float = 0.02,
                    angles: Optional[Sequence[float]] = None, repetitions: Optional[int] = None,
                    protocol: Optional[Union[str, "os.PathLike[str]"]] = None, free_slow_fraction: bool = False,
-                   jobs: int = 2) -> Tuple[Dict[str, Any], List[Dict[str, Any]]]: ...
+                   jobs: int = 2, truth_population: Optional[Union[str, "os.PathLike[str]"]] = None,
+                   prior: Optional[Union[str, "os.PathLike[str]"]] = None) -> Tuple[Dict[str, Any], List[Dict[str, Any]]]: ...
 def design_protocol(population: Optional[Union[str, "os.PathLike[str]"]] = None,
                     angles: Sequence[float] = (15, 30, 45, 60, 75, 90, 105, 120, 135),
                     levels: Optional[Sequence[float]] = None, extension: bool = True, trials: int = 15,

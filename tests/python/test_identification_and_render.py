@@ -72,6 +72,9 @@ def test_identify_torque_runs_every_method_and_equals_the_cpp_api(reference):
 def test_validate_elbow_equals_the_cpp_api(reference):
     rows, summary = armsim.validate_elbow(subjects=2, noise=[0.02])
     np.testing.assert_allclose(rows["mass"], reference["validate_elbow_masses"], rtol=REL_TOL)
+    # Out of family: the stronger mismatch population as truth, the default as prior: the same people 1.26x heavier.
+    strong, _ = armsim.validate_elbow(subjects=2, noise=[0.02], truth_population="subjects/mismatch/stronger.yaml")
+    np.testing.assert_allclose(strong["true_mass"], 1.26 * np.asarray(rows["true_mass"]), rtol=1e-12)
     assert rows["method"][:3] == ["thesis", "synergist", "synergist-va"]
     assert rows["true_mass"].dtype == np.float64 and rows["true_mass"].shape == (6,)
     assert {s["method"] for s in summary} == {"thesis", "synergist", "synergist-va"}
