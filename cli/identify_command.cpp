@@ -303,12 +303,16 @@ void runElbowValidate(const ValidateOptions& o) {
     const std::vector<ElbowValidationRow> rows =
         runElbowValidation(population, prior, s, [](int d, int n) { printProgress("subjects", d, n); });
     const std::vector<ElbowValidationSummary> summary = summarizeElbowValidation(rows);
-    std::printf("%-13s %6s %9s %14s %14s %9s %15s %15s %9s\n", "method", "noise", "converged", "mass bias",
+    std::printf("%-13s %6s %9s %17s %17s %13s %20s %20s %13s\n", "method", "noise", "converged", "mass bias",
                 "mass RMSE", "coverage", "L0T bias", "L0T RMSE", "coverage");
     for (const ElbowValidationSummary& x : summary)
-        std::printf("%-13s %5.1f%% %5d/%-3d %+13.1f%% %13.1f%% %9.2f %+12.1f mm %12.1f mm %9.2f\n", x.method.c_str(),
-                    100 * x.noise, x.converged, x.subjects, 100 * x.massBias, 100 * x.massRmse, x.massCoverage,
-                    1000 * x.tendonBias, 1000 * x.tendonRmse, x.tendonCoverage);
+        std::printf("%-13s %5.1f%% %5d/%-3d %+8.1f +/- %3.1f%% %8.1f +/- %3.1f%% %5.2f +/- %4.2f %+8.1f +/- %3.1f mm "
+                    "%8.1f +/- %3.1f mm %5.2f +/- %4.2f\n",
+                    x.method.c_str(), 100 * x.noise, x.converged, x.subjects, 100 * x.massBias, 100 * x.massBiasSe,
+                    100 * x.massRmse, 100 * x.massRmseSe, x.massCoverage, x.massCoverageSe, 1000 * x.tendonBias,
+                    1000 * x.tendonBiasSe, 1000 * x.tendonRmse, 1000 * x.tendonRmseSe, x.tendonCoverage,
+                    x.tendonCoverageSe);
+    std::printf("(+/- one standard error over the subjects; a 95 %% interval is about twice that)\n");
     std::printf("goal (issue 11, synergist-aware at 2 %% noise): |mass bias| <= 3 %%, mass RMSE <= 10 %%, "
                 "L0T RMSE <= 10 mm, coverage 0.90-0.98\n");
     OutputFolder out(o.out, OutputFolder::Mode::AddFiles);

@@ -137,6 +137,24 @@ std::vector<ElbowValidationSummary> summarizeElbowValidation(const std::vector<E
         }
         if (mn > 0) s.massCoverage = double(mc) / mn, s.massIntervalWidth = mw / mn;
         if (tn > 0) s.tendonCoverage = double(tc) / tn, s.tendonIntervalWidth = tw / tn;
+        // Standard errors over subjects: the mean's, the RMSE's by the delta method (sd of the squared
+        // error / (2 RMSE sqrt n)), a fraction's binomial sqrt(p (1 - p) / n).
+        std::vector<double> me, te;
+        for (const ElbowValidationRow& r : rows)
+            if (r.method == s.method && r.noise == s.noise && std::isfinite(r.massError) && std::isfinite(r.tendonError))
+                me.push_back(r.massError), te.push_back(r.tendonError);
+        auto errors = [](const std::vector<double>& e, double mean, double rmse, double& biasSe, double& rmseSe) {
+            const double k = double(e.size());
+            if (k < 2) return;
+            double v = 0, v2 = 0;
+            for (double x : e) v += (x - mean) * (x - mean), v2 += std::pow(x * x - rmse * rmse, 2);
+            biasSe = std::sqrt(v / (k - 1) / k);
+            rmseSe = rmse > 0 ? std::sqrt(v2 / (k - 1) / k) / (2 * rmse) : 0.0;
+        };
+        errors(me, s.massBias, s.massRmse, s.massBiasSe, s.massRmseSe);
+        errors(te, s.tendonBias, s.tendonRmse, s.tendonBiasSe, s.tendonRmseSe);
+        if (mn > 0) s.massCoverageSe = std::sqrt(s.massCoverage * (1 - s.massCoverage) / mn);
+        if (tn > 0) s.tendonCoverageSe = std::sqrt(s.tendonCoverage * (1 - s.tendonCoverage) / tn);
     }
     return out;
 }
@@ -164,12 +182,15 @@ std::string formatElbowValidationCsv(const std::vector<ElbowValidationRow>& rows
 
 std::string formatElbowValidationSummaryCsv(const std::vector<ElbowValidationSummary>& summaries) {
     CsvText csv({"method", "noise", "subjects", "converged", "mass_bias_pct", "mass_rmse_pct", "mass_coverage",
-                 "tendon_bias_mm", "tendon_rmse_mm", "tendon_coverage"});
+                 "tendon_bias_mm", "tendon_rmse_mm", "tendon_coverage", "mass_bias_se_pct", "mass_rmse_se_pct",
+                 "mass_coverage_se", "tendon_bias_se_mm", "tendon_rmse_se_mm", "tendon_coverage_se"});
     for (const ElbowValidationSummary& s : summaries) {
         CsvRow row;
         row.addText(s.method).addNumber(s.noise).addInteger(s.subjects).addInteger(s.converged);
         row.addNumber(100 * s.massBias).addNumber(100 * s.massRmse).addNumber(s.massCoverage);
         row.addNumber(1000 * s.tendonBias).addNumber(1000 * s.tendonRmse).addNumber(s.tendonCoverage);
+        row.addNumber(100 * s.massBiasSe).addNumber(100 * s.massRmseSe).addNumber(s.massCoverageSe);
+        row.addNumber(1000 * s.tendonBiasSe).addNumber(1000 * s.tendonRmseSe).addNumber(s.tendonCoverageSe);
         csv.addRow(row);
     }
     return csv.getText();

@@ -41,6 +41,10 @@ struct ElbowValidationSummary {
     double massCoverage = 0.0 / 0.0, tendonCoverage = 0.0 / 0.0;  ///< fraction of subjects [1]
     double massIntervalWidth = 0.0 / 0.0;     ///< mean 95 % interval width / estimate [1]
     double tendonIntervalWidth = 0.0 / 0.0;   ///< mean 95 % interval width [m]
+    /// Standard errors over the subjects (NaN with fewer than 2): of the bias (the mean), of the RMSE
+    /// (delta method) and of the coverage (binomial); a 95 % interval is about +/- 2 of them.
+    double massBiasSe = 0.0 / 0.0, massRmseSe = 0.0 / 0.0, massCoverageSe = 0.0 / 0.0;
+    double tendonBiasSe = 0.0 / 0.0, tendonRmseSe = 0.0 / 0.0, tendonCoverageSe = 0.0 / 0.0;
 };
 
 /// Settings of runElbowValidation.
@@ -69,7 +73,7 @@ std::vector<ElbowValidationRow> runElbowValidation(const Population& population,
 std::vector<ElbowValidationSummary> summarizeElbowValidation(const std::vector<ElbowValidationRow>& rows);
 /// One CSV line per row: truth, estimate, 95 % interval, coverage, nuisance truths (SI units, errors in %).
 std::string formatElbowValidationCsv(const std::vector<ElbowValidationRow>& rows);
-/// Per method and noise level: bias, RMSE, coverage (CSV).
+/// Per method and noise level: bias, RMSE, coverage, then their standard errors (CSV).
 std::string formatElbowValidationSummaryCsv(const std::vector<ElbowValidationSummary>& summaries);
 
 }  // namespace armsim

@@ -69,3 +69,34 @@ TEST(Validation, OutOfFamilyDrawsFromTheTruthAndIdentifiesWithThePrior) {
         EXPECT_NE(std::string(e.what()).find("'BRA'"), std::string::npos) << e.what();
     }
 }
+
+// The summary's standard errors against closed forms: errors +x and -x alternate, so the bias is 0 with
+// SE = sample sd / sqrt(n); every squared error is x^2, so the RMSE is x with SE 0; coverage 3 of 4 has
+// SE sqrt(0.75 0.25 / 4).
+TEST(Validation, SummaryStandardErrorsMatchClosedForms) {
+    constexpr double kExact = 1e-12;
+    const double x = 0.1;
+    std::vector<ElbowValidationRow> rows;
+    for (int k = 0; k < 4; ++k) {
+        ElbowValidationRow r;
+        r.subject = k;
+        r.method = "m";
+        r.massError = k % 2 ? -x : x;
+        r.tendonError = 0.002 * k;
+        r.massCovered = k < 3;
+        r.estimate.mass = 1, r.estimate.massLower = 0.9, r.estimate.massUpper = 1.1;
+        rows.push_back(r);
+    }
+    const std::vector<ElbowValidationSummary> s = summarizeElbowValidation(rows);
+    ASSERT_EQ(s.size(), 1u);
+    EXPECT_NEAR(s[0].massBias, 0, kExact);
+    EXPECT_NEAR(s[0].massBiasSe, std::sqrt(4 * x * x / 3 / 4), kExact);   // sample sd / sqrt(n)
+    EXPECT_NEAR(s[0].massRmse, x, kExact);
+    EXPECT_NEAR(s[0].massRmseSe, 0, kExact);
+    EXPECT_NEAR(s[0].massCoverage, 0.75, kExact);
+    EXPECT_NEAR(s[0].massCoverageSe, std::sqrt(0.75 * 0.25 / 4), kExact);
+    // tendon errors 0, 2, 4, 6 mm: mean 3 mm, sample sd sqrt(20/3) mm
+    EXPECT_NEAR(s[0].tendonBiasSe, 0.001 * std::sqrt(20.0 / 3 / 4), kExact);
+    const std::string csv = formatElbowValidationSummaryCsv(s);
+    EXPECT_NE(csv.find("mass_rmse_se_pct"), std::string::npos);
+}
