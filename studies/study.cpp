@@ -64,6 +64,12 @@ std::string resolveStudyFile(const ParamNode& n, const std::string& field, const
 
 void Study::validate() const {
     population.validate();
+    prior.validate();
+    const std::string& truthPrimary = population.base.muscles.at(population.base.primary).params.name;
+    const std::string& priorPrimary = prior.base.muscles.at(prior.base.primary).params.name;
+    if (truthPrimary != priorPrimary)
+        throw FieldError("prior", "identifies muscle '" + priorPrimary + "' but the truth's primary muscle is '" +
+                                      truthPrimary + "': expected the same muscle");
     checkField("subjects", subjects, Bound::closed(1, 1e7));
     if (protocols.empty()) throw FieldError("protocols", "is empty: expected at least one protocol");
     if (noiseLevels.empty()) throw FieldError("noise_levels", "is empty: expected at least one noise level");
@@ -115,10 +121,17 @@ Study readStudy(const std::string& path) {
                          "': expected 'study' (a study file starts with `kind: study`)");
     s.name = n.getString("name", std::filesystem::path(path).stem().string());
     s.description = n.getString("description", "");
-    s.populationReference = n.getString("population", "default");
-    s.population = s.populationReference == "default"
-                       ? loadDefaultPopulation()
-                       : loadPopulation(resolveStudyFile(n, "population", s.populationReference, "population file"));
+    if (n.has("population") && n.has("truth"))
+        throw InputError(n.where("truth") + ": give 'population' (in family) or 'truth' (with 'prior'), not both");
+    const char* truthKey = n.has("truth") ? "truth" : "population";
+    auto loadStudyPopulation = [&](const char* key, const std::string& reference) {
+        return reference == "default" ? loadDefaultPopulation()
+                                      : loadPopulation(resolveStudyFile(n, key, reference, "population file"));
+    };
+    s.populationReference = n.getString(truthKey, "default");
+    s.population = loadStudyPopulation(truthKey, s.populationReference);
+    s.priorReference = n.getString("prior", "");
+    s.prior = s.priorReference.empty() ? s.population : loadStudyPopulation("prior", s.priorReference);
     s.subjects = n.getInt("subjects", 1, 10000000);
     s.seed = unsigned(n.getInt("seed", 0, 2147483647, 1));
     const std::vector<std::string> protocols = n.getStrings("protocols");
@@ -159,6 +172,11 @@ std::string calcStudyFingerprint(const Study& s) {
           << (std::isfinite(m.options.noiseLevel) ? formatNumber(m.options.noiseLevel) : "");
     for (const StudyProtocol& p : s.protocols) t << "\nprotocol\n" << formatTorqueProtocol(p.protocol);
     if (!s.population.file.empty()) t << "\npopulation\n" << readFileText(s.population.file);
+    if (!s.priorReference.empty()) {  // out of family (an in-family study's fingerprint is as before)
+        t << "\nprior " << s.priorReference << '\n';
+        if (!s.prior.file.empty()) t << readFileText(s.prior.file);
+        if (!s.prior.base.file.empty()) t << "\nprior model\n" << readFileText(s.prior.base.file);
+    }
     if (!s.population.base.file.empty()) t << "\nmodel\n" << readFileText(s.population.base.file);
     for (const MuscleSpec& m : s.population.base.muscles) {
         const MuscleParameters& p = m.params;
@@ -219,7 +237,7 @@ std::vector<StudyResult> runStudyGroup(const Study& study, long group, const std
             try {
                 auto it = noisy.find(t.noise);
                 if (it == noisy.end()) it = noisy.emplace(t.noise, setTransducerNoise(clean, level)).first;
-                e = identifyElbowMethod(m, study.population, it->second, study.seed, subject);
+                e = identifyElbowMethod(m, study.prior, it->second, study.seed, subject);
             } catch (const InterruptedError&) {
                 throw;
             } catch (const std::exception& x) {

@@ -1,5 +1,6 @@
 // Population studies (issue 13): Monte Carlo over virtual subjects. A study file names the truth (a
-// population of virtual subjects around a model), the protocols, the identifiers with their options,
+// population of virtual subjects around a model: `population:`, or `truth:` with `prior:`, the
+// population the identifiers assume, for a study out of family), the protocols, the identifiers with their options,
 // the transducer noise levels, the number of subjects, the seed and the output folder. Every
 // (subject, protocol, noise, method) cell is one task: the subject's data are synthesized, read at the
 // noise level and identified; the estimate, the truth, the 95 % intervals, the residual, the iterations
@@ -39,7 +40,9 @@ struct Study {
     std::string description;
     std::string file;                       ///< the study file ("" when built in code)
     std::string populationReference = "default";  ///< "default" or the population file as written
-    Population population;                  ///< the truth: subjects are drawn from it
+    Population population;                  ///< the truth: subjects are drawn from it (`population:` or `truth:`)
+    std::string priorReference;             ///< `prior:` as written; "" = the truth population (in family)
+    Population prior;                       ///< the identifiers' prior and model (the truth unless `prior:`)
     int subjects = 20;                      ///< persons 0 .. subjects-1 of the population
     unsigned seed = 1;                      ///< population, synthesis noise and VA-measurement seed
     std::vector<StudyProtocol> protocols;   ///< at least one

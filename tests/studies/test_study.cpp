@@ -27,7 +27,7 @@ std::string readText(const fs::path& p) { return armsim::testing::readFileText(p
 Study makeSmallStudy() {
     Study s;
     s.name = "small";
-    s.population = loadDefaultPopulation();
+    s.population = s.prior = loadDefaultPopulation();
     s.subjects = 3;
     s.seed = 5;
     StudyProtocol thesis{"thesis", TorqueProtocol()};
@@ -271,3 +271,44 @@ TEST(Study, ReadsAStudyFileAndNamesTheFileLineAndFieldOfEveryError) {
         }
     }
 }
+
+// Out of family in a study file (issue 31): `truth:` draws the subjects, `prior:` is what the
+// identifiers assume; the cells equal runElbowValidation(truth, prior) of the same subjects, an in-family
+// study keeps its fingerprint, and `population` with `truth` is refused.
+TEST(Study, TruthAndPriorInAStudyFileAreTheOutOfFamilyValidation) {
+    const fs::path dir = fs::temp_directory_path() / ("armsim_study_oof_" + std::to_string(::getpid()));
+    fs::create_directories(dir);
+    const std::string stronger = std::string(ARMSIM_ASSET_DIR) + "/subjects/mismatch/stronger.yaml";
+    const std::string body = "subjects: 1\nseed: 3\nprotocols: [thesis]\nnoise_levels: [0.02]\nmethods:\n  - {method: synergist}\n";
+    std::ofstream(dir / "oof.yaml") << "kind: study\nname: oof\ntruth: " << stronger << "\nprior: default\n" << body;
+    std::ofstream(dir / "fam.yaml") << "kind: study\nname: oof\npopulation: " << stronger << "\n" << body;
+    std::ofstream(dir / "both.yaml") << "kind: study\nname: oof\npopulation: default\ntruth: " << stronger << "\n" << body;
+    const Study oof = readStudy((dir / "oof.yaml").string()), fam = readStudy((dir / "fam.yaml").string());
+    EXPECT_EQ(oof.prior.name, "default");
+    EXPECT_EQ(oof.population.name, "stronger");
+    EXPECT_NE(calcStudyFingerprint(oof), calcStudyFingerprint(fam));
+    ElbowValidationSettings v;
+    v.subjects = 1;
+    v.seed = 3;
+    v.noiseLevels = {0.02};
+    v.activationSd = 0;
+    const std::vector<ElbowValidationRow> rows = runElbowValidation(oof.population, oof.prior, v);
+    int compared = 0;
+    for (const StudyResult& r : runStudyGroup(oof, 0, {0})) {
+        for (const ElbowValidationRow& w : rows)
+            if (w.method == r.row.method) {
+                EXPECT_EQ(r.row.estimate.mass, w.estimate.mass);   // bitwise: the same computation
+                EXPECT_EQ(r.row.trueMass, w.trueMass);
+                ++compared;
+            }
+    }
+    EXPECT_EQ(compared, 1);
+    try {
+        readStudy((dir / "both.yaml").string());
+        FAIL() << "population and truth together were accepted";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("not both"), std::string::npos) << e.what();
+    }
+    fs::remove_all(dir);
+}
+
