@@ -201,10 +201,8 @@ void runElbowMvcAngles(const MainJobContext& ctx) {
                                             [](int d, int n) { printProgress("elbow MVC trials", d, n); });
     const int n = setup.getNumMuscles(), primary = setup.primary;
     const std::string biceps = setup.muscles[primary].params.name;
-    // The thesis's one biceps is both heads here (the muscles named BIC...).
-    std::vector<int> heads;
-    for (int i = 0; i < n; ++i)
-        if (setup.muscles[i].params.name.rfind("BIC", 0) == 0) heads.push_back(i);
+    // The thesis's one biceps is every head the model file names (roles.biceps).
+    const std::vector<int> heads = setup.getBicepsHeads();
     std::vector<std::string> columns{"elbow_angle_deg", "flexion_deg", "tared_torque_Nm", "strap_force_N",
                                      "primary_moment_arm_m", "primary_force_N", "biceps_both_heads_N",
                                      "thesis_estimate_N", "estimate_error_vs_both_heads_pct"};

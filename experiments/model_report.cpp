@@ -112,6 +112,21 @@ Table calcMomentArmTable(const ArmSetup& setup, double stepDeg) {
 
 namespace {
 
+// One series per muscle from a moment-arm table's <prefix><muscle>_m columns [cm], against column x;
+// skipZero leaves out muscles whose moment arm is 0 throughout.
+void addMomentArmSeries(PlotSpec& plot, const ArmSetup& setup, const Table& t, const std::string& x,
+                        const std::string& prefix, bool skipZero) {
+    const std::vector<double> xs = t.getColumn(x);
+    int color = 0;
+    for (const MuscleSpec& m : setup.muscles) {
+        PlotSeries ps{m.params.name, xs, {}, false, color % 8};
+        for (double h : t.getColumn(prefix + m.params.name + "_m")) ps.y.push_back(100 * h);
+        if (skipZero && std::all_of(ps.y.begin(), ps.y.end(), [](double v) { return v == 0; })) continue;
+        plot.series.push_back(ps);
+        ++color;
+    }
+}
+
 // y range over every series and 0, with the upper half left free for a legend above the curves.
 void setRangeWithLegendRoom(PlotSpec& plot) {
     double lo = 0, hi = 0;
@@ -216,15 +231,7 @@ ModelReportFiles writeModelReport(const ArmSetup& setup, const std::string& outD
     armPlot.xLabel = "flexion angle (deg, 0 = extended)";
     armPlot.yLabel = "moment arm (cm, + = flexion)";
     armPlot.legend = PlotSpec::Legend::TopLeft;
-    const std::vector<double> q = arms.getColumn("flexion_deg");
-    for (int i = 0; i < setup.getNumMuscles(); ++i) {
-        PlotSeries s;
-        s.label = setup.muscles[i].params.name;
-        s.x = q;
-        for (double h : arms.getColumn("moment_arm_" + s.label + "_m")) s.y.push_back(100 * h);
-        s.color = i % 8;
-        armPlot.series.push_back(s);
-    }
+    addMomentArmSeries(armPlot, setup, arms, "flexion_deg", "moment_arm_", false);
     PlotSeries refs;
     refs.label = "published min/max";
     refs.markers = true;
@@ -253,15 +260,7 @@ ModelReportFiles writeModelReport(const ArmSetup& setup, const std::string& outD
         plot.xLabel = "forearm rotation (deg, - pronated, + supinated)";
         plot.yLabel = "moment arm (cm, + = supination)";
         plot.legend = PlotSpec::Legend::TopLeft;
-        const std::vector<double> phi = fa.getColumn("rotation_deg");
-        int color = 0;
-        for (int i = 0; i < setup.getNumMuscles(); ++i) {  // the muscles that act on the rotation
-            PlotSeries ps{setup.muscles[i].params.name, phi, {}, false, color % 8};
-            for (double h : fa.getColumn("forearm_moment_arm_" + ps.label + "_m")) ps.y.push_back(100 * h);
-            if (std::all_of(ps.y.begin(), ps.y.end(), [](double v) { return v == 0; })) continue;
-            plot.series.push_back(ps);
-            ++color;
-        }
+        addMomentArmSeries(plot, setup, fa, "rotation_deg", "forearm_moment_arm_", true);  // those that rotate it
         setRangeWithLegendRoom(plot);
         writePlotPng(path("forearm_moment_arms.png"), plot);
         out.files.push_back(path("forearm_moment_arms.png"));

@@ -88,8 +88,8 @@ SynergistModel::SynergistModel(const Population& prior, const SynergistOptions& 
                                const std::vector<TorqueCondition>& conditions)
     : base_(&prior.base) {
     const ArmSetup& base = prior.base;
-    biceps_ = findMuscles(base, options.biceps, "biceps");
-    synergists_ = findMuscles(base, options.synergists, "synergists");
+    biceps_ = options.biceps.empty() ? base.getBicepsHeads() : findMuscles(base, options.biceps, "biceps");
+    synergists_ = options.synergists.empty() ? base.synergists : findMuscles(base, options.synergists, "synergists");
     if (!options.includeSynergists) leftOut_ = synergists_;
     for (int i = 0; i < base.getNumMuscles(); ++i)
         if (base.muscles[i].group == MuscleGroup::Extensor) extensors_.push_back(i);

@@ -20,9 +20,10 @@ namespace armsim {
 
 /// The synergist-aware identifier's model and extra measurements.
 struct SynergistOptions {
-    /// Which muscles the model groups (names in the population's base model).
-    std::vector<std::string> biceps = {"BIClong", "BICshort"};  ///< share s_b and t_b
-    std::vector<std::string> synergists = {"BRA", "BRD"};       ///< share s_s
+    /// Which muscles the model groups (names in the population's base model); empty: the model file's
+    /// roles (ArmSetup::bicepsHeads, ArmSetup::synergists).
+    std::vector<std::string> biceps;       ///< share s_b and t_b
+    std::vector<std::string> synergists;   ///< share s_s
     /// false: the synergists are left out of the identifier's model (no torque from them): the
     /// ablation that shows what they are for.
     bool includeSynergists = true;

@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <set>
 
 namespace armsim {
 
@@ -43,6 +44,14 @@ double findOptimumAngle(const SteadyMvcCurve& c, int m) {
             return c.flexionDeg[a - 1] + (c.flexionDeg[a] - c.flexionDeg[a - 1]) * l0 / (l0 - l1);
     }
     return NAN;
+}
+
+// A forearm target the model can score: it rotates, and the target's posture is within its range.
+bool isScoredForearmTarget(const ArmSetup& setup, const AnatomyTarget& t) {
+    const ArmParameters::ForearmRotation& rot = setup.arm.forearmRotation;
+    const bool forearm = t.kind == TargetKind::ForearmMvc || t.kind == TargetKind::PostureRatio;
+    return forearm && rot.enabled && t.rotationDeg >= rot.minDeg && t.rotationDeg <= rot.maxDeg &&
+           t.flexionDeg >= setup.arm.getMinFlexionDeg() && t.flexionDeg <= setup.arm.getMaxFlexionDeg();
 }
 
 }  // namespace
@@ -127,6 +136,16 @@ AnatomySweep calcAnatomySweep(const ArmSetup& setup, const std::vector<AnatomyTa
     std::sort(angles.begin(), angles.end());
     angles.erase(std::unique(angles.begin(), angles.end()), angles.end());
     sweep.geometry = calcMvcGeometry(setup, angles);
+
+    std::set<double> forearmAngles, rotations;
+    for (const AnatomyTarget& t : targets)
+        if (isScoredForearmTarget(setup, t)) {
+            forearmAngles.insert(t.flexionDeg);
+            rotations.insert(t.rotationDeg);
+            if (t.kind == TargetKind::PostureRatio) rotations.insert(0.0);
+        }
+    for (double r : rotations)
+        sweep.byRotation[r] = calcMvcGeometry(setup, {forearmAngles.begin(), forearmAngles.end()}, r);
     return sweep;
 }
 
@@ -155,20 +174,20 @@ std::vector<TargetScore> scoreAnatomy(const ArmSetup& setup, const std::vector<A
         s.pass = std::isfinite(value) && value >= t.lower - t.tolerance && value <= t.upper + t.tolerance;
         out.push_back(s);
     };
-    const ArmParameters::ForearmRotation& rot = setup.arm.forearmRotation;
     for (const AnatomyTarget& t : targets) {
         const bool inRange = !std::isfinite(t.flexionDeg) || (t.flexionDeg >= minFlexion && t.flexionDeg <= maxFlexion);
         if (!inRange) continue;
         if (t.kind == TargetKind::ForearmMvc || t.kind == TargetKind::PostureRatio) {
-            if (!rot.enabled || t.rotationDeg < rot.minDeg || t.rotationDeg > rot.maxDeg) continue;
-            const MvcGeometry g = calcMvcGeometry(setup, {t.flexionDeg}, t.rotationDeg);
+            if (!isScoredForearmTarget(setup, t)) continue;
+            const MvcGeometry& g = sweep.byRotation.at(t.rotationDeg);
+            const std::size_t a = std::lower_bound(g.flexionDeg.begin(), g.flexionDeg.end(), t.flexionDeg) - g.flexionDeg.begin();
             if (t.kind == TargetKind::ForearmMvc) {
                 const SteadyMvcCurve c = calcSteadyForearmMvc(setup.muscles, g, t.forearmEffort, setup.effort);
-                add(t, "", std::abs(c.totalForearmTorque[0]));
+                add(t, "", std::abs(c.totalForearmTorque[a]));
             } else {
-                const MvcGeometry neutral = calcMvcGeometry(setup, {t.flexionDeg}, 0.0);
-                const double at = calcSteadyMvcCurve(setup.muscles, g, MuscleGroup::Flexor, setup.effort).totalTorque[0];
-                const double ref = calcSteadyMvcCurve(setup.muscles, neutral, MuscleGroup::Flexor, setup.effort).totalTorque[0];
+                const double at = calcSteadyMvcCurve(setup.muscles, g, MuscleGroup::Flexor, setup.effort).totalTorque[a];
+                const double ref =
+                    calcSteadyMvcCurve(setup.muscles, sweep.byRotation.at(0.0), MuscleGroup::Flexor, setup.effort).totalTorque[a];
                 add(t, "", ref > 0 ? at / ref : NAN);
             }
             continue;

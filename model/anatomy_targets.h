@@ -7,6 +7,7 @@
 #include "model/model_file.h"
 #include "model/mvc_curve.h"
 
+#include <map>
 #include <string>
 #include <vector>
 
@@ -70,11 +71,14 @@ struct TargetScore {
 std::vector<TargetScore> scoreAnatomy(const ArmSetup& setup, const std::vector<AnatomyTarget>& targets);
 
 /// The angles scoreAnatomy evaluates a model at (each target's angle, and every 1 deg of the elbow's range
-/// when an optimum_angle target needs the fibre-length crossing)
-/// and the geometry there. Scales of a calibration change no geometry, so a fit computes it once.
+/// when an optimum_angle target needs the fibre-length crossing) and the geometry there, per forearm
+/// posture for the forearm targets. Scales of a calibration change no geometry, so a fit computes it once.
 struct AnatomySweep {
     std::vector<double> flexionDeg;   ///< sorted, unique [deg]
     MvcGeometry geometry;
+    /// The forearm targets' angles (sorted, unique) at each forearm posture they need [deg]: theirs, and
+    /// neutral for a posture_ratio. Empty without a forearm rotation.
+    std::map<double, MvcGeometry> byRotation;
 };
 AnatomySweep calcAnatomySweep(const ArmSetup& setup, const std::vector<AnatomyTarget>& targets);
 /// scoreAnatomy on a sweep made for this model's geometry.

@@ -326,6 +326,26 @@ ArmSetup loadModelFile(const std::string& file) {
             throw InputError(root.where("primary") + ": field 'primary' = '" + primary + "': " + e.what());
         }
     }
+    if (root.has("roles")) {
+        const ParamNode roles = root.child("roles");
+        auto read = [&](const char* key) {
+            std::vector<int> out;
+            for (const std::string& name : roles.getStrings(key)) {
+                try {
+                    out.push_back(s.findMuscle(name));
+                } catch (const InputError& e) {
+                    throw InputError(roles.where(key) + ": field '" + roles.path(key) + "': " + e.what());
+                }
+            }
+            return out;
+        };
+        if (roles.has("biceps")) s.bicepsHeads = read("biceps");
+        if (roles.has("synergists")) s.synergists = read("synergists");
+        roles.finish();
+        if (!s.bicepsHeads.empty() && std::find(s.bicepsHeads.begin(), s.bicepsHeads.end(), s.primary) == s.bicepsHeads.end())
+            throw InputError(roles.where("biceps") + ": field 'roles.biceps' does not name the primary muscle '" +
+                             s.muscles[s.primary].params.name + "': expected it among the biceps heads");
+    }
     root.finish();
     if (!s.arm.forearmRotation.enabled)
         for (const MuscleSpec& m : s.muscles)

@@ -13,6 +13,10 @@
 //                                        (defaults of the virtual subject's effort, see SubjectEffort)
 //   specific_tension: SIGMA              [N/m^2] every muscle's sigma unless the muscle gives its own
 //                                        (default: the fibre-type file's, Virtual Muscle's 31.8 N/cm^2)
+//   roles: {biceps: [NAMES], synergists: [NAMES]}
+//                                        the heads of the thesis's "biceps" (the primary among them) and
+//                                        the flexors the synergist-aware identifier estimates one by one
+//                                        (default: the primary alone; none)
 //   primary: NAME                        the muscle the thesis calls "the biceps": the transducer
 //                                        estimate and the identification address it (default: first)
 //   muscles: [...]                       each: name, group (flexor|extensor|forearm), Virtual Muscle
@@ -114,6 +118,12 @@ struct ArmSetup {
     SubjectEffort effort;                 ///< defaults of the subject's effort
     std::vector<MuscleSpec> muscles;
     int primary = 0;                      ///< index of the thesis's "biceps"
+    /// Roles from the model file's `roles:` (muscle indices). bicepsHeads: the muscles that together are
+    /// the thesis's "biceps" (the primary among them; empty: the primary alone, see getBicepsHeads);
+    /// synergists: the other flexors an identifier estimates one by one (default none).
+    std::vector<int> bicepsHeads;
+    std::vector<int> synergists;
+    std::vector<int> getBicepsHeads() const { return bicepsHeads.empty() ? std::vector<int>{primary} : bicepsHeads; }
 
     int getNumMuscles() const { return int(muscles.size()); }
     /// Index of the muscle called name; throws InputError listing the names.

@@ -194,7 +194,6 @@ void resolveMaxPathLengths(ArmSetup& setup) {
     }
     for (int i = 0; i < setup.getNumMuscles(); ++i)
         if (setup.muscles[i].maxPathFromRange) setup.muscles[i].params.maxPathLength = longest[i];
-    if (rot.enabled) geometry.setForearmRotation(degToRad(rot.postureDeg));
 }
 
 }  // namespace armsim

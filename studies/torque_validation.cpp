@@ -27,20 +27,13 @@ ElbowValidationRow makeElbowValidationRow(const Population& population, const Vi
     row.voluntaryActivation = v.setup.effort.voluntaryActivation;
     row.coContraction = v.setup.effort.coContraction;
     row.strengthLevel = v.strengthLevel;
-    // Nuisance truths of the muscles the model has (a model without them leaves NaN).
-    auto present = [&](const std::vector<std::string>& names) {
-        std::vector<int> out;
-        for (const std::string& n : names)
-            for (int i = 0; i < population.base.getNumMuscles(); ++i)
-                if (population.base.muscles[i].params.name == n) out.push_back(i);
-        return out;
-    };
-    for (int i : present(SynergistOptions().biceps))
+    // Nuisance truths of the model file's roles (a model without them leaves NaN).
+    const ArmSetup& base = population.base;
+    for (int i : base.getBicepsHeads())
         if (i != primary) row.bicepsShortScale = v.massScale[i] / v.massScale[primary];
-    const std::vector<int> synergists = present(SynergistOptions().synergists);
     double syn = 0;
-    for (int i : synergists) syn += v.massScale[i];
-    if (!synergists.empty()) row.synergistScale = syn / double(synergists.size()) / v.massScale[primary];
+    for (int i : base.synergists) syn += v.massScale[i];
+    if (!base.synergists.empty()) row.synergistScale = syn / double(base.synergists.size()) / v.massScale[primary];
     return row;
 }
 

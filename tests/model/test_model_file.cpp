@@ -457,3 +457,33 @@ TEST(ForearmRotation, TwinMomentArmsTwoWaysAndTheRotatorsSigns) {
         "      insertion: {body: radius, location: [0, -0.05, 0]}\n"));
     EXPECT_NE(bad.find("forearm_rotation"), std::string::npos) << bad;
 }
+
+// Muscle roles come from the model file (no muscle name in library code): the elbow names its biceps
+// heads and synergists; a model without `roles:` has the primary alone; a role that leaves out the
+// primary or names no muscle is refused with file, line and field.
+TEST(ModelFile, RolesComeFromTheModelFile) {
+    const ArmSetup& e = elbow();
+    ASSERT_EQ(e.getBicepsHeads().size(), 2u);
+    EXPECT_EQ(e.muscles[e.getBicepsHeads()[1]].params.name, "BICshort");
+    ASSERT_EQ(e.synergists.size(), 2u);
+    EXPECT_EQ(e.muscles[e.synergists[0]].params.name, "BRA");
+    const ArmSetup thesis = loadModel("thesis");
+    EXPECT_EQ(thesis.getBicepsHeads(), std::vector<int>{thesis.primary});
+    EXPECT_TRUE(thesis.synergists.empty());
+    const std::string head = "name: r\narm: arm/default_male.yaml\nmuscles:\n  - name: a\n    parameters: " +
+                             std::string(ARMSIM_ASSET_DIR) + "/muscles/biceps_long_head.yaml\n" +
+                             "    path:\n      origin: {body: upper_arm, location: [0, 0.3, 0]}\n"
+                             "      insertion: {body: forearm, location: [0, -0.05, 0]}\n";
+    std::string msg = messageOf(writeTemp("roles_bad1.yaml", head + "roles: {synergists: [BRA]}\n"));
+    EXPECT_NE(msg.find("roles_bad1.yaml:9"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("'BRA'"), std::string::npos) << msg;
+    msg = messageOf(writeTemp("roles_empty.yaml", head + "roles: {biceps: []}\n"));
+    EXPECT_EQ(msg, "");   // empty: the primary alone
+    msg = messageOf(writeTemp("roles_bad3.yaml", head.substr(0, head.find("  - name: a")) +
+                                                     "  - name: b\n    parameters: " + std::string(ARMSIM_ASSET_DIR) +
+                                                     "/muscles/biceps_short_head.yaml\n" +
+                                                     "    path:\n      origin: {body: upper_arm, location: [0, 0.3, 0]}\n"
+                                                     "      insertion: {body: forearm, location: [0, -0.05, 0]}\n" +
+                                                     head.substr(head.find("  - name: a")) + "primary: a\nroles: {biceps: [b]}\n"));
+    EXPECT_NE(msg.find("primary muscle 'a'"), std::string::npos) << msg;
+}
