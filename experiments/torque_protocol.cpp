@@ -46,6 +46,11 @@ bool TorqueProtocol::usesEmg() const {
     return std::any_of(conditions.begin(), conditions.end(), [](const TorqueCondition& c) { return c.level < 1; });
 }
 
+bool TorqueProtocol::hasChannels() const {
+    return volumeScan || anthropometry ||
+           std::any_of(conditions.begin(), conditions.end(), [](const TorqueCondition& c) { return c.ultrasound || c.emg; });
+}
+
 void TorqueProtocol::validate() const {
     if (conditions.empty()) throw FieldError("conditions", "no conditions: expected at least one");
     std::set<std::tuple<double, int, double>> seen;
@@ -65,24 +70,35 @@ void TorqueProtocol::validate() const {
     checkField("trial.sample_rate", sampleRate, Bound::positive("Hz"));
     checkField("subject.transducer_noise", transducerNoise, Bound::closed(0, 0.5));
     checkField("subject.index", subjectIndex, Bound::closed(0, 1e6));
+    const ChannelNoise& n = channelNoise;
+    checkField("channel_noise.fascicle_length", n.fascicleLength, Bound{0, 0.5, true, true, "relative sd"});
+    checkField("channel_noise.volume", n.volume, Bound{0, 0.5, true, true, "relative sd"});
+    checkField("channel_noise.emg", n.emg, Bound{0, 1, true, true, "relative sd"});
+    checkField("channel_noise.emg_crosstalk", n.emgCrosstalk, Bound::closed(0, 0.5));
+    checkField("channel_noise.upper_arm_length", n.upperArmLength, Bound{0, 0.1, true, true, "m"});
 }
 
 std::string describeConditions(const TorqueProtocol& protocol) {
-    std::vector<std::tuple<int, double, int>> groups;  // effort, level, repetitions in first-seen order
-    std::map<std::tuple<int, double, int>, std::string> angles;
+    using Key = std::tuple<int, double, int, int>;  // effort, level, repetitions, channels in first-seen order
+    std::vector<Key> groups;
+    std::map<Key, std::string> angles;
     for (const TorqueCondition& c : protocol.conditions) {
-        const auto key = std::make_tuple(int(c.effort), c.level, c.repetitions);
+        const Key key = std::make_tuple(int(c.effort), c.level, c.repetitions, (c.ultrasound ? 1 : 0) + (c.emg ? 2 : 0));
         if (!angles.count(key)) groups.push_back(key);
         std::string& a = angles[key];
         a += (a.empty() ? "" : ", ") + formatNumber(c.flexionDeg);
     }
     std::string out;
     for (const auto& key : groups) {
-        const auto [effort, level, repetitions] = key;
+        const auto [effort, level, repetitions, channels] = key;
         out += (out.empty() ? "" : "; ") + std::string(getEffortName(MuscleGroup(effort))) + " " +
                (level == 1 ? std::string("MVC") : formatNumber(100 * level) + " %") + " at " + angles[key] +
                " deg x " + std::to_string(repetitions);
+        if (channels) out += std::string(" with ") + (channels & 1 ? "ultrasound" : "") + (channels == 3 ? " and " : "") +
+                             (channels & 2 ? "EMG" : "");
     }
+    if (protocol.volumeScan) out += "; volume scan";
+    if (protocol.anthropometry) out += "; anthropometry";
     return out;
 }
 
@@ -114,6 +130,22 @@ TorqueProtocol readTorqueProtocol(const std::string& path) {
         }
         s.finish();
     }
+    if (root.has("measurements")) {
+        const ParamNode m = root.child("measurements");
+        p.volumeScan = m.getBool("volume_scan", false);
+        p.anthropometry = m.getBool("anthropometry", false);
+        m.finish();
+    }
+    if (root.has("channel_noise")) {
+        const ParamNode n = root.child("channel_noise");
+        ChannelNoise& c = p.channelNoise;
+        c.fascicleLength = n.getNumber("fascicle_length", Bound{0, 0.5, true, true, "relative sd"}, c.fascicleLength);
+        c.volume = n.getNumber("volume", Bound{0, 0.5, true, true, "relative sd"}, c.volume);
+        c.emg = n.getNumber("emg", Bound{0, 1, true, true, "relative sd"}, c.emg);
+        c.emgCrosstalk = n.getNumber("emg_crosstalk", Bound::closed(0, 0.5), c.emgCrosstalk);
+        c.upperArmLength = n.getNumber("upper_arm_length", Bound{0, 0.1, true, true, "m"}, c.upperArmLength);
+        n.finish();
+    }
     p.conditions.clear();
     for (const ParamNode& c : root.children("conditions")) {
         TorqueCondition tc;
@@ -122,6 +154,19 @@ TorqueProtocol readTorqueProtocol(const std::string& path) {
                                                                                             : MuscleGroup::Extensor;
         tc.level = c.getNumber("level", Bound{0, 1, true, false, "fraction of maximal, in (0, 1]"}, 1.0);
         tc.repetitions = c.getInt("repetitions", 1, 100, 1);
+        if (c.has("channels")) {
+            const std::vector<std::string> channels = c.getStrings("channels");
+            for (const std::string& name : channels) {
+                if (name == "ultrasound") tc.ultrasound = true;
+                else if (name == "emg") tc.emg = true;
+                else if (name != "torque")
+                    throw InputError(c.where("channels") + ": field '" + c.path("channels") + "' = '" + name +
+                                     "': expected torque, ultrasound or emg");
+            }
+            if (std::find(channels.begin(), channels.end(), "torque") == channels.end())
+                throw InputError(c.where("channels") + ": field '" + c.path("channels") +
+                                 "' leaves out torque: expected every effort to be read by the transducer (list torque)");
+        }
         c.finish();
         p.conditions.push_back(tc);
     }
@@ -144,10 +189,22 @@ std::string formatTorqueProtocol(const TorqueProtocol& p) {
         out += "  population: " + p.population + "\n  index: " + std::to_string(p.subjectIndex) + "\n";
     else
         out += "  model: " + p.model + "\n  transducer_noise: " + formatNumber(p.transducerNoise) + "\n";
+    if (p.hasChannels()) {
+        const ChannelNoise& n = p.channelNoise;
+        out += std::string("measurements: {volume_scan: ") + (p.volumeScan ? "true" : "false") +
+               ", anthropometry: " + (p.anthropometry ? "true" : "false") + "}\n";
+        out += "channel_noise: {fascicle_length: " + formatNumber(n.fascicleLength) + ", volume: " + formatNumber(n.volume) +
+               ", emg: " + formatNumber(n.emg) + ", emg_crosstalk: " + formatNumber(n.emgCrosstalk) +
+               ", upper_arm_length: " + formatNumber(n.upperArmLength) + "}  # relative sd; upper_arm_length in m\n";
+    }
     out += "conditions:          # flexion_deg: 0 = extended; level: fraction of maximal (< 1: EMG feedback)\n";
-    for (const TorqueCondition& c : p.conditions)
+    for (const TorqueCondition& c : p.conditions) {
         out += "  - {effort: " + std::string(getEffortName(c.effort)) + ", flexion_deg: " + formatNumber(c.flexionDeg) +
-               ", level: " + formatNumber(c.level) + ", repetitions: " + std::to_string(c.repetitions) + "}\n";
+               ", level: " + formatNumber(c.level) + ", repetitions: " + std::to_string(c.repetitions);
+        if (c.ultrasound || c.emg)
+            out += std::string(", channels: [torque") + (c.ultrasound ? ", ultrasound" : "") + (c.emg ? ", emg" : "") + "]";
+        out += "}\n";
+    }
     return out;
 }
 
@@ -200,11 +257,16 @@ std::vector<TorqueObservation> synthesizeTorqueData(const VirtualSubject& subjec
             o.level = c.level;
             o.repetition = r;
             o.activation = s.activation;
+            o.antagonistActivation = s.antagonistActivation;
             o.noiseDraw = rng.drawNormal();
             data.push_back(o);
         }
     const std::vector<IsometricTrialResult> results = runIsometricTrials(subject.setup, trials, jobs);
-    for (std::size_t k = 0; k < data.size(); ++k) data[k].cleanTorque = results[k].summary.meanMuscleTorque;
+    for (std::size_t k = 0; k < data.size(); ++k) {
+        data[k].cleanTorque = results[k].summary.meanMuscleTorque;
+        data[k].restFascicleLength = results[k].summary.restFascicleLength;
+        data[k].fascicleLength = results[k].summary.meanFascicleLength;
+    }
     return setTransducerNoise(std::move(data), subject.transducerNoise);
 }
 

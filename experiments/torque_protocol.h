@@ -27,6 +27,20 @@ struct TorqueCondition {
     MuscleGroup effort = MuscleGroup::Flexor;   ///< which group the subject drives
     double level = 1.0;                         ///< drive as a fraction of maximal (1 = MVC) [1]
     int repetitions = 3;                        ///< trials of this condition
+    /// Channels recorded in each trial besides torque (experiments/channels.h): ultrasound images the
+    /// primary muscle's fascicle at rest and at the plateau; emg records the surface_emg muscles.
+    bool ultrasound = false;
+    bool emg = false;
+};
+
+/// Measurement error of the channels besides torque (experiments/channels.h). Defaults and their
+/// sources: docs/channels.md.
+struct ChannelNoise {
+    double fascicleLength = 0.05;   ///< relative sd of one ultrasound fascicle length (extended field of view) [1]
+    double volume = 0.10;           ///< relative sd of one head's volume from a panoramic scan [1]
+    double emg = 0.15;              ///< relative sd of one trial's normalised EMG amplitude [1]
+    double emgCrosstalk = 0.10;     ///< c: fraction of the other group's activation an electrode picks up [1]
+    double upperArmLength = 0.01;   ///< sd of the anthropometric upper-arm length [m]
 };
 
 /// "flexion" or "extension".
@@ -49,12 +63,17 @@ struct TorqueProtocol {
     std::string model = "elbow";
     double transducerNoise = 0.02;   ///< relative sd (model subject only) [1]
     unsigned seed = 1;               ///< population and noise seed
+    bool volumeScan = false;         ///< one panoramic ultrasound scan of the primary muscle's volume
+    bool anthropometry = false;      ///< the upper-arm length measured
+    ChannelNoise channelNoise;       ///< errors of the channels besides torque
 
     /// Flexion MVCs at the angles, each repeated.
     static std::vector<TorqueCondition> makeFlexionMvcs(const std::vector<double>& flexionDeg, int repetitions);
     int getNumTrials() const;        ///< sum of the repetitions
     /// true when some condition is a submaximal (EMG-feedback) effort.
     bool usesEmg() const;
+    /// true when some condition or measurement records a channel besides torque.
+    bool hasChannels() const;
     /// FieldError naming the field ("conditions[2].level", ...) unless every value is in range.
     void validate() const;
 };
@@ -84,6 +103,9 @@ struct TorqueObservation {
     double activation = NAN;   ///< agonist activation the subject actually produced (truth; not used by identifiers) [1]
     double cleanTorque = NAN;  ///< the torque before transducer noise (truth) [N m]
     double noiseDraw = NAN;    ///< the standard normal draw of its noise: torque = cleanTorque (1 + sd noiseDraw)
+    double antagonistActivation = NAN;  ///< the antagonists' activation (truth) [1]
+    double restFascicleLength = NAN;    ///< the primary's fascicle at rest before the effort (truth) [m]
+    double fascicleLength = NAN;        ///< the primary's fascicle at the plateau, window mean (truth) [m]
     int line = 0;              ///< line in the file it was read from (0: synthesized)
     /// A maximal flexion effort (what the thesis's method uses).
     bool isFlexionMvc() const { return effort == MuscleGroup::Flexor && level == 1; }

@@ -1,6 +1,7 @@
 #include "identification/synergist_identifier.h"
 
 #include "basics/bound.h"
+#include "basics/format.h"
 #include "basics/portable_random.h"
 #include "estimation/map_estimate.h"
 #include "estimation/statistics.h"
@@ -98,13 +99,31 @@ SynergistModel::SynergistModel(const Population& prior, const SynergistOptions& 
                          "' is not in the biceps group");
     std::vector<double> angles;
     for (const TorqueCondition& c : conditions) {
-        auto it = std::find(angles.begin(), angles.end(), c.flexionDeg);
-        angleOf_.push_back(int(it - angles.begin()));
-        if (it == angles.end()) angles.push_back(c.flexionDeg);
-        auto kt = std::find_if(kinds_.begin(), kinds_.end(),
-                               [&](const EffortKind& k) { return k.group == c.effort && k.level == c.level; });
-        kindOf_.push_back(int(kt - kinds_.begin()));
-        if (kt == kinds_.end()) kinds_.push_back({c.effort, c.level});
+        angleOf_.push_back(findAngle(c.flexionDeg, angles));
+        kindOf_.push_back(findKind(c.effort, c.level));
+    }
+    channels_ = options.channels;
+    emgCrosstalk_ = options.emgCrosstalk;
+    checkField("emg crosstalk", emgCrosstalk_, Bound::closed(0, 0.5));
+    for (const ChannelObservation& o : channels_) {
+        const std::string at = o.line > 0 ? "channel data line " + std::to_string(o.line) + ": " : "channel data: ";
+        int m = -1, angle = -1, kind = -1;
+        if (o.channel != "upper_arm_length") {
+            try {
+                m = base.findMuscle(o.muscle);
+            } catch (const InputError& e) {
+                throw InputError(at + o.channel + " of muscle '" + o.muscle + "': " + e.what());
+            }
+        }
+        if (o.channel == "fascicle_length" || o.channel == "emg") {
+            angle = findAngle(o.flexionDeg, angles);
+            if (o.channel == "fascicle_length" && o.level > 0) kind = findKind(o.effort, o.level);
+        }
+        if (o.channel == "emg" && base.muscles[m].group != MuscleGroup::Flexor && base.muscles[m].group != MuscleGroup::Extensor)
+            throw InputError(at + "emg of muscle '" + o.muscle + "': expected a flexor or an extensor (its MVC normalises it)");
+        channelMuscle_.push_back(m);
+        channelAngle_.push_back(angle);
+        channelKind_.push_back(kind);
     }
     geometry_ = calcMvcGeometry(base, angles);
 
@@ -119,6 +138,8 @@ SynergistModel::SynergistModel(const Population& prior, const SynergistOptions& 
     for (int a : masses)
         for (int b : masses) cov[a][b] = s2;
     cov[kBicepsSlow][kBicepsSlow] = cov[kSynergistSlow][kSynergistSlow] = std::pow(prior.slowFractionSd, 2);
+    cov[kSigma][kSigma] = std::pow(prior.specificTensionSd, 2);
+    cov[kSize][kSize] = std::pow(prior.geometryScaleSd, 2);
     cov[kExtensorMass][kExtensorMass] += m2 / double(std::max<std::size_t>(extensors_.size(), 1));
     for (int a = kFirstMass; a < n; ++a) cov[a][a] += m2;
     cov[kTendon][kTendon] = cov[kSynergistTendon][kSynergistTendon] = std::pow(prior.tendonLengthSd, 2);
@@ -129,6 +150,8 @@ SynergistModel::SynergistModel(const Population& prior, const SynergistOptions& 
     priorMean_.assign(n, 0.0);
     for (int a : masses) priorMean_[a] = std::log(prior.strengthMeanScale);
     priorMean_[kBicepsSlow] = priorMean_[kSynergistSlow] = prior.slowFractionMeanShift;
+    priorMean_[kSigma] = std::log(prior.specificTensionMeanScale);
+    priorMean_[kSize] = std::log(prior.geometryMeanScale);
     priorMean_[kActivation] = 0.5 * (prior.voluntaryActivation.min + prior.voluntaryActivation.max);
     priorMean_[kCoContraction] = 0.5 * (prior.coContraction.min + prior.coContraction.max);
     const double lnLo = std::log(0.25), lnHi = std::log(4.0), lenLo = std::log(0.6), lenHi = std::log(1.4);
@@ -145,6 +168,9 @@ SynergistModel::SynergistModel(const Population& prior, const SynergistOptions& 
         lower_[j] = options.freeSlowFraction ? prior.slowFractionMeanShift - 0.3 : prior.slowFractionMeanShift;
         upper_[j] = options.freeSlowFraction ? prior.slowFractionMeanShift + 0.3 : prior.slowFractionMeanShift;
     }
+    // Person-level scales the prior does not vary are known: held at their mean.
+    if (prior.specificTensionSd == 0) lower_[kSigma] = upper_[kSigma] = priorMean_[kSigma];
+    if (prior.geometryScaleSd == 0) lower_[kSize] = upper_[kSize] = priorMean_[kSize];
     lower_[kActivation] = inside(prior.voluntaryActivation.min);
     upper_[kActivation] = inside(prior.voluntaryActivation.max);
     lower_[kCoContraction] = inside(prior.coContraction.min);
@@ -156,10 +182,25 @@ std::vector<std::string> SynergistModel::getParameterNames() const {
     std::vector<std::string> names = {"ln_biceps_tendon_scale", "voluntary_activation", "co_contraction",
                                       "ln_biceps_fascicle_scale", "ln_synergist_tendon_scale",
                                       "ln_synergist_fascicle_scale", "ln_extensor_mass_scale",
-                                      "biceps_slow_fraction_shift", "synergist_slow_fraction_shift"};
+                                      "biceps_slow_fraction_shift", "synergist_slow_fraction_shift",
+                                      "ln_specific_tension_scale", "ln_size_scale"};
     for (int i : biceps_) names.push_back("ln_" + base_->muscles[i].params.name + "_mass_scale");
     for (int i : synergists_) names.push_back("ln_" + base_->muscles[i].params.name + "_mass_scale");
     return names;
+}
+
+int SynergistModel::findAngle(double flexionDeg, std::vector<double>& angles) {
+    auto it = std::find(angles.begin(), angles.end(), flexionDeg);
+    if (it != angles.end()) return int(it - angles.begin());
+    angles.push_back(flexionDeg);
+    return int(angles.size()) - 1;
+}
+
+int SynergistModel::findKind(MuscleGroup group, double level) {
+    auto it = std::find_if(kinds_.begin(), kinds_.end(), [&](const EffortKind& k) { return k.group == group && k.level == level; });
+    if (it != kinds_.end()) return int(it - kinds_.begin());
+    kinds_.push_back({group, level});
+    return int(kinds_.size()) - 1;
 }
 
 int SynergistModel::findMassIndex(int muscle) const {
@@ -195,20 +236,69 @@ std::vector<MuscleSpec> SynergistModel::makeMuscles(const double* x) const {
         q.slowFraction = std::clamp(q.slowFraction + x[kSynergistSlow], 0.05, 0.95);
     }
     for (int i : extensors_) m[i].params.mass *= std::exp(x[kExtensorMass]);
+    const double sigma = std::exp(x[kSigma]), g = std::exp(x[kSize]);
+    for (MuscleSpec& spec : m) {
+        MuscleParameters& q = spec.params;
+        q.coefficients.sigma *= sigma;
+        q.optimalFascicleLength *= g;
+        q.optimalTendonLength *= g;
+        q.maxPathLength *= g;
+    }
     return m;
 }
 
 std::vector<double> SynergistModel::calcTorques(const double* x) const {
+    std::vector<double> torques, channels;
+    calcPredictions(x, torques, channels);
+    return torques;
+}
+
+void SynergistModel::calcPredictions(const double* x, std::vector<double>& torques, std::vector<double>& channels) const {
     // Guard: the bounds keep difference probes inside [0, 1].
     const double va = std::clamp(x[kActivation], 0.0, 1.0), cc = std::clamp(x[kCoContraction], 0.0, 1.0);
     const std::vector<MuscleSpec> muscles = makeMuscles(x);
-    const SteadyMvcCurve relaxed = calcRelaxedCurve(muscles, geometry_);
-    std::vector<std::vector<double>> byKind;
+    const double g = std::exp(x[kSize]);
+    MvcGeometry scaled;
+    if (g != 1) {  // every length scales by g: paths and moment arms too
+        scaled = geometry_;
+        for (auto* table : {&scaled.pathLength, &scaled.momentArm, &scaled.forearmMomentArm})
+            for (std::vector<double>& row : *table)
+                for (double& v : row) v *= g;
+    }
+    const MvcGeometry& geometry = g != 1 ? scaled : geometry_;
+    const SteadyMvcCurve relaxed = calcRelaxedCurve(muscles, geometry);
+    std::vector<SteadyMvcCurve> active;
     for (const EffortKind& k : kinds_)
-        byKind.push_back(calcTaredTorque(muscles, geometry_, k.group, makeEffort(k.level, va, cc), relaxed, leftOut_));
-    std::vector<double> t;
-    for (std::size_t c = 0; c < angleOf_.size(); ++c) t.push_back(byKind[kindOf_[c]][angleOf_[c]]);
-    return t;
+        active.push_back(calcSteadyMvcCurve(muscles, geometry, k.group, makeEffort(k.level, va, cc)));
+    torques.clear();
+    for (std::size_t c = 0; c < angleOf_.size(); ++c) {
+        const int a = angleOf_[c];
+        const SteadyMvcCurve& curve = active[kindOf_[c]];
+        double t = 0;
+        for (std::size_t i = 0; i < muscles.size(); ++i)
+            if (std::find(leftOut_.begin(), leftOut_.end(), int(i)) == leftOut_.end())
+                t += curve.points[a][i].torque - relaxed.points[a][i].torque;
+        torques.push_back(t);
+    }
+    channels.clear();
+    for (std::size_t k = 0; k < channels_.size(); ++k) {
+        const ChannelObservation& o = channels_[k];
+        const int m = channelMuscle_[k];
+        double v = 0;
+        if (o.channel == "fascicle_length") {
+            const SteadyMvcCurve& curve = channelKind_[k] < 0 ? relaxed : active[channelKind_[k]];
+            v = curve.points[channelAngle_[k]][m].fibreLength * muscles[m].params.optimalFascicleLength;
+        } else if (o.channel == "volume") {
+            v = muscles[m].params.mass / muscles[m].params.coefficients.density;
+        } else if (o.channel == "emg") {
+            const bool agonist = muscles[m].group == o.effort;
+            const double own = o.level * (agonist ? va : cc), other = o.level * (agonist ? cc : va);
+            v = (own + emgCrosstalk_ * other) / (va + emgCrosstalk_ * cc);
+        } else {  // upper_arm_length
+            v = base_->arm.upperArmLength * g;
+        }
+        channels.push_back(v);
+    }
 }
 
 MuscleEstimate identifySynergistAware(const Population& prior, const std::vector<TorqueObservation>& data,
@@ -227,9 +317,16 @@ MuscleEstimate identifySynergistAware(const Population& prior, const std::vector
         torque.push_back(o.torque);
     }
     const SynergistModel model(prior, options, conditions);
+    const std::vector<ChannelObservation>& channels = options.channels;
+    for (const ChannelObservation& o : channels)
+        if (!(o.sd > 0) || !std::isfinite(o.value))
+            throw InputError("synergist-aware identifier: " + o.channel + " measurement" +
+                             (o.line > 0 ? " on line " + std::to_string(o.line) : std::string()) +
+                             " has value " + formatNumber(o.value) + " and sd " + formatNumber(o.sd) +
+                             ": expected a finite value and sd > 0");
 
     MuscleEstimate est;
-    est.method = measured ? "synergist-va" : "synergist";
+    est.method = !channels.empty() ? "channels" : measured ? "synergist-va" : "synergist";
     std::tie(est.noiseLevel, est.noiseDegreesOfFreedom) = estimateNoiseLevel(data);
     if (std::isfinite(options.noiseLevel)) {
         checkField("noise level", options.noiseLevel, Bound{0, 0.5, true, true, "relative sd"});
@@ -244,21 +341,28 @@ MuscleEstimate identifySynergistAware(const Population& prior, const std::vector
     for (double t : torque) sd.push_back(est.noiseLevel * std::max(std::abs(t), 1.0));
 
     using P = SynergistModel;
+    const std::size_t nt = torque.size(), nc = channels.size();
     MapProblem map;
     map.priorMean = model.getPriorMean();
     map.priorCovariance = model.getPriorCovariance();
     map.lower = model.getLower();
     map.upper = model.getUpper();
-    map.numResiduals = int(torque.size()) + (measured ? 1 : 0);
+    map.numResiduals = int(nt + nc) + (measured ? 1 : 0);
+    // Residuals: torques, then channels, then the measured activation.
+    auto calcResiduals = [&](const double* x, double* r) {
+        std::vector<double> t, c;
+        model.calcPredictions(x, t, c);
+        for (std::size_t k = 0; k < nt; ++k) r[k] = (t[k] - torque[k]) / sd[k];
+        for (std::size_t k = 0; k < nc; ++k) r[nt + k] = (c[k] - channels[k].value) / channels[k].sd;
+        if (measured) r[nt + nc] = (x[P::kActivation] - options.measuredActivation) / options.activationSd;
+        return t;
+    };
     map.residuals = [&](const double* x, double* r) {
-        if (measured) r[torque.size()] = (x[P::kActivation] - options.measuredActivation) / options.activationSd;
-        std::vector<double> t;
         try {
-            t = model.calcTorques(x);
+            calcResiduals(x, r);
         } catch (const std::exception&) {
             return false;
         }
-        for (std::size_t k = 0; k < torque.size(); ++k) r[k] = (t[k] - torque[k]) / sd[k];
         return true;
     };
     const MapResult m = calcMapEstimate(map);
@@ -273,7 +377,7 @@ MuscleEstimate identifySynergistAware(const Population& prior, const std::vector
     const int im = model.getMassIndex();
     est.numParameters = model.getNumParameters();
     est.mass = b.mass * std::exp(x[im]);
-    est.tendonLength = b.optimalTendonLength * std::exp(x[P::kTendon]);
+    est.tendonLength = b.optimalTendonLength * std::exp(x[P::kTendon] + x[P::kSize]);
     est.nuisanceNames = {"voluntary_activation", "co_contraction", "biceps_fascicle_scale", "synergist_tendon_scale",
                          "synergist_fascicle_scale", "extensor_mass_scale"};
     est.nuisance = {x[P::kActivation], x[P::kCoContraction], std::exp(x[P::kFascicle]),
@@ -282,34 +386,87 @@ MuscleEstimate identifySynergistAware(const Population& prior, const std::vector
         est.nuisanceNames.insert(est.nuisanceNames.end(), {"biceps_slow_fraction_shift", "synergist_slow_fraction_shift"});
         est.nuisance.insert(est.nuisance.end(), {x[P::kBicepsSlow], x[P::kSynergistSlow]});
     }
+    if (prior.specificTensionSd > 0) {
+        est.nuisanceNames.push_back("specific_tension_scale");
+        est.nuisance.push_back(std::exp(x[P::kSigma]));
+    }
+    if (prior.geometryScaleSd > 0) {
+        est.nuisanceNames.push_back("size_scale");
+        est.nuisance.push_back(std::exp(x[P::kSize]));
+    }
     for (int i = 0; i < base.getNumMuscles(); ++i) {
         const int k = model.findMassIndex(i);
         if (k < 0 || i == base.primary) continue;
         est.nuisanceNames.push_back(base.muscles[i].params.name + "_mass_scale");
         est.nuisance.push_back(std::exp(x[k]));
     }
+    const MuscleParameters q = model.makeMuscles(x.data())[base.primary].params;
+    est.specificTension = q.coefficients.sigma;
+    est.maxForce = q.coefficients.sigma * q.mass / (q.coefficients.density * q.optimalFascicleLength);
+    std::vector<double> r(map.numResiduals);
     try {
-        const std::vector<double> t = model.calcTorques(x.data());
+        const std::vector<double> t = calcResiduals(x.data(), r.data());
         double ss = 0;
-        for (std::size_t k = 0; k < torque.size(); ++k) {
+        for (std::size_t k = 0; k < nt; ++k) {
             est.predictedTorque.push_back(t[k]);
             ss += std::pow(t[k] - torque[k], 2);
         }
-        est.rmsResidual = std::sqrt(ss / double(torque.size()));
+        est.rmsResidual = std::sqrt(ss / double(nt));
     } catch (const std::exception& e) {
         est.converged = false;
         est.message += "; no steady state at the estimate: " + std::string(e.what());
         return est;
     }
+    // Per channel: chi-square of its residuals and the worst measurement.
+    auto addFit = [&](const std::string& channel, std::size_t k, const std::string& what) {
+        auto it = std::find_if(est.channelFits.begin(), est.channelFits.end(),
+                               [&](const ChannelFit& f) { return f.channel == channel; });
+        if (it == est.channelFits.end()) {
+            ChannelFit f;
+            f.channel = channel;
+            f.chiSquare = 0;
+            est.channelFits.push_back(f);
+            it = est.channelFits.end() - 1;
+        }
+        ++it->n;
+        it->chiSquare += r[k] * r[k];
+        if (!(std::abs(r[k]) <= std::abs(it->worstResidual))) {
+            it->worstResidual = r[k];
+            it->worst = what;
+        }
+    };
+    auto describe = [](double flexionDeg, MuscleGroup effort, double level) {
+        return std::string(getEffortName(effort)) + (level == 1 ? " MVC" : level == 0 ? " (at rest)" : " " + formatNumber(100 * level) + " %") +
+               " at " + formatNumber(flexionDeg) + " deg";
+    };
+    for (std::size_t k = 0; k < nt; ++k) addFit("torque", k, describe(data[k].flexionDeg, data[k].effort, data[k].level));
+    for (std::size_t k = 0; k < nc; ++k) {
+        const ChannelObservation& o = channels[k];
+        addFit(o.channel, nt + k,
+               o.muscle + (std::isfinite(o.flexionDeg) ? ", " + describe(o.flexionDeg, o.effort, o.level) : std::string()));
+    }
+    if (measured) addFit("activation", nt + nc, "twitch interpolation");
+    for (ChannelFit& f : est.channelFits) f.p = calcChiSquareSurvival(f.chiSquare, f.n);
     if (!m.covariance.empty()) {
         const double quantile = est.noiseDegreesOfFreedom > 0 ? calcStudentTQuantile(0.975, est.noiseDegreesOfFreedom)
                                                           : calcNormalQuantile(0.975);
-        const double sm = std::sqrt(m.covariance[im][im]), st = std::sqrt(m.covariance[P::kTendon][P::kTendon]);
-        est.massLower = b.mass * std::exp(x[im] - quantile * sm);
-        est.massUpper = b.mass * std::exp(x[im] + quantile * sm);
-        est.tendonLower = b.optimalTendonLength * std::exp(x[P::kTendon] - quantile * st);
-        est.tendonUpper = b.optimalTendonLength * std::exp(x[P::kTendon] + quantile * st);
-        est.massTendonCorrelation = m.covariance[im][P::kTendon] / (sm * st);
+        const auto& C = m.covariance;
+        const int it = P::kTendon, ig = P::kSize, is = P::kSigma, jf = P::kFascicle;
+        const double sm = std::sqrt(C[im][im]);
+        // ln L0T = ln t_b + ln g; ln F0 = ln sigma + ln M - ln f_b - ln g (+ constants).
+        const double vt = C[it][it] + C[ig][ig] + 2 * C[it][ig];
+        const std::vector<std::pair<int, double>> f0 = {{is, 1}, {im, 1}, {jf, -1}, {ig, -1}};
+        double vf = 0;
+        for (const auto& [a, ca] : f0)
+            for (const auto& [c, cb] : f0) vf += ca * cb * C[a][c];
+        const double st = std::sqrt(std::max(vt, 0.0)), sf = std::sqrt(std::max(vf, 0.0));
+        est.massLower = est.mass * std::exp(-quantile * sm);
+        est.massUpper = est.mass * std::exp(quantile * sm);
+        est.tendonLower = est.tendonLength * std::exp(-quantile * st);
+        est.tendonUpper = est.tendonLength * std::exp(quantile * st);
+        est.maxForceLower = est.maxForce * std::exp(-quantile * sf);
+        est.maxForceUpper = est.maxForce * std::exp(quantile * sf);
+        est.massTendonCorrelation = (C[im][it] + C[im][ig]) / (sm * st);
     }
     return est;
 }

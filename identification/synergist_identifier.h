@@ -2,14 +2,17 @@
 // by the whole model (every muscle at its steady state), with the population as prior. Free: a log
 // mass scale per biceps head and per synergist, one for the extensors, the biceps heads' tendon and
 // fascicle length scales, the synergists' tendon and fascicle scales, voluntary activation VA and
-// co-contraction CC (and optionally the flexors' slow-fibre fractions). Data residuals are weighted by
+// co-contraction CC (and optionally the flexors' slow-fibre fractions); the person's specific-tension
+// and size scales when the prior population varies them. Data residuals are weighted by
 // a relative noise level estimated from the repetitions' scatter; the posterior covariance is the
 // Laplace approximation; 95 % intervals are symmetric in the log scales (Student-t quantile with the
 // noise estimate's degrees of freedom), so the M and L0T intervals are exp-transformed. With VA
-// measured by twitch interpolation it has one more residual ("synergist-va").
+// measured by twitch interpolation it has one more residual ("synergist-va"); with the channels of
+// experiments/channels.h (ultrasound fascicle length and volume, EMG, anthropometry) one residual per
+// measurement, each divided by its own sd ("channels").
 #pragma once
 
-#include "experiments/torque_protocol.h"
+#include "experiments/channels.h"
 #include "identification/torque_estimate.h"
 #include "model/mvc_curve.h"
 
@@ -38,21 +41,28 @@ struct SynergistOptions {
     /// Relative sd of one trial's torque [1]; NaN: estimated from the repetitions (pooled over the
     /// conditions), or the population's transducer noise when nothing is repeated.
     double noiseLevel = 0.0 / 0.0;
+    /// Measurements besides torque (experiments/channels.h), each a residual (model - value) / sd.
+    std::vector<ChannelObservation> channels;
+    double emgCrosstalk = 0.10;  ///< c of the EMG measurement model (ChannelNoise::emgCrosstalk) [1]
 };
 
 /// The synergist-aware identifier's model: its parameters x, their prior and bounds, and the tared
 /// steady torque it predicts for a list of effort conditions (also used by experiment design).
-/// x = [ln t_b, VA, CC, ln f_b, ln t_s, ln f_s, ln s_e, d_b, d_s, then ln s_m for every biceps head and
-/// synergist m]: t tendon, f fascicle length and s mass scales; b the biceps heads (one tendon and one
-/// fascicle scale), s the synergists, e the extensors (one mass scale); d the change of the slow-fibre
-/// fraction F_slow (added, biceps heads and synergists; held at 0 unless freeSlowFraction). Prior: every mass scale shares the
-/// person-level variance (the extensors' one scale averages their muscle terms); lengths and effort
-/// independent, effort uniform ranges as their mean and sd.
+/// x = [ln t_b, VA, CC, ln f_b, ln t_s, ln f_s, ln s_e, d_b, d_s, ln sigma, ln g, then ln s_m for every
+/// biceps head and synergist m]: t tendon, f fascicle length and s mass scales; b the biceps heads (one
+/// tendon and one fascicle scale), s the synergists, e the extensors (one mass scale); d the change of
+/// the slow-fibre fraction F_slow (added, biceps heads and synergists; held at 0 unless
+/// freeSlowFraction); sigma the person's specific-tension scale (every muscle; F0 = sigma M / (rho L0))
+/// and g the person's size (every length; moment arms and path lengths scale with it), each held at the
+/// prior's mean when the prior population does not vary it. Prior: every mass scale shares the
+/// person-level variance (the extensors' one scale averages their muscle terms); lengths, sigma, g and
+/// effort independent, effort uniform ranges as their mean and sd.
 class SynergistModel {
 public:
     /// Throws InputError for muscle names not in the population's model or a primary muscle that is
-    /// not in the biceps group. Conditions may repeat (each distinct angle and effort kind is computed
-    /// once); their repetitions are ignored.
+    /// not in the biceps group, and for channel measurements of muscles not in the model. Conditions
+    /// may repeat (each distinct angle and effort kind is computed once); their repetitions are ignored.
+    /// options.channels are the measurements calcChannels predicts.
     SynergistModel(const Population& prior, const SynergistOptions& options,
                    const std::vector<TorqueCondition>& conditions);
     int getNumParameters() const { return kFirstMass + int(biceps_.size() + synergists_.size()); }
@@ -61,19 +71,24 @@ public:
     std::vector<int> getFlexorMassIndices() const;  ///< the biceps heads' and synergists' ln mass scales
     static constexpr int getTendonIndex() { return kTendon; }          ///< ln t_b
     static constexpr int getActivationIndex() { return kActivation; }  ///< VA
+    static constexpr int getFascicleIndex() { return kFascicle; }      ///< ln f_b
+    static constexpr int getSpecificTensionIndex() { return kSigma; }  ///< ln sigma
+    static constexpr int getSizeIndex() { return kSize; }              ///< ln g
     const std::vector<double>& getPriorMean() const { return priorMean_; }
     const std::vector<std::vector<double>>& getPriorCovariance() const { return priorCovariance_; }
     const std::vector<double>& getLower() const { return lower_; }
     const std::vector<double>& getUpper() const { return upper_; }
     /// Tared torque of every condition at x [N m]; throws SimulationError where a muscle has no steady state.
     std::vector<double> calcTorques(const double* x) const;
+    /// Tared torques and every channel measurement's predicted value (options.channels' order) at x.
+    void calcPredictions(const double* x, std::vector<double>& torques, std::vector<double>& channels) const;
     /// The population's model with x's muscles.
     std::vector<MuscleSpec> makeMuscles(const double* x) const;
 
 private:
     static constexpr int kTendon = 0, kActivation = 1, kCoContraction = 2, kFascicle = 3, kSynergistTendon = 4,
                          kSynergistFascicle = 5, kExtensorMass = 6, kBicepsSlow = 7, kSynergistSlow = 8,
-                         kFirstMass = 9;
+                         kSigma = 9, kSize = 10, kFirstMass = 11;
     struct EffortKind {
         MuscleGroup group;
         double level;
@@ -84,6 +99,11 @@ private:
     MvcGeometry geometry_;
     std::vector<EffortKind> kinds_;
     std::vector<int> angleOf_, kindOf_;       // condition -> angle index, effort kind
+    std::vector<ChannelObservation> channels_;
+    std::vector<int> channelMuscle_, channelAngle_, channelKind_;  // kind -1: relaxed
+    double emgCrosstalk_ = 0;
+    int findKind(MuscleGroup group, double level);
+    int findAngle(double flexionDeg, std::vector<double>& angles);
     std::vector<double> priorMean_, lower_, upper_;
     std::vector<std::vector<double>> priorCovariance_;
     friend MuscleEstimate identifySynergistAware(const Population&, const std::vector<TorqueObservation>&,

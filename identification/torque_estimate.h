@@ -7,6 +7,16 @@
 
 namespace armsim {
 
+/// How one channel's measurements fit at an estimate: chi-square of (model - value) / sd.
+struct ChannelFit {
+    std::string channel;           ///< torque, fascicle_length, volume, emg, upper_arm_length, activation
+    int n = 0;                     ///< measurements
+    double chiSquare = 0.0 / 0.0;
+    double p = 0.0 / 0.0;          ///< chi-square tail probability with n degrees of freedom; < 0.05: misfit
+    std::string worst;             ///< the measurement with the largest |residual| / sd, described
+    double worstResidual = 0.0 / 0.0;  ///< its (model - value) / sd
+};
+
 /// An identifier's estimate of the primary muscle (the biceps long head).
 struct MuscleEstimate {
     std::string method;                  ///< "thesis", "synergist" or "synergist-va"
@@ -25,6 +35,12 @@ struct MuscleEstimate {
     /// Per observation: the torque the method predicts at the estimate [N m] (thesis: the fitted biceps
     /// force x the biceps moment arm, flexion MVCs only; NaN elsewhere).
     std::vector<double> predictedTorque;
+    /// F0 = sigma M / (rho L0) of the primary muscle [N] with its 95 % interval, and the specific tension
+    /// sigma the mass assumes [N/m^2] (NaN for methods that do not estimate them).
+    double maxForce = 0.0 / 0.0, maxForceLower = 0.0 / 0.0, maxForceUpper = 0.0 / 0.0;
+    double specificTension = 0.0 / 0.0;
+    /// Per channel (torque first), the fit at the estimate (synergist kinds only).
+    std::vector<ChannelFit> channelFits;
     int numParameters = 0;                     ///< free parameters of the fit
     int iterations = 0;                        ///< solver iterations
 };

@@ -11,12 +11,13 @@
 namespace armsim {
 
 const std::vector<std::string>& getElbowMethodKinds() {
-    static const std::vector<std::string> kinds = {"thesis", "synergist", "synergist-va"};
+    static const std::vector<std::string> kinds = {"thesis", "synergist", "synergist-va", "channels"};
     return kinds;
 }
 
 MuscleEstimate identifyElbowMethod(const ElbowMethod& method, const Population& population,
-                                   const std::vector<TorqueObservation>& data, unsigned seed, int subject) {
+                                   const std::vector<TorqueObservation>& data, unsigned seed, int subject,
+                                   const std::vector<ChannelObservation>& channels) {
     MuscleEstimate e;
     if (method.kind == "thesis") {
         e = identifyThesisMethod(population.base, data);
@@ -29,8 +30,19 @@ MuscleEstimate identifyElbowMethod(const ElbowMethod& method, const Population& 
         checkField("activation_sd", o.activationSd, Bound{0, 0.5, true, false});
         o.measuredActivation = measureVoluntaryActivation(data, o.activationSd, seed + 7919u * unsigned(subject));
         e = identifySynergistAware(population, data, o);
+    } else if (method.kind == "channels") {
+        if (channels.empty())
+            throw InputError("identifier 'channels': the data hold no channel besides torque (the protocol records "
+                             "none: add ultrasound or emg to its conditions, or measurements)");
+        SynergistOptions o = method.options;
+        checkField("activation_sd", o.activationSd, Bound{0, 0.5, false, false});
+        o.measuredActivation = o.activationSd > 0
+                                   ? measureVoluntaryActivation(data, o.activationSd, seed + 7919u * unsigned(subject))
+                                   : 0.0 / 0.0;
+        o.channels = channels;
+        e = identifySynergistAware(population, data, o);
     } else {
-        throw InputError("identifier '" + method.kind + "': expected thesis, synergist or synergist-va");
+        throw InputError("identifier '" + method.kind + "': expected thesis, synergist, synergist-va or channels");
     }
     e.method = method.label.empty() ? method.kind : method.label;
     return e;

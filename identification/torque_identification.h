@@ -52,19 +52,23 @@ double findJudgingNoiseLevel(const TorqueIdentificationOptions& options, const s
 /// One identifier of a validation or a study, with its options.
 struct ElbowMethod {
     std::string label;           ///< its name in results (default: the kind)
-    std::string kind = "synergist";  ///< "thesis", "synergist" or "synergist-va"
-    /// synergist kinds: freeSlowFraction, includeSynergists, noiseLevel; synergist-va also activationSd
-    /// (the twitch-interpolation measurement's sd, drawn per subject by measureVoluntaryActivation).
+    std::string kind = "synergist";  ///< "thesis", "synergist", "synergist-va" or "channels"
+    /// synergist kinds: freeSlowFraction, includeSynergists, noiseLevel; synergist-va and channels also
+    /// activationSd (the twitch-interpolation measurement's sd, drawn per subject by
+    /// measureVoluntaryActivation; channels: 0 = not measured); channels also emgCrosstalk.
     SynergistOptions options;
 };
 /// The kinds ElbowMethod::kind may name.
 const std::vector<std::string>& getElbowMethodKinds();
 
 /// Identifies `data` of person `subject` with `method` (population as the synergist prior, its base
-/// model as the thesis method's assumed model). seed: of the study or validation (the VA measurement's
-/// seed derives from it and the subject). Throws what the identifier throws.
+/// model as the thesis method's assumed model); the channels method also fits `channels` (every channel
+/// the protocol recorded) with twitch interpolation. seed: of the study or validation (the VA
+/// measurement's seed derives from it and the subject). Throws what the identifier throws, and
+/// InputError for the channels method without channel data.
 MuscleEstimate identifyElbowMethod(const ElbowMethod& method, const Population& population,
-                                   const std::vector<TorqueObservation>& data, unsigned seed, int subject);
+                                   const std::vector<TorqueObservation>& data, unsigned seed, int subject,
+                                   const std::vector<ChannelObservation>& channels = {});
 
 
 }  // namespace armsim

@@ -341,6 +341,7 @@ ArmSetup loadModelFile(const std::string& file) {
         };
         if (roles.has("biceps")) s.bicepsHeads = read("biceps");
         if (roles.has("synergists")) s.synergists = read("synergists");
+        if (roles.has("surface_emg")) s.surfaceEmg = read("surface_emg");
         roles.finish();
         if (!s.bicepsHeads.empty() && std::find(s.bicepsHeads.begin(), s.bicepsHeads.end(), s.primary) == s.bicepsHeads.end())
             throw InputError(roles.where("biceps") + ": field 'roles.biceps' does not name the primary muscle '" +

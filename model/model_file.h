@@ -13,7 +13,7 @@
 //                                        (defaults of the virtual subject's effort, see SubjectEffort)
 //   specific_tension: SIGMA              [N/m^2] every muscle's sigma unless the muscle gives its own
 //                                        (default: the fibre-type file's, Virtual Muscle's 31.8 N/cm^2)
-//   roles: {biceps: [NAMES], synergists: [NAMES]}
+//   roles: {biceps: [NAMES], synergists: [NAMES], surface_emg: [NAMES]}
 //                                        the heads of the thesis's "biceps" (the primary among them) and
 //                                        the flexors the synergist-aware identifier estimates one by one
 //                                        (default: the primary alone; none)
@@ -123,6 +123,8 @@ struct ArmSetup {
     /// synergists: the other flexors an identifier estimates one by one (default none).
     std::vector<int> bicepsHeads;
     std::vector<int> synergists;
+    /// surface_emg: the muscles surface electrodes reach (their EMG is a channel; default none).
+    std::vector<int> surfaceEmg;
     std::vector<int> getBicepsHeads() const { return bicepsHeads.empty() ? std::vector<int>{primary} : bicepsHeads; }
 
     int getNumMuscles() const { return int(muscles.size()); }

@@ -255,6 +255,9 @@ IsometricTrialResult runIsometricTrial(const ArmSetup& setup, const IsometricTri
     while (first < time.size() && time[first] < from) ++first;
     sum.finalForce = t.get(t.getNumRows() - 1, "muscle_force_N");
     sum.meanForce = mean(t.getColumn("muscle_force_N"), first);
+    const std::vector<double> fascicle = t.getColumn("fascicle_length_m");
+    sum.restFascicleLength = fascicle.front();
+    sum.meanFascicleLength = mean(fascicle, first);
     sum.meanStrapForce = mean(t.getColumn("strap_force_N"), first);
     sum.meanForceMomentArm = mean(t.getColumn("force_moment_arm_N"), first);
     sum.meanForceFixedRatio = mean(t.getColumn("force_fixed_ratio_N"), first);

@@ -85,6 +85,8 @@ struct IsometricSummary {
     double restForce = 0;           ///< passive force of the primary muscle at rest (hidden by the tare) [N]
     double finalForce = 0;          ///< true force Fse of the primary muscle at the last sample [N]
     double meanForce = 0;           ///< true force of the primary muscle, window mean [N]
+    double restFascicleLength = 0;  ///< fascicle length L of the primary muscle at rest (first sample) [m]
+    double meanFascicleLength = 0;  ///< fascicle length of the primary muscle, window mean [m]
     double meanMuscleTorque = 0;    ///< tared elbow torque (what the transducer sees), window mean [N m]
     std::vector<double> pathLengths;     ///< per muscle [m]
     std::vector<double> momentArms;      ///< per muscle [m], + = flexor

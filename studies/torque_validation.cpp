@@ -18,6 +18,11 @@ ElbowValidationRow makeElbowValidationRow(const Population& population, const Vi
     row.method = method;
     row.trueMass = v.setup.muscles[primary].params.mass;
     row.trueTendonLength = v.setup.muscles[primary].params.optimalTendonLength;
+    const MuscleParameters& q = v.setup.muscles[primary].params;
+    row.trueMaxForce = q.coefficients.sigma * q.mass / (q.coefficients.density * q.optimalFascicleLength);
+    if (std::isfinite(e.maxForce)) row.maxForceError = e.maxForce / row.trueMaxForce - 1;
+    if (std::isfinite(e.maxForceLower))
+        row.maxForceCovered = row.trueMaxForce >= e.maxForceLower && row.trueMaxForce <= e.maxForceUpper;
     row.estimate = e;
     row.massError = e.mass / row.trueMass - 1;
     row.tendonError = e.tendonLength - row.trueTendonLength;
@@ -59,17 +64,25 @@ std::vector<ElbowValidationRow> runElbowValidation(const Population& population,
     std::vector<double> levels = settings.noiseLevels;
     if (levels.empty()) levels.push_back(population.transducerNoise);
     for (double v : levels) checkField("noise", v, Bound{0, 0.5, false, true, "relative sd"});
-    std::vector<ElbowMethod> methods(settings.activationSd > 0 ? 3 : 2);
-    for (std::size_t k = 0; k < methods.size(); ++k) {
-        methods[k].kind = getElbowMethodKinds()[k];
-        methods[k].options.freeSlowFraction = settings.freeSlowFraction;
-        methods[k].options.activationSd = settings.activationSd;
+    std::vector<ElbowMethod> methods;
+    for (const std::string& kind : getElbowMethodKinds()) {
+        if ((kind == "synergist-va" && settings.activationSd == 0) || (kind == "channels" && !settings.protocol.hasChannels()))
+            continue;
+        ElbowMethod m;
+        m.kind = kind;
+        m.options.freeSlowFraction = settings.freeSlowFraction;
+        m.options.activationSd = settings.activationSd;
+        m.options.emgCrosstalk = settings.protocol.channelNoise.emgCrosstalk;
+        methods.push_back(m);
     }
 
     std::vector<std::vector<ElbowValidationRow>> perSubject(settings.subjects);
     runParallel(settings.subjects, settings.jobs, [&](int s) {
         const VirtualSubject v = drawSubject(population, settings.seed, s);
         const std::vector<TorqueObservation> clean = synthesizeTorqueData(v, settings.protocol, settings.seed, 1);
+        const std::vector<ChannelObservation> channels =
+            settings.protocol.hasChannels() ? synthesizeChannelData(v, settings.protocol, clean, settings.seed)
+                                            : std::vector<ChannelObservation>{};
         for (double level : levels) {
             const std::vector<TorqueObservation> data = setTransducerNoise(clean, level);
             for (const ElbowMethod& m : methods) {
@@ -77,7 +90,7 @@ std::vector<ElbowValidationRow> runElbowValidation(const Population& population,
                 // than unknowns) is recorded as failed, not fatal.
                 MuscleEstimate e;
                 try {
-                    e = identifyElbowMethod(m, prior, data, settings.seed, s);
+                    e = identifyElbowMethod(m, prior, data, settings.seed, s, channels);
                 } catch (const std::exception& x) {
                     e.method = m.kind;
                     e.message = x.what();
@@ -129,6 +142,15 @@ std::vector<ElbowValidationSummary> summarizeElbowValidation(const std::vector<E
             s.tendonBias = tb / n, s.tendonRmse = std::sqrt(tm / n);
         }
         if (mn > 0) s.massCoverage = double(mc) / mn, s.massIntervalWidth = mw / mn;
+        double fb = 0, fm = 0;
+        int fn = 0, fc = 0, fcn = 0;
+        for (const ElbowValidationRow& r : rows) {
+            if (r.method != s.method || r.noise != s.noise || !std::isfinite(r.maxForceError)) continue;
+            ++fn, fb += r.maxForceError, fm += r.maxForceError * r.maxForceError;
+            if (r.maxForceCovered >= 0) ++fcn, fc += r.maxForceCovered;
+        }
+        if (fn > 0) s.maxForceBias = fb / fn, s.maxForceRmse = std::sqrt(fm / fn);
+        if (fcn > 0) s.maxForceCoverage = double(fc) / fcn;
         if (tn > 0) s.tendonCoverage = double(tc) / tn, s.tendonIntervalWidth = tw / tn;
         // Standard errors over subjects: the mean's, the RMSE's by the delta method (sd of the squared
         // error / (2 RMSE sqrt n)), a fraction's binomial sqrt(p (1 - p) / n).
@@ -156,7 +178,9 @@ std::string formatElbowValidationCsv(const std::vector<ElbowValidationRow>& rows
     CsvText csv({"subject", "noise", "method", "converged", "true_mass_kg", "mass_kg", "mass_lower_kg", "mass_upper_kg",
                  "mass_error_pct", "mass_covered", "true_tendon_length_m", "tendon_length_m", "tendon_lower_m",
                  "tendon_upper_m", "tendon_error_mm", "tendon_covered", "voluntary_activation", "co_contraction",
-                 "strength_level", "biceps_short_scale", "synergist_scale", "noise_level_used", "rms_residual"});
+                 "strength_level", "biceps_short_scale", "synergist_scale", "noise_level_used", "rms_residual",
+                 "true_max_force_N", "max_force_N", "max_force_lower_N", "max_force_upper_N", "max_force_error_pct",
+                 "max_force_covered"});
     auto flag = [](CsvRow& row, int c) -> CsvRow& { return c < 0 ? row.addEmpty() : row.addInteger(c); };
     for (const ElbowValidationRow& r : rows) {
         const MuscleEstimate& e = r.estimate;
@@ -168,6 +192,8 @@ std::string formatElbowValidationCsv(const std::vector<ElbowValidationRow>& rows
         flag(row.addNumber(1000 * r.tendonError), r.tendonCovered);
         row.addNumber(r.voluntaryActivation).addNumber(r.coContraction).addNumber(r.strengthLevel);
         row.addNumber(r.bicepsShortScale).addNumber(r.synergistScale).addNumber(e.noiseLevel).addNumber(e.rmsResidual);
+        row.addNumber(r.trueMaxForce).addNumber(e.maxForce).addNumber(e.maxForceLower).addNumber(e.maxForceUpper);
+        flag(row.addNumber(100 * r.maxForceError), r.maxForceCovered);
         csv.addRow(row);
     }
     return csv.getText();
@@ -176,7 +202,8 @@ std::string formatElbowValidationCsv(const std::vector<ElbowValidationRow>& rows
 std::string formatElbowValidationSummaryCsv(const std::vector<ElbowValidationSummary>& summaries) {
     CsvText csv({"method", "noise", "subjects", "converged", "mass_bias_pct", "mass_rmse_pct", "mass_coverage",
                  "tendon_bias_mm", "tendon_rmse_mm", "tendon_coverage", "mass_bias_se_pct", "mass_rmse_se_pct",
-                 "mass_coverage_se", "tendon_bias_se_mm", "tendon_rmse_se_mm", "tendon_coverage_se"});
+                 "mass_coverage_se", "tendon_bias_se_mm", "tendon_rmse_se_mm", "tendon_coverage_se",
+                 "max_force_bias_pct", "max_force_rmse_pct", "max_force_coverage"});
     for (const ElbowValidationSummary& s : summaries) {
         CsvRow row;
         row.addText(s.method).addNumber(s.noise).addInteger(s.subjects).addInteger(s.converged);
@@ -184,6 +211,7 @@ std::string formatElbowValidationSummaryCsv(const std::vector<ElbowValidationSum
         row.addNumber(1000 * s.tendonBias).addNumber(1000 * s.tendonRmse).addNumber(s.tendonCoverage);
         row.addNumber(100 * s.massBiasSe).addNumber(100 * s.massRmseSe).addNumber(s.massCoverageSe);
         row.addNumber(1000 * s.tendonBiasSe).addNumber(1000 * s.tendonRmseSe).addNumber(s.tendonCoverageSe);
+        row.addNumber(100 * s.maxForceBias).addNumber(100 * s.maxForceRmse).addNumber(s.maxForceCoverage);
         csv.addRow(row);
     }
     return csv.getText();

@@ -16,11 +16,14 @@ struct ElbowValidationRow {
     double noise = 0;                  ///< transducer noise used [1]
     std::string method;
     double trueMass = 0, trueTendonLength = 0;   ///< the subject's primary muscle [kg], [m]
+    double trueMaxForce = 0;                     ///< its F0 = sigma M / (rho L0) [N]
     MuscleEstimate estimate;
     double massError = 0.0 / 0.0;      ///< estimate / truth - 1 [1]
     double tendonError = 0.0 / 0.0;    ///< estimate - truth [m]
     int massCovered = -1;              ///< 1/0: truth inside/outside the interval; -1: no interval
     int tendonCovered = -1;
+    double maxForceError = 0.0 / 0.0;  ///< F0 estimate / truth - 1 (methods that estimate F0) [1]
+    int maxForceCovered = -1;
     // Nuisance truths, for error-vs-nuisance plots.
     double voluntaryActivation = 0, coContraction = 0, strengthLevel = 0;
     double bicepsShortScale = 0.0 / 0.0;  ///< second biceps head's mass scale / primary's [1]
@@ -38,6 +41,8 @@ struct ElbowValidationSummary {
     int subjects = 0, converged = 0;
     double massBias = 0, massRmse = 0;        ///< relative [1]; NaN when no subject has an estimate
     double tendonBias = 0, tendonRmse = 0;    ///< [m]
+    double maxForceBias = 0.0 / 0.0, maxForceRmse = 0.0 / 0.0;  ///< relative [1]; NaN without F0 estimates
+    double maxForceCoverage = 0.0 / 0.0;
     double massCoverage = 0.0 / 0.0, tendonCoverage = 0.0 / 0.0;  ///< fraction of subjects [1]
     double massIntervalWidth = 0.0 / 0.0;     ///< mean 95 % interval width / estimate [1]
     double tendonIntervalWidth = 0.0 / 0.0;   ///< mean 95 % interval width [m]
@@ -61,7 +66,9 @@ struct ElbowValidationSettings {
 };
 
 /// Draws subjects 0..subjects-1 from `truth`, synthesizes each one's data once per noise level (common
-/// random numbers across levels), identifies with every method using `prior` as the identifiers' prior
+/// random numbers across levels; the channels besides torque once), identifies with every method
+/// (thesis, synergist, synergist-va when activationSd > 0, and channels when the protocol records
+/// channels besides torque) using `prior` as the identifiers' prior
 /// and model (out of family when the two differ). Throws InputError unless the two models' primary
 /// muscles have the same name. progress(done, total) per subject.
 std::vector<ElbowValidationRow> runElbowValidation(const Population& truth, const Population& prior,

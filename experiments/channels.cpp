@@ -1,0 +1,243 @@
+#include "experiments/channels.h"
+
+#include "basics/bound.h"
+#include "basics/csv.h"
+#include "basics/errors.h"
+#include "basics/files.h"
+#include "basics/format.h"
+#include "basics/plot.h"
+#include "basics/portable_random.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <sstream>
+
+namespace armsim {
+
+namespace {
+
+// Baseline noise of a normalised EMG amplitude: a relaxed muscle reads about 1-2 % of its MVC
+// amplitude (docs/channels.md), so the sd of small values does not shrink to zero.
+constexpr double kEmgFloor = 0.02;
+
+const TorqueCondition* findCondition(const TorqueProtocol& p, const TorqueObservation& o) {
+    for (const TorqueCondition& c : p.conditions)
+        if (c.flexionDeg == o.flexionDeg && c.effort == o.effort && c.level == o.level) return &c;
+    return nullptr;
+}
+
+}  // namespace
+
+const std::vector<std::string>& getChannelNames() {
+    static const std::vector<std::string> names = {"fascicle_length", "volume", "emg", "upper_arm_length"};
+    return names;
+}
+
+std::vector<ChannelObservation> synthesizeChannelData(const VirtualSubject& subject, const TorqueProtocol& protocol,
+                                                      const std::vector<TorqueObservation>& torque,
+                                                      unsigned noiseSeed) {
+    protocol.validate();
+    const ArmSetup& s = subject.setup;
+    const ChannelNoise& n = protocol.channelNoise;
+    PortableRandom rng{noiseSeed, subject.seed, unsigned(subject.index), 2u};
+    const std::string primary = s.muscles[s.primary].params.name;
+    std::vector<ChannelObservation> out;
+    auto add = [&](ChannelObservation o, double clean, double relativeSd, double floor) {
+        o.cleanValue = clean;
+        o.value = clean * (1 + relativeSd * rng.drawNormal());
+        o.sd = relativeSd * std::max(std::abs(o.value), floor);
+        out.push_back(o);
+    };
+    const SubjectEffort& e = s.effort;
+    const double emgMvc = e.voluntaryActivation + n.emgCrosstalk * e.coContraction;  // at its own group's MVC
+    for (const TorqueObservation& t : torque) {
+        const TorqueCondition* c = findCondition(protocol, t);
+        if (!c) throw InputError("synthesizeChannelData: a torque trial at " + formatNumber(t.flexionDeg) +
+                                 " deg is not a condition of protocol '" + protocol.name + "'");
+        ChannelObservation o;
+        o.flexionDeg = t.flexionDeg;
+        o.effort = t.effort;
+        o.repetition = t.repetition;
+        if (c->ultrasound) {
+            if (!std::isfinite(t.restFascicleLength) || !std::isfinite(t.fascicleLength))
+                throw InputError("synthesizeChannelData: trial at " + formatNumber(t.flexionDeg) +
+                                 " deg has no fascicle length (expected synthesizeTorqueData's output)");
+            o.channel = "fascicle_length";
+            o.muscle = primary;
+            o.level = 0;
+            add(o, t.restFascicleLength, n.fascicleLength, 0);
+            o.level = t.level;
+            add(o, t.fascicleLength, n.fascicleLength, 0);
+        }
+        if (c->emg) {
+            o.channel = "emg";
+            o.level = t.level;
+            for (int m : s.surfaceEmg) {
+                const MuscleGroup g = s.muscles[m].group;
+                if (g != MuscleGroup::Flexor && g != MuscleGroup::Extensor) continue;
+                const bool agonist = g == t.effort;
+                const double own = agonist ? t.activation : t.antagonistActivation;
+                const double other = agonist ? t.antagonistActivation : t.activation;
+                o.muscle = s.muscles[m].params.name;
+                add(o, (own + n.emgCrosstalk * other) / emgMvc, n.emg, kEmgFloor);
+            }
+        }
+    }
+    if (protocol.volumeScan) {
+        const MuscleParameters& p = s.muscles[s.primary].params;
+        ChannelObservation o;
+        o.channel = "volume";
+        o.muscle = primary;
+        add(o, p.mass / p.coefficients.density, n.volume, 0);
+    }
+    if (protocol.anthropometry) {
+        ChannelObservation o;
+        o.channel = "upper_arm_length";
+        o.cleanValue = s.arm.upperArmLength;
+        o.value = o.cleanValue + n.upperArmLength * rng.drawNormal();
+        o.sd = n.upperArmLength;
+        out.push_back(o);
+    }
+    return out;
+}
+
+std::string formatChannelData(const std::vector<ChannelObservation>& data, bool truth) {
+    std::vector<std::string> header = {"channel", "muscle", "flexion_deg", "effort", "level", "repetition", "value", "sd"};
+    if (truth) header.push_back("clean_value");
+    CsvText csv(header);
+    for (const ChannelObservation& o : data) {
+        CsvRow r;
+        r.addText(o.channel).addText(o.muscle).addNumber(o.flexionDeg).addInteger(o.effort == MuscleGroup::Flexor ? 1 : -1);
+        r.addNumber(o.level).addInteger(o.repetition).addNumber(o.value).addNumber(o.sd);
+        if (truth) r.addNumber(o.cleanValue);
+        csv.addRow(r);
+    }
+    return "# channels besides torque (docs/channels.md): fascicle_length [m] (level 0: at rest), volume [m^3],\n"
+           "# emg [1, of the muscle's MVC amplitude], upper_arm_length [m]; sd: the measurement's sd, same units\n" +
+           csv.getText();
+}
+
+std::vector<ChannelObservation> readChannelData(const std::string& path) {
+    checkInputFile(path, 64u << 20);
+    std::istringstream in(readFileText(path));
+    std::string line;
+    int lineNo = 0;
+    std::vector<std::string> header;
+    std::map<std::string, int> column;
+    std::vector<ChannelObservation> data;
+    static const std::vector<std::string> known = {"channel", "muscle", "flexion_deg", "effort", "level",
+                                                   "repetition", "value", "sd", "clean_value"};
+    while (std::getline(in, line)) {
+        ++lineNo;
+        if (!line.empty() && line.back() == '\r') line.pop_back();
+        const auto first = line.find_first_not_of(" \t");
+        if (first == std::string::npos || line[first] == '#') continue;
+        const std::vector<std::string> cells = splitCsvRecord(line);
+        const std::string at = path + ":" + std::to_string(lineNo);
+        if (header.empty()) {
+            header = cells;
+            for (std::size_t k = 0; k < header.size(); ++k) {
+                if (std::find(known.begin(), known.end(), header[k]) == known.end())
+                    throw InputError(at + ": unknown column '" + header[k] +
+                                     "': expected channel, muscle, flexion_deg, effort, level, repetition, value, sd "
+                                     "(clean_value: truth of synthetic data, ignored)");
+                if (!column.emplace(header[k], int(k)).second)
+                    throw InputError(at + ": column '" + header[k] + "' appears twice");
+            }
+            for (const char* c : {"channel", "value", "sd"})
+                if (!column.count(c)) throw InputError(at + ": missing column '" + std::string(c) + "'");
+            continue;
+        }
+        if (cells.size() != header.size())
+            throw InputError(at + ": " + std::to_string(cells.size()) + " cells: expected " +
+                             std::to_string(header.size()) + " (one per header column)");
+        auto text = [&](const char* c) { return column.count(c) ? cells[column[c]] : std::string(); };
+        auto number = [&](const char* c, double fallback) {
+            const std::string v = text(c);
+            if (v.empty()) return fallback;
+            std::size_t used = 0;
+            double x = 0;
+            try {
+                x = std::stod(v, &used);
+            } catch (const std::exception&) {
+                used = 0;
+            }
+            if (used != v.size() || !std::isfinite(x))
+                throw InputError(at + ": column '" + std::string(c) + "' = '" + v + "': expected a finite number");
+            return x;
+        };
+        auto fail = [&](const char* c, const std::string& v, const std::string& expected) {
+            throw InputError(at + ": column '" + std::string(c) + "' = " + v + ": expected " + expected);
+        };
+        ChannelObservation o;
+        o.line = lineNo;
+        o.channel = text("channel");
+        if (std::find(getChannelNames().begin(), getChannelNames().end(), o.channel) == getChannelNames().end())
+            fail("channel", "'" + o.channel + "'", "fascicle_length, volume, emg or upper_arm_length");
+        o.muscle = text("muscle");
+        if (o.muscle.empty() && o.channel != "upper_arm_length") fail("muscle", "''", "the muscle's name in the model");
+        o.flexionDeg = number("flexion_deg", 0.0 / 0.0);
+        const bool atAngle = o.channel == "fascicle_length" || o.channel == "emg";
+        if (atAngle && !(o.flexionDeg >= 0 && o.flexionDeg <= 180))
+            fail("flexion_deg", formatNumber(o.flexionDeg), "in [0, 180] (0 = extended) for " + o.channel);
+        const double effort = number("effort", 1);
+        if (effort != 1 && effort != -1) fail("effort", formatNumber(effort), "1 (flexion) or -1 (extension)");
+        o.effort = effort == 1 ? MuscleGroup::Flexor : MuscleGroup::Extensor;
+        o.level = number("level", 0);
+        if (!(o.level >= 0 && o.level <= 1)) fail("level", formatNumber(o.level), "in [0, 1] (0: relaxed)");
+        if (o.channel == "emg" && o.level == 0) fail("level", "0", "> 0 for emg (an effort's EMG)");
+        const double rep = number("repetition", 0);
+        if (rep != std::floor(rep) || rep < 0 || rep > 1e6) fail("repetition", formatNumber(rep), "an integer >= 0");
+        o.repetition = int(rep);
+        o.value = number("value", 0.0 / 0.0);
+        if (!std::isfinite(o.value) || (o.channel != "emg" && o.value <= 0))
+            fail("value", formatNumber(o.value), o.channel == "emg" ? "a finite number" : "> 0 (SI units)");
+        o.sd = number("sd", 0.0 / 0.0);
+        if (!(o.sd > 0)) fail("sd", formatNumber(o.sd), "> 0 (the measurement's sd, units of value)");
+        o.cleanValue = number("clean_value", 0.0 / 0.0);
+        data.push_back(o);
+    }
+    if (header.empty()) throw InputError(path + ": no header line");
+    if (data.empty()) throw InputError(path + ": no data rows");
+    return data;
+}
+
+std::vector<std::string> writeChannelPlots(const std::string& dir, const std::vector<ChannelObservation>& data,
+                                           const std::string& title) {
+    PlotSpec fascicle, emg;
+    fascicle.title = title + ": fascicle length (ultrasound)";
+    fascicle.xLabel = emg.xLabel = "elbow flexion (deg, 0 = extended)";
+    fascicle.yLabel = "fascicle length (cm)";
+    emg.title = title + ": normalised EMG";
+    emg.yLabel = "EMG (fraction of MVC amplitude)";
+    auto seriesOf = [](PlotSpec& p, const std::string& label) -> PlotSeries& {
+        for (PlotSeries& s : p.series)
+            if (s.label == label) return s;
+        p.series.push_back({label, {}, {}, true, int(p.series.size()) % 8});
+        return p.series.back();
+    };
+    for (const ChannelObservation& o : data) {
+        if (o.channel == "fascicle_length") {
+            PlotSeries& s = seriesOf(fascicle, o.muscle + (o.level == 0 ? " at rest" : " at " + formatNumber(100 * o.level) + " %"));
+            s.x.push_back(o.flexionDeg);
+            s.y.push_back(100 * o.value);
+        } else if (o.channel == "emg") {
+            PlotSeries& s = seriesOf(emg, o.muscle + (o.effort == MuscleGroup::Flexor ? " in flexion" : " in extension"));
+            s.x.push_back(o.flexionDeg);
+            s.y.push_back(o.value);
+        }
+    }
+    std::vector<std::string> paths;
+    if (!fascicle.series.empty()) {
+        paths.push_back(dir + "/fascicle_length.png");
+        writePlotPng(paths.back(), fascicle);
+    }
+    if (!emg.series.empty()) {
+        paths.push_back(dir + "/emg.png");
+        writePlotPng(paths.back(), emg);
+    }
+    return paths;
+}
+
+}  // namespace armsim
