@@ -229,6 +229,7 @@ struct ValidateOptions {
     std::vector<double> angles;  // flexion angles [deg] of the elbow protocol; empty: the thesis's five
     int repetitions = 3;
     std::string protocol;   // torque protocol file (replaces --angles/--repetitions)
+    bool freeSlowFraction = false;
     bool noiseGiven = false;
 };
 
@@ -246,8 +247,10 @@ void addElbowValidationPlots(const std::vector<ElbowValidationRow>& rows, Output
     vsSynergists.xLabel = "synergists' mass scale / biceps's";
     vsSynergists.yLabel = "mass error (%)";
     double lo = 1e9, hi = 0;
-    for (const char* method : {"thesis", "synergist", "synergist-va"}) {
-        const int color = std::string(method) == "thesis" ? 1 : std::string(method) == "synergist" ? 0 : 2;
+    for (const char* method : {"thesis", "synergist", "synergist-va", "channels"}) {
+        const std::string m = method;
+        const int color = m == "thesis" ? 1 : m == "synergist" ? 0 : m == "synergist-va" ? 2 : 3;
+        if (std::none_of(rows.begin(), rows.end(), [&](const ElbowValidationRow& r) { return r.method == m; })) continue;
         PlotSeries a{method, {}, {}, true, color}, b = a, c = a;
         for (const ElbowValidationRow& r : rows) {
             if (r.method != method || !std::isfinite(r.estimate.mass)) continue;
@@ -280,6 +283,7 @@ void runElbowValidate(const ValidateOptions& o) {
     s.seed = o.seed;
     s.jobs = o.jobs;
     s.activationSd = o.activationSd;
+    s.freeSlowFraction = o.freeSlowFraction;
     if (!o.protocol.empty()) {
         s.protocol = readTorqueProtocol(o.protocol);
     } else {
@@ -296,9 +300,11 @@ void runElbowValidate(const ValidateOptions& o) {
     std::printf("validation on the elbow model as truth: population '%s' (%s), %d subjects, seed %u; protocol "
                 "'%s' (%d trials: %s); identifiers: thesis (biceps only), synergist-aware (MAP) and, with "
                 "--activation-sd > 0, synergist-aware with voluntary activation measured by twitch interpolation "
-                "(synergist-va)\n",
+                "(synergist-va)%s\n",
                 population.name.c_str(), population.file.c_str(), s.subjects, s.seed, s.protocol.name.c_str(),
-                s.protocol.getNumTrials(), describeConditions(s.protocol).c_str());
+                s.protocol.getNumTrials(), describeConditions(s.protocol).c_str(),
+                s.protocol.hasChannels() ? "; with the protocol's channels besides torque, the same MAP fitting every "
+                                           "channel (channels)" : "");
     std::fflush(stdout);
     const std::vector<ElbowValidationRow> rows =
         runElbowValidation(population, prior, s, [](int d, int n) { printProgress("subjects", d, n); });
@@ -313,8 +319,15 @@ void runElbowValidate(const ValidateOptions& o) {
                     1000 * x.tendonBiasSe, 1000 * x.tendonRmse, 1000 * x.tendonRmseSe, x.tendonCoverage,
                     x.tendonCoverageSe);
     std::printf("(+/- one standard error over the subjects; a 95 %% interval is about twice that)\n");
+    for (const ElbowValidationSummary& x : summary)
+        if (std::isfinite(x.maxForceRmse))
+            std::printf("%-13s F0: bias %+.1f %%, RMSE %.1f %%, coverage %.2f\n", x.method.c_str(), 100 * x.maxForceBias,
+                        100 * x.maxForceRmse, x.maxForceCoverage);
     std::printf("goal (issue 11, synergist-aware at 2 %% noise): |mass bias| <= 3 %%, mass RMSE <= 10 %%, "
                 "L0T RMSE <= 10 mm, coverage 0.90-0.98\n");
+    if (s.protocol.hasChannels())
+        std::printf("goal (issue 31, every channel, out of family): |mass bias| <= 3 %%, mass and F0 RMSE <= 7 %%, "
+                    "mass coverage 0.90-0.98, L0T RMSE <= 5 mm\n");
     OutputFolder out(o.out, OutputFolder::Mode::AddFiles);
     out.write("elbow_validation.csv", formatElbowValidationCsv(rows));
     out.write("elbow_validation_summary.csv", formatElbowValidationSummaryCsv(summary));
@@ -397,6 +410,8 @@ void addValidateCommand(CLI::App& app) {
     c->add_option("--protocol", o->protocol,
                   "--truth elbow: torque protocol file (kind: torque, e.g. written by `armsim design`) instead of "
                   "--angles/--repetitions");
+    c->add_flag("--free-slow-fraction", o->freeSlowFraction,
+                "--truth elbow: the synergist identifiers free the flexors' slow-fibre fractions");
     c->add_option("--subjects", o->subjects, "subjects for --truth elbow")->capture_default_str()->check(CLI::Range(1, 1000000));
     c->callback([o, c] {
         o->noiseGiven = c->count("--noise") > 0;
@@ -406,7 +421,7 @@ void addValidateCommand(CLI::App& app) {
             throw InputError("--population is both the truth and the prior: with --truth-population and --prior "
                              "it has nothing left to do; give two of the three");
         for (const char* option : {"--population", "--truth-population", "--prior", "--subjects", "--activation-sd",
-                                   "--angles", "--repetitions", "--protocol"})
+                                   "--angles", "--repetitions", "--protocol", "--free-slow-fraction"})
             if (o->truth != "elbow" && c->count(option))
                 throw InputError(std::string(option) + " needs --truth elbow");
         if (o->truth == "elbow")

@@ -1,9 +1,11 @@
 // armsim identify-torque: the biceps long head's mass and tendon length from tared elbow torque data
-// (a torque data file: measured, or written by `armsim protocol` for a torque protocol) with every
-// elbow method (thesis, synergist, synergist-va), with residuals checked against the measurement noise.
+// (a torque data file: measured, or written by `armsim protocol` for a torque protocol) and the lab's
+// other channels (--channels: ultrasound, EMG, anthropometry) with every elbow method (thesis,
+// synergist, synergist-va, channels), with residuals checked against the measurement noise per channel.
 #include "basics/output_folder.h"
 #include "basics/plot.h"
 #include "cli/commands.h"
+#include "experiments/channels.h"
 #include "identification/torque_identification.h"
 #include "muscles/muscle_file.h"
 
@@ -21,6 +23,9 @@ struct IdentifyTorqueOptions {
     double noiseLevel = NAN;     // relative sd of one trial's torque; NaN: from repetitions
     double activation = NAN;     // measured voluntary activation (twitch interpolation); NaN: not measured
     double activationSd = 0.02;
+    std::string channels;        // channel CSV; empty: torque only
+    double emgCrosstalk = 0.10;
+    bool freeSlowFraction = false;
     std::string out = "out/identify_torque";
 };
 
@@ -35,6 +40,12 @@ void runIdentifyTorque(const IdentifyTorqueOptions& o) {
     to.noiseLevel = o.noiseLevel;
     to.activation = o.activation;
     to.activationSd = o.activationSd;
+    to.freeSlowFraction = o.freeSlowFraction;
+    to.emgCrosstalk = o.emgCrosstalk;
+    if (!o.channels.empty()) {
+        to.channels = readChannelData(findAsset(o.channels));
+        std::printf("channel data %s: %zu measurements\n", findAsset(o.channels).c_str(), to.channels.size());
+    }
     std::string skipped;
     const std::vector<MuscleEstimate> estimates = identifyTorqueData(prior, data, to, &skipped);
     if (!skipped.empty()) std::printf("%s\n", skipped.c_str());
@@ -55,6 +66,15 @@ void runIdentifyTorque(const IdentifyTorqueOptions& o) {
     }
     std::printf("verdict: 'noise' = residuals consistent with the measurement noise (chi-square p >= 0.05), "
                 "'misfit' = larger than the noise explains\n");
+    for (const MuscleEstimate& e : estimates) {
+        if (e.method != "channels") continue;
+        std::printf("channels fit: F0 %.0f N [%.0f, %.0f] at specific tension %.1f N/cm^2\n", e.maxForce, e.maxForceLower,
+                    e.maxForceUpper, 1e-4 * e.specificTension);
+        std::printf("%-17s %4s %10s %7s %8s   %s\n", "channel", "n", "chi2", "p", "verdict", "largest residual (sd): where");
+        for (const ChannelFit& f : e.channelFits)
+            std::printf("%-17s %4d %10.1f %7.3f %8s   %+.1f: %s\n", f.channel.c_str(), f.n, f.chiSquare, f.p,
+                        f.p >= 0.05 ? "noise" : "misfit", f.worstResidual, f.worst.c_str());
+    }
     std::printf("%-9s %6s %6s %4s %11s", "effort", "angle", "level", "rep", "measured");
     for (const MuscleEstimate& e : estimates) std::printf(" %13s", e.method.c_str());
     std::printf("   (predicted torque, N m)\n");
@@ -69,6 +89,7 @@ void runIdentifyTorque(const IdentifyTorqueOptions& o) {
     OutputFolder out(o.out, OutputFolder::Mode::AddFiles);
     out.write("torque_estimates.csv", formatTorqueEstimatesCsv(data, estimates, noise));
     out.write("torque_predictions.csv", formatTorquePredictionsCsv(data, estimates));
+    out.write("channel_fits.csv", formatChannelFitsCsv(estimates));
     PlotSpec plot;
     plot.title = "Torque data and each method's fit";
     plot.xLabel = "elbow flexion (deg, 0 = extended)";
@@ -85,7 +106,7 @@ void runIdentifyTorque(const IdentifyTorqueOptions& o) {
     }
     out.writeWith("torque_fit.png", [&](const std::string& p) { writePlotPng(p, plot); });
     out.commit();
-    std::printf("wrote %s/torque_estimates.csv, torque_predictions.csv, torque_fit.png\n", o.out.c_str());
+    std::printf("wrote %s/torque_estimates.csv, torque_predictions.csv, channel_fits.csv, torque_fit.png\n", o.out.c_str());
 }
 
 void addIdentifyTorqueCommand(CLI::App& app) {
@@ -101,6 +122,12 @@ void addIdentifyTorqueCommand(CLI::App& app) {
     c->add_option("--activation", o->activation, "measured voluntary activation (twitch interpolation): adds synergist-va")
         ->check(CLI::Range(0.0, 1.0));
     c->add_option("--activation-sd", o->activationSd, "sd of that measurement")->capture_default_str()->check(CLI::Range(1e-4, 0.5));
+    c->add_option("--channels", o->channels,
+                  "channel CSV (docs/channels.md: ultrasound fascicle length and volume, EMG, upper-arm length): adds "
+                  "the channels fit");
+    c->add_option("--emg-crosstalk", o->emgCrosstalk, "crosstalk c of the EMG measurement model")
+        ->capture_default_str()->check(CLI::Range(0.0, 0.5));
+    c->add_flag("--free-slow-fraction", o->freeSlowFraction, "the synergist fits free the flexors' slow-fibre fractions");
     c->add_option("--out", o->out, "output directory")->capture_default_str();
     c->callback([o] { runIdentifyTorque(*o); });
 }

@@ -5,6 +5,7 @@
 #include "basics/parallel.h"
 #include "basics/table.h"
 #include "cli/commands.h"
+#include "experiments/channels.h"
 #include "cli/plugins.h"
 #include "experiments/protocol.h"
 #include "experiments/torque_protocol.h"
@@ -132,9 +133,14 @@ void runTorqueProtocolCommand(const ProtocolOptions& o, const std::string& file)
     std::printf("  %-9s %6s %6s %4s %12s\n", "effort", "angle", "level", "rep", "torque (N m)");
     for (const TorqueObservation& d : data)
         std::printf("  %-9s %6.1f %6.2f %4d %12.2f\n", getEffortName(d.effort), d.flexionDeg, d.level, d.repetition, d.torque);
-    writeTorqueProtocolRun(out, protocol, data);
-    std::printf("wrote %s/torque_data.csv (identify with `armsim identify --torque-data`), protocol.yaml, torque_angle.png\n",
-                out.c_str());
+    const std::vector<ChannelObservation> channels =
+        protocol.hasChannels() ? synthesizeChannelData(subject, protocol, data, protocol.seed) : std::vector<ChannelObservation>{};
+    if (!channels.empty()) std::printf("  channels besides torque: %zu measurements (channel_data.csv)\n", channels.size());
+    const std::vector<std::string> files = writeTorqueProtocolRun(out, protocol, data, channels);
+    std::printf("wrote");
+    for (const std::string& f : files) std::printf(" %s", f.c_str());
+    std::printf("\n(identify with `armsim identify-torque %s/torque_data.csv%s`)\n", out.c_str(),
+                channels.empty() ? "" : (" --channels " + out + "/channel_data.csv").c_str());
 }
 
 void runProtocolCommand(const ProtocolOptions& o) {

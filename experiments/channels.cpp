@@ -46,7 +46,7 @@ std::vector<ChannelObservation> synthesizeChannelData(const VirtualSubject& subj
     auto add = [&](ChannelObservation o, double clean, double relativeSd, double floor) {
         o.cleanValue = clean;
         o.value = clean * (1 + relativeSd * rng.drawNormal());
-        o.sd = relativeSd * std::max(std::abs(o.value), floor);
+        o.sd = relativeSd * std::max(std::abs(clean), floor);  // the device's sd at the true level
         out.push_back(o);
     };
     const SubjectEffort& e = s.effort;
@@ -84,11 +84,17 @@ std::vector<ChannelObservation> synthesizeChannelData(const VirtualSubject& subj
             }
         }
     }
-    if (protocol.volumeScan) {
-        const MuscleParameters& p = s.muscles[s.primary].params;
+    for (const std::string& name : protocol.volumeScan) {
+        int m = 0;
+        try {
+            m = s.findMuscle(name);
+        } catch (const InputError& x) {
+            throw InputError("protocol '" + protocol.name + "': measurements.volume_scan: " + x.what());
+        }
+        const MuscleParameters& p = s.muscles[m].params;
         ChannelObservation o;
         o.channel = "volume";
-        o.muscle = primary;
+        o.muscle = name;
         add(o, p.mass / p.coefficients.density, n.volume, 0);
     }
     if (protocol.anthropometry) {

@@ -3,8 +3,8 @@
 // - fascicle_length: B-mode ultrasound of the primary muscle's fascicle length [m], imaged at rest
 //   (level 0) just before an effort and at the effort's plateau; relative error sd_f (the fascicle
 //   runs beyond the probe and is extrapolated).
-// - volume: the primary muscle's volume [m^3] from a panoramic ultrasound scan (ACSA x length x shape
-//   factor): relative error sd_v. With specific tension varying between people, torque sees
+// - volume: a muscle's volume [m^3] from a panoramic ultrasound scan (ACSA x length x shape factor):
+//   relative error sd_v. With specific tension varying between people, torque sees
 //   F0 = sigma V / L0 and only this channel sees V (mass = rho V).
 // - emg: surface EMG amplitude of each muscle in the model's surface_emg role, normalised to that
 //   muscle's amplitude in an MVC of its own group: e_m = (a_m + c a_o) / (VA + c CC) with a_m the

@@ -1,5 +1,7 @@
 #include "experiments/torque_protocol.h"
 
+#include "experiments/channels.h"
+
 #include "basics/files.h"
 #include "basics/param_node.h"
 #include "basics/plot.h"
@@ -47,7 +49,7 @@ bool TorqueProtocol::usesEmg() const {
 }
 
 bool TorqueProtocol::hasChannels() const {
-    return volumeScan || anthropometry ||
+    return !volumeScan.empty() || anthropometry ||
            std::any_of(conditions.begin(), conditions.end(), [](const TorqueCondition& c) { return c.ultrasound || c.emg; });
 }
 
@@ -97,7 +99,7 @@ std::string describeConditions(const TorqueProtocol& protocol) {
         if (channels) out += std::string(" with ") + (channels & 1 ? "ultrasound" : "") + (channels == 3 ? " and " : "") +
                              (channels & 2 ? "EMG" : "");
     }
-    if (protocol.volumeScan) out += "; volume scan";
+    if (!protocol.volumeScan.empty()) out += "; volume scan of " + formatList(protocol.volumeScan);
     if (protocol.anthropometry) out += "; anthropometry";
     return out;
 }
@@ -132,7 +134,7 @@ TorqueProtocol readTorqueProtocol(const std::string& path) {
     }
     if (root.has("measurements")) {
         const ParamNode m = root.child("measurements");
-        p.volumeScan = m.getBool("volume_scan", false);
+        if (m.has("volume_scan")) p.volumeScan = m.getStrings("volume_scan");
         p.anthropometry = m.getBool("anthropometry", false);
         m.finish();
     }
@@ -191,7 +193,9 @@ std::string formatTorqueProtocol(const TorqueProtocol& p) {
         out += "  model: " + p.model + "\n  transducer_noise: " + formatNumber(p.transducerNoise) + "\n";
     if (p.hasChannels()) {
         const ChannelNoise& n = p.channelNoise;
-        out += std::string("measurements: {volume_scan: ") + (p.volumeScan ? "true" : "false") +
+        std::string names;
+        for (const std::string& v : p.volumeScan) names += (names.empty() ? "" : ", ") + v;
+        out += "measurements: {volume_scan: [" + names + "]" +
                ", anthropometry: " + (p.anthropometry ? "true" : "false") + "}\n";
         out += "channel_noise: {fascicle_length: " + formatNumber(n.fascicleLength) + ", volume: " + formatNumber(n.volume) +
                ", emg: " + formatNumber(n.emg) + ", emg_crosstalk: " + formatNumber(n.emgCrosstalk) +
@@ -375,11 +379,17 @@ void writeTorquePlot(const std::string& path, const std::vector<TorqueObservatio
 }
 
 std::vector<std::string> writeTorqueProtocolRun(const std::string& dir, const TorqueProtocol& protocol,
-                                                const std::vector<TorqueObservation>& data) {
-    const std::vector<std::string> paths = {dir + "/torque_data.csv", dir + "/protocol.yaml", dir + "/torque_angle.png"};
+                                                const std::vector<TorqueObservation>& data,
+                                                const std::vector<ChannelObservation>& channels) {
+    std::vector<std::string> paths = {dir + "/torque_data.csv", dir + "/protocol.yaml", dir + "/torque_angle.png"};
     writeFileAtomically(paths[0], formatTorqueData(data, true));
     writeFileAtomically(paths[1], formatTorqueProtocol(protocol));
     writeTorquePlot(paths[2], data, "Protocol " + protocol.name + ": tared torque per trial");
+    if (!channels.empty()) {
+        paths.push_back(dir + "/channel_data.csv");
+        writeFileAtomically(paths.back(), formatChannelData(channels, true));
+        for (const std::string& p : writeChannelPlots(dir, channels, "Protocol " + protocol.name)) paths.push_back(p);
+    }
     return paths;
 }
 

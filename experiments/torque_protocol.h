@@ -20,6 +20,7 @@
 namespace armsim {
 
 class Table;
+struct ChannelObservation;
 
 /// One condition of a torque protocol.
 struct TorqueCondition {
@@ -63,7 +64,8 @@ struct TorqueProtocol {
     std::string model = "elbow";
     double transducerNoise = 0.02;   ///< relative sd (model subject only) [1]
     unsigned seed = 1;               ///< population and noise seed
-    bool volumeScan = false;         ///< one panoramic ultrasound scan of the primary muscle's volume
+    /// Muscles whose volume a panoramic ultrasound scan measures (once each; names in the model).
+    std::vector<std::string> volumeScan;
     bool anthropometry = false;      ///< the upper-arm length measured
     ChannelNoise channelNoise;       ///< errors of the channels besides torque
 
@@ -139,8 +141,10 @@ std::vector<TorqueObservation> makeTorqueData(const Table& table, const std::str
 void writeTorquePlot(const std::string& path, const std::vector<TorqueObservation>& data, const std::string& title);
 
 /// What `armsim protocol` writes for a torque protocol's run into dir: torque_data.csv (with the
-/// truth columns), protocol.yaml and torque_angle.png, each whole or not at all. Returns the paths.
+/// truth columns), protocol.yaml and torque_angle.png, and with channels channel_data.csv (truth
+/// column too) and their plots (writeChannelPlots), each whole or not at all. Returns the paths.
 std::vector<std::string> writeTorqueProtocolRun(const std::string& dir, const TorqueProtocol& protocol,
-                                                const std::vector<TorqueObservation>& data);
+                                                const std::vector<TorqueObservation>& data,
+                                                const std::vector<ChannelObservation>& channels = {});
 
 }  // namespace armsim

@@ -51,15 +51,29 @@ MuscleEstimate identifyElbowMethod(const ElbowMethod& method, const Population& 
 std::string formatTorqueEstimatesCsv(const std::vector<TorqueObservation>& data,
                                      const std::vector<MuscleEstimate>& estimates, double noiseLevel) {
     CsvText csv({"method", "converged", "mass_kg", "mass_lower_kg", "mass_upper_kg", "tendon_length_m",
-                 "tendon_lower_m", "tendon_upper_m", "rms_residual_Nm", "chi_square", "dof", "p_value", "noise_level"});
+                 "tendon_lower_m", "tendon_upper_m", "rms_residual_Nm", "chi_square", "dof", "p_value", "noise_level",
+                 "max_force_N", "max_force_lower_N", "max_force_upper_N", "specific_tension_N_per_m2"});
     for (const MuscleEstimate& e : estimates) {
         const TorqueResidualCheck c = checkTorqueResiduals(data, e, noiseLevel);
         CsvRow row;
         row.addText(e.method).addInteger(e.converged ? 1 : 0).addNumber(e.mass).addNumber(e.massLower);
         row.addNumber(e.massUpper).addNumber(e.tendonLength).addNumber(e.tendonLower).addNumber(e.tendonUpper);
         row.addNumber(c.rms).addNumber(c.chiSquare).addInteger(c.dof).addNumber(c.p).addNumber(noiseLevel);
+        row.addNumber(e.maxForce).addNumber(e.maxForceLower).addNumber(e.maxForceUpper).addNumber(e.specificTension);
         csv.addRow(row);
     }
+    return csv.getText();
+}
+
+std::string formatChannelFitsCsv(const std::vector<MuscleEstimate>& estimates) {
+    CsvText csv({"method", "channel", "n", "chi_square", "p_value", "verdict", "worst", "worst_residual_sd"});
+    for (const MuscleEstimate& e : estimates)
+        for (const ChannelFit& f : e.channelFits) {
+            CsvRow row;
+            row.addText(e.method).addText(f.channel).addInteger(f.n).addNumber(f.chiSquare).addNumber(f.p);
+            row.addText(f.p >= 0.05 ? "noise" : "misfit").addText(f.worst).addNumber(f.worstResidual);
+            csv.addRow(row);
+        }
     return csv.getText();
 }
 
@@ -83,6 +97,7 @@ void TorqueIdentificationOptions::validate() const {
     if (!std::isnan(noiseLevel)) checkField("noise_level", noiseLevel, Bound::closed(1e-4, 0.5));
     if (!std::isnan(activation)) checkField("activation", activation, Bound::closed(0, 1));
     checkField("activation_sd", activationSd, Bound::closed(1e-4, 0.5));
+    checkField("emg_crosstalk", emgCrosstalk, Bound::closed(0, 0.5));
 }
 
 std::vector<MuscleEstimate> identifyTorqueData(const Population& prior, const std::vector<TorqueObservation>& data,
@@ -100,10 +115,16 @@ std::vector<MuscleEstimate> identifyTorqueData(const Population& prior, const st
                    std::to_string(mvcAngles.size()) + ")";
     SynergistOptions so;
     so.noiseLevel = o.noiseLevel;
+    so.freeSlowFraction = o.freeSlowFraction;
     estimates.push_back(identifySynergistAware(prior, data, so));
     if (std::isfinite(o.activation)) {
         so.measuredActivation = o.activation;
         so.activationSd = o.activationSd;
+        estimates.push_back(identifySynergistAware(prior, data, so));
+    }
+    if (!o.channels.empty()) {
+        so.channels = o.channels;
+        so.emgCrosstalk = o.emgCrosstalk;
         estimates.push_back(identifySynergistAware(prior, data, so));
     }
     return estimates;

@@ -15,13 +15,18 @@ struct TorqueIdentificationOptions {
     double noiseLevel = 0.0 / 0.0;   ///< relative sd of one trial's torque [1]; NaN: estimated from repetitions
     double activation = 0.0 / 0.0;   ///< measured voluntary activation [1]; NaN: not measured (no synergist-va)
     double activationSd = 0.02;      ///< sd of that measurement [1]
+    bool freeSlowFraction = false;   ///< the synergist kinds free the flexors' slow-fibre fractions
+    /// Channels besides torque (experiments/channels.h); non-empty: also the "channels" fit.
+    std::vector<ChannelObservation> channels;
+    double emgCrosstalk = 0.10;      ///< c of the EMG measurement model [1]
     /// InputError naming the field (noise_level in [1e-4, 0.5], activation in [0, 1], activation_sd
-    /// in [1e-4, 0.5]).
+    /// in [1e-4, 0.5], emg_crosstalk in [0, 0.5]).
     void validate() const;
 };
 
 /// Runs "thesis" (when the data hold flexion MVCs at two or more angles; otherwise *skipped says why),
-/// "synergist" and, with a measured activation, "synergist-va", each with the prior population.
+/// "synergist", with a measured activation "synergist-va", and with channels "channels" (every
+/// channel, and the activation when measured), each with the prior population.
 std::vector<MuscleEstimate> identifyTorqueData(const Population& prior, const std::vector<TorqueObservation>& data,
                                                const TorqueIdentificationOptions& options = {},
                                                std::string* skipped = nullptr);
@@ -42,6 +47,8 @@ TorqueResidualCheck checkTorqueResiduals(const std::vector<TorqueObservation>& d
 /// noiseLevel (checkTorqueResiduals) and the noise level.
 std::string formatTorqueEstimatesCsv(const std::vector<TorqueObservation>& data,
                                      const std::vector<MuscleEstimate>& estimates, double noiseLevel);
+/// channel_fits.csv: per estimate and channel, the chi-square check and the worst measurement.
+std::string formatChannelFitsCsv(const std::vector<MuscleEstimate>& estimates);
 /// torque_predictions.csv: every observation with each estimate's predicted torque (empty where none).
 std::string formatTorquePredictionsCsv(const std::vector<TorqueObservation>& data,
                                        const std::vector<MuscleEstimate>& estimates);

@@ -211,10 +211,12 @@ std::vector<StudyResult> runStudyGroup(const Study& study, long group, const std
     const auto t0 = Clock::now();
     VirtualSubject v;
     std::vector<TorqueObservation> clean;
+    std::vector<ChannelObservation> channels;
     std::string synthesisError;
     try {
         v = drawSubject(study.population, study.seed, subject);
         clean = synthesizeTorqueData(v, pr, study.seed, 1);
+        if (pr.hasChannels()) channels = synthesizeChannelData(v, pr, clean, study.seed);
     } catch (const InterruptedError&) {
         throw;  // not a failed task: the study stops and resumes later
     } catch (const std::exception& e) {
@@ -233,11 +235,14 @@ std::vector<StudyResult> runStudyGroup(const Study& study, long group, const std
         MuscleEstimate e;
         e.method = m.label;
         std::string error = synthesisError;
-        if (error.empty()) {
+        const bool skipped = m.kind == "channels" && !pr.hasChannels();
+        if (error.empty() && !skipped) {
             try {
                 auto it = noisy.find(t.noise);
                 if (it == noisy.end()) it = noisy.emplace(t.noise, setTransducerNoise(clean, level)).first;
-                e = identifyElbowMethod(m, study.prior, it->second, study.seed, subject);
+                ElbowMethod method = m;  // the EMG model's crosstalk is the protocol's
+                method.options.emgCrosstalk = pr.channelNoise.emgCrosstalk;
+                e = identifyElbowMethod(method, study.prior, it->second, study.seed, subject, channels);
             } catch (const InterruptedError&) {
                 throw;
             } catch (const std::exception& x) {
@@ -254,6 +259,10 @@ std::vector<StudyResult> runStudyGroup(const Study& study, long group, const std
             e.method = m.label;
             r.status = "failed";
             r.reason = error;
+        } else if (skipped) {
+            e.method = m.label;
+            r.status = "skipped";
+            r.reason = "protocol " + pr.name + " records no channel besides torque";
         } else {
             r.status = e.converged ? "ok" : std::isfinite(e.mass) ? "not-converged" : "failed";
             if (!e.converged) r.reason = e.message;
@@ -352,7 +361,7 @@ bool parseStudyJournalLine(const std::string& line, StudyResult& r) {
     e.iterations = int(iterations);
     e.numParameters = int(parameters);
     r.rank = int(rank);
-    return r.status == "ok" || r.status == "not-converged" || r.status == "failed";
+    return r.status == "ok" || r.status == "not-converged" || r.status == "failed" || r.status == "skipped";
 }
 
 std::vector<StudySummaryRow> summarizeStudy(const Study& study, const std::vector<StudyResult>& results) {
@@ -360,7 +369,7 @@ std::vector<StudySummaryRow> summarizeStudy(const Study& study, const std::vecto
     for (const StudyProtocol& p : study.protocols) {
         std::vector<ElbowValidationRow> rows;
         for (const StudyResult& r : results) {
-            if (r.protocol != p.protocol.name) continue;
+            if (r.protocol != p.protocol.name || r.status == "skipped") continue;
             rows.push_back(r.row);
             if (r.status == "failed") rows.back().massError = rows.back().tendonError = 0.0 / 0.0;
         }

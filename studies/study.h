@@ -78,7 +78,7 @@ StudyTask getStudyTask(const Study& study, long index);
 struct StudyResult {
     long task = 0;
     std::string protocol;          ///< the protocol's name
-    std::string status;            ///< "ok", "not-converged" or "failed"
+    std::string status;            ///< "ok", "not-converged", "failed" or "skipped" (channels on a torque-only protocol)
     std::string reason;            ///< why not ok (the solver's report or the error); "" when ok
     ElbowValidationRow row;        ///< truth, estimate, intervals, coverage (row.method: the method's label)
     // Not part of the deterministic results (timing.csv):

@@ -116,7 +116,8 @@ TEST(Population, BadFilesNameTheFileLineAndField) {
 // without them.
 TEST(Population, MeanScalesAndPersonLevelScalesMoveWhatTheyName) {
     constexpr double kExact = 1e-12;   // relative: scaling is exact arithmetic
-    const Population& base = population();
+    Population base = population();
+    base.specificTensionSd = base.geometryScaleSd = 0;  // the reference: no person-level scales
     Population p = base;
     p.strengthMeanScale = 1.26;
     p.slowFractionMeanShift = 0.1;

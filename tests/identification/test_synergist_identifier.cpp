@@ -126,3 +126,93 @@ TEST(ElbowIdentification, ZeroWidthEffortRangesAreHeldFixed) {
     EXPECT_LT(e.massLower, e.mass);
     EXPECT_GT(e.massUpper, e.mass);
 }
+
+// Issue 31: the channels fit recovers a known person from data its own model predicts (every
+// channel, 1 % errors), reports F0 = sigma M / (rho L0) at the estimate, and judges each channel on
+// its own: one fascicle image moved by 10 sd makes that channel a misfit, named with its angle, while
+// the others stay consistent with their noise.
+TEST(ElbowIdentification, ChannelsRecoverAKnownPersonAndJudgeEachChannel) {
+    constexpr double kRelSd = 0.01;              // every measurement's relative sd
+    constexpr double kMassTol = 0.03;            // relative: prior pull with 1 % data
+    constexpr double kTendonTol = 0.003;         // m
+    const Population& prior = population();
+    ASSERT_GT(prior.specificTensionSd, 0);       // sigma and size are free
+    ASSERT_GT(prior.geometryScaleSd, 0);
+    const ArmSetup& base = prior.base;
+    const std::string head = base.muscles[base.primary].params.name;
+    std::vector<TorqueCondition> conditions;
+    std::vector<ChannelObservation> channels;
+    for (double q : {30.0, 90.0, 135.0}) {
+        conditions.push_back({q, MuscleGroup::Flexor, 1.0, 1});
+        for (double level : {0.0, 1.0}) {
+            ChannelObservation o;
+            o.channel = "fascicle_length";
+            o.muscle = head;
+            o.flexionDeg = q;
+            o.level = level;
+            channels.push_back(o);
+        }
+        ChannelObservation e;
+        e.channel = "emg";
+        e.muscle = base.muscles[base.surfaceEmg.back()].params.name;
+        e.flexionDeg = q;
+        e.level = 1;
+        channels.push_back(e);
+    }
+    for (int m : base.getBicepsHeads()) {
+        ChannelObservation v;
+        v.channel = "volume";
+        v.muscle = base.muscles[m].params.name;
+        channels.push_back(v);
+    }
+    ChannelObservation arm;
+    arm.channel = "upper_arm_length";
+    channels.push_back(arm);
+    for (ChannelObservation& o : channels) o.sd = 1;  // placeholders for the model's construction
+    SynergistOptions options;
+    options.channels = channels;
+    const SynergistModel model(prior, options, conditions);
+    std::vector<double> x = model.getPriorMean();
+    const int im = model.getMassIndex();
+    x[im] += 0.2;
+    x[SynergistModel::getTendonIndex()] += 0.04;
+    x[SynergistModel::getSpecificTensionIndex()] += 0.1;
+    x[SynergistModel::getSizeIndex()] += 0.03;
+    std::vector<double> torques, predicted;
+    model.calcPredictions(x.data(), torques, predicted);
+    std::vector<TorqueObservation> data;
+    for (std::size_t k = 0; k < conditions.size(); ++k) {
+        TorqueObservation t;
+        t.flexionDeg = conditions[k].flexionDeg;
+        t.torque = torques[k];
+        data.push_back(t);
+    }
+    for (std::size_t k = 0; k < channels.size(); ++k) {
+        options.channels[k].value = predicted[k];
+        options.channels[k].sd = kRelSd * std::abs(predicted[k]);
+    }
+    options.noiseLevel = kRelSd;
+    const MuscleEstimate e = identifySynergistAware(prior, data, options);
+    ASSERT_TRUE(e.converged) << e.message;
+    EXPECT_EQ(e.method, "channels");
+    const MuscleParameters truth = model.makeMuscles(x.data())[base.primary].params;
+    EXPECT_NEAR(e.mass / truth.mass - 1, 0, kMassTol);
+    EXPECT_NEAR(e.tendonLength, truth.optimalTendonLength, kTendonTol);
+    EXPECT_LT(e.massLower, truth.mass);
+    EXPECT_GT(e.massUpper, truth.mass);
+    const double f0 = truth.coefficients.sigma * truth.mass / (truth.coefficients.density * truth.optimalFascicleLength);
+    EXPECT_NEAR(e.maxForce / f0 - 1, 0, 2 * kMassTol);
+    ASSERT_EQ(e.channelFits.size(), 5u);  // torque, fascicle_length, emg, volume, upper_arm_length
+    for (const ChannelFit& f : e.channelFits) EXPECT_GT(f.p, 0.05) << f.channel;
+
+    // One image 10 sd off: its channel is the misfit and names the angle.
+    options.channels[3].value += 10 * options.channels[3].sd;  // 90 deg at rest (after 30 deg: rest, MVC, EMG)
+    const MuscleEstimate bad = identifySynergistAware(prior, data, options);
+    for (const ChannelFit& f : bad.channelFits) {
+        if (f.channel == "fascicle_length") {
+            EXPECT_LT(f.p, 0.05);
+            EXPECT_NE(f.worst.find("90 deg"), std::string::npos) << f.worst;
+            EXPECT_NE(f.worst.find("rest"), std::string::npos) << f.worst;
+        }
+    }
+}
