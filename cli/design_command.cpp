@@ -6,6 +6,7 @@
 #include "basics/output_folder.h"
 #include "basics/plot.h"
 #include "cli/commands.h"
+#include "muscles/muscle_file.h"
 #include "studies/experiment_design.h"
 #include "studies/torque_validation.h"
 
@@ -30,6 +31,7 @@ struct DesignOptions {
     int jobs = 2;
     int validateSubjects = 0;
     bool freeSlowFraction = false;
+    double budget = 0;           // lab minutes: > 0 designs across channels
     std::string out = "out/design";
 };
 
@@ -59,6 +61,7 @@ void runDesign(const DesignOptions& o) {
     s.activationSd = o.activationSd;
     s.jobs = o.jobs;
     s.freeSlowFraction = o.freeSlowFraction;
+    s.budgetMinutes = o.budget;
     s.validate();
     std::printf("experiment design for the synergist-aware identifier: population '%s', budget %d trials in blocks "
                 "of %d, angles %s deg, extension MVCs %s, submaximal EMG-feedback levels %s, VA %s; %d prior draws\n",
@@ -69,19 +72,42 @@ void runDesign(const DesignOptions& o) {
     std::fflush(stdout);
     TorqueProtocol thesis;
     thesis.name = "thesis";
-    const DesignResult d = designProtocol(population, s, thesis, [](int done, int n) { printProgress("design", done, n); });
+    const bool channels = s.budgetMinutes > 0;
+    if (channels)
+        std::printf("across channels: budget %s lab minutes (MVC block %s, EMG set-up %s, ultrasound per angle %s, volume "
+                    "scan %s, anthropometry %s min: docs/channels.md)\n",
+                    formatNumber(s.budgetMinutes).c_str(), formatNumber(s.costs.mvcBlock).c_str(),
+                    formatNumber(s.costs.emgSetup).c_str(), formatNumber(s.costs.ultrasoundAngle).c_str(),
+                    formatNumber(s.costs.volumeScan).c_str(), formatNumber(s.costs.anthropometry).c_str());
+    auto progress = [](int done, int n) { printProgress("design", done, n); };
+    const DesignResult d = channels ? designChannelProtocol(population, s, thesis, progress)
+                                    : designProtocol(population, s, thesis, progress);
     const ProtocolPrediction& reference = d.reference;
 
-    std::printf("greedy picks (block of %d trials each, criterion after the pick; 1 = both sds at the goals 10 %%, 1 cm):\n",
-                s.repetitions);
-    for (std::size_t k = 0; k < d.steps.size(); ++k)
-        std::printf("  %2zu. %-9s %s at %5.1f deg   criterion %.3f\n", k + 1, getEffortName(d.steps[k].condition.effort),
-                    d.steps[k].condition.level == 1 ? "MVC " : (formatNumber(100 * d.steps[k].condition.level) + " %").c_str(),
-                    d.steps[k].condition.flexionDeg, d.steps[k].criterion);
+    std::printf("greedy picks (%s, criterion after the pick; 1 = both sds at the goals 10 %%, 1 cm):\n",
+                channels ? "largest drop per lab minute" : ("block of " + std::to_string(s.repetitions) + " trials each").c_str());
+    double minutes = 0;
+    for (std::size_t k = 0; k < d.steps.size(); ++k) {
+        const DesignStep& step = d.steps[k];
+        const std::string what = step.item == "torque" || step.item == "ultrasound"
+                                     ? std::string(step.item == "ultrasound" ? "ultrasound at " : "") +
+                                           getEffortName(step.condition.effort) + " " +
+                                           (step.condition.level == 1 ? "MVC" : formatNumber(100 * step.condition.level) + " %") +
+                                           " at " + formatNumber(step.condition.flexionDeg) + " deg"
+                                     : step.item;
+        minutes += std::isfinite(step.minutes) ? step.minutes : 0;
+        std::printf("  %2zu. %-38s criterion %.3f%s\n", k + 1, what.c_str(), step.criterion,
+                    channels ? (", " + formatNumber(minutes) + " min").c_str() : "");
+    }
     std::printf("designed protocol: %s\n", describeConditions(d.protocol).c_str());
     std::printf("predicted uncertainty (Laplace, mean over prior draws):\n");
     printPrediction(reference);
     printPrediction(d.predicted);
+    if (channels) {
+        const TorqueProtocol recommended = readTorqueProtocol(findAsset("protocols/recommended.yaml"));
+        std::printf("  (recommended.yaml, %s lab minutes:)\n", formatNumber(s.costs.calcMinutes(recommended)).c_str());
+        printPrediction(predictProtocol(population, recommended, s));
+    }
 
     OutputFolder out(o.out, OutputFolder::Mode::AddFiles);
     const std::string protocolPath = out.getTargetPath("designed_protocol.yaml");
@@ -156,6 +182,10 @@ void addDesignCommand(CLI::App& app) {
     addNumberListOption(*c, "--levels", o->levels,
                   "allowed submaximal levels (EMG feedback, fractions of MVC in (0, 1)), comma-separated; default none");
     c->add_flag("--no-extension", o->noExtension, "no extension MVCs");
+    c->add_option("--budget", o->budget,
+                  "lab minutes: design across channels (MVC blocks, ultrasound, EMG, volume scans, anthropometry; "
+                  "costs in docs/channels.md) instead of a trial budget")
+        ->check(CLI::Range(1.0, 10000.0));
     c->add_flag("--free-slow-fraction", o->freeSlowFraction,
                 "the identifier frees the flexors' slow-fibre fractions (biceps heads, synergists)");
     c->add_option("--trials", o->trials, "budget: total trials")->capture_default_str()->check(CLI::Range(1, 10000));

@@ -8,6 +8,7 @@
 #include "basics/plot.h"
 #include "basics/table.h"
 #include "cli/commands.h"
+#include "experiments/channels.h"
 #include "studies/torque_validation.h"
 #include "identification/faithful_model.h"
 #include "identification/forward_choice.h"
@@ -519,10 +520,71 @@ void runIdentificationStep(const MainJobContext& ctx) {
     std::printf("  wrote reports (JSON, history CSV, convergence PNG) to %s/\n", dir.c_str());
 }
 
+// One virtual person out of family (subject 0 of the stronger mismatch population, the default population
+// as prior) through the recommended protocol: every channel synthesized and plotted, identified with
+// every method, truth beside estimate and interval.
+void runOutOfFamilyPersonStep(const MainJobContext& ctx) {
+    const Population truth = loadPopulation(findAsset("subjects/mismatch/stronger.yaml"));
+    const Population prior = loadDefaultPopulation();
+    ElbowValidationSettings s;
+    s.subjects = 1;
+    s.jobs = ctx.jobs;
+    s.protocol = readTorqueProtocol(findAsset("protocols/recommended.yaml"));
+    std::printf("truth: person 0 of population %s (%s); prior: %s; protocol %s: %s\n", truth.name.c_str(),
+                truth.file.c_str(), prior.name.c_str(), s.protocol.name.c_str(), describeConditions(s.protocol).c_str());
+    std::fflush(stdout);
+    const std::vector<ElbowValidationRow> rows = runElbowValidation(truth, prior, s);
+    // The same person's data again (same seeds as the validation) for the files and plots.
+    const VirtualSubject v = drawSubject(truth, s.seed, 0);
+    const std::vector<TorqueObservation> torque =
+        setTransducerNoise(synthesizeTorqueData(v, s.protocol, s.seed, ctx.jobs), truth.transducerNoise);
+    const std::vector<ChannelObservation> channels = synthesizeChannelData(v, s.protocol, torque, s.seed);
+    const std::string dir = ctx.outDir + "/out_of_family_person";
+    createFolder(dir);
+    writeTorqueProtocolRun(dir, s.protocol, torque, channels);
+    writeFileAtomically(dir + "/estimates.csv", formatElbowValidationCsv(rows));
+    std::printf("%-13s %22s %22s %22s\n", "method", "M (g) [95 %]", "L0T (cm) [95 %]", "F0 (N) [95 %]");
+    const ElbowValidationRow& t = rows.front();
+    std::printf("%-13s %22.1f %22.2f %22.0f\n", "truth", 1000 * t.trueMass, 100 * t.trueTendonLength, t.trueMaxForce);
+    PlotSpec plot;
+    plot.title = "One person out of family: biceps long-head mass per method";
+    plot.legend = PlotSpec::Legend::TopRight;
+    plot.xLabel = "method (1 thesis, 2 synergist, 3 synergist-va, 4 channels)";
+    plot.yLabel = "mass (g)";
+    PlotSeries estimate{"estimate", {}, {}, true, 0}, interval{"95 % interval ends", {}, {}, true, 5};
+    for (std::size_t k = 0; k < rows.size(); ++k) {
+        const MuscleEstimate& e = rows[k].estimate;
+        auto cell = [](double v, double lo, double hi, double scale, int digits) {
+            if (!std::isfinite(v)) return std::string("-");
+            char b[64];
+            std::snprintf(b, sizeof b, "%.*f [%.*f, %.*f]", digits, scale * v, digits, scale * lo, digits, scale * hi);
+            return std::string(b);
+        };
+        std::printf("%-13s %22s %22s %22s%s\n", e.method.c_str(), cell(e.mass, e.massLower, e.massUpper, 1000, 1).c_str(),
+                    cell(e.tendonLength, e.tendonLower, e.tendonUpper, 100, 2).c_str(),
+                    cell(e.maxForce, e.maxForceLower, e.maxForceUpper, 1, 0).c_str(), e.converged ? "" : "  (not converged)");
+        if (!std::isfinite(e.mass)) continue;
+        estimate.x.push_back(double(k + 1));
+        estimate.y.push_back(1000 * e.mass);
+        for (double end : {e.massLower, e.massUpper})
+            if (std::isfinite(end)) interval.x.push_back(double(k + 1)), interval.y.push_back(1000 * end);
+    }
+    plot.series = {estimate, interval, {"truth", {0.5, double(rows.size()) + 0.5}, {1000 * t.trueMass, 1000 * t.trueMass}, false, 1}};
+    writePlotPng(dir + "/mass_estimates.png", plot);
+    for (const MuscleEstimate& e : {rows.back().estimate})
+        for (const ChannelFit& f : e.channelFits)
+            std::printf("  %s fit, %-17s n %3d  chi2 %6.1f  p %.3f  %s\n", e.method.c_str(), f.channel.c_str(), f.n,
+                        f.chiSquare, f.p, f.p >= 0.05 ? "noise" : ("misfit, worst: " + f.worst).c_str());
+    std::printf("  wrote torque and channel data, their plots, estimates.csv and mass_estimates.png to %s/\n", dir.c_str());
+}
+
 const CommandRegistrar registerIdentify(40, addIdentifyCommand);
 const CommandRegistrar registerValidate(41, addValidateCommand);
 const MainJobStepRegistrar registerIdentificationStep(50, "Identification: mass and tendon length (thesis data, own MVC data)",
                                                       runIdentificationStep);
+const MainJobStepRegistrar registerOutOfFamilyPersonStep(
+    52, "Identification out of family: one person of a stronger population, every channel of the recommended protocol",
+    runOutOfFamilyPersonStep);
 
 }  // namespace
 

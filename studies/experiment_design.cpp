@@ -2,6 +2,7 @@
 
 #include "basics/bound.h"
 #include "basics/csv.h"
+#include "basics/format.h"
 #include "basics/parallel.h"
 #include "basics/portable_random.h"
 
@@ -27,16 +28,20 @@ Eigen::MatrixXd toMatrix(const std::vector<std::vector<double>>& rows) {
     return m;
 }
 
-// Tared torques of every candidate condition and their gradients at one prior draw.
+// Predictions of every row (candidate conditions' tared torques, then channel measurements) and their
+// gradients at one prior draw.
 struct DrawSensitivity {
     bool ok = false;
-    std::vector<double> torque;    // [condition]
-    Eigen::MatrixXd jacobian;      // [condition][parameter]
+    std::vector<double> prediction;  // [row]
+    Eigen::MatrixXd jacobian;        // [row][parameter]
 };
 
 struct Sensitivities {
     std::vector<std::string> names;
-    int massIndex = 0, tendonIndex = 0, activationIndex = 0;
+    int massIndex = 0, tendonIndex = 0, activationIndex = 0, sizeIndex = 0;
+    int numTorqueRows = 0;           // rows 0..numTorqueRows-1 are torques, the rest channels
+    std::vector<ChannelObservation> channels;
+    ChannelNoise noise;
     Eigen::VectorXd flexorMean;    // weights of the mean of the flexors' ln mass scales
     Eigen::MatrixXd priorPrecision;
     double priorMassSd = 0, priorTendonSd = 0, priorFlexorStrengthSd = 0, baseTendonLength = 0;
@@ -78,9 +83,12 @@ std::vector<std::vector<double>> drawFromPrior(const SynergistModel& model, unsi
 namespace {
 
 Sensitivities calcSensitivities(const Population& prior, const std::vector<TorqueCondition>& conditions,
-                                const DesignSettings& settings, const std::function<void(int, int)>& progress) {
+                                const DesignSettings& settings, const std::function<void(int, int)>& progress,
+                                const std::vector<ChannelObservation>& channels = {}, const ChannelNoise& noise = {}) {
     SynergistOptions options;
     options.freeSlowFraction = settings.freeSlowFraction;
+    options.channels = channels;
+    options.emgCrosstalk = noise.emgCrosstalk;
     const SynergistModel model(prior, options, conditions);
     const int n = model.getNumParameters();
     Sensitivities s;
@@ -88,6 +96,10 @@ Sensitivities calcSensitivities(const Population& prior, const std::vector<Torqu
     s.massIndex = model.getMassIndex();
     s.tendonIndex = SynergistModel::getTendonIndex();
     s.activationIndex = SynergistModel::getActivationIndex();
+    s.sizeIndex = SynergistModel::getSizeIndex();
+    s.numTorqueRows = int(conditions.size());
+    s.channels = channels;
+    s.noise = noise;
     const Eigen::MatrixXd sigma = toMatrix(model.getPriorCovariance());
     s.priorPrecision = sigma.inverse();
     s.flexorMean = Eigen::VectorXd::Zero(n);
@@ -96,18 +108,26 @@ Sensitivities calcSensitivities(const Population& prior, const std::vector<Torqu
     s.priorFlexorStrengthSd = std::sqrt(s.flexorMean.dot(sigma * s.flexorMean));
     s.baseTendonLength = prior.base.muscles[prior.base.primary].params.optimalTendonLength;
     s.priorMassSd = std::sqrt(sigma(s.massIndex, s.massIndex));
-    s.priorTendonSd = s.baseTendonLength * std::sqrt(sigma(s.tendonIndex, s.tendonIndex));
+    s.priorTendonSd = s.baseTendonLength * std::sqrt(sigma(s.tendonIndex, s.tendonIndex) + sigma(s.sizeIndex, s.sizeIndex) +
+                                                     2 * sigma(s.tendonIndex, s.sizeIndex));
     s.relativeSd = std::hypot(prior.transducerNoise, prior.trialCv);
     s.activationSd = settings.activationSd;
 
     const std::vector<std::vector<double>> xs = drawFromPrior(model, settings.seed, settings.draws);
+    const int rows = int(conditions.size() + channels.size());
+    auto predict = [&](const double* x) {
+        std::vector<double> t, c;
+        model.calcPredictions(x, t, c);
+        t.insert(t.end(), c.begin(), c.end());
+        return t;
+    };
     s.draws.resize(xs.size());
     runParallel(int(xs.size()), settings.jobs, [&](int d) {
         DrawSensitivity& out = s.draws[d];
         try {
             std::vector<double> x = xs[d];
-            out.torque = model.calcTorques(x.data());
-            out.jacobian.resize(int(conditions.size()), n);
+            out.prediction = predict(x.data());
+            out.jacobian.resize(rows, n);
             for (int j = 0; j < n; ++j) {
                 const double x0 = x[j];
                 if (model.getLower()[j] == model.getUpper()[j]) {  // held fixed
@@ -115,12 +135,11 @@ Sensitivities calcSensitivities(const Population& prior, const std::vector<Torqu
                     continue;
                 }
                 x[j] = x0 + kStep;
-                const std::vector<double> up = model.calcTorques(x.data());
+                const std::vector<double> up = predict(x.data());
                 x[j] = x0 - kStep;
-                const std::vector<double> down = model.calcTorques(x.data());
+                const std::vector<double> down = predict(x.data());
                 x[j] = x0;
-                for (std::size_t c = 0; c < conditions.size(); ++c)
-                    out.jacobian(int(c), j) = (up[c] - down[c]) / (2 * kStep);
+                for (int r = 0; r < rows; ++r) out.jacobian(r, j) = (up[r] - down[r]) / (2 * kStep);
             }
             out.ok = true;
         } catch (const SimulationError&) {
@@ -130,13 +149,25 @@ Sensitivities calcSensitivities(const Population& prior, const std::vector<Torqu
     return s;
 }
 
+// The sd of row r at draw d: torques as the identifier weights them (transducer and trial variation),
+// channels as their measurement models (experiments/channels.h).
+double calcRowSd(const Sensitivities& s, int d, int r) {
+    const double v = std::abs(s.draws[d].prediction[r]);
+    if (r < s.numTorqueRows) return s.relativeSd * std::max(v, 1.0);
+    const std::string& channel = s.channels[r - s.numTorqueRows].channel;
+    if (channel == "fascicle_length") return s.noise.fascicleLength * v;
+    if (channel == "volume") return s.noise.volume * v;
+    if (channel == "emg") return s.noise.emg * std::max(v, 0.02);
+    return s.noise.upperArmLength;
+}
+
 // Posterior covariance at draw d with `counts[c]` trials of condition c.
 Eigen::MatrixXd calcPosterior(const Sensitivities& s, int d, const std::vector<int>& counts) {
     const DrawSensitivity& ds = s.draws[d];
     Eigen::MatrixXd precision = s.priorPrecision;
     for (std::size_t c = 0; c < counts.size(); ++c) {
         if (counts[c] == 0) continue;
-        const double sd = s.relativeSd * std::max(std::abs(ds.torque[c]), 1.0);
+        const double sd = calcRowSd(s, d, int(c));
         const Eigen::RowVectorXd g = ds.jacobian.row(int(c));
         precision += double(counts[c]) * g.transpose() * g / (sd * sd);
     }
@@ -147,7 +178,7 @@ Eigen::MatrixXd calcPosterior(const Sensitivities& s, int d, const std::vector<i
 ProtocolPrediction evaluate(const Sensitivities& s, const std::vector<int>& counts, const std::string& name) {
     ProtocolPrediction p;
     p.name = name;
-    for (int c : counts) p.trials += c;
+    for (int c = 0; c < s.numTorqueRows && c < int(counts.size()); ++c) p.trials += counts[c];
     p.parameterNames = s.names;
     p.priorMassSd = s.priorMassSd;
     p.priorTendonSd = s.priorTendonSd;
@@ -160,7 +191,8 @@ ProtocolPrediction evaluate(const Sensitivities& s, const std::vector<int>& coun
     for (std::size_t d = 0; d < s.draws.size(); ++d) {
         if (!s.draws[d].ok) continue;
         const Eigen::MatrixXd C = calcPosterior(s, int(d), counts);
-        const double cm = C(s.massIndex, s.massIndex), ct = C(s.tendonIndex, s.tendonIndex);
+        const double cm = C(s.massIndex, s.massIndex);
+        const double ct = C(s.tendonIndex, s.tendonIndex) + C(s.sizeIndex, s.sizeIndex) + 2 * C(s.tendonIndex, s.sizeIndex);
         crit += cm / (kMassGoal * kMassGoal) + ct / (gT * gT);
         vm += cm;
         vt += ct;
@@ -191,6 +223,36 @@ std::vector<int> countTrials(const std::vector<TorqueCondition>& conditions) {
     return counts;
 }
 
+ChannelObservation makeRow(const char* channel, const std::string& muscle, double flexionDeg, MuscleGroup effort,
+                           double level) {
+    ChannelObservation o;
+    o.channel = channel;
+    o.muscle = muscle;
+    o.flexionDeg = flexionDeg;
+    o.effort = effort;
+    o.level = level;
+    o.sd = 1;  // the sd comes from calcRowSd
+    return o;
+}
+
+// The channel rows a condition can record: its fascicle at rest and at the plateau, then every
+// surface_emg muscle's EMG.
+std::vector<ChannelObservation> makeConditionRows(const ArmSetup& base, const TorqueCondition& c, bool ultrasound, bool emg) {
+    std::vector<ChannelObservation> rows;
+    const std::string& primary = base.muscles[base.primary].params.name;
+    if (ultrasound) {
+        rows.push_back(makeRow("fascicle_length", primary, c.flexionDeg, c.effort, 0));
+        rows.push_back(makeRow("fascicle_length", primary, c.flexionDeg, c.effort, c.level));
+    }
+    if (emg)
+        for (int m : base.surfaceEmg) {
+            const MuscleGroup g = base.muscles[m].group;
+            if (g == MuscleGroup::Flexor || g == MuscleGroup::Extensor)
+                rows.push_back(makeRow("emg", base.muscles[m].params.name, c.flexionDeg, c.effort, c.level));
+        }
+    return rows;
+}
+
 }  // namespace
 
 void DesignSettings::validate() const {
@@ -202,14 +264,193 @@ void DesignSettings::validate() const {
     checkField("draws", draws, Bound::closed(1, 100000));
     checkField("activation_sd", activationSd, Bound::closed(0, 0.5));
     checkField("jobs", jobs, Bound::closed(1, 1024));
+    checkField("budget", budgetMinutes, Bound::closed(0, 10000, "min"));
 }
 
 ProtocolPrediction predictProtocol(const Population& prior, const TorqueProtocol& protocol,
                                    const DesignSettings& settings) {
     protocol.validate();
     settings.validate();
-    const Sensitivities s = calcSensitivities(prior, protocol.conditions, settings, {});
-    return evaluate(s, countTrials(protocol.conditions), protocol.name);
+    std::vector<int> counts = countTrials(protocol.conditions);
+    std::vector<ChannelObservation> rows;
+    for (const TorqueCondition& c : protocol.conditions)
+        for (const ChannelObservation& o : makeConditionRows(prior.base, c, c.ultrasound, c.emg)) {
+            rows.push_back(o);
+            counts.push_back(c.repetitions);
+        }
+    for (const std::string& m : protocol.volumeScan) {
+        rows.push_back(makeRow("volume", m, 0.0 / 0.0, MuscleGroup::Flexor, 0));
+        counts.push_back(1);
+    }
+    if (protocol.anthropometry) {
+        rows.push_back(makeRow("upper_arm_length", "", 0.0 / 0.0, MuscleGroup::Flexor, 0));
+        counts.push_back(1);
+    }
+    const Sensitivities s = calcSensitivities(prior, protocol.conditions, settings, {}, rows, protocol.channelNoise);
+    return evaluate(s, counts, protocol.name);
+}
+
+double LabCosts::calcMinutes(const TorqueProtocol& p) const {
+    double minutes = 0;
+    bool emg = false;
+    for (const TorqueCondition& c : p.conditions) {
+        minutes += mvcBlock * double(c.repetitions) / 3 + (c.ultrasound ? ultrasoundAngle : 0);
+        emg = emg || c.emg;
+    }
+    return minutes + (emg ? emgSetup : 0) + volumeScan * double(p.volumeScan.size()) + (p.anthropometry ? anthropometry : 0);
+}
+
+DesignResult designChannelProtocol(const Population& prior, const DesignSettings& settings,
+                                   const TorqueProtocol& reference, const std::function<void(int, int)>& progress) {
+    reference.validate();
+    settings.validate();
+    prior.validate();
+    if (!(settings.budgetMinutes > 0)) throw FieldError("budget", "expected > 0 minutes for a design across channels");
+    const ArmSetup& base = prior.base;
+    const LabCosts& cost = settings.costs;
+    DesignResult result;
+    std::vector<double> levels = {1.0};
+    levels.insert(levels.end(), settings.levels.begin(), settings.levels.end());
+    for (MuscleGroup effort : {MuscleGroup::Flexor, MuscleGroup::Extensor}) {
+        if (effort == MuscleGroup::Extensor && !settings.extension) continue;
+        for (double level : levels)
+            for (double q : settings.flexionDeg) result.candidates.push_back({q, effort, level, 1});
+    }
+    // Rows: candidate torques, then per candidate its fascicle and EMG rows, the volume candidates
+    // (flexors surface electrodes reach: superficial, so a panoramic scan reaches them too) and the arm.
+    const int nc = int(result.candidates.size());
+    std::vector<ChannelObservation> rows;
+    std::vector<std::vector<int>> ultrasoundRows(nc), emgRows(nc);
+    for (int c = 0; c < nc; ++c) {
+        for (const ChannelObservation& o : makeConditionRows(base, result.candidates[c], true, false)) {
+            ultrasoundRows[c].push_back(nc + int(rows.size()));
+            rows.push_back(o);
+        }
+        for (const ChannelObservation& o : makeConditionRows(base, result.candidates[c], false, true)) {
+            emgRows[c].push_back(nc + int(rows.size()));
+            rows.push_back(o);
+        }
+    }
+    std::vector<std::pair<std::string, int>> volumeRows;
+    for (int m : base.surfaceEmg)
+        if (base.muscles[m].group == MuscleGroup::Flexor) {
+            volumeRows.push_back({base.muscles[m].params.name, nc + int(rows.size())});
+            rows.push_back(makeRow("volume", base.muscles[m].params.name, 0.0 / 0.0, MuscleGroup::Flexor, 0));
+        }
+    const int armRow = nc + int(rows.size());
+    rows.push_back(makeRow("upper_arm_length", "", 0.0 / 0.0, MuscleGroup::Flexor, 0));
+    const ChannelNoise noise = reference.channelNoise;
+    const int total = 2 * settings.draws + 1;
+    Sensitivities s = calcSensitivities(prior, result.candidates, settings, [&](int done, int) {
+        if (progress) progress(done, total);
+    }, rows, noise);
+    Sensitivities r = calcSensitivities(prior, reference.conditions, settings, [&](int done, int) {
+        if (progress) progress(settings.draws + done, total);
+    });
+    for (std::size_t d = 0; d < s.draws.size(); ++d) s.draws[d].ok = r.draws[d].ok = s.draws[d].ok && r.draws[d].ok;
+    result.reference = evaluate(r, countTrials(reference.conditions), reference.name);
+
+    // Items: a block of MVCs at a candidate (repeatable), ultrasound at a picked candidate, EMG (once,
+    // every picked block), a volume scan per muscle, anthropometry. Greedy by criterion drop per minute.
+    struct Choice {
+        std::vector<int> torque;        // repetitions per candidate
+        std::vector<bool> ultrasound;
+        bool emg = false, arm = false;
+        std::vector<bool> volume;
+    } chosen{std::vector<int>(nc, 0), std::vector<bool>(nc, false), false, false, std::vector<bool>(volumeRows.size(), false)};
+    auto toCounts = [&](const Choice& ch) {
+        std::vector<int> counts(nc + rows.size(), 0);
+        for (int c = 0; c < nc; ++c) {
+            counts[c] = ch.torque[c];
+            if (ch.ultrasound[c]) for (int k : ultrasoundRows[c]) counts[k] = ch.torque[c];
+            if (ch.emg) for (int k : emgRows[c]) counts[k] = ch.torque[c];
+        }
+        for (std::size_t v = 0; v < volumeRows.size(); ++v) counts[volumeRows[v].second] = ch.volume[v] ? 1 : 0;
+        counts[armRow] = ch.arm ? 1 : 0;
+        return counts;
+    };
+    const int reps = settings.repetitions;
+    const double block = cost.mvcBlock * double(reps) / 3;
+    double spent = 0, current = evaluate(s, toCounts(chosen), "").criterion;
+    for (;;) {
+        double bestScore = 0, bestMinutes = 0, bestCriterion = current;
+        Choice best;
+        std::string bestItem;
+        TorqueCondition bestCondition;
+        auto consider = [&](const Choice& ch, double minutes, const std::string& item, const TorqueCondition& c) {
+            if (spent + minutes > settings.budgetMinutes + 1e-9) return;
+            const double v = evaluate(s, toCounts(ch), "").criterion;
+            const double score = (current - v) / minutes;
+            if (score > bestScore) bestScore = score, best = ch, bestMinutes = minutes, bestItem = item, bestCriterion = v,
+                                   bestCondition = c;
+        };
+        for (int c = 0; c < nc; ++c) {
+            Choice ch = chosen;
+            ch.torque[c] += reps;
+            consider(ch, block, "torque", result.candidates[c]);
+            if (chosen.torque[c] > 0 && !chosen.ultrasound[c]) {
+                ch = chosen;
+                ch.ultrasound[c] = true;
+                consider(ch, cost.ultrasoundAngle, "ultrasound", result.candidates[c]);
+            }
+        }
+        const TorqueCondition none{0.0 / 0.0, MuscleGroup::Flexor, 0, 0};
+        if (!chosen.emg && std::any_of(chosen.torque.begin(), chosen.torque.end(), [](int n) { return n > 0; })) {
+            Choice ch = chosen;
+            ch.emg = true;
+            consider(ch, cost.emgSetup, "emg", none);
+        }
+        for (std::size_t v = 0; v < volumeRows.size(); ++v)
+            if (!chosen.volume[v]) {
+                Choice ch = chosen;
+                ch.volume[v] = true;
+                consider(ch, cost.volumeScan, "volume " + volumeRows[v].first, none);
+            }
+        if (!chosen.arm) {
+            Choice ch = chosen;
+            ch.arm = true;
+            consider(ch, cost.anthropometry, "anthropometry", none);
+        }
+        if (bestItem.empty()) break;  // nothing fits the budget or helps
+        chosen = best;
+        spent += bestMinutes;
+        current = bestCriterion;
+        DesignStep step;
+        step.condition = bestCondition;
+        step.condition.repetitions = bestItem == "torque" ? reps : 0;
+        step.criterion = current;
+        step.item = bestItem;
+        step.minutes = bestMinutes;
+        result.steps.push_back(step);
+        if (progress) progress(2 * settings.draws, total);
+    }
+    if (progress) progress(total, total);
+    if (std::none_of(chosen.torque.begin(), chosen.torque.end(), [](int n) { return n > 0; }))
+        throw InputError("design --budget " + formatNumber(settings.budgetMinutes) + " min: no MVC block (" +
+                         formatNumber(block) + " min) fits: expected a larger budget");
+
+    TorqueProtocol& p = result.protocol;
+    p.name = "designed";
+    p.conditions.clear();
+    for (int c = 0; c < nc; ++c)
+        if (chosen.torque[c] > 0) {
+            TorqueCondition tc = result.candidates[c];
+            tc.repetitions = chosen.torque[c];
+            tc.ultrasound = chosen.ultrasound[c];
+            tc.emg = chosen.emg;
+            p.conditions.push_back(tc);
+        }
+    for (std::size_t v = 0; v < volumeRows.size(); ++v)
+        if (chosen.volume[v]) p.volumeScan.push_back(volumeRows[v].first);
+    p.anthropometry = chosen.arm;
+    p.channelNoise = noise;
+    result.predicted = evaluate(s, toCounts(chosen), p.name);
+    p.description = fmt::format(
+        "designed by armsim design --budget {}: {:.0f} lab minutes ({} trials), {} prior draws (seed {}); predicted "
+        "posterior sd of ln M {:.1f} %, of L0T {:.1f} mm",
+        formatNumber(settings.budgetMinutes), cost.calcMinutes(p), result.predicted.trials, settings.draws,
+        settings.seed, 100 * result.predicted.massSd, 1000 * result.predicted.tendonSd);
+    return result;
 }
 
 DesignResult designProtocol(const Population& prior, const DesignSettings& settings, const TorqueProtocol& reference,
@@ -272,12 +513,13 @@ DesignResult designProtocol(const Population& prior, const DesignSettings& setti
 }
 
 std::string formatDesignStepsCsv(const DesignResult& result) {
-    CsvText csv({"step", "effort", "flexion_deg", "level", "repetitions", "criterion"});
+    CsvText csv({"step", "effort", "flexion_deg", "level", "repetitions", "criterion", "item", "minutes"});
     for (std::size_t k = 0; k < result.steps.size(); ++k) {
         const DesignStep& s = result.steps[k];
         CsvRow row;
         row.addInteger(long(k) + 1).addText(getEffortName(s.condition.effort)).addNumber(s.condition.flexionDeg);
         row.addNumber(s.condition.level).addInteger(s.condition.repetitions).addNumber(s.criterion);
+        row.addText(s.item).addNumber(s.minutes);
         csv.addRow(row);
     }
     return csv.getText();

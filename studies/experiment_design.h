@@ -25,6 +25,18 @@
 
 namespace armsim {
 
+/// Lab minutes of what a design across channels may pick (docs/channels.md, Lab time: assumptions,
+/// no published protocol states minutes).
+struct LabCosts {
+    double mvcBlock = 8;          ///< one condition's 3 efforts with 2 min rests (scaled by repetitions / 3) [min]
+    double emgSetup = 20;         ///< electrodes and MVC normalisation, once [min]
+    double ultrasoundAngle = 7;   ///< fascicle images at rest and at the plateau at one angle [min]
+    double volumeScan = 10;       ///< one muscle's panoramic scan [min]
+    double anthropometry = 10;    ///< [min]
+    /// Lab minutes of a protocol (twitch interpolation, if any, not counted: every design has it or not).
+    double calcMinutes(const TorqueProtocol& protocol) const;
+};
+
 /// What an experimenter may do.
 struct DesignSettings {
     std::vector<double> flexionDeg = {15, 30, 45, 60, 75, 90, 105, 120, 135};  ///< allowed angles [deg]
@@ -39,6 +51,9 @@ struct DesignSettings {
     double activationSd = 0.02;          ///< > 0: VA measured by twitch interpolation to this sd; 0: not
     bool freeSlowFraction = false;       ///< the identifier frees the slow fractions (SynergistOptions)
     int jobs = 2;                        ///< threads (over draws)
+    /// > 0: design across channels within this many lab minutes (designChannelProtocol) [min].
+    double budgetMinutes = 0;
+    LabCosts costs;
     /// FieldError naming the field for values out of range.
     void validate() const;
 };
@@ -66,8 +81,10 @@ struct ProtocolPrediction {
 
 /// One greedy pick.
 struct DesignStep {
-    TorqueCondition condition;           ///< with repetitions = the block
+    TorqueCondition condition;           ///< with repetitions = the block (0 for an item of no condition)
     double criterion = 0;                ///< after the pick
+    std::string item = "torque";         ///< torque, ultrasound, emg, volume MUSCLE, anthropometry
+    double minutes = 0.0 / 0.0;          ///< its lab minutes (designs across channels)
 };
 
 struct DesignResult {
@@ -78,14 +95,15 @@ struct DesignResult {
     std::vector<TorqueCondition> candidates;  ///< every condition considered
 };
 
-/// design_steps.csv: step, effort, flexion_deg, level, repetitions, criterion after the pick.
+/// design_steps.csv: step, effort, flexion_deg, level, repetitions, criterion after the pick, item, minutes.
 std::string formatDesignStepsCsv(const DesignResult& result);
 
 /// `draws` parameter vectors of the identifier's prior (Gaussian, clipped to its bounds), seeded by
 /// (seed, draw): the draws the predictions average over.
 std::vector<std::vector<double>> drawFromPrior(const SynergistModel& model, unsigned seed, int draws);
 
-/// Predicted uncertainty of the synergist-aware identifier with this protocol.
+/// Predicted uncertainty of the synergist-aware identifier with this protocol (with its channels when it
+/// records any: the channels fit).
 ProtocolPrediction predictProtocol(const Population& prior, const TorqueProtocol& protocol,
                                    const DesignSettings& settings);
 
@@ -94,6 +112,14 @@ ProtocolPrediction predictProtocol(const Population& prior, const TorqueProtocol
 /// of both). progress(done, total) over the sensitivities (the expensive part) and the picks.
 DesignResult designProtocol(const Population& prior, const DesignSettings& settings, const TorqueProtocol& reference,
                             const std::function<void(int, int)>& progress = {});
+
+/// The design across channels: greedy by criterion drop per lab minute over MVC blocks at the candidate
+/// angles and levels, ultrasound at a picked condition, EMG (once: every block), a volume scan of each
+/// superficial flexor (surface_emg role) and anthropometry, until nothing fits settings.budgetMinutes.
+/// Channel errors are the reference protocol's channelNoise. Predicted widths include every channel
+/// (Laplace approximation as the identifier's). Throws InputError when no MVC block fits the budget.
+DesignResult designChannelProtocol(const Population& prior, const DesignSettings& settings,
+                                   const TorqueProtocol& reference, const std::function<void(int, int)>& progress = {});
 
 /// CSV: one row per protocol: name, trials, criterion, mass_sd_pct, tendon_sd_mm, prior sds, and the
 /// mean posterior correlation of ln M with every parameter.

@@ -265,3 +265,41 @@ TEST(CliDesign, DesignedProtocolRunsAndItsDataAreIdentified) {
     EXPECT_NE(r.exitCode, 0);
     EXPECT_NE(r.output.find("missing.csv"), std::string::npos) << r.output;
 }
+
+// docs/channels.md's worked example: the recommended protocol writes every channel beside the torque,
+// and identify-torque --channels fits them, prints the per-channel check and writes channel_fits.csv
+// and the F0 columns. A bad channel file names its line.
+TEST(CliIdentifyTorque, RecommendedProtocolChannelsAreSynthesizedAndFitted) {
+    const fs::path d = freshDir("channels");
+    const std::string protocol = std::string(ARMSIM_ASSET_DIR) + "/protocols/recommended.yaml";
+    CommandResult r = runArmsim("protocol " + protocol + " --out " + (d / "recommended").string());
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    for (const char* f : {"torque_data.csv", "channel_data.csv", "fascicle_length.png", "emg.png"})
+        EXPECT_TRUE(fs::exists(d / "recommended" / f)) << f;
+    r = runArmsim("identify-torque " + (d / "recommended" / "torque_data.csv").string() + " --channels " +
+                  (d / "recommended" / "channel_data.csv").string() + " --activation 0.93 --out " +
+                  (d / "identify_channels").string());
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    EXPECT_NE(r.output.find("channels fit: F0"), std::string::npos) << r.output;
+    std::ifstream in(d / "identify_channels" / "channel_fits.csv");
+    std::string header, line;
+    std::getline(in, header);
+    EXPECT_EQ(header, "method,channel,n,chi_square,p_value,verdict,worst,worst_residual_sd");
+    int channels = 0;
+    while (std::getline(in, line)) channels += line.rfind("channels,", 0) == 0;
+    EXPECT_EQ(channels, 6);  // torque, fascicle_length, emg, volume, upper_arm_length, activation
+    std::ifstream est(d / "identify_channels" / "torque_estimates.csv");
+    std::getline(est, header);
+    EXPECT_NE(header.find("max_force_N"), std::string::npos) << header;
+    bool found = false;
+    while (std::getline(est, line)) found = found || line.rfind("channels,1,", 0) == 0;
+    EXPECT_TRUE(found) << "no converged channels estimate";
+
+    std::ofstream(d / "bad.csv") << "channel,muscle,value,sd\nvolume,BIClong,0.0002,0.00002\nvolume,NOPE,0.0002,0.00002\n";
+    r = runArmsim("identify-torque " + (d / "recommended" / "torque_data.csv").string() + " --channels " +
+                  (d / "bad.csv").string() + " --out " + (d / "bad").string());
+    EXPECT_EQ(r.exitCode, kInputErrorExit) << r.output;
+    EXPECT_NE(r.output.find("line 3"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("NOPE"), std::string::npos) << r.output;
+    EXPECT_FALSE(fs::exists(d / "bad"));
+}

@@ -1,6 +1,7 @@
 // Experiment design (issue 11): the predicted posterior width checked against a second method (the
 // spread of actual MAP estimates when the identifier's own model is the truth), information that only
 // grows with trials, and a greedy design that does at least as well as the reference it is compared to.
+#include "basics/errors.h"
 #include "basics/parallel.h"
 #include "basics/portable_random.h"
 #include "studies/experiment_design.h"
@@ -153,4 +154,42 @@ TEST(ExperimentDesign, FreedSlowFractionsAreInformedBySubmaximalEfforts) {
     const MuscleEstimate fixed = identifySynergistAware(prior, data, options);
     EXPECT_TRUE(std::find(fixed.nuisanceNames.begin(), fixed.nuisanceNames.end(), "biceps_slow_fraction_shift") ==
                 fixed.nuisanceNames.end());
+}
+
+// Issue 31, design across channels: the picks' minutes add up to the written protocol's lab minutes
+// (counted a second way, LabCosts::calcMinutes) within the budget; predicting the written protocol
+// reproduces the design's own prediction (rows built from the protocol file's fields instead of the
+// candidates); channels shrink the predicted mass width below the torque-only reference; a budget that
+// fits no MVC block is refused.
+TEST(ExperimentDesign, ChannelDesignStaysWithinItsBudgetAndItsProtocolPredictsAlike) {
+    constexpr double kSame = 1e-9;  // relative: the same posterior computed from the same rows
+    const Population prior = makePrior();
+    DesignSettings settings;
+    settings.draws = 4;
+    settings.flexionDeg = {30, 90, 135};
+    settings.budgetMinutes = 70;
+    TorqueProtocol thesis;
+    const DesignResult d = designChannelProtocol(prior, settings, thesis);
+    double minutes = 0;
+    for (const DesignStep& s : d.steps) minutes += s.minutes;
+    EXPECT_LE(minutes, settings.budgetMinutes);
+    EXPECT_NEAR(minutes, settings.costs.calcMinutes(d.protocol), 1e-9);
+    EXPECT_TRUE(d.protocol.hasChannels());
+    const ProtocolPrediction again = predictProtocol(prior, d.protocol, settings);
+    EXPECT_NEAR(again.massSd, d.predicted.massSd, kSame * d.predicted.massSd);
+    EXPECT_NEAR(again.tendonSd, d.predicted.tendonSd, kSame * d.predicted.tendonSd);
+    EXPECT_LT(d.predicted.massSd, d.reference.massSd);
+    // The protocol reads back as written.
+    const TorqueProtocol back = readTorqueProtocol([&] {
+        const std::string path = ::testing::TempDir() + "armsim_channel_design.yaml";
+        std::FILE* f = std::fopen(path.c_str(), "w");
+        const std::string text = formatTorqueProtocol(d.protocol);
+        std::fwrite(text.data(), 1, text.size(), f);
+        std::fclose(f);
+        return path;
+    }());
+    EXPECT_EQ(back.volumeScan, d.protocol.volumeScan);
+    EXPECT_EQ(back.anthropometry, d.protocol.anthropometry);
+    settings.budgetMinutes = 5;
+    EXPECT_THROW(designChannelProtocol(prior, settings, thesis), InputError);
 }
