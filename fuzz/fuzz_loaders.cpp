@@ -1,12 +1,13 @@
 // libFuzzer target for armsim's file loaders (issue 15). One binary, the loader chosen by the
 // ARMSIM_FUZZ_LOADER environment variable (muscle, arm, model, protocol, torque_protocol, population,
-// study, force_csv, torque_csv, sto, trace). Each input is written to a scratch file and loaded; a loader
+// study, force_csv, torque_csv, channel_csv, sto, trace). Each input is written to a scratch file and loaded; a loader
 // may reject it only with InputError (bad input) or SimulationError (a model it cannot solve). Any
 // other exception, a crash, a hang or a sanitizer report is a finding.
 #include "basics/errors.h"
 #include "experiments/data_files.h"
 #include "experiments/population.h"
 #include "experiments/protocol.h"
+#include "experiments/channels.h"
 #include "experiments/torque_protocol.h"
 #include "identification/observations.h"
 #include "studies/study.h"
@@ -41,6 +42,7 @@ const std::map<std::string, std::pair<std::string, Loader>>& getLoaders() {
         {"study", {".yaml", [](const std::string& p) { readStudy(p); }}},
         {"force_csv", {".csv", [](const std::string& p) { readObservations(p); }}},
         {"torque_csv", {".csv", [](const std::string& p) { readTorqueData(p); }}},
+        {"channel_csv", {".csv", [](const std::string& p) { readChannelData(p); }}},
         {"sto", {".sto", [](const std::string& p) { readStorage(p); }}},
         {"trace", {".csv", [](const std::string& p) { loadActivationTrace(p); }}},
     };

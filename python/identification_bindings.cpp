@@ -5,6 +5,7 @@
 // report `armsim identify` writes (report_io.h).
 #include "basics/bound.h"
 #include "basics/files.h"
+#include "experiments/channels.h"
 #include "experiments/protocol.h"
 #include "studies/torque_validation.h"
 #include "studies/experiment_design.h"
@@ -172,6 +173,22 @@ py::dict toDict(const MuscleEstimate& e) {
     d["predicted_torque"] = toArray(e.predictedTorque);
     d["parameters"] = e.numParameters;
     d["iterations"] = e.iterations;
+    d["max_force"] = e.maxForce;
+    d["max_force_interval"] = py::make_tuple(e.maxForceLower, e.maxForceUpper);
+    d["specific_tension"] = e.specificTension;
+    py::list fits;
+    for (const ChannelFit& f : e.channelFits) {
+        py::dict c;
+        c["channel"] = f.channel;
+        c["n"] = f.n;
+        c["chi_square"] = f.chiSquare;
+        c["p_value"] = f.p;
+        c["consistent_with_noise"] = f.p >= 0.05;
+        c["worst"] = f.worst;
+        c["worst_residual_sd"] = f.worstResidual;
+        fits.append(c);
+    }
+    d["channel_fits"] = fits;
     return d;
 }
 
@@ -307,13 +324,17 @@ py::dict identifyPy(const Model& m, const py::object& data, const std::string& m
 }
 
 py::list identifyTorquePy(const py::object& data, const py::object& population, const std::optional<double>& noiseLevel,
-                          const std::optional<double>& activation, double activationSd) {
+                          const std::optional<double>& activation, double activationSd, const py::object& channels,
+                          double emgCrosstalk, bool freeSlowFraction) {
     const std::vector<TorqueObservation> obs = toTorqueData(data);
     const Population prior = toPopulation(population);
     TorqueIdentificationOptions o;
     o.noiseLevel = optionalNumber(noiseLevel, "noise_level");
     o.activation = optionalNumber(activation, "activation");
     o.activationSd = activationSd;
+    o.emgCrosstalk = emgCrosstalk;
+    o.freeSlowFraction = freeSlowFraction;
+    if (!channels.is_none()) o.channels = readChannelData(findFile(pathOf(channels, "channels")));
     std::vector<MuscleEstimate> estimates;
     std::string skipped;
     {
@@ -501,15 +522,42 @@ py::dict runProtocolPy(const py::object& file, const py::object& outArgument, in
     if (isTorqueProtocolFile(path)) {
         const TorqueProtocol protocol = readTorqueProtocol(path);
         std::vector<TorqueObservation> data;
+        std::vector<ChannelObservation> channels;
         std::vector<std::string> files;
         {
             py::gil_scoped_release release;
-            data = synthesizeTorqueData(loadTorqueProtocolSubject(protocol), protocol, protocol.seed, jobs);
-            if (!out.empty()) files = writeTorqueProtocolRun(out, protocol, data);
+            const VirtualSubject subject = loadTorqueProtocolSubject(protocol);
+            data = synthesizeTorqueData(subject, protocol, protocol.seed, jobs);
+            if (protocol.hasChannels()) channels = synthesizeChannelData(subject, protocol, data, protocol.seed);
+            if (!out.empty()) files = writeTorqueProtocolRun(out, protocol, data, channels);
         }
         d["name"] = protocol.name;
         d["kind"] = "torque";
         d["data"] = toDict(data);
+        py::dict c;  // channels besides torque, as channel_data.csv's columns
+        py::list channel, muscle;
+        std::vector<double> flexion, effort, level, repetition, value, sd, clean;
+        for (const ChannelObservation& o : channels) {
+            channel.append(o.channel);
+            muscle.append(o.muscle);
+            flexion.push_back(o.flexionDeg);
+            effort.push_back(o.effort == MuscleGroup::Flexor ? 1 : -1);
+            level.push_back(o.level);
+            repetition.push_back(o.repetition);
+            value.push_back(o.value);
+            sd.push_back(o.sd);
+            clean.push_back(o.cleanValue);
+        }
+        c["channel"] = channel;
+        c["muscle"] = muscle;
+        c["flexion_deg"] = toArray(flexion);
+        c["effort"] = toArray(effort);
+        c["level"] = toArray(level);
+        c["repetition"] = toArray(repetition);
+        c["value"] = toArray(value);
+        c["sd"] = toArray(sd);
+        c["clean_value"] = toArray(clean);
+        d["channels"] = c;
         d["files"] = files;
         return d;
     }
@@ -572,11 +620,15 @@ model_checks: the estimate re-checked by the steady model and the faithful model
 estimate {name: value}, observations and history as dicts of float64 arrays. Releases the GIL.)");
 
     mod.def("identify_torque", &identifyTorquePy, "data"_a, "population"_a = py::none(), "noise_level"_a = py::none(),
-            "activation"_a = py::none(), "activation_sd"_a = 0.02,
+            "activation"_a = py::none(), "activation_sd"_a = 0.02, "channels"_a = py::none(), "emg_crosstalk"_a = 0.10,
+            "free_slow_fraction"_a = false,
             R"(Identifies the biceps long head's mass and tendon length from tared elbow torque data with
 every elbow method, as `armsim identify-torque`: 'thesis' (flexion MVCs at >= 2 angles),
-'synergist' (MAP over the whole elbow, the population as prior) and, given a measured voluntary
-activation, 'synergist-va'.
+'synergist' (MAP over the whole elbow, the population as prior), given a measured voluntary
+activation 'synergist-va', and given channel data (`channels`: a channel CSV path, docs/channels.md:
+ultrasound fascicle length and volume, EMG, upper-arm length) 'channels', which also reports
+max_force (F0) with its interval, the specific_tension the mass assumes and channel_fits (a
+chi-square check per channel naming its worst measurement).
 
 data: a torque CSV path or a dict of columns (flexion_deg [deg, 0 = extended], torque_Nm, optional
 effort 1/-1, level, repetition; e.g. run_protocol(...)['data']).  population: prior population file

@@ -223,6 +223,19 @@ std::vector<int> countTrials(const std::vector<TorqueCondition>& conditions) {
     return counts;
 }
 
+// Every condition the settings allow: flexion (and extension) efforts at each angle and level.
+std::vector<TorqueCondition> makeCandidates(const DesignSettings& settings) {
+    std::vector<TorqueCondition> out;
+    std::vector<double> levels = {1.0};
+    levels.insert(levels.end(), settings.levels.begin(), settings.levels.end());
+    for (MuscleGroup effort : {MuscleGroup::Flexor, MuscleGroup::Extensor}) {
+        if (effort == MuscleGroup::Extensor && !settings.extension) continue;
+        for (double level : levels)
+            for (double q : settings.flexionDeg) out.push_back({q, effort, level, 1});
+    }
+    return out;
+}
+
 ChannelObservation makeRow(const char* channel, const std::string& muscle, double flexionDeg, MuscleGroup effort,
                            double level) {
     ChannelObservation o;
@@ -309,13 +322,7 @@ DesignResult designChannelProtocol(const Population& prior, const DesignSettings
     const ArmSetup& base = prior.base;
     const LabCosts& cost = settings.costs;
     DesignResult result;
-    std::vector<double> levels = {1.0};
-    levels.insert(levels.end(), settings.levels.begin(), settings.levels.end());
-    for (MuscleGroup effort : {MuscleGroup::Flexor, MuscleGroup::Extensor}) {
-        if (effort == MuscleGroup::Extensor && !settings.extension) continue;
-        for (double level : levels)
-            for (double q : settings.flexionDeg) result.candidates.push_back({q, effort, level, 1});
-    }
+    result.candidates = makeCandidates(settings);
     // Rows: candidate torques, then per candidate its fascicle and EMG rows, the volume candidates
     // (flexors surface electrodes reach: superficial, so a panoramic scan reaches them too) and the arm.
     const int nc = int(result.candidates.size());
@@ -459,13 +466,7 @@ DesignResult designProtocol(const Population& prior, const DesignSettings& setti
     settings.validate();
     prior.validate();
     DesignResult result;
-    std::vector<double> levels = {1.0};
-    levels.insert(levels.end(), settings.levels.begin(), settings.levels.end());
-    for (MuscleGroup effort : {MuscleGroup::Flexor, MuscleGroup::Extensor}) {
-        if (effort == MuscleGroup::Extensor && !settings.extension) continue;
-        for (double level : levels)
-            for (double q : settings.flexionDeg) result.candidates.push_back({q, effort, level, 1});
-    }
+    result.candidates = makeCandidates(settings);
     const int picks = settings.trials / settings.repetitions;
     const int total = 2 * settings.draws + picks;
     Sensitivities s = calcSensitivities(prior, result.candidates, settings, [&](int done, int) {

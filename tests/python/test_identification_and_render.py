@@ -273,3 +273,20 @@ def test_identify_and_a_torque_protocol_give_the_commands_numbers(thesis, tmp_pa
     cli_data = armsim.read_torque_data(str(tmp_path / "tp" / "torque_data.csv"))
     py_data = armsim.run_protocol("protocols/designed_emg_torque.yaml")["data"]
     np.testing.assert_allclose(cli_data["torque_Nm"], py_data["torque_Nm"], rtol=1e-15, atol=0)
+
+
+def test_recommended_protocol_channels_feed_identify_torque(tmp_path):
+    run = armsim.run_protocol("protocols/recommended.yaml", out=str(tmp_path / "run"))
+    names = sorted(os.path.basename(f) for f in run["files"])
+    assert "channel_data.csv" in names and "fascicle_length.png" in names
+    assert set(run["channels"]["channel"]) == {"fascicle_length", "emg", "volume", "upper_arm_length"}
+    estimates = armsim.identify_torque(str(tmp_path / "run" / "torque_data.csv"),
+                                       channels=str(tmp_path / "run" / "channel_data.csv"), activation=0.93)
+    fit = [e for e in estimates if e["method"] == "channels"]
+    assert len(fit) == 1 and fit[0]["converged"]
+    lo, hi = fit[0]["max_force_interval"]
+    assert lo < fit[0]["max_force"] < hi
+    assert [f["channel"] for f in fit[0]["channel_fits"]][:2] == ["torque", "fascicle_length"]
+    # the channels narrow the mass interval of the same torques
+    width = {e["method"]: e["mass_interval"][1] - e["mass_interval"][0] for e in estimates}
+    assert width["channels"] < 0.8 * width["synergist-va"]
