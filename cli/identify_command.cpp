@@ -410,7 +410,8 @@ void addValidateCommand(CLI::App& app) {
         ->check(CLI::Range(1, 100));
     c->add_option("--protocol", o->protocol,
                   "--truth elbow: torque protocol file (kind: torque, e.g. written by `armsim design`) instead of "
-                  "--angles/--repetitions");
+                  "--angles/--repetitions; channels it records besides torque add the channels fit (e.g. "
+                  "assets/protocols/recommended.yaml)");
     c->add_flag("--free-slow-fraction", o->freeSlowFraction,
                 "--truth elbow: the synergist identifiers free the flexors' slow-fibre fractions");
     c->add_option("--subjects", o->subjects, "subjects for --truth elbow")->capture_default_str()->check(CLI::Range(1, 1000000));
