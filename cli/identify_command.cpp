@@ -237,7 +237,7 @@ struct ValidateOptions {
 // Identified vs true biceps mass per method, and the error against two nuisances.
 void addElbowValidationPlots(const std::vector<ElbowValidationRow>& rows, OutputFolder& out) {
     PlotSpec vsTruth;
-    vsTruth.title = "Biceps long-head mass: identified vs true (elbow model as truth)";
+    vsTruth.title = "Biceps long-head mass: identified vs true (virtual subjects as truth)";
     vsTruth.xLabel = "true mass (g)";
     vsTruth.yLabel = "identified mass (g)";
     PlotSpec vsActivation = vsTruth, vsSynergists = vsTruth;
@@ -298,11 +298,12 @@ void runElbowValidate(const ValidateOptions& o) {
         std::printf("out of family: truth population '%s' (%s, model %s), identifiers' prior '%s' (%s, model %s)\n",
                     population.name.c_str(), population.file.c_str(), population.base.name.c_str(), prior.name.c_str(),
                     prior.file.c_str(), prior.base.name.c_str());
-    std::printf("validation on the elbow model as truth: population '%s' (%s), %d subjects, seed %u; protocol "
-                "'%s' (%d trials: %s); identifiers: thesis (biceps only), synergist-aware (MAP) and, with "
+    std::printf("validation on virtual subjects of the %s model as truth: population '%s' (%s), %d subjects, seed %u; "
+                "protocol '%s' (%d trials: %s); identifiers: thesis (biceps only), synergist-aware (MAP) and, with "
                 "--activation-sd > 0, synergist-aware with voluntary activation measured by twitch interpolation "
                 "(synergist-va)%s\n",
-                population.name.c_str(), population.file.c_str(), s.subjects, s.seed, s.protocol.name.c_str(),
+                population.base.name.c_str(), population.name.c_str(), population.file.c_str(), s.subjects, s.seed,
+                s.protocol.name.c_str(),
                 s.protocol.getNumTrials(), describeConditions(s.protocol).c_str(),
                 s.protocol.hasChannels() ? "; with the protocol's channels besides torque, the same MAP fitting every "
                                            "channel (channels)" : "");

@@ -216,3 +216,23 @@ TEST(ElbowIdentification, ChannelsRecoverAKnownPersonAndJudgeEachChannel) {
         }
     }
 }
+
+// The twin (ten muscles, forearm locked at its posture): the identifier's steady prediction against
+// the integrated, tared trial, as for the elbow above, and the fascicle at rest and at the plateau.
+TEST(ElbowIdentification, TwinTaredSteadyTorqueEqualsTheIntegratedTrial) {
+    constexpr double kTrialRelTol = 0.01;  // as the elbow's: slow activation dynamics over a 3 s hold
+    Population p = population();
+    p.base = loadModel("twin");
+    const VirtualSubject v = drawSubject(p, 3, 2);
+    const std::vector<double> flexion = {30, 90, 135};
+    const std::vector<double> t = calcTaredSteadyTorque(v.setup, v.setup.effort, flexion);
+    for (std::size_t a = 0; a < flexion.size(); ++a) {
+        IsometricTrialSettings s;
+        s.elbowAngle = degToRad(180 - flexion[a]);
+        s.activation = v.setup.effort.voluntaryActivation;
+        s.antagonistActivation = v.setup.effort.coContraction;
+        s.averagingWindow = 0.2;
+        const double trial = runIsometricTrial(v.setup, s).summary.meanMuscleTorque;
+        EXPECT_NEAR(trial, t[a], kTrialRelTol * std::abs(t[a])) << flexion[a] << " deg";
+    }
+}
