@@ -448,25 +448,77 @@ MuscleEstimate identifySynergistAware(const Population& prior, const std::vector
     if (measured) addFit("activation", nt + nc, "twitch interpolation");
     for (ChannelFit& f : est.channelFits) f.p = calcChiSquareSurvival(f.chiSquare, f.n);
     if (!m.covariance.empty()) {
-        const double quantile = est.noiseDegreesOfFreedom > 0 ? calcStudentTQuantile(0.975, est.noiseDegreesOfFreedom)
-                                                          : calcNormalQuantile(0.975);
         const auto& C = m.covariance;
+        const int n = int(C.size());
         const int it = P::kTendon, ig = P::kSize, is = P::kSigma, jf = P::kFascicle;
-        const double sm = std::sqrt(C[im][im]);
-        // ln L0T = ln t_b + ln g; ln F0 = ln sigma + ln M - ln f_b - ln g (+ constants).
-        const double vt = C[it][it] + C[ig][ig] + 2 * C[it][ig];
-        const std::vector<std::pair<int, double>> f0 = {{is, 1}, {im, 1}, {jf, -1}, {ig, -1}};
-        double vf = 0;
-        for (const auto& [a, ca] : f0)
-            for (const auto& [c, cb] : f0) vf += ca * cb * C[a][c];
-        const double st = std::sqrt(std::max(vt, 0.0)), sf = std::sqrt(std::max(vf, 0.0));
-        est.massLower = est.mass * std::exp(-quantile * sm);
-        est.massUpper = est.mass * std::exp(quantile * sm);
-        est.tendonLower = est.tendonLength * std::exp(-quantile * st);
-        est.tendonUpper = est.tendonLength * std::exp(quantile * st);
-        est.maxForceLower = est.maxForce * std::exp(-quantile * sf);
-        est.maxForceUpper = est.maxForce * std::exp(quantile * sf);
-        est.massTendonCorrelation = (C[im][it] + C[im][ig]) / (sm * st);
+        // Reported quantities as linear combinations of x: ln M; ln L0T = ln t_b + ln g;
+        // ln F0 = ln sigma + ln M - ln f_b - ln g (+ constants).
+        std::vector<double> gm(n, 0.0), gt(n, 0.0), gf(n, 0.0);
+        gm[im] = 1;
+        gt[it] += 1, gt[ig] += 1;
+        gf[is] += 1, gf[im] += 1, gf[jf] -= 1, gf[ig] -= 1;
+        auto quadratic = [&](const std::vector<double>& a, const std::vector<std::vector<double>>& M,
+                             const std::vector<double>& b) {
+            double v = 0;
+            for (int i = 0; i < n; ++i)
+                for (int j = 0; j < n; ++j) v += a[i] * M[i][j] * b[j];
+            return v;
+        };
+        // Degrees of freedom of each interval. The torque rows' sd is the noise level estimated with nu
+        // dof; a quantity whose posterior variance owes the fraction f = g'C Ht C g / g'C g to the torque
+        // rows (Ht = Jt'Jt, their whitened Jacobian) has that variance estimated with about nu / f^2 dof
+        // (Satterthwaite); the channels' and the prior's sds are known. Torque alone: f near 1, the
+        // Student-t of nu; a volume measured: f small, near the normal quantile.
+        std::vector<double> fraction(3, 1.0);
+        const int nu = est.noiseDegreesOfFreedom;
+        if (nu > 0) {
+            constexpr double kStep = 1e-5;
+            std::vector<std::vector<double>> jt(nt, std::vector<double>(n, 0.0));
+            std::vector<double> xp = x, rp(map.numResiduals), rm(map.numResiduals);
+            bool ok = true;
+            for (int j = 0; j < n && ok; ++j) {
+                if (map.lower[j] == map.upper[j]) continue;  // held fixed
+                try {
+                    xp[j] = x[j] + kStep;
+                    calcResiduals(xp.data(), rp.data());
+                    xp[j] = x[j] - kStep;
+                    calcResiduals(xp.data(), rm.data());
+                } catch (const std::exception&) {
+                    ok = false;  // keep the conservative quantile of nu
+                }
+                xp[j] = x[j];
+                for (std::size_t k = 0; k < nt && ok; ++k) jt[k][j] = (rp[k] - rm[k]) / (2 * kStep);
+            }
+            if (ok) {
+                std::vector<std::vector<double>> ht(n, std::vector<double>(n, 0.0));
+                for (std::size_t k = 0; k < nt; ++k)
+                    for (int a = 0; a < n; ++a)
+                        if (jt[k][a] != 0)
+                            for (int b = 0; b < n; ++b) ht[a][b] += jt[k][a] * jt[k][b];
+                int q = 0;
+                for (const std::vector<double>* g : {&gm, &gt, &gf}) {
+                    std::vector<double> cg(n, 0.0);  // C g
+                    for (int a = 0; a < n; ++a)
+                        for (int b = 0; b < n; ++b) cg[a] += C[a][b] * (*g)[b];
+                    const double v = quadratic(*g, C, *g);
+                    fraction[q++] = v > 0 ? std::clamp(quadratic(cg, ht, cg) / v, 0.0, 1.0) : 1.0;
+                }
+            }
+        }
+        auto quantileOf = [&](double f) {
+            if (nu <= 0 || f <= 0) return calcNormalQuantile(0.975);
+            return calcStudentTQuantile(0.975, std::min(double(nu) / (f * f), 1e6));
+        };
+        const double sm = std::sqrt(std::max(quadratic(gm, C, gm), 0.0)), st = std::sqrt(std::max(quadratic(gt, C, gt), 0.0)),
+                     sf = std::sqrt(std::max(quadratic(gf, C, gf), 0.0));
+        const double qm = quantileOf(fraction[0]), qt = quantileOf(fraction[1]), qf = quantileOf(fraction[2]);
+        est.massLower = est.mass * std::exp(-qm * sm);
+        est.massUpper = est.mass * std::exp(qm * sm);
+        est.tendonLower = est.tendonLength * std::exp(-qt * st);
+        est.tendonUpper = est.tendonLength * std::exp(qt * st);
+        est.maxForceLower = est.maxForce * std::exp(-qf * sf);
+        est.maxForceUpper = est.maxForce * std::exp(qf * sf);
+        est.massTendonCorrelation = quadratic(gm, C, gt) / (sm * st);
     }
     return est;
 }
