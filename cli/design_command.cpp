@@ -74,7 +74,7 @@ void runDesign(const DesignOptions& o) {
     thesis.name = "thesis";
     const bool channels = s.budgetMinutes > 0;
     if (channels)
-        std::printf("across channels: budget %s lab minutes (MVC block %s, EMG set-up %s, ultrasound per angle %s, volume "
+        std::printf("across channels: budget %s lab minutes, --trials ignored (MVC block %s, EMG set-up %s, ultrasound per condition %s, volume "
                     "scan %s, anthropometry %s min: docs/channels.md)\n",
                     formatNumber(s.budgetMinutes).c_str(), formatNumber(s.costs.mvcBlock).c_str(),
                     formatNumber(s.costs.emgSetup).c_str(), formatNumber(s.costs.ultrasoundAngle).c_str(),
@@ -118,15 +118,20 @@ void runDesign(const DesignOptions& o) {
     out.write("design_predictions.csv", formatPredictionsCsv({reference, d.predicted}));
     out.write("design_steps.csv", formatDesignStepsCsv(d));
     PlotSpec plot;
-    plot.title = "Greedy design: expected criterion after each block of trials";
-    plot.xLabel = "trials";
+    plot.title = channels ? "Greedy design across channels: expected criterion after each pick"
+                          : "Greedy design: expected criterion after each block of trials";
+    plot.xLabel = channels ? "lab minutes" : "trials";
     plot.yLabel = "criterion (1 = sds at the goals)";
     PlotSeries greedy{"designed", {}, {}, false, 0};
+    double spent = 0;
     for (std::size_t k = 0; k < d.steps.size(); ++k) {
-        greedy.x.push_back(double((k + 1) * s.repetitions));
+        spent += channels ? d.steps[k].minutes : double(s.repetitions);
+        greedy.x.push_back(spent);
         greedy.y.push_back(d.steps[k].criterion);
     }
-    plot.series = {greedy, {"thesis five angles", {double(reference.trials)}, {reference.criterion}, true, 1}};
+    plot.series = {greedy};
+    if (!channels)  // the reference's lab minutes are not on this axis with channels
+        plot.series.push_back({"thesis five angles", {double(reference.trials)}, {reference.criterion}, true, 1});
     out.writeWith("design_criterion.png", [&](const std::string& p) { writePlotPng(p, plot); });
     out.commit();
     std::printf("wrote %s, %s/design_predictions.csv, design_steps.csv, design_criterion.png\n", protocolPath.c_str(),
@@ -149,6 +154,8 @@ void runDesign(const DesignOptions& o) {
             population, v, [label = "validate " + protocol.name](int done, int n) { printProgress(label, done, n); });
         for (const ElbowValidationSummary& x : summarizeElbowValidation(rows)) {
             if (x.method == "thesis") continue;
+            // With channels the prediction is the channels fit's (the torque-only fits' is the reference's).
+            if (channels && protocol.name == d.protocol.name && x.method != "channels") continue;
             std::printf("  %-9s %-13s mass bias %+5.1f %%  RMSE %5.1f %% (predicted sd %4.1f %%)  coverage %.2f  "
                         "95 %% width %5.1f %%   L0T RMSE %5.1f mm (predicted %4.1f mm)  coverage %.2f\n",
                         protocol.name.c_str(), x.method.c_str(), 100 * x.massBias, 100 * x.massRmse,
@@ -163,8 +170,9 @@ void runDesign(const DesignOptions& o) {
             csv.addRow(row);
         }
     }
-    std::printf("  (predicted: synergist-%s; the RMSE is the obtained counterpart of the predicted sd)\n",
-                o.activationSd > 0 ? "va" : "aware");
+    std::printf("  (predicted: %s; the RMSE is the obtained counterpart of the predicted sd)\n",
+                channels ? "the thesis protocol's for synergist-va, the design's for the channels fit"
+                         : o.activationSd > 0 ? "synergist-va" : "synergist-aware");
     OutputFolder validation(o.out, OutputFolder::Mode::AddFiles);
     validation.write("design_validation.csv", csv.getText());
     validation.commit();

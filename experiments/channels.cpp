@@ -45,8 +45,8 @@ std::vector<ChannelObservation> synthesizeChannelData(const VirtualSubject& subj
     std::vector<ChannelObservation> out;
     auto add = [&](ChannelObservation o, double clean, double relativeSd, double floor) {
         o.cleanValue = clean;
-        o.value = clean * (1 + relativeSd * rng.drawNormal());
         o.sd = relativeSd * std::max(std::abs(clean), floor);  // the device's sd at the true level
+        o.value = clean + o.sd * rng.drawNormal();
         out.push_back(o);
     };
     const SubjectEffort& e = s.effort;
@@ -71,6 +71,10 @@ std::vector<ChannelObservation> synthesizeChannelData(const VirtualSubject& subj
             add(o, t.fascicleLength, n.fascicleLength, 0);
         }
         if (c->emg) {
+            if (s.surfaceEmg.empty())
+                throw InputError("protocol '" + protocol.name + "' records emg at " + formatNumber(c->flexionDeg) +
+                                 " deg, but model '" + s.name + "' names no muscles for it: expected a roles: "
+                                 "surface_emg list in the model file");
             o.channel = "emg";
             o.level = t.level;
             for (int m : s.surfaceEmg) {
@@ -120,7 +124,8 @@ std::string formatChannelData(const std::vector<ChannelObservation>& data, bool 
         csv.addRow(r);
     }
     return "# channels besides torque (docs/channels.md): fascicle_length [m] (level 0: at rest), volume [m^3],\n"
-           "# emg [1, of the muscle's MVC amplitude], upper_arm_length [m]; sd: the measurement's sd, same units\n" +
+           "# emg [1, of the muscle's MVC amplitude], upper_arm_length [m]; sd: the measurement's sd, same units.\n"
+           "# The EMG crosstalk is the protocol's channel_noise.emg_crosstalk (identify-torque --emg-crosstalk).\n" +
            csv.getText();
 }
 
@@ -202,6 +207,7 @@ std::vector<ChannelObservation> readChannelData(const std::string& path) {
         o.sd = number("sd", 0.0 / 0.0);
         if (!(o.sd > 0)) fail("sd", formatNumber(o.sd), "> 0 (the measurement's sd, units of value)");
         o.cleanValue = number("clean_value", 0.0 / 0.0);
+        o.source = path;
         data.push_back(o);
     }
     if (header.empty()) throw InputError(path + ": no header line");

@@ -34,6 +34,7 @@ struct ChannelObservation {
     double sd = 0;              ///< its measurement sd, same units [> 0]
     double cleanValue = 0.0 / 0.0;  ///< before measurement error (truth; synthetic data)
     int line = 0;               ///< line in the file it was read from (0: synthesized)
+    std::string source;         ///< the file it was read from ("" : synthesized)
 };
 
 /// The names channels may have.
@@ -44,7 +45,8 @@ const std::vector<std::string>& getChannelNames();
 /// `torque`, which must be synthesizeTorqueData's output for the same subject and protocol); per
 /// condition with emg, every surface_emg muscle's normalised amplitude per trial; the volume scan and
 /// anthropometry when the protocol asks. Errors from the protocol's channel noise, seeded by
-/// (noiseSeed, subject).
+/// (noiseSeed, subject). Throws InputError for a protocol that records EMG on a model without a
+/// surface_emg role, or a volume scan of a muscle the model does not have.
 std::vector<ChannelObservation> synthesizeChannelData(const VirtualSubject& subject, const TorqueProtocol& protocol,
                                                       const std::vector<TorqueObservation>& torque,
                                                       unsigned noiseSeed);
@@ -52,7 +54,7 @@ std::vector<ChannelObservation> synthesizeChannelData(const VirtualSubject& subj
 /// Channel data as CSV: channel, muscle, flexion_deg, effort (1 flexion, -1 extension), level,
 /// repetition, value, sd; with truth=true also clean_value.
 std::string formatChannelData(const std::vector<ChannelObservation>& data, bool truth);
-/// Reads channel data (Table::readCsv: '#' comments, header). Required: channel, value, sd; muscle
+/// Reads channel data ('#' comments, a header line, RFC 4180 cells). Required: channel, value, sd; muscle
 /// (required except for upper_arm_length), flexion_deg (required for fascicle_length and emg),
 /// effort, level, repetition optional. Errors name file, line, column, value and what was expected.
 std::vector<ChannelObservation> readChannelData(const std::string& path);

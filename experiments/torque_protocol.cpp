@@ -72,6 +72,10 @@ void TorqueProtocol::validate() const {
     checkField("trial.sample_rate", sampleRate, Bound::positive("Hz"));
     checkField("subject.transducer_noise", transducerNoise, Bound::closed(0, 0.5));
     checkField("subject.index", subjectIndex, Bound::closed(0, 1e6));
+    for (std::size_t k = 0; k < volumeScan.size(); ++k)
+        if (std::find(volumeScan.begin(), volumeScan.begin() + long(k), volumeScan[k]) != volumeScan.begin() + long(k))
+            throw FieldError("measurements.volume_scan[" + std::to_string(k) + "]",
+                             "'" + volumeScan[k] + "' is listed twice: expected each muscle once");
     const ChannelNoise& n = channelNoise;
     checkField("channel_noise.fascicle_length", n.fascicleLength, Bound{0, 0.5, true, true, "relative sd"});
     checkField("channel_noise.volume", n.volume, Bound{0, 0.5, true, true, "relative sd"});

@@ -106,7 +106,8 @@ SynergistModel::SynergistModel(const Population& prior, const SynergistOptions& 
     emgCrosstalk_ = options.emgCrosstalk;
     checkField("emg crosstalk", emgCrosstalk_, Bound::closed(0, 0.5));
     for (const ChannelObservation& o : channels_) {
-        const std::string at = o.line > 0 ? "channel data line " + std::to_string(o.line) + ": " : "channel data: ";
+        const std::string at = o.line > 0 ? (o.source.empty() ? "channel data" : o.source) + ":" + std::to_string(o.line) + ": "
+                                          : "channel data: ";
         int m = -1, angle = -1, kind = -1;
         if (o.channel != "upper_arm_length") {
             try {
@@ -116,6 +117,11 @@ SynergistModel::SynergistModel(const Population& prior, const SynergistOptions& 
             }
         }
         if (o.channel == "fascicle_length" || o.channel == "emg") {
+            const double lo = base.arm.getMinFlexionDeg(), hi = base.arm.getMaxFlexionDeg();
+            if (!(o.flexionDeg >= lo - 1e-9 && o.flexionDeg <= hi + 1e-9))
+                throw InputError(at + o.channel + " at flexion_deg " + formatNumber(o.flexionDeg) +
+                                 ": expected an angle in the elbow's range [" + formatNumber(lo) + ", " +
+                                 formatNumber(hi) + "] deg of model '" + base.name + "'");
             angle = findAngle(o.flexionDeg, angles);
             if (o.channel == "fascicle_length" && o.level > 0) kind = findKind(o.effort, o.level);
         }

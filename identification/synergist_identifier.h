@@ -5,8 +5,10 @@
 // co-contraction CC (and optionally the flexors' slow-fibre fractions); the person's specific-tension
 // and size scales when the prior population varies them. Data residuals are weighted by
 // a relative noise level estimated from the repetitions' scatter; the posterior covariance is the
-// Laplace approximation; 95 % intervals are symmetric in the log scales (Student-t quantile with the
-// noise estimate's degrees of freedom), so the M and L0T intervals are exp-transformed. With VA
+// Laplace approximation; 95 % intervals are symmetric in the log scales, so the M, L0T and F0 intervals
+// are exp-transformed. Their quantile is Student-t's with nu / f^2 degrees of freedom: nu those of the
+// torque noise estimate, f the share of the quantity's posterior variance owed to the torque rows
+// (Satterthwaite; channels and prior have known sds, so f -> 0 gives the normal quantile). With VA
 // measured by twitch interpolation it has one more residual ("synergist-va"); with the channels of
 // experiments/channels.h (ultrasound fascicle length and volume, EMG, anthropometry) one residual per
 // measurement, each divided by its own sd ("channels").

@@ -286,6 +286,17 @@ ProtocolPrediction predictProtocol(const Population& prior, const TorqueProtocol
     settings.validate();
     std::vector<int> counts = countTrials(protocol.conditions);
     std::vector<ChannelObservation> rows;
+    for (std::size_t k = 0; k < protocol.volumeScan.size(); ++k) {
+        try {
+            prior.base.findMuscle(protocol.volumeScan[k]);
+        } catch (const InputError& e) {
+            throw InputError("protocol '" + protocol.name + "': measurements.volume_scan[" + std::to_string(k) + "]: " + e.what());
+        }
+    }
+    for (const TorqueCondition& c : protocol.conditions)
+        if (c.emg && prior.base.surfaceEmg.empty())
+            throw InputError("protocol '" + protocol.name + "' records emg, but model '" + prior.base.name +
+                             "' names no muscles for it: expected a roles: surface_emg list in the model file");
     for (const TorqueCondition& c : protocol.conditions)
         for (const ChannelObservation& o : makeConditionRows(prior.base, c, c.ultrasound, c.emg)) {
             rows.push_back(o);

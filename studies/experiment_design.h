@@ -30,10 +30,11 @@ namespace armsim {
 struct LabCosts {
     double mvcBlock = 8;          ///< one condition's 3 efforts with 2 min rests (scaled by repetitions / 3) [min]
     double emgSetup = 20;         ///< electrodes and MVC normalisation, once [min]
-    double ultrasoundAngle = 7;   ///< fascicle images at rest and at the plateau at one angle [min]
+    double ultrasoundAngle = 7;   ///< fascicle images at rest and at the plateau during one condition's trials [min]
     double volumeScan = 10;       ///< one muscle's panoramic scan [min]
     double anthropometry = 10;    ///< [min]
-    /// Lab minutes of a protocol (twitch interpolation, if any, not counted: every design has it or not).
+    /// Lab minutes of a protocol: MVC blocks, ultrasound per condition, EMG set-up, volume scans and
+    /// anthropometry (twitch interpolation, about 25 min, not counted: every design has it or not).
     double calcMinutes(const TorqueProtocol& protocol) const;
 };
 

@@ -97,13 +97,15 @@ void Study::validate() const {
     for (std::size_t i = 0; i < methods.size(); ++i) {
         const std::string f = "methods[" + std::to_string(i) + "]";
         if (std::find(kinds.begin(), kinds.end(), methods[i].kind) == kinds.end())
-            throw FieldError(f + ".method", "= '" + methods[i].kind + "': expected thesis, synergist or synergist-va");
+            throw FieldError(f + ".method", "= '" + methods[i].kind + "': expected thesis, synergist, synergist-va or channels");
         if (methods[i].label.empty()) throw FieldError(f + ".label", "is empty: expected a name");
         for (std::size_t j = 0; j < i; ++j)
             if (methods[j].label == methods[i].label)
                 throw FieldError(f + ".label", "= '" + methods[i].label + "': also methods[" + std::to_string(j) +
                                                    "]'s label: expected unique labels");
-        checkField(f + ".activation_sd", methods[i].options.activationSd, Bound{0, 0.5, true, false});
+        // channels: 0 leaves voluntary activation unmeasured; synergist-va needs a measurement.
+        checkField(f + ".activation_sd", methods[i].options.activationSd,
+                   Bound{0, 0.5, methods[i].kind != "channels", false});
         if (std::isfinite(methods[i].options.noiseLevel))
             checkField(f + ".noise_level", methods[i].options.noiseLevel, Bound{0, 0.5, true, false});
     }
@@ -149,7 +151,7 @@ Study readStudy(const std::string& path) {
         ElbowMethod e;
         e.kind = m.getChoice("method", getElbowMethodKinds(), "");
         e.label = m.getString("label", e.kind);
-        e.options.activationSd = m.getNumber("activation_sd", Bound{0, 0.5, true, false}, 0.02);
+        e.options.activationSd = m.getNumber("activation_sd", Bound{0, 0.5, false, false}, 0.02);
         e.options.freeSlowFraction = m.getBool("free_slow_fraction", false);
         e.options.includeSynergists = m.getBool("include_synergists", true);
         if (m.has("noise_level")) e.options.noiseLevel = m.getNumber("noise_level", Bound{0, 0.5, true, false});

@@ -299,7 +299,7 @@ TEST(CliIdentifyTorque, RecommendedProtocolChannelsAreSynthesizedAndFitted) {
     r = runArmsim("identify-torque " + (d / "recommended" / "torque_data.csv").string() + " --channels " +
                   (d / "bad.csv").string() + " --out " + (d / "bad").string());
     EXPECT_EQ(r.exitCode, kInputErrorExit) << r.output;
-    EXPECT_NE(r.output.find("line 3"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("bad.csv:3"), std::string::npos) << r.output;
     EXPECT_NE(r.output.find("NOPE"), std::string::npos) << r.output;
     EXPECT_FALSE(fs::exists(d / "bad"));
 }
