@@ -87,6 +87,19 @@ TEST(Channels, BadProtocolChannelsNameFileLineAndValue) {
     });
     EXPECT_NE(e.find("volume"), std::string::npos) << e;
     EXPECT_NE(e.find("0.9"), std::string::npos) << e;
+    e = errorOf([&] {
+        readTorqueProtocol(writeTemp("armsim_ch_bad4.yaml", "name: x\nkind: torque\nmeasurements: {volume_scan: [BIClong, BIClong]}\n"
+                                                            "conditions:\n  - {flexion_deg: 90}\n"));
+    });
+    EXPECT_NE(e.find("volume_scan[1]"), std::string::npos) << e;
+    EXPECT_NE(e.find("listed twice"), std::string::npos) << e;
+    {  // EMG on a model that names no surface_emg muscles
+        VirtualSubject bare = drawSubject(population(), 1, 0);
+        bare.setup.surfaceEmg.clear();
+        const TorqueProtocol q = makeChannelProtocol(0.05);
+        e = errorOf([&] { synthesizeChannelData(bare, q, synthesizeTorqueData(bare, q, 1), 1); });
+        EXPECT_NE(e.find("surface_emg"), std::string::npos) << e;
+    }
     // A volume scan of a muscle the subject does not have: named at synthesis.
     TorqueProtocol p = makeChannelProtocol(0.05);
     p.volumeScan = {"DELT"};
