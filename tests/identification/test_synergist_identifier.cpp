@@ -24,6 +24,20 @@ const Population& population() {
     return p;
 }
 
+// The integrated, tared MVC trial of v at each angle (3 s hold, last 0.2 s) against `steady`.
+void expectTrialsMatch(const VirtualSubject& v, const std::vector<double>& flexion, const std::vector<double>& steady,
+                       double relTol) {
+    for (std::size_t a = 0; a < flexion.size(); ++a) {
+        IsometricTrialSettings s;
+        s.elbowAngle = degToRad(180 - flexion[a]);
+        s.activation = v.setup.effort.voluntaryActivation;
+        s.antagonistActivation = v.setup.effort.coContraction;
+        s.averagingWindow = 0.2;
+        const double trial = runIsometricTrial(v.setup, s).summary.meanMuscleTorque;
+        EXPECT_NEAR(trial, steady[a], relTol * std::abs(steady[a])) << v.setup.name << " at " << flexion[a] << " deg";
+    }
+}
+
 }  // namespace
 
 // The identifier's prediction two ways: the steady MVC curves of model/ (active minus relaxed), and
@@ -35,16 +49,9 @@ TEST(ElbowIdentification, TaredSteadyTorqueEqualsTheMvcCurvesAndTheIntegratedTri
     const std::vector<double> t = calcTaredSteadyTorque(v.setup, v.setup.effort, flexion);
     const SteadyMvcCurve active = calcSteadyMvcCurve(v.setup, MuscleGroup::Flexor, v.setup.effort, flexion);
     const SteadyMvcCurve relaxed = calcSteadyMvcCurve(v.setup, MuscleGroup::Flexor, SubjectEffort{0, 0}, flexion);
-    for (std::size_t a = 0; a < flexion.size(); ++a) {
+    for (std::size_t a = 0; a < flexion.size(); ++a)
         EXPECT_NEAR(t[a], active.totalTorque[a] - relaxed.totalTorque[a], 1e-9 * std::abs(t[a]));
-        IsometricTrialSettings s;
-        s.elbowAngle = degToRad(180 - flexion[a]);
-        s.activation = v.setup.effort.voluntaryActivation;
-        s.antagonistActivation = v.setup.effort.coContraction;
-        s.averagingWindow = 0.2;
-        const double trial = runIsometricTrial(v.setup, s).summary.meanMuscleTorque;
-        EXPECT_NEAR(trial, t[a], kTrialRelTol * std::abs(t[a])) << flexion[a] << " deg";
-    }
+    expectTrialsMatch(v, flexion, t, kTrialRelTol);
 }
 
 // Issue 11: with the elbow as truth (20 seeded subjects, five angles x 3 efforts, 2 % transducer
@@ -225,14 +232,5 @@ TEST(ElbowIdentification, TwinTaredSteadyTorqueEqualsTheIntegratedTrial) {
     p.base = loadModel("twin");
     const VirtualSubject v = drawSubject(p, 3, 2);
     const std::vector<double> flexion = {30, 90, 135};
-    const std::vector<double> t = calcTaredSteadyTorque(v.setup, v.setup.effort, flexion);
-    for (std::size_t a = 0; a < flexion.size(); ++a) {
-        IsometricTrialSettings s;
-        s.elbowAngle = degToRad(180 - flexion[a]);
-        s.activation = v.setup.effort.voluntaryActivation;
-        s.antagonistActivation = v.setup.effort.coContraction;
-        s.averagingWindow = 0.2;
-        const double trial = runIsometricTrial(v.setup, s).summary.meanMuscleTorque;
-        EXPECT_NEAR(trial, t[a], kTrialRelTol * std::abs(t[a])) << flexion[a] << " deg";
-    }
+    expectTrialsMatch(v, flexion, calcTaredSteadyTorque(v.setup, v.setup.effort, flexion), kTrialRelTol);
 }
