@@ -7,6 +7,8 @@
 #include "model/mvc_curve.h"
 #include "muscles/muscle_file.h"
 
+#include "tests/support/temp_files.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -17,20 +19,9 @@ using namespace armsim;
 
 namespace {
 
-std::string writeTemp(const std::string& name, const std::string& text) {
-    const auto path = std::filesystem::temp_directory_path() / name;
-    std::ofstream(path) << text;
-    return path.string();
-}
+std::string writeTemp(const std::string& name, const std::string& text) { return armsim::testing::writeTempFile(name, text); }
 
-template <class F> std::string errorOf(F&& f) {
-    try {
-        f();
-    } catch (const InputError& e) {
-        return e.what();
-    }
-    return "";
-}
+template <class F> std::string errorOf(F&& f) { return armsim::testing::getInputErrorOf(f); }
 
 // Two flexion MVCs with every channel, a submaximal one with EMG only, every measurement.
 TorqueProtocol makeChannelProtocol(double noise) {

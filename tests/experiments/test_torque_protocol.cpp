@@ -3,6 +3,8 @@
 #include "basics/errors.h"
 #include "experiments/torque_protocol.h"
 
+#include "tests/support/temp_files.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -13,20 +15,9 @@ using namespace armsim;
 
 namespace {
 
-std::string writeTemp(const std::string& name, const std::string& text) {
-    const auto path = std::filesystem::temp_directory_path() / name;
-    std::ofstream(path) << text;
-    return path.string();
-}
+std::string writeTemp(const std::string& name, const std::string& text) { return armsim::testing::writeTempFile(name, text); }
 
-template <class F> std::string errorOf(F&& f) {
-    try {
-        f();
-    } catch (const InputError& e) {
-        return e.what();
-    }
-    return "";
-}
+template <class F> std::string errorOf(F&& f) { return armsim::testing::getInputErrorOf(f); }
 
 TorqueProtocol makeMixedProtocol() {
     TorqueProtocol p;

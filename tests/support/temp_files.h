@@ -1,6 +1,8 @@
 // Scratch folders and whole-file reads for the tests of every folder.
 #pragma once
 
+#include "basics/errors.h"
+
 #include <unistd.h>
 
 #include <filesystem>
@@ -26,6 +28,23 @@ inline std::string readFileText(const std::filesystem::path& p) {
     std::ostringstream s;
     s << in.rdbuf();
     return s.str();
+}
+
+/// Writes text to <tmp>/name and returns its path (input files for the loaders' tests).
+inline std::string writeTempFile(const std::string& name, const std::string& text) {
+    const auto path = std::filesystem::temp_directory_path() / name;
+    std::ofstream(path) << text;
+    return path.string();
+}
+
+/// The message of the InputError f throws ("" when it throws none).
+template <class F> std::string getInputErrorOf(F&& f) {
+    try {
+        f();
+    } catch (const InputError& e) {
+        return e.what();
+    }
+    return "";
 }
 
 }  // namespace armsim::testing
