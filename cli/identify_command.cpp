@@ -530,17 +530,14 @@ void runOutOfFamilyPersonStep(const MainJobContext& ctx) {
     const Population prior = loadDefaultPopulation();
     ElbowValidationSettings s;
     s.subjects = 1;
-    s.jobs = ctx.jobs;
     s.protocol = readTorqueProtocol(findAsset("protocols/recommended.yaml"));
     std::printf("truth: person 0 of population %s (%s); prior: %s; protocol %s: %s\n", truth.name.c_str(),
                 truth.file.c_str(), prior.name.c_str(), s.protocol.name.c_str(), describeConditions(s.protocol).c_str());
     std::fflush(stdout);
-    const std::vector<ElbowValidationRow> rows = runElbowValidation(truth, prior, s);
-    // The same person's data again (same seeds as the validation) for the files and plots.
-    const VirtualSubject v = drawSubject(truth, s.seed, 0);
-    const std::vector<TorqueObservation> torque =
-        setTransducerNoise(synthesizeTorqueData(v, s.protocol, s.seed, ctx.jobs), truth.transducerNoise);
-    const std::vector<ChannelObservation> channels = synthesizeChannelData(v, s.protocol, torque, s.seed);
+    const ElbowValidationSubject person = runElbowValidationSubject(truth, prior, s, 0);
+    const std::vector<ElbowValidationRow>& rows = person.rows;
+    const std::vector<TorqueObservation> torque = setTransducerNoise(person.torque, truth.transducerNoise);
+    const std::vector<ChannelObservation>& channels = person.channels;
     const std::string dir = ctx.outDir + "/out_of_family_person";
     createFolder(dir);
     writeTorqueProtocolRun(dir, s.protocol, torque, channels);

@@ -17,10 +17,6 @@ namespace armsim {
 
 namespace {
 
-// Baseline noise of a normalised EMG amplitude: a relaxed muscle reads about 1-2 % of its MVC
-// amplitude (docs/channels.md), so the sd of small values does not shrink to zero.
-constexpr double kEmgFloor = 0.02;
-
 const TorqueCondition* findCondition(const TorqueProtocol& p, const TorqueObservation& o) {
     for (const TorqueCondition& c : p.conditions)
         if (c.flexionDeg == o.flexionDeg && c.effort == o.effort && c.level == o.level) return &c;

@@ -37,6 +37,10 @@ struct ChannelObservation {
     std::string source;         ///< the file it was read from ("" : synthesized)
 };
 
+/// Floor of the level an EMG amplitude's relative error applies to: a relaxed muscle reads about 1-2 %
+/// of its MVC amplitude (an assumption, docs/channels.md), so the sd of small values does not vanish.
+inline constexpr double kEmgFloor = 0.02;
+
 /// The names channels may have.
 const std::vector<std::string>& getChannelNames();
 

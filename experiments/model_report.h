@@ -11,7 +11,7 @@
 
 namespace armsim {
 
-/// Published moment-arm range of a muscle (or muscle family: "BIC" covers BIClong and BICshort).
+/// Published moment-arm range of a muscle (or of a muscle family: doesFamilyCoverMuscle).
 struct MomentArmReference {
     std::string muscle;
     double flexionDeg = 0;

@@ -17,22 +17,15 @@ namespace armsim {
 
 namespace {
 
-// Tared steady torque at each angle of the geometry: the curve of an effort of `group` less the
-// relaxed one, summed over the muscles not left out. Throws SimulationError when a muscle has no steady
-// state.
-std::vector<double> calcTaredTorque(const std::vector<MuscleSpec>& muscles, const MvcGeometry& g, MuscleGroup group,
-                                    const SubjectEffort& effort, const SteadyMvcCurve& relaxed,
-                                    const std::vector<int>& leftOut = {}) {
-    const SteadyMvcCurve active = calcSteadyMvcCurve(muscles, g, group, effort);
-    std::vector<double> torque;
-    for (std::size_t a = 0; a < g.flexionDeg.size(); ++a) {
-        double t = 0;
-        for (std::size_t i = 0; i < muscles.size(); ++i)
-            if (std::find(leftOut.begin(), leftOut.end(), int(i)) == leftOut.end())
-                t += active.points[a][i].torque - relaxed.points[a][i].torque;
-        torque.push_back(t);
-    }
-    return torque;
+// Tared steady torque at angle a: the active curve less the relaxed one, summed over the muscles not
+// left out.
+double sumTaredTorque(const SteadyMvcCurve& active, const SteadyMvcCurve& relaxed, std::size_t a,
+                      const std::vector<int>& leftOut = {}) {
+    double t = 0;
+    for (std::size_t i = 0; i < active.points[a].size(); ++i)
+        if (std::find(leftOut.begin(), leftOut.end(), int(i)) == leftOut.end())
+            t += active.points[a][i].torque - relaxed.points[a][i].torque;
+    return t;
 }
 
 SteadyMvcCurve calcRelaxedCurve(const std::vector<MuscleSpec>& muscles, const MvcGeometry& g) {
@@ -82,7 +75,11 @@ std::pair<double, int> estimateNoiseLevel(const std::vector<TorqueObservation>& 
 std::vector<double> calcTaredSteadyTorque(const ArmSetup& setup, const SubjectEffort& effort,
                                           const std::vector<double>& flexionDeg, MuscleGroup group) {
     const MvcGeometry g = calcMvcGeometry(setup, flexionDeg);
-    return calcTaredTorque(setup.muscles, g, group, effort, calcRelaxedCurve(setup.muscles, g));
+    const SteadyMvcCurve active = calcSteadyMvcCurve(setup.muscles, g, group, effort);
+    const SteadyMvcCurve relaxed = calcRelaxedCurve(setup.muscles, g);
+    std::vector<double> torque;
+    for (std::size_t a = 0; a < flexionDeg.size(); ++a) torque.push_back(sumTaredTorque(active, relaxed, a));
+    return torque;
 }
 
 SynergistModel::SynergistModel(const Population& prior, const SynergistOptions& options,
@@ -278,13 +275,7 @@ void SynergistModel::calcPredictions(const double* x, std::vector<double>& torqu
         active.push_back(calcSteadyMvcCurve(muscles, geometry, k.group, makeEffort(k.level, va, cc)));
     torques.clear();
     for (std::size_t c = 0; c < angleOf_.size(); ++c) {
-        const int a = angleOf_[c];
-        const SteadyMvcCurve& curve = active[kindOf_[c]];
-        double t = 0;
-        for (std::size_t i = 0; i < muscles.size(); ++i)
-            if (std::find(leftOut_.begin(), leftOut_.end(), int(i)) == leftOut_.end())
-                t += curve.points[a][i].torque - relaxed.points[a][i].torque;
-        torques.push_back(t);
+        torques.push_back(sumTaredTorque(active[kindOf_[c]], relaxed, std::size_t(angleOf_[c]), leftOut_));
     }
     channels.clear();
     for (std::size_t k = 0; k < channels_.size(); ++k) {

@@ -23,11 +23,12 @@ const char* getTargetSiUnit(TargetKind k);
 /// Factor from the file unit to SI (1e-3 for mm).
 double getTargetFileToSi(TargetKind k);
 
-/// True when a family name covers a model muscle: a prefix ("BIC" covers "BIClong", "TRI" "TRImed").
+/// True when a family name covers a model muscle: a prefix (family "ABC" covers muscles "ABClong" and
+/// "ABCshort"; the names are the target file's and the model file's).
 bool doesFamilyCoverMuscle(const std::string& family, const std::string& muscle);
 
-/// One published value with its band. Family names cover model muscles by prefix ("BIC" covers
-/// BIClong and BICshort); moment-arm and optimum-angle targets score each covered muscle, volume and
+/// One published value with its band. Family names cover model muscles by prefix
+/// (doesFamilyCoverMuscle); moment-arm and optimum-angle targets score each covered muscle, volume and
 /// share targets the family's sum.
 struct AnatomyTarget {
     TargetKind kind = TargetKind::MomentArm;

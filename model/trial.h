@@ -18,7 +18,7 @@ namespace armsim {
 class ParamNode;
 
 /// Trial tables end with one column per muscle state (MuscleArm::getStateColumnNames: "state_L",
-/// "state_feff_3" for a one-muscle model, "state_BIClong_L" otherwise), so a recorded trial can be
+/// "state_feff_3" for a one-muscle model, "state_<muscle>_L" otherwise), so a recorded trial can be
 /// replayed exactly (rendering, analysis). Models with several muscles also get per-muscle columns
 /// force_<muscle>_N and activation_<muscle>.
 inline const std::string kStateColumnPrefix = "state_";

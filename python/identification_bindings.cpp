@@ -153,6 +153,34 @@ py::dict toDict(const std::vector<TorqueObservation>& data) {
     return d;
 }
 
+/// Channel data as columns with channel_data.csv's names (formatChannelData with the truth).
+py::dict toDict(const std::vector<ChannelObservation>& data) {
+    py::list channel, muscle;
+    std::vector<double> flexion, effort, level, repetition, value, sd, clean;
+    for (const ChannelObservation& o : data) {
+        channel.append(o.channel);
+        muscle.append(o.muscle);
+        flexion.push_back(o.flexionDeg);
+        effort.push_back(o.effort == MuscleGroup::Flexor ? 1 : -1);
+        level.push_back(o.level);
+        repetition.push_back(o.repetition);
+        value.push_back(o.value);
+        sd.push_back(o.sd);
+        clean.push_back(o.cleanValue);
+    }
+    py::dict d;
+    d["channel"] = channel;
+    d["muscle"] = muscle;
+    d["flexion_deg"] = toArray(flexion);
+    d["effort"] = toArray(effort);
+    d["level"] = toArray(level);
+    d["repetition"] = toArray(repetition);
+    d["value"] = toArray(value);
+    d["sd"] = toArray(sd);
+    d["clean_value"] = toArray(clean);
+    return d;
+}
+
 py::dict toDict(const MuscleEstimate& e) {
     py::dict d;
     d["method"] = e.method;
@@ -534,30 +562,7 @@ py::dict runProtocolPy(const py::object& file, const py::object& outArgument, in
         d["name"] = protocol.name;
         d["kind"] = "torque";
         d["data"] = toDict(data);
-        py::dict c;  // channels besides torque, as channel_data.csv's columns
-        py::list channel, muscle;
-        std::vector<double> flexion, effort, level, repetition, value, sd, clean;
-        for (const ChannelObservation& o : channels) {
-            channel.append(o.channel);
-            muscle.append(o.muscle);
-            flexion.push_back(o.flexionDeg);
-            effort.push_back(o.effort == MuscleGroup::Flexor ? 1 : -1);
-            level.push_back(o.level);
-            repetition.push_back(o.repetition);
-            value.push_back(o.value);
-            sd.push_back(o.sd);
-            clean.push_back(o.cleanValue);
-        }
-        c["channel"] = channel;
-        c["muscle"] = muscle;
-        c["flexion_deg"] = toArray(flexion);
-        c["effort"] = toArray(effort);
-        c["level"] = toArray(level);
-        c["repetition"] = toArray(repetition);
-        c["value"] = toArray(value);
-        c["sd"] = toArray(sd);
-        c["clean_value"] = toArray(clean);
-        d["channels"] = c;
+        d["channels"] = toDict(channels);
         d["files"] = files;
         return d;
     }

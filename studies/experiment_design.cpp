@@ -33,7 +33,7 @@ Eigen::MatrixXd toMatrix(const std::vector<std::vector<double>>& rows) {
 struct DrawSensitivity {
     bool ok = false;
     std::vector<double> prediction;  // [row]
-    Eigen::MatrixXd jacobian;        // [row][parameter]
+    Eigen::MatrixXd jacobian;        // [row][parameter], each row divided by the row's sd (whitened)
 };
 
 struct Sensitivities {
@@ -81,6 +81,18 @@ std::vector<std::vector<double>> drawFromPrior(const SynergistModel& model, unsi
 }
 
 namespace {
+
+// The sd of row r whose prediction is v: torques as the identifier weights them (transducer and trial
+// variation), channels as their measurement models (experiments/channels.h).
+double calcRowSd(const Sensitivities& s, int r, double v) {
+    v = std::abs(v);
+    if (r < s.numTorqueRows) return s.relativeSd * std::max(v, 1.0);
+    const std::string& channel = s.channels[r - s.numTorqueRows].channel;
+    if (channel == "fascicle_length") return s.noise.fascicleLength * v;
+    if (channel == "volume") return s.noise.volume * v;
+    if (channel == "emg") return s.noise.emg * std::max(v, kEmgFloor);
+    return s.noise.upperArmLength;
+}
 
 Sensitivities calcSensitivities(const Population& prior, const std::vector<TorqueCondition>& conditions,
                                 const DesignSettings& settings, const std::function<void(int, int)>& progress,
@@ -141,6 +153,7 @@ Sensitivities calcSensitivities(const Population& prior, const std::vector<Torqu
                 x[j] = x0;
                 for (int r = 0; r < rows; ++r) out.jacobian(r, j) = (up[r] - down[r]) / (2 * kStep);
             }
+            for (int r = 0; r < rows; ++r) out.jacobian.row(r) /= calcRowSd(s, r, out.prediction[r]);
             out.ok = true;
         } catch (const SimulationError&) {
             out.ok = false;  // no steady state for this draw: left out of the averages
@@ -149,27 +162,14 @@ Sensitivities calcSensitivities(const Population& prior, const std::vector<Torqu
     return s;
 }
 
-// The sd of row r at draw d: torques as the identifier weights them (transducer and trial variation),
-// channels as their measurement models (experiments/channels.h).
-double calcRowSd(const Sensitivities& s, int d, int r) {
-    const double v = std::abs(s.draws[d].prediction[r]);
-    if (r < s.numTorqueRows) return s.relativeSd * std::max(v, 1.0);
-    const std::string& channel = s.channels[r - s.numTorqueRows].channel;
-    if (channel == "fascicle_length") return s.noise.fascicleLength * v;
-    if (channel == "volume") return s.noise.volume * v;
-    if (channel == "emg") return s.noise.emg * std::max(v, 0.02);
-    return s.noise.upperArmLength;
-}
-
 // Posterior covariance at draw d with `counts[c]` trials of condition c.
 Eigen::MatrixXd calcPosterior(const Sensitivities& s, int d, const std::vector<int>& counts) {
     const DrawSensitivity& ds = s.draws[d];
     Eigen::MatrixXd precision = s.priorPrecision;
     for (std::size_t c = 0; c < counts.size(); ++c) {
         if (counts[c] == 0) continue;
-        const double sd = calcRowSd(s, d, int(c));
-        const Eigen::RowVectorXd g = ds.jacobian.row(int(c));
-        precision += double(counts[c]) * g.transpose() * g / (sd * sd);
+        const Eigen::RowVectorXd g = ds.jacobian.row(int(c));  // whitened
+        precision += double(counts[c]) * g.transpose() * g;
     }
     if (s.activationSd > 0) precision(s.activationIndex, s.activationIndex) += 1 / (s.activationSd * s.activationSd);
     return precision.inverse();

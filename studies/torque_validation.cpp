@@ -47,9 +47,16 @@ std::vector<ElbowValidationRow> runElbowValidation(const Population& population,
     return runElbowValidation(population, population, settings, progress);
 }
 
-std::vector<ElbowValidationRow> runElbowValidation(const Population& population, const Population& prior,
-                                                   const ElbowValidationSettings& settings,
-                                                   const std::function<void(int, int)>& progress) {
+namespace {
+
+// What every subject of a validation shares: the noise levels and the methods.
+struct ValidationPlan {
+    std::vector<double> levels;
+    std::vector<ElbowMethod> methods;
+};
+
+ValidationPlan planElbowValidation(const Population& population, const Population& prior,
+                                   const ElbowValidationSettings& settings) {
     population.validate();
     prior.validate();
     const std::string& truthPrimary = population.base.muscles[population.base.primary].params.name;
@@ -61,10 +68,10 @@ std::vector<ElbowValidationRow> runElbowValidation(const Population& population,
     settings.protocol.validate();
     checkField("subjects", settings.subjects, Bound::closed(1, 1e6));
     checkField("activation_sd", settings.activationSd, Bound::closed(0, 0.5));
-    std::vector<double> levels = settings.noiseLevels;
-    if (levels.empty()) levels.push_back(population.transducerNoise);
-    for (double v : levels) checkField("noise", v, Bound{0, 0.5, false, true, "relative sd"});
-    std::vector<ElbowMethod> methods;
+    ValidationPlan plan;
+    plan.levels = settings.noiseLevels;
+    if (plan.levels.empty()) plan.levels.push_back(population.transducerNoise);
+    for (double v : plan.levels) checkField("noise", v, Bound{0, 0.5, false, true, "relative sd"});
     for (const std::string& kind : getElbowMethodKinds()) {
         if ((kind == "synergist-va" && settings.activationSd == 0) || (kind == "channels" && !settings.protocol.hasChannels()))
             continue;
@@ -73,31 +80,51 @@ std::vector<ElbowValidationRow> runElbowValidation(const Population& population,
         m.options.freeSlowFraction = settings.freeSlowFraction;
         m.options.activationSd = settings.activationSd;
         m.options.emgCrosstalk = settings.protocol.channelNoise.emgCrosstalk;
-        methods.push_back(m);
+        plan.methods.push_back(m);
     }
+    return plan;
+}
 
+ElbowValidationSubject runPlannedSubject(const Population& population, const Population& prior,
+                                         const ElbowValidationSettings& settings, const ValidationPlan& plan, int index) {
+    ElbowValidationSubject out;
+    out.subject = drawSubject(population, settings.seed, index);
+    const VirtualSubject& v = out.subject;
+    out.torque = synthesizeTorqueData(v, settings.protocol, settings.seed, 1);
+    if (settings.protocol.hasChannels()) out.channels = synthesizeChannelData(v, settings.protocol, out.torque, settings.seed);
+    for (double level : plan.levels) {
+        const std::vector<TorqueObservation> data = setTransducerNoise(out.torque, level);
+        for (const ElbowMethod& m : plan.methods) {
+            // A method that cannot use these data (the thesis method with fewer flexion-MVC angles
+            // than unknowns) is recorded as failed, not fatal.
+            MuscleEstimate e;
+            try {
+                e = identifyElbowMethod(m, prior, data, settings.seed, index, out.channels);
+            } catch (const std::exception& x) {
+                e.method = m.kind;
+                e.message = x.what();
+            }
+            out.rows.push_back(makeElbowValidationRow(population, v, level, m.kind, e));
+        }
+    }
+    return out;
+}
+
+}  // namespace
+
+ElbowValidationSubject runElbowValidationSubject(const Population& truth, const Population& prior,
+                                                 const ElbowValidationSettings& settings, int index) {
+    checkField("subject index", index, Bound::closed(0, 1e6));
+    return runPlannedSubject(truth, prior, settings, planElbowValidation(truth, prior, settings), index);
+}
+
+std::vector<ElbowValidationRow> runElbowValidation(const Population& population, const Population& prior,
+                                                   const ElbowValidationSettings& settings,
+                                                   const std::function<void(int, int)>& progress) {
+    const ValidationPlan plan = planElbowValidation(population, prior, settings);
     std::vector<std::vector<ElbowValidationRow>> perSubject(settings.subjects);
     runParallel(settings.subjects, settings.jobs, [&](int s) {
-        const VirtualSubject v = drawSubject(population, settings.seed, s);
-        const std::vector<TorqueObservation> clean = synthesizeTorqueData(v, settings.protocol, settings.seed, 1);
-        const std::vector<ChannelObservation> channels =
-            settings.protocol.hasChannels() ? synthesizeChannelData(v, settings.protocol, clean, settings.seed)
-                                            : std::vector<ChannelObservation>{};
-        for (double level : levels) {
-            const std::vector<TorqueObservation> data = setTransducerNoise(clean, level);
-            for (const ElbowMethod& m : methods) {
-                // A method that cannot use these data (the thesis method with fewer flexion-MVC angles
-                // than unknowns) is recorded as failed, not fatal.
-                MuscleEstimate e;
-                try {
-                    e = identifyElbowMethod(m, prior, data, settings.seed, s, channels);
-                } catch (const std::exception& x) {
-                    e.method = m.kind;
-                    e.message = x.what();
-                }
-                perSubject[s].push_back(makeElbowValidationRow(population, v, level, m.kind, e));
-            }
-        }
+        perSubject[s] = runPlannedSubject(population, prior, settings, plan, s).rows;
     }, progress);
     std::vector<ElbowValidationRow> rows;
     for (auto& r : perSubject) rows.insert(rows.end(), r.begin(), r.end());

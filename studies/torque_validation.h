@@ -74,6 +74,17 @@ struct ElbowValidationSettings {
 std::vector<ElbowValidationRow> runElbowValidation(const Population& truth, const Population& prior,
                                                    const ElbowValidationSettings& settings,
                                                    const std::function<void(int, int)>& progress = {});
+/// One subject of such a validation: the person, its clean (noise-free) torque data and channels as
+/// synthesized, and one row per noise level and method.
+struct ElbowValidationSubject {
+    VirtualSubject subject;
+    std::vector<TorqueObservation> torque;       ///< before transducer noise (setTransducerNoise adds it)
+    std::vector<ChannelObservation> channels;    ///< empty when the protocol records only torque
+    std::vector<ElbowValidationRow> rows;
+};
+/// Subject `index` of runElbowValidation(truth, prior, settings), alone (the same rows, computed once).
+ElbowValidationSubject runElbowValidationSubject(const Population& truth, const Population& prior,
+                                                 const ElbowValidationSettings& settings, int index);
 /// In family: the truth population is the prior.
 std::vector<ElbowValidationRow> runElbowValidation(const Population& population, const ElbowValidationSettings& settings,
                                                    const std::function<void(int, int)>& progress = {});
