@@ -247,8 +247,13 @@ TEST(Cli, MainJobRunsTheThesisArmAndTheElbowSubject) {
     for (const char* f : {"force_length.csv", "force_length.png", "step_activation.csv", "mvc_angles.csv",
                           "mvc_angles.png", "mvc_angles_elbow.csv", "mvc_angles_elbow.png", "model_elbow/muscles.csv",
                           "model_elbow/moment_arms.png", "model_elbow/mvc_flexion.csv", "model_elbow/mvc_flexion.png",
-                          "protocol_mvc/summary.csv"})
+                          "protocol_mvc/summary.csv", "out_of_family_person/estimates.csv",
+                          "out_of_family_person/channel_data.csv", "out_of_family_person/mass_estimates.png",
+                          "out_of_family_person/fascicle_length.png", "out_of_family_person/emg.png"})
         EXPECT_TRUE(fs::exists(d / f) && fs::file_size(d / f) > 0) << f;
+    // The out-of-family person: one row per method, the channels fit among them.
+    EXPECT_NE(armsim::testing::readFileText(d / "out_of_family_person" / "estimates.csv").find(",channels,"),
+              std::string::npos);
     const armsim::Table t = armsim::Table::readCsv((d / "mvc_angles_elbow.csv").string());
     ASSERT_EQ(t.getNumRows(), 5);
     for (int i = 0; i < t.getNumRows(); ++i) {

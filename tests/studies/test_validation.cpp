@@ -128,3 +128,28 @@ TEST(Validation, ChannelsOfTheRecommendedProtocolBeatTorqueAloneOutOfFamily) {
         << "channels " << channels.massRmse << " vs torque only " << torque.massRmse;
     EXPECT_TRUE(std::isfinite(channels.maxForceRmse));
 }
+
+// One subject alone (the main job's out-of-family person) gives that subject's rows of the whole
+// validation, bit for bit, and its clean data with noise added are what the rows were fitted to.
+TEST(Validation, OneSubjectAloneEqualsItsRowsOfTheWholeValidation) {
+    const Population prior = loadDefaultPopulation();
+    ElbowValidationSettings v;
+    v.subjects = 2;
+    v.noiseLevels = {0.02};
+    v.activationSd = 0;
+    v.protocol.conditions = TorqueProtocol::makeFlexionMvcs({30, 90, 135}, 2);
+    const std::vector<ElbowValidationRow> all = runElbowValidation(prior, prior, v);
+    const ElbowValidationSubject one = runElbowValidationSubject(prior, prior, v, 1);
+    std::vector<ElbowValidationRow> second;
+    for (const ElbowValidationRow& r : all)
+        if (r.subject == 1) second.push_back(r);
+    ASSERT_EQ(one.rows.size(), second.size());
+    for (std::size_t k = 0; k < second.size(); ++k) {
+        EXPECT_EQ(one.rows[k].method, second[k].method);
+        EXPECT_EQ(one.rows[k].estimate.mass, second[k].estimate.mass);
+        EXPECT_EQ(one.rows[k].trueMass, second[k].trueMass);
+    }
+    EXPECT_EQ(one.torque.size(), 6u);
+    EXPECT_TRUE(one.channels.empty());
+    EXPECT_EQ(one.subject.index, 1);
+}
