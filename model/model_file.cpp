@@ -1,6 +1,7 @@
 #include "model/model_file.h"
 
 #include "basics/files.h"
+#include "basics/format.h"
 #include "basics/param_node.h"
 #include "model/muscle_arm.h"
 #include "muscles/muscle_file.h"
@@ -75,18 +76,25 @@ ArmBody readBody(const ParamNode& n) {
     return b == "upper_arm" ? ArmBody::UpperArm : b == "forearm" ? ArmBody::Forearm : ArmBody::Radius;
 }
 
-PathElementSpec readPoint(const ParamNode& n, const std::string& label) {
+PathElementSpec readPoint(const ParamNode& n, const std::string& label, bool via = false) {
     PathElementSpec e;
     e.body = readBody(n);
     e.location = readVec3(n, "location", Bound::closed(-2, 2, "m"));
     e.label = label;
+    if (via && n.has("active_rotation_deg")) {
+        const std::vector<double> r = n.getNumbers("active_rotation_deg", Bound::closed(-180, 180, "deg"));
+        if (r.size() != 2 || !(r[0] < r[1]))
+            throw InputError(n.where("active_rotation_deg") + ": field '" + n.path("active_rotation_deg") +
+                             "' = " + formatList(r) + ": expected [min, max] with min < max (forearm rotation, deg)");
+        e.activeRotationDeg = {r[0], r[1]};
+    }
     n.finish();
     return e;
 }
 
 PathElementSpec readViaElement(const ParamNode& n, int index) {
     const bool cylinder = n.has("cylinder"), sphere = n.has("sphere");
-    if (!cylinder && !sphere) return readPoint(n, "via " + std::to_string(index + 1));
+    if (!cylinder && !sphere) return readPoint(n, "via " + std::to_string(index + 1), true);
     if ((cylinder && sphere) || n.has("location"))
         throw InputError(n.where() + ": via element '" + n.path("") +
                          "' must be one of: a point (location), a cylinder or a sphere");
@@ -103,6 +111,12 @@ PathElementSpec readViaElement(const ParamNode& n, int index) {
     }
     s.finish();
     if (n.has("side")) e.side = readVec3(n, "side", Bound::closed(-1e3, 1e3));
+    if (n.has("winds")) {
+        e.winds = n.getBool("winds", false);
+        if (e.winds && !n.has("side"))
+            throw InputError(n.where("winds") + ": field '" + n.path("winds") +
+                             "' = true needs a 'side': the path winds round that side of the surface");
+    }
     e.label = std::string(cylinder ? "cylinder " : "sphere ") + std::to_string(index + 1);
     n.finish();
     return e;

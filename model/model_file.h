@@ -65,6 +65,11 @@ struct PathElementSpec {
     std::array<double, 3> axis{0, 0, 1};  ///< cylinder axis [1]
     double radius = 0;                  ///< [m]
     std::array<double, 3> side{};       ///< the path passes on this side; zero = the shorter way
+    bool winds = false;                 ///< with a side: may wind round by more than half a turn (muscle_path.h)
+    /// A via point used only while the forearm rotation is in [min, max] (OpenSim's conditional path
+    /// point; `active_rotation_deg: [min, max]`, + = supination) [deg]; both NaN = always.
+    std::array<double, 2> activeRotationDeg{0.0 / 0.0, 0.0 / 0.0};
+    bool isConditional() const { return activeRotationDeg[0] == activeRotationDeg[0]; }
     std::string label;                  ///< "origin", "via 1", "cylinder 2", "insertion"
 };
 

@@ -29,6 +29,15 @@ MusclePath buildMusclePath(const ArmModel& arm, const MuscleSpec& muscle) {
         e.axis = UnitVec3(toVec3(s.axis));
         e.radius = s.radius;
         e.side = toVec3(s.side);
+        e.winds = s.winds;
+        if (s.isConditional()) {
+            if (!arm.hasForearmRotation())
+                throw InputError("muscle '" + muscle.params.name + "': " + s.label +
+                                 " has active_rotation_deg but the arm has no forearm_rotation");
+            e.joint = arm.getRadius();
+            e.activeMin = degToRad(s.activeRotationDeg[0]);
+            e.activeMax = degToRad(s.activeRotationDeg[1]);
+        }
         e.label = s.label;
         elements.push_back(e);
     }

@@ -72,7 +72,7 @@ SurfaceWrap wrapSurface(const PathElement& e, const State& s, const Vec3& a, con
         const Vec2 p2(dot(p, e1), dot(p, e2)), q2(dot(q, e1), dot(q, e2)), s2(dot(side, e1), dot(side, e2));
         if (p2.norm() <= e.radius) throwInside(muscle, e, p2.norm());
         if (q2.norm() <= e.radius) throwInside(muscle, e, q2.norm());
-        const CircleWrap w = calcCircleWrap(p2, q2, e.radius, s2, s2.norm() > 0);
+        const CircleWrap w = calcCircleWrap(p2, q2, e.radius, s2, s2.norm() > 0, e.winds);
         if (!w.active) return {};
         return liftWrap(w, c, e1, e2, Vec3(e3), dot(p, e3), dot(q, e3), e.radius, withArc);
     }
@@ -85,14 +85,14 @@ SurfaceWrap wrapSurface(const PathElement& e, const State& s, const Vec3& a, con
     const UnitVec3 e1(p), e3(n);
     const UnitVec3 e2(e3 % e1, true);
     const Vec2 p2(p.norm(), 0), q2(dot(q, e1), dot(q, e2)), s2(dot(side, e1), dot(side, e2));
-    const CircleWrap w = calcCircleWrap(p2, q2, e.radius, s2, s2.norm() > 0);
+    const CircleWrap w = calcCircleWrap(p2, q2, e.radius, s2, s2.norm() > 0, e.winds);
     if (!w.active) return {};
     return liftWrap(w, c, e1, e2, Vec3(0), 0, 0, e.radius, withArc);
 }
 
 }  // namespace
 
-CircleWrap calcCircleWrap(const Vec2& p, const Vec2& q, double R, const Vec2& side, bool hasSide) {
+CircleWrap calcCircleWrap(const Vec2& p, const Vec2& q, double R, const Vec2& side, bool hasSide, bool winds) {
     CircleWrap w;
     const Vec2 d = q - p;
     const double dd = d.normSqr();
@@ -106,20 +106,42 @@ CircleWrap calcCircleWrap(const Vec2& p, const Vec2& q, double R, const Vec2& si
         const Vec2 s = side / side.norm(), u(-s[1], s[0]);
         const double a = dot(p, u), b = dot(d, u);
         double u0 = 0, u1 = 1;
+        bool inStrip = true;
         if (std::abs(b) < 1e-300) {
-            if (std::abs(a) >= R) return w;
+            inStrip = std::abs(a) < R;
         } else {
             const double e0 = (-R - a) / b, e1 = (R - a) / b;
             u0 = std::max(0.0, std::min(e0, e1));
             u1 = std::min(1.0, std::max(e0, e1));
-            if (u0 >= u1) return w;
+            inStrip = u0 < u1;
         }
-        const bool behind = std::min(dot(p + u0 * d, s), dot(p + u1 * d, s)) < 0;
-        const double tc = std::clamp(tClosest, u0, u1);
-        const bool cuts = (p + tc * d).norm() < R;
-        if (!behind && !cuts) return w;
-        // Passing on the +s side puts the centre on the path's right when s is on its left: clockwise.
-        sigma = cross2(d, s) > 0 ? -1 : +1;
+        bool blocked = false;
+        if (inStrip) {
+            const bool behind = std::min(dot(p + u0 * d, s), dot(p + u1 * d, s)) < 0;
+            const double tc = std::clamp(tClosest, u0, u1);
+            blocked = behind || (p + tc * d).norm() < R;
+        }
+        if (!blocked && (!winds || dot(p + std::clamp(tClosest, 0.0, 1.0) * d, s) >= 0)) return w;
+        if (!winds) {
+            // Passing on the +s side puts the centre on the path's right when s is on its left: clockwise.
+            sigma = cross2(d, s) > 0 ? -1 : +1;
+        } else {
+            // Wound (the segment's direction says nothing past half a turn): the shorter of the ways whose
+            // arc passes s, else the way whose arc's middle is nearest s.
+            const double ths = std::atan2(s[1], s[0]);
+            double best = -1e300;
+            sigma = 1;
+            for (int sg : {1, -1}) {
+                const double thP = std::atan2(p[1], p[0]) + sg * std::acos(R / p.norm());
+                const double thQ = std::atan2(q[1], q[0]) - sg * std::acos(R / q.norm());
+                double angle = std::fmod(sg * (thQ - thP), kTwoPi);
+                if (angle < 0) angle += kTwoPi;
+                double toS = std::fmod(sg * (ths - thP), kTwoPi);
+                if (toS < 0) toS += kTwoPi;
+                const double score = toS <= angle ? 2 * kTwoPi - angle : std::cos(thP + sg * 0.5 * angle - ths);
+                if (score > best) best = score, sigma = sg;
+            }
+        }
     } else {
         if (tClosest <= 0 || tClosest >= 1) return w;
         const Vec2 c = p + tClosest * d;
@@ -168,6 +190,14 @@ MusclePath::MusclePath(std::vector<PathElement> elements) : elements_(std::move(
                              "' follow each other; put a via point between them (one surface between two points)");
         checkField(e.label + ".radius", e.radius, Bound::positive("m"));
     }
+    for (int k = 0; k < n; ++k) {
+        if (!elements_[k].isConditional()) continue;
+        if (k == 0 || k == n - 1 || elements_[k].isSurface() || elements_[k - 1].isSurface() || elements_[k + 1].isSurface())
+            throw InputError("muscle path: '" + elements_[k].label +
+                             "' is used over a range of rotation: it must be a via point between two points, not next to a wrapping surface");
+        if (!(elements_[k].activeMin < elements_[k].activeMax))
+            throw InputError("muscle path: '" + elements_[k].label + "': its active range is empty");
+    }
 }
 
 PathGeometry MusclePath::calcGeometry(const State& s, const std::string& muscleName, bool withPolyline) const {
@@ -181,12 +211,20 @@ PathGeometry MusclePath::calcGeometry(const State& s, const std::string& muscleN
         const MobilizedBody& body = elements_[k].body;
         g.loads.push_back({k, body.getMobilizedBodyIndex(), point, point - body.getBodyTransform(s).p(), force});
     };
+    auto isActive = [&](int k) {
+        const PathElement& e = elements_[k];
+        if (!e.isConditional()) return true;
+        const double q = e.joint.getOneQ(s, MobilizerQIndex(0));
+        return q >= e.activeMin && q <= e.activeMax;
+    };
     int i = 0;
     Vec3 a = pointInGround(0);
     if (withPolyline) g.polyline.push_back(a);
     while (i < n - 1) {
-        const int k = elements_[i + 1].isSurface() ? i + 1 : -1;  // the surface between two points
-        const int j = k >= 0 ? i + 2 : i + 1;
+        int next = i + 1;
+        while (!isActive(next)) ++next;   // conditional points lie between points: next is a point
+        const int k = elements_[next].isSurface() ? next : -1;  // the surface between two points
+        const int j = k >= 0 ? next + 1 : next;
         const Vec3 b = pointInGround(j);
         SurfaceWrap w;
         if (k >= 0) {

@@ -40,6 +40,14 @@ struct PathElement {
     SimTK::UnitVec3 axis{0, 0, 1};    ///< cylinder axis (unit) [1]
     double radius = 0;                ///< cylinder or sphere radius [m]
     SimTK::Vec3 side{0};              ///< the path passes on this side of the surface; 0 = shorter way
+    /// With a side: the path may wind round the surface by more than half a turn (a rotator round the
+    /// radius), so a straight segment passing by the centre on the far side still wraps.
+    bool winds = false;
+    /// A via point used only while `joint`'s coordinate is in [activeMin, activeMax] (OpenSim's
+    /// conditional path point); its neighbours must be points. Empty joint = always.
+    SimTK::MobilizedBody joint;
+    double activeMin = 0, activeMax = 0;   ///< [rad]
+    bool isConditional() const { return !joint.isEmptyHandle(); }
     std::string label;                ///< for messages and drawing ("via 1", "cylinder TRI")
     bool isSurface() const { return kind != Kind::Point; }
 };
@@ -106,8 +114,10 @@ struct CircleWrap {
 
 /// The 2D construction both surfaces use (see the file comment). p and q must lie outside the circle
 /// (|p|, |q| > R). side: the path passes on this side; hasSide false: the shorter way, only if the
-/// segment p-q cuts the circle.
+/// segment p-q cuts the circle. winds (with a side): the path may be wound round the +side by more than
+/// half a turn, so a segment clear of the strip behind the circle whose nearest point to the centre is on
+/// the far side wraps too, and every wrap goes the shorter way whose arc passes the side.
 CircleWrap calcCircleWrap(const SimTK::Vec2& p, const SimTK::Vec2& q, double R, const SimTK::Vec2& side,
-                          bool hasSide);
+                          bool hasSide, bool winds = false);
 
 }  // namespace armsim

@@ -73,6 +73,31 @@ TEST(CircleWrap, ClearOnTheAllowedSideWrapsBehindTheStrip) {
     EXPECT_LT(cut.angle, kPi);
 }
 
+// A path wound round a surface by more than half a turn (a supinator round the radius in pronation):
+// both ends beside the circle behind it, the segment clear of the strip. Without `winds` it runs
+// straight; with it, it wraps round +y: from p at 198.4 deg clockwise through 90 deg to q at 225 deg,
+// 333.4 deg of polar angle less the two tangent angles acos(R / |p|) and acos(R / |q|).
+TEST(CircleWrap, AWoundPathWrapsTheLongWayRoundItsSide) {
+    const Vec2 p(-1.5, -0.5), q(-1.2, -1.2), side(0, 1);
+    EXPECT_FALSE(calcCircleWrap(p, q, 1.0, side, true).active);
+    const CircleWrap w = calcCircleWrap(p, q, 1.0, side, true, true);
+    ASSERT_TRUE(w.active);
+    EXPECT_EQ(w.direction, -1);
+    const double polar = std::atan2(p[1], p[0]) - std::atan2(q[1], q[0]) + 2 * kPi;
+    EXPECT_NEAR(w.angle, polar - std::acos(1 / p.norm()) - std::acos(1 / q.norm()), kExactTol);
+    EXPECT_GT(w.angle, kPi);
+    EXPECT_NEAR(w.tp.norm(), 1.0, kExactTol);           // tangent: on the circle, perpendicular to the line
+    EXPECT_NEAR(dot(w.tp, p - w.tp), 0.0, kExactTol);
+    EXPECT_NEAR(dot(w.tq, q - w.tq), 0.0, kExactTol);
+    // A segment that passes by the centre on the allowed side stays straight, winding or not.
+    EXPECT_FALSE(calcCircleWrap(Vec2(-1.5, 1.2), Vec2(1.5, 1.2), 1.0, side, true, true).active);
+    // Where the old rule wraps (behind, in the strip), winding keeps its way and arc.
+    const CircleWrap a = calcCircleWrap(Vec2(-2, 2), Vec2(-2, -2), 1.0, Vec2(1, 0), true);
+    const CircleWrap b = calcCircleWrap(Vec2(-2, 2), Vec2(-2, -2), 1.0, Vec2(1, 0), true, true);
+    EXPECT_EQ(a.direction, b.direction);
+    EXPECT_NEAR(a.angle, b.angle, kExactTol);
+}
+
 TEST(ModelFile, ThesisModelIsTheStraightBicepsArm) {
     const ArmSetup s = loadModel("thesis");
     ASSERT_EQ(s.getNumMuscles(), 1);
@@ -417,7 +442,7 @@ TEST(ForearmRotation, TwinMomentArmsTwoWaysAndTheRotatorsSigns) {
     ArmGeometry g(twin);
     EXPECT_NEAR(g.getArm().getForearmRotation(g.getState()), 0.0, kExactTol);   // the posture of the file
     for (double flexion : {30.0, 90.0})
-        for (double phiDeg : {-60.0, 0.0, 45.0}) {
+        for (double phiDeg : {-80.0, -60.0, 0.0, 45.0}) {
             g.setElbowAngle(elbowAngleFromFlexion(degToRad(flexion)));
             const double phi = degToRad(phiDeg);
             for (int i = 0; i < g.getNumMuscles(); ++i) {
@@ -441,6 +466,15 @@ TEST(ForearmRotation, TwinMomentArmsTwoWaysAndTheRotatorsSigns) {
     EXPECT_LT(g.calcForearmMomentArm(twin.findMuscle("PQ")), -0.003);
     EXPECT_EQ(g.calcForearmMomentArm(twin.findMuscle("BRA")), 0.0);
     EXPECT_EQ(g.calcForearmMomentArm(twin.findMuscle("TRIlong")), 0.0);
+    // Over the whole range the supinator supinates (it winds round the radius in pronation) and the
+    // pronator teres pronates until about 85 deg pronation.
+    for (double phiDeg = -90; phiDeg <= 90; phiDeg += 5) {
+        g.setForearmRotation(degToRad(phiDeg));
+        EXPECT_GT(g.calcForearmMomentArm(twin.findMuscle("SUP")), 0.004) << phiDeg;
+        if (phiDeg >= -80) {
+            EXPECT_LT(g.calcForearmMomentArm(twin.findMuscle("PT")), -0.001) << phiDeg;
+        }
+    }
     // The brachioradialis turns the forearm towards neutral: a supinator when pronated, a pronator when supinated.
     g.setForearmRotation(degToRad(-80));
     EXPECT_GT(g.calcForearmMomentArm(twin.findMuscle("BRD")), 0.005);
@@ -456,6 +490,49 @@ TEST(ForearmRotation, TwinMomentArmsTwoWaysAndTheRotatorsSigns) {
         "/muscles/biceps_long_head.yaml\n    path:\n      origin: {body: upper_arm, location: [0, 0.3, 0]}\n"
         "      insertion: {body: radius, location: [0, -0.05, 0]}\n"));
     EXPECT_NE(bad.find("forearm_rotation"), std::string::npos) << bad;
+}
+
+// A conditional via point (MoBL's PT-P4, `active_rotation_deg: [-29.2, 90]`): outside its range the
+// path is the path without it (a second model with the point removed), inside it the path through it.
+TEST(ForearmRotation, ConditionalViaPointIsSkippedOutsideItsRange) {
+    const ArmSetup twin = loadModel("twin");
+    const int pt = twin.findMuscle("PT");
+    ArmSetup without = twin;
+    auto& path = without.muscles[pt].path;
+    const auto conditional = std::find_if(path.begin(), path.end(), [](const PathElementSpec& e) { return e.isConditional(); });
+    ASSERT_NE(conditional, path.end());
+    path.erase(conditional);
+    ArmGeometry a(twin), b(without);
+    for (ArmGeometry* g : {&a, &b}) g->setElbowAngle(elbowAngleFromFlexion(kPi / 2));
+    for (double phiDeg : {-60.0, -30.0}) {
+        a.setForearmRotation(degToRad(phiDeg));
+        b.setForearmRotation(degToRad(phiDeg));
+        EXPECT_NEAR(a.calcPathLength(pt), b.calcPathLength(pt), kExactTol) << phiDeg;
+    }
+    for (double phiDeg : {-29.0, 0.0, 60.0}) {
+        a.setForearmRotation(degToRad(phiDeg));
+        b.setForearmRotation(degToRad(phiDeg));
+        EXPECT_GT(a.calcPathLength(pt), b.calcPathLength(pt) + 1e-4) << phiDeg;   // through the point: longer
+    }
+    // Refused: a range on an arm without a forearm rotation, a malformed range, winding without a side.
+    const std::string muscle = "name: bad\narm: arm/default_male.yaml\nmuscles:\n  - name: m\n    parameters: " +
+                               std::string(ARMSIM_ASSET_DIR) + "/muscles/biceps_long_head.yaml\n    path:\n"
+                               "      origin: {body: upper_arm, location: [0, 0.3, 0]}\n";
+    const std::string noRotation = messageOf(writeTemp("conditional_no_rotation.yaml", muscle +
+        "      via:\n        - {body: forearm, location: [0.02, -0.02, 0], active_rotation_deg: [-30, 90]}\n"
+        "      insertion: {body: forearm, location: [0.01, -0.05, 0]}\n"));
+    EXPECT_NE(noRotation.find("active_rotation_deg"), std::string::npos) << noRotation;
+    EXPECT_NE(noRotation.find("forearm_rotation"), std::string::npos) << noRotation;
+    const std::string reversed = messageOf(writeTemp("conditional_reversed.yaml", muscle +
+        "      via:\n        - {body: forearm, location: [0.02, -0.02, 0], active_rotation_deg: [90, -30]}\n"
+        "      insertion: {body: forearm, location: [0.01, -0.05, 0]}\n"));
+    EXPECT_NE(reversed.find("= 90,-30"), std::string::npos) << reversed;
+    EXPECT_NE(reversed.find(".yaml:9"), std::string::npos) << reversed;
+    const std::string sideless = messageOf(writeTemp("winds_without_side.yaml", muscle +
+        "      via:\n        - {body: upper_arm, cylinder: {centre: [0, 0, 0], axis: [0, 0, 1], radius: 0.01}, winds: true}\n"
+        "      insertion: {body: forearm, location: [0.01, -0.05, 0]}\n"));
+    EXPECT_NE(sideless.find("winds"), std::string::npos) << sideless;
+    EXPECT_NE(sideless.find("side"), std::string::npos) << sideless;
 }
 
 // Muscle roles come from the model file (no muscle name in library code): the elbow names its biceps
