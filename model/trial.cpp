@@ -224,6 +224,7 @@ IsometricTrialResult runIsometricTrial(const ArmSetup& setup, const IsometricTri
             f.first.push_back(firstState[i]);
             f.size.push_back(muscles[i]->getNumStates());
         }
+        f.banded = settings.bandedNewton && n > 1;
         f.calcBlock = [&](int b, double t, const double* yIn, double* ydot) {
             if (b == 0) {
                 std::fill(ydot, ydot + nqu, 0.0);

@@ -64,6 +64,9 @@ struct IsometricTrialSettings {
     double averagingWindow = 1.0;  ///< end of the hold averaged for the summary [s]
     /// How the trial is integrated and the holding torque read (TrialSolver).
     TrialSolver solver = TrialSolver::LockedOde;
+    /// LockedOde with several muscles: Newton's systems as a band matrix (the muscles' states are
+    /// independent blocks; numerics/stiff_ode.h), cost linear in the muscles. false: the dense solve.
+    bool bandedNewton = true;
     IntegrationSettings integration;
 
     /// Throws InputError naming the field unless every value is in range (angle inside the arm's

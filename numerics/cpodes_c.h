@@ -77,6 +77,7 @@ int CPodeSetMinStep(void* cpode_mem, double hmin);
 int CPodeSetMaxStep(void* cpode_mem, double hmax);
 int CPodeSetNonlinConvCoef(void* cpode_mem, double nlscoef);
 int CPLapackDense(void* cpode_mem, int N);
+int CPLapackBand(void* cpode_mem, int N, int mupper, int mlower);
 int CPode(void* cpode_mem, double tout, double* tret, NVector yout, NVector ypout, int mode);
 int CPodeGetDky(void* cpode_mem, double t, int k, NVector dky);
 int CPodeGetNumSteps(void* cpode_mem, long* nsteps);

@@ -140,19 +140,19 @@ private:
         }
         return 0;
     }
-    // ydot from the last full evaluation and at most one block, if y differs from it in at most one
-    // block at the same t (bitwise: a block function may tell -0 from +0).
+    // ydot from the last full evaluation and the blocks in which y differs from it, at the same t
+    // (bitwise: a block function may tell -0 from +0); false when every block differs.
     bool calcFromBase(double t, const double* y, double* ydot) {
         if (!hasBase_ || t != baseT_) return false;
-        int changed = -1;
-        for (int b = 0; b < int(blocks_->first.size()); ++b) {
+        const int numBlocks = int(blocks_->first.size());
+        changed_.clear();
+        for (int b = 0; b < numBlocks; ++b) {
             const std::size_t first = std::size_t(blocks_->first[b]), bytes = sizeof(double) * blocks_->size[b];
-            if (std::memcmp(y + first, &baseY_[first], bytes) == 0) continue;
-            if (changed >= 0) return false;
-            changed = b;
+            if (std::memcmp(y + first, &baseY_[first], bytes) != 0) changed_.push_back(b);
         }
+        if (numBlocks > 1 && int(changed_.size()) == numBlocks) return false;
         std::copy(baseYdot_.begin(), baseYdot_.end(), ydot);
-        if (changed >= 0) blocks_->calcBlock(changed, t, y, ydot);
+        for (int b : changed_) blocks_->calcBlock(b, t, y, ydot);
         ++partial_;
         return true;
     }
@@ -162,15 +162,17 @@ private:
     bool hasBase_ = false;
     double baseT_ = 0;
     std::vector<double> baseY_, baseYdot_;  // the last full evaluation
+    std::vector<int> changed_;
     std::string lastError_, solverMessage_;
 };
 
 // One CPODES run (a segment between breakpoints), configured as Simbody's CPodesIntegrator configures
-// its CPodes: BDF, Newton, dense LAPACK Jacobian by CPODES' difference quotients.
+// its CPodes: BDF, Newton, dense LAPACK Jacobian by CPODES' difference quotients (or, with a half
+// bandwidth >= 0, a LAPACK band Jacobian by CPODES' grouped difference quotients).
 class Cpodes {
 public:
     Cpodes(RhsContext& context, double t0, std::vector<double>& y0, std::vector<double>& yp0, double relTol,
-           double absTol, const IntegrationSettings& settings)
+           double absTol, const IntegrationSettings& settings, int halfBandwidth)
         : mem_(cpodes::CPodeCreate(cpodes::CP_EXPL, cpodes::CP_BDF, cpodes::CP_NEWTON)), absTol_(absTol) {
         if (!mem_) throw std::bad_alloc();
         try {
@@ -181,7 +183,10 @@ public:
                   "CPodeInit", t0);
             check(cpodes::CPodeSetErrHandlerFn(mem_, &RhsContext::handleError, &context), "CPodeSetErrHandlerFn",
                   t0);
-            check(cpodes::CPLapackDense(mem_, n), "CPLapackDense", t0);
+            if (halfBandwidth < 0)
+                check(cpodes::CPLapackDense(mem_, n), "CPLapackDense", t0);
+            else
+                check(cpodes::CPLapackBand(mem_, n, halfBandwidth, halfBandwidth), "CPLapackBand", t0);
             check(cpodes::CPodeSetNonlinConvCoef(mem_, 0.01), "CPodeSetNonlinConvCoef", t0);
             check(cpodes::CPodeSetMinStep(mem_, IntegrationSettings::kMinStepSize), "CPodeSetMinStep", t0);
             if (settings.maxStepSize > 0)
@@ -246,12 +251,14 @@ IntegrationStats integrate(const OdeRhs& f, const OdeBlocks* blocks, double t0, 
     sample(t0, y.data());
     run.start();
     const double relTol = settings.accuracy, absTol = settings.accuracy / 10;  // CPodesIntegrator's choice
+    int halfBandwidth = -1;  // dense
+    if (blocks && blocks->banded) halfBandwidth = *std::max_element(blocks->size.begin(), blocks->size.end()) - 1;
     double t = t0;
     std::vector<double> yv = y, ydot(n), yout(n), ypout(n);
     for (double segmentEnd : run.getSegmentEnds()) {
         context.evaluate(t, yv.data(), ydot.data());
         run.restart(t, yv.data(), ydot.data());
-        Cpodes cpodes(context, t, yv, ydot, relTol, absTol, settings);
+        Cpodes cpodes(context, t, yv, ydot, relTol, absTol, settings, halfBandwidth);
         ++stats.restarts;
         while (t < segmentEnd - run.getEpsilon()) {
             checkInterruption();  // a long trial stops within a step of Ctrl-C

@@ -68,13 +68,18 @@ IntegrationStats integrateSampled(const OdeRhs& f, double t0, std::vector<double
 struct OdeBlocks {
     std::vector<int> first, size;
     std::function<void(int block, double t, const double* y, double* ydot)> calcBlock;
+    /// Newton's linear systems as a band matrix of half-bandwidth max(size) - 1 (the Jacobian is block
+    /// diagonal), so factorisation and solves cost linear in the number of blocks instead of cubic in
+    /// y's size. Steps and samples then differ from the dense solve's by rounding only; false keeps the
+    /// dense solve, bit for bit the OdeRhs path.
+    bool banded = false;
 };
 
 /// integrateSampled for a block-structured f, with the same steps and samples as for the equivalent
-/// OdeRhs: a call at the time of the last full evaluation whose state differs from that one in a
-/// single block (a column of CPODES' difference-quotient Jacobian) evaluates that block and copies the
-/// others' derivatives, which are bit-for-bit what a full evaluation would give. std::invalid_argument
-/// if the blocks do not partition y.
+/// OdeRhs (unless banded): a call at the time of the last full evaluation whose state differs from
+/// that one in some blocks only (a column, or with `banded` a column group, of CPODES'
+/// difference-quotient Jacobian) evaluates those blocks and copies the others' derivatives, which are
+/// bit-for-bit what a full evaluation would give. std::invalid_argument if the blocks do not partition y.
 IntegrationStats integrateSampled(const OdeBlocks& f, double t0, std::vector<double>& y, double duration,
                                   double sampleRate, const std::vector<double>& breakpoints,
                                   const IntegrationSettings& settings, const OdeVisitor& sample,

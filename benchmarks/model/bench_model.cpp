@@ -84,6 +84,30 @@ void BM_TwinMvcTrial(benchmark::State& state) {
 }
 BENCHMARK(BM_TwinMvcTrial)->Arg(1000)->Arg(100)->Unit(benchmark::kMillisecond);
 
+// Issue 30: the locked MVC (0.5 s rest + 3 s hold, 1000 Hz) of N copies of the thesis's straight biceps;
+// arg 0 = N, arg 1 = 1 for the banded Newton solve (the default), 0 for the dense one. Goals: time(64) /
+// time(8) <= 10; 256 muscles <= 1 s.
+void BM_LockedMvcNMuscles(benchmark::State& state) {
+    ArmSetup setup = subject();
+    const MuscleSpec one = setup.muscles[0];
+    setup.muscles.clear();
+    for (int i = 0; i < int(state.range(0)); ++i) {
+        setup.muscles.push_back(one);
+        setup.muscles.back().params.name = "m" + std::to_string(i + 1);
+    }
+    IsometricTrialSettings s;
+    s.bandedNewton = state.range(1) != 0;
+    s.sampleRate = 1000;
+    IntegrationStats stats;
+    for (auto _ : state) stats = runIsometricTrial(setup, s).summary.stats;
+    state.counters["steps"] = stats.steps;
+    state.counters["rhs"] = stats.realizations;
+}
+BENCHMARK(BM_LockedMvcNMuscles)
+    ->ArgsProduct({{1, 8, 16, 32, 64, 128, 256}, {1}})
+    ->ArgsProduct({{1, 8, 16, 32}, {0}})
+    ->Unit(benchmark::kMillisecond);
+
 // Issue 14's floor: one right-hand side of the locked elbow is every muscle's state derivative at its
 // fixed path (90 deg flexion; agonists 0.95, antagonists 0.10); arg 0 = thesis arm, 1 = elbow.
 void BM_LockedArmDerivative(benchmark::State& state) {

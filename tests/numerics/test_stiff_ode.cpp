@@ -138,6 +138,21 @@ TEST(StiffOde, BlocksGiveTheSameStepsAndSamplesAsTheWholeRightHandSide) {
     EXPECT_EQ(samplesWhole, samplesBlocks);  // exactly
     EXPECT_EQ(y1, y2);
 
+    // Banded (issue 30): Newton's systems as a band of half-width max(size) - 1 = 1. Its own steps, so
+    // the samples agree to the integration's accuracy: at 1e-9, within 1e-6 (the issue's tolerance).
+    constexpr double kBandTol = 1e-6;
+    IntegrationSettings tight;
+    tight.accuracy = 1e-9;
+    OdeBlocks banded = blocks;
+    banded.banded = true;
+    std::vector<std::vector<double>> samplesDense, samplesBanded;
+    std::vector<double> y3{0.3, 0.0, 0.5, 0.8, -1.0}, y4 = y3;
+    integrateSampled(whole, 0.0, y3, 1.0, 200.0, {kStepTime}, tight, [&](double, const double* y) { samplesDense.emplace_back(y, y + 5); });
+    integrateSampled(banded, 0.0, y4, 1.0, 200.0, {kStepTime}, tight, [&](double, const double* y) { samplesBanded.emplace_back(y, y + 5); });
+    ASSERT_EQ(samplesDense.size(), samplesBanded.size());
+    for (std::size_t k = 0; k < samplesDense.size(); ++k)
+        for (int i = 0; i < 5; ++i) EXPECT_NEAR(samplesBanded[k][i], samplesDense[k][i], kBandTol) << k << " " << i;
+
     OdeBlocks overlapping = blocks;
     overlapping.first = {0, 1, 4};
     EXPECT_THROW(integrateSampled(overlapping, 0.0, y2, 1.0, 10.0, {}, IntegrationSettings{}, [](double, const double*) {}),
