@@ -75,12 +75,13 @@ void runIdentifyTorque(const IdentifyTorqueOptions& o) {
             std::printf("%-17s %4d %10.1f %7.3f %8s   %+.1f: %s\n", f.channel.c_str(), f.n, f.chiSquare, f.p,
                         f.p >= 0.05 ? "noise" : "misfit", f.worstResidual, f.worst.c_str());
     }
-    std::printf("%-9s %6s %6s %4s %11s", "effort", "angle", "level", "rep", "measured");
+    std::printf("%-9s %6s %7s %6s %4s %11s", "effort", "angle", "forearm", "level", "rep", "measured");
     for (const MuscleEstimate& e : estimates) std::printf(" %13s", e.method.c_str());
     std::printf("   (predicted torque, N m)\n");
     for (std::size_t k = 0; k < data.size(); ++k) {
         const TorqueObservation& d = data[k];
-        std::printf("%-9s %6.1f %6.2f %4d %11.2f", getEffortName(d.effort), d.flexionDeg, d.level, d.repetition, d.torque);
+        std::printf("%-9s %6.1f %7s %6.2f %4d %11.2f", getEffortName(d.effort), d.flexionDeg, formatPosture(d.rotationDeg).c_str(),
+                    d.level, d.repetition, d.torque);
         for (const MuscleEstimate& e : estimates) {
             std::printf(" %13.2f", e.predictedTorque[k]);
         }
@@ -114,7 +115,7 @@ void addIdentifyTorqueCommand(CLI::App& app) {
     CLI::App* c = app.add_subcommand("identify-torque",
                                      "biceps mass and tendon length from tared elbow torque data with the thesis, "
                                      "synergist and (with --activation) synergist-va methods");
-    c->add_option("data", o->data, "torque CSV: flexion_deg, torque_Nm [, effort, level, repetition]")->required();
+    c->add_option("data", o->data, "torque CSV: flexion_deg, torque_Nm [, effort, level, repetition, rotation_deg]")->required();
     c->add_option("--population", o->population, "prior population (default assets/subjects/default_population.yaml)");
     c->add_option("--noise-level", o->noiseLevel,
                   "relative sd of one trial's torque (default: estimated from repeated trials)")

@@ -24,8 +24,10 @@ std::string conditionField(std::size_t k, const char* key) {
     return "conditions[" + std::to_string(k) + "]." + key;
 }
 
-std::tuple<double, int, double> conditionKey(double flexionDeg, MuscleGroup effort, double level) {
-    return {flexionDeg, int(effort), level};
+// (flexion, effort, level, rotation); NaN rotation (the model's posture) as a value of its own.
+std::tuple<double, int, double, double> conditionKey(double flexionDeg, MuscleGroup effort, double level,
+                                                     double rotationDeg) {
+    return {flexionDeg, int(effort), level, std::isnan(rotationDeg) ? 1e300 : rotationDeg};
 }
 
 }  // namespace
@@ -55,16 +57,23 @@ bool TorqueProtocol::hasChannels() const {
 
 void TorqueProtocol::validate() const {
     if (conditions.empty()) throw FieldError("conditions", "no conditions: expected at least one");
-    std::set<std::tuple<double, int, double>> seen;
+    std::set<std::tuple<double, int, double, double>> seen;
     for (std::size_t k = 0; k < conditions.size(); ++k) {
         const TorqueCondition& c = conditions[k];
         checkField(conditionField(k, "flexion_deg"), c.flexionDeg, Bound::closed(0, 180, "deg, 0 = extended"));
         checkField(conditionField(k, "level"), c.level, Bound{0, 1, true, false, "fraction of maximal, in (0, 1]"});
         checkField(conditionField(k, "repetitions"), c.repetitions, Bound::closed(1, 100));
-        if (!seen.insert(conditionKey(c.flexionDeg, c.effort, c.level)).second)
+        if (!std::isnan(c.rotationDeg)) {
+            checkField(conditionField(k, "rotation_deg"), c.rotationDeg, Bound::closed(-180, 180, "deg, + = supination"));
+            if (c.ultrasound || c.emg)
+                throw FieldError(conditionField(k, "channels"),
+                                 "ultrasound and EMG are read at the model's forearm posture only: expected torque "
+                                 "alone with rotation_deg (or no rotation_deg)");
+        }
+        if (!seen.insert(conditionKey(c.flexionDeg, c.effort, c.level, c.rotationDeg)).second)
             throw FieldError(conditionField(k, "flexion_deg"),
-                             "the same condition (angle, effort, level) is listed twice: expected each once "
-                             "(raise its repetitions instead)");
+                             "the same condition (angle, effort, level, posture) is listed twice: expected each "
+                             "once (raise its repetitions instead)");
     }
     checkField("trial.rest", restDuration, Bound::positive("s"));
     checkField("trial.hold", holdDuration, Bound::positive("s"));
@@ -160,6 +169,7 @@ TorqueProtocol readTorqueProtocol(const std::string& path) {
                                                                                             : MuscleGroup::Extensor;
         tc.level = c.getNumber("level", Bound{0, 1, true, false, "fraction of maximal, in (0, 1]"}, 1.0);
         tc.repetitions = c.getInt("repetitions", 1, 100, 1);
+        if (c.has("rotation_deg")) tc.rotationDeg = c.getNumber("rotation_deg", Bound::closed(-180, 180, "deg, + = supination"));
         if (c.has("channels")) {
             const std::vector<std::string> channels = c.getStrings("channels");
             for (const std::string& name : channels) {
@@ -209,6 +219,7 @@ std::string formatTorqueProtocol(const TorqueProtocol& p) {
     for (const TorqueCondition& c : p.conditions) {
         out += "  - {effort: " + std::string(getEffortName(c.effort)) + ", flexion_deg: " + formatNumber(c.flexionDeg) +
                ", level: " + formatNumber(c.level) + ", repetitions: " + std::to_string(c.repetitions);
+        if (!std::isnan(c.rotationDeg)) out += ", rotation_deg: " + formatNumber(c.rotationDeg);
         if (c.ultrasound || c.emg)
             out += std::string(", channels: [torque") + (c.ultrasound ? ", ultrasound" : "") + (c.emg ? ", emg" : "") + "]";
         out += "}\n";
@@ -233,8 +244,11 @@ VirtualSubject loadTorqueProtocolSubject(const TorqueProtocol& protocol) {
     return v;
 }
 
+std::string formatPosture(double rotationDeg) { return std::isnan(rotationDeg) ? "-" : formatNumber(rotationDeg); }
+
 bool isSameCondition(const TorqueObservation& a, const TorqueObservation& b) {
-    return conditionKey(a.flexionDeg, a.effort, a.level) == conditionKey(b.flexionDeg, b.effort, b.level);
+    return conditionKey(a.flexionDeg, a.effort, a.level, a.rotationDeg) ==
+           conditionKey(b.flexionDeg, b.effort, b.level, b.rotationDeg);
 }
 
 std::vector<TorqueObservation> synthesizeTorqueData(const VirtualSubject& subject, const TorqueProtocol& protocol,
@@ -251,6 +265,7 @@ std::vector<TorqueObservation> synthesizeTorqueData(const VirtualSubject& subjec
             if (r >= c.repetitions) continue;
             IsometricTrialSettings s;
             s.elbowAngle = elbowAngleFromFlexion(degToRad(c.flexionDeg));
+            s.forearmRotationDeg = c.rotationDeg;
             s.activation = std::clamp(c.level * e.voluntaryActivation * (1 + e.trialCv * rng.drawNormal()), 0.0, 1.0);
             s.antagonistActivation = c.level * e.coContraction;
             s.effort = c.effort;
@@ -261,6 +276,7 @@ std::vector<TorqueObservation> synthesizeTorqueData(const VirtualSubject& subjec
             trials.push_back(s);
             TorqueObservation o;
             o.flexionDeg = c.flexionDeg;
+            o.rotationDeg = c.rotationDeg;
             o.effort = c.effort;
             o.level = c.level;
             o.repetition = r;
@@ -285,13 +301,17 @@ std::vector<TorqueObservation> setTransducerNoise(std::vector<TorqueObservation>
 }
 
 std::string formatTorqueData(const std::vector<TorqueObservation>& data, bool truth) {
+    const bool postures = std::any_of(data.begin(), data.end(), [](const TorqueObservation& o) { return !std::isnan(o.rotationDeg); });
     std::string out = "# tared elbow torque per trial; flexion_deg: 0 = extended; effort: 1 = flexion, -1 = extension;\n"
-                      "# level: drive as a fraction of maximal; torque_Nm: + = flexion\n"
-                      "flexion_deg,effort,level,repetition,torque_Nm";
+                      "# level: drive as a fraction of maximal; torque_Nm: + = flexion";
+    out += postures ? "; rotation_deg: forearm posture, + = supination, NaN = the model's\n" : "\n";
+    out += "flexion_deg,effort,level,repetition,torque_Nm";
+    out += postures ? ",rotation_deg" : "";
     out += truth ? ",activation,clean_torque_Nm\n" : "\n";
     for (const TorqueObservation& o : data) {
         out += formatNumber(o.flexionDeg) + "," + (o.effort == MuscleGroup::Flexor ? "1" : "-1") + "," +
                formatNumber(o.level) + "," + std::to_string(o.repetition) + "," + formatNumber(o.torque);
+        if (postures) out += "," + (std::isnan(o.rotationDeg) ? std::string("NaN") : formatNumber(o.rotationDeg));
         if (truth) out += "," + formatNumber(o.activation) + "," + formatNumber(o.cleanTorque);
         out += "\n";
     }
@@ -304,18 +324,18 @@ std::vector<TorqueObservation> readTorqueData(const std::string& path) {
 
 std::vector<TorqueObservation> makeTorqueData(const Table& t, const std::string& path) {
     static const std::set<std::string> known = {"flexion_deg", "effort", "level", "repetition", "torque_Nm",
-                                                "activation", "clean_torque_Nm"};
+                                                "rotation_deg", "activation", "clean_torque_Nm"};
     for (const std::string& c : t.getColumnNames())
         if (!known.count(c))
             throw InputError(path + ": unknown column '" + c +
-                             "': expected flexion_deg, torque_Nm and optionally effort, level, repetition "
+                             "': expected flexion_deg, torque_Nm and optionally effort, level, repetition, rotation_deg "
                              "(activation, clean_torque_Nm: truth of synthetic data, ignored)");
     for (const char* c : {"flexion_deg", "torque_Nm"})
         if (!t.hasColumn(c)) throw InputError(path + ": missing column '" + std::string(c) + "'");
     if (t.getNumRows() == 0) throw InputError(path + ": no data rows");
     std::vector<TorqueObservation> data;
-    std::map<std::tuple<double, int, double>, int> count;
-    std::set<std::tuple<double, int, double, int>> seen;
+    std::map<std::tuple<double, int, double, double>, int> count;
+    std::set<std::tuple<std::tuple<double, int, double, double>, int>> seen;
     for (int r = 0; r < t.getNumRows(); ++r) {
         const std::string at = t.describeRow(path, r);
         auto fail = [&](const std::string& column, double v, const std::string& expected) {
@@ -337,7 +357,12 @@ std::vector<TorqueObservation> makeTorqueData(const Table& t, const std::string&
             o.level = t.get(r, "level");
             if (!(o.level > 0 && o.level <= 1)) fail("level", o.level, "in (0, 1] (fraction of maximal)");
         }
-        const auto key = conditionKey(o.flexionDeg, o.effort, o.level);
+        if (t.hasColumn("rotation_deg")) {
+            o.rotationDeg = t.get(r, "rotation_deg");   // NaN = the model's posture
+            if (std::isinf(o.rotationDeg) || std::abs(o.rotationDeg) > 180)
+                fail("rotation_deg", o.rotationDeg, "in [-180, 180] (+ = supination) or NaN (the model's posture)");
+        }
+        const auto key = conditionKey(o.flexionDeg, o.effort, o.level, o.rotationDeg);
         if (t.hasColumn("repetition")) {
             const double v = t.get(r, "repetition");
             if (!std::isfinite(v) || v != std::floor(v) || v < 0 || v > 1e6) fail("repetition", v, "an integer >= 0");
@@ -346,9 +371,10 @@ std::vector<TorqueObservation> makeTorqueData(const Table& t, const std::string&
             o.repetition = count[key];
         }
         ++count[key];
-        if (!seen.insert({o.flexionDeg, int(o.effort), o.level, o.repetition}).second)
+        if (!seen.insert({key, o.repetition}).second)
             throw InputError(at + ": repetition " + std::to_string(o.repetition) + " of " + getEffortName(o.effort) +
                              " at " + formatNumber(o.flexionDeg) + " deg, level " + formatNumber(o.level) +
+                             (std::isnan(o.rotationDeg) ? std::string() : ", rotation " + formatNumber(o.rotationDeg) + " deg") +
                              " appears earlier: expected each trial once");
         if (o.effort == MuscleGroup::Flexor ? o.torque < 0 : o.torque > 0)
             fail("torque_Nm", o.torque,

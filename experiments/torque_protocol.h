@@ -32,6 +32,9 @@ struct TorqueCondition {
     /// primary muscle's fascicle at rest and at the plateau; emg records the surface_emg muscles.
     bool ultrasound = false;
     bool emg = false;
+    /// Forearm posture [deg], + = supination (rotation_deg; a model with a forearm rotation only);
+    /// NaN = the model's posture. Ultrasound and EMG are read at the model's posture only.
+    double rotationDeg = 0.0 / 0.0;
 };
 
 /// Measurement error of the channels besides torque (experiments/channels.h). Defaults and their
@@ -108,6 +111,7 @@ struct TorqueObservation {
     double antagonistActivation = NAN;  ///< the antagonists' activation (truth) [1]
     double restFascicleLength = NAN;    ///< the primary's fascicle at rest before the effort (truth) [m]
     double fascicleLength = NAN;        ///< the primary's fascicle at the plateau, window mean (truth) [m]
+    double rotationDeg = 0.0 / 0.0;  ///< forearm posture [deg], + = supination; NaN = the model's posture
     int line = 0;              ///< line in the file it was read from (0: synthesized)
     /// A maximal flexion effort (what the thesis's method uses).
     bool isFlexionMvc() const { return effort == MuscleGroup::Flexor && level == 1; }
@@ -115,6 +119,8 @@ struct TorqueObservation {
 
 /// true when a and b are the same condition (angle, effort, level).
 bool isSameCondition(const TorqueObservation& a, const TorqueObservation& b);
+/// A forearm posture for tables: "-" for the model's (NaN), else the rotation in deg ("-90", "90").
+std::string formatPosture(double rotationDeg);
 
 /// Runs the protocol on the subject and adds relative transducer noise of the subject's sd.
 /// Reproducible from (subject, noiseSeed); trials run on `jobs` threads. Trial order: repetition-major

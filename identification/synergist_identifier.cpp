@@ -55,8 +55,9 @@ std::vector<int> findMuscles(const ArmSetup& setup, const std::vector<std::strin
 // Relative torque sd pooled over the conditions' repetitions (NaN without repetitions) and its degrees
 // of freedom.
 std::pair<double, int> estimateNoiseLevel(const std::vector<TorqueObservation>& data) {
-    std::map<std::tuple<double, int, double>, std::vector<double>> byCondition;
-    for (const TorqueObservation& o : data) byCondition[{o.flexionDeg, int(o.effort), o.level}].push_back(o.torque);
+    std::map<std::tuple<double, int, double, double>, std::vector<double>> byCondition;
+    for (const TorqueObservation& o : data)
+        byCondition[{o.flexionDeg, int(o.effort), o.level, std::isnan(o.rotationDeg) ? INFINITY : o.rotationDeg}].push_back(o.torque);
     double ss = 0;
     int dof = 0;
     for (const auto& [condition, v] : byCondition) {
@@ -94,9 +95,12 @@ SynergistModel::SynergistModel(const Population& prior, const SynergistOptions& 
     if (std::find(biceps_.begin(), biceps_.end(), base.primary) == biceps_.end())
         throw InputError("synergist-aware identifier: the primary muscle '" + base.muscles[base.primary].params.name +
                          "' is not in the biceps group");
-    std::vector<double> angles;
+    std::vector<std::pair<double, double>> angles;   // poses: (flexion, rotation)
     for (const TorqueCondition& c : conditions) {
-        angleOf_.push_back(findAngle(c.flexionDeg, angles));
+        if (!std::isnan(c.rotationDeg) && !base.arm.forearmRotation.enabled)
+            throw InputError("synergist-aware identifier: a condition at forearm rotation " + formatNumber(c.rotationDeg) +
+                             " deg, but the prior's model '" + base.name + "' has no forearm rotation");
+        angleOf_.push_back(findAngle(c.flexionDeg, angles, c.rotationDeg));
         kindOf_.push_back(findKind(c.effort, c.level));
     }
     channels_ = options.channels;
@@ -128,7 +132,26 @@ SynergistModel::SynergistModel(const Population& prior, const SynergistOptions& 
         channelAngle_.push_back(angle);
         channelKind_.push_back(kind);
     }
-    geometry_ = calcMvcGeometry(base, angles);
+    // The geometry of every pose, one calcMvcGeometry per posture, rows in pose order.
+    std::map<double, std::vector<int>> byRotation;   // NaN (the model's posture) as +inf
+    for (std::size_t k = 0; k < angles.size(); ++k)
+        byRotation[std::isnan(angles[k].second) ? INFINITY : angles[k].second].push_back(int(k));
+    geometry_.flexionDeg.assign(angles.size(), 0);
+    geometry_.pathLength.assign(angles.size(), {});
+    geometry_.momentArm.assign(angles.size(), {});
+    geometry_.forearmMomentArm.assign(angles.size(), {});
+    for (const auto& [rotation, poses] : byRotation) {
+        std::vector<double> flexion;
+        for (int k : poses) flexion.push_back(angles[k].first);
+        const MvcGeometry g = calcMvcGeometry(base, flexion, std::isinf(rotation) ? NAN : rotation);
+        for (std::size_t j = 0; j < poses.size(); ++j) {
+            geometry_.flexionDeg[poses[j]] = g.flexionDeg[j];
+            geometry_.pathLength[poses[j]] = g.pathLength[j];
+            geometry_.momentArm[poses[j]] = g.momentArm[j];
+            geometry_.forearmMomentArm[poses[j]] = g.forearmMomentArm[j];
+        }
+        geometry_.rotationDeg = g.rotationDeg;   // the rows' own postures differ; the field is not used here
+    }
 
     const int n = getNumParameters();
     const double s2 = prior.strengthSubjectSd * prior.strengthSubjectSd;
@@ -192,11 +215,13 @@ std::vector<std::string> SynergistModel::getParameterNames() const {
     return names;
 }
 
-int SynergistModel::findAngle(double flexionDeg, std::vector<double>& angles) {
-    auto it = std::find(angles.begin(), angles.end(), flexionDeg);
-    if (it != angles.end()) return int(it - angles.begin());
-    angles.push_back(flexionDeg);
-    return int(angles.size()) - 1;
+int SynergistModel::findAngle(double flexionDeg, std::vector<std::pair<double, double>>& poses, double rotationDeg) {
+    auto it = std::find_if(poses.begin(), poses.end(), [&](const std::pair<double, double>& p) {
+        return p.first == flexionDeg && (p.second == rotationDeg || (std::isnan(p.second) && std::isnan(rotationDeg)));
+    });
+    if (it != poses.end()) return int(it - poses.begin());
+    poses.emplace_back(flexionDeg, rotationDeg);
+    return int(poses.size()) - 1;
 }
 
 int SynergistModel::findKind(MuscleGroup group, double level) {
@@ -310,7 +335,9 @@ MuscleEstimate identifySynergistAware(const Population& prior, const std::vector
     std::vector<TorqueCondition> conditions;
     std::vector<double> torque;
     for (const TorqueObservation& o : data) {
-        conditions.push_back({o.flexionDeg, o.effort, o.level, 1});
+        TorqueCondition c{o.flexionDeg, o.effort, o.level, 1};
+        c.rotationDeg = o.rotationDeg;
+        conditions.push_back(c);
         torque.push_back(o.torque);
     }
     const SynergistModel model(prior, options, conditions);

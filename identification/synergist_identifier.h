@@ -98,14 +98,15 @@ private:
     int findMassIndex(int muscle) const;
     const ArmSetup* base_;
     std::vector<int> biceps_, synergists_, extensors_, leftOut_;
-    MvcGeometry geometry_;
+    MvcGeometry geometry_;                    // one row per pose (flexion angle, forearm posture)
     std::vector<EffortKind> kinds_;
-    std::vector<int> angleOf_, kindOf_;       // condition -> angle index, effort kind
+    std::vector<int> angleOf_, kindOf_;       // condition -> pose index, effort kind
     std::vector<ChannelObservation> channels_;
     std::vector<int> channelMuscle_, channelAngle_, channelKind_;  // kind -1: relaxed
     double emgCrosstalk_ = 0;
     int findKind(MuscleGroup group, double level);
-    int findAngle(double flexionDeg, std::vector<double>& angles);
+    /// Index of the pose (flexion, forearm rotation; NaN = the model's posture), added if new.
+    int findAngle(double flexionDeg, std::vector<std::pair<double, double>>& poses, double rotationDeg = 0.0 / 0.0);
     std::vector<double> priorMean_, lower_, upper_;
     std::vector<std::vector<double>> priorCovariance_;
     friend MuscleEstimate identifySynergistAware(const Population&, const std::vector<TorqueObservation>&,

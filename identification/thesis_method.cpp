@@ -12,9 +12,11 @@ namespace armsim {
 MuscleEstimate identifyThesisMethod(const ArmSetup& assumed, const std::vector<TorqueObservation>& allData) {
     MuscleEstimate est;
     est.method = "thesis";
-    std::vector<TorqueObservation> data;  // the method knows flexion MVCs only
+    // The method knows flexion MVCs in one forearm posture (the model's) only.
+    auto usable = [](const TorqueObservation& o) { return o.isFlexionMvc() && std::isnan(o.rotationDeg); };
+    std::vector<TorqueObservation> data;
     for (const TorqueObservation& o : allData)
-        if (o.isFlexionMvc()) data.push_back(o);
+        if (usable(o)) data.push_back(o);
     if (data.empty()) throw InputError("thesis method: no flexion MVC in the data (it uses those only)");
     std::vector<double> angles;
     for (const TorqueObservation& o : data) angles.push_back(o.flexionDeg);
@@ -49,8 +51,8 @@ MuscleEstimate identifyThesisMethod(const ArmSetup& assumed, const std::vector<T
     est.numParameters = 2;
     std::size_t k = 0;
     for (const TorqueObservation& o : allData) {
-        est.predictedTorque.push_back(o.isFlexionMvc() ? r.modelForces[k] * g.momentArm[k][assumed.primary] : NAN);
-        k += o.isFlexionMvc();
+        est.predictedTorque.push_back(usable(o) ? r.modelForces[k] * g.momentArm[k][assumed.primary] : NAN);
+        k += usable(o);
     }
     return est;
 }

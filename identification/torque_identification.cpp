@@ -79,7 +79,9 @@ std::string formatChannelFitsCsv(const std::vector<MuscleEstimate>& estimates) {
 
 std::string formatTorquePredictionsCsv(const std::vector<TorqueObservation>& data,
                                        const std::vector<MuscleEstimate>& estimates) {
+    const bool postures = std::any_of(data.begin(), data.end(), [](const TorqueObservation& d) { return !std::isnan(d.rotationDeg); });
     std::vector<std::string> header = {"flexion_deg", "effort", "level", "repetition", "torque_Nm"};
+    if (postures) header.push_back("rotation_deg");   // NaN: the model's posture
     for (const MuscleEstimate& e : estimates) header.push_back(e.method + "_Nm");
     CsvText csv(header);
     for (std::size_t k = 0; k < data.size(); ++k) {
@@ -87,6 +89,7 @@ std::string formatTorquePredictionsCsv(const std::vector<TorqueObservation>& dat
         CsvRow row;
         row.addNumber(d.flexionDeg).addInteger(d.effort == MuscleGroup::Flexor ? 1 : -1).addNumber(d.level);
         row.addInteger(d.repetition).addNumber(d.torque);
+        if (postures) row.addNumber(d.rotationDeg);
         for (const MuscleEstimate& e : estimates) row.addNumber(e.predictedTorque[k]);
         csv.addRow(row);
     }
@@ -106,12 +109,12 @@ std::vector<MuscleEstimate> identifyTorqueData(const Population& prior, const st
     std::vector<MuscleEstimate> estimates;
     std::set<double> mvcAngles;
     for (const TorqueObservation& d : data)
-        if (d.isFlexionMvc()) mvcAngles.insert(d.flexionDeg);
+        if (d.isFlexionMvc() && std::isnan(d.rotationDeg)) mvcAngles.insert(d.flexionDeg);   // the thesis's posture
     if (skipped) skipped->clear();
     if (mvcAngles.size() >= 2)
         estimates.push_back(identifyThesisMethod(prior.base, data));
     else if (skipped)
-        *skipped = "thesis method: skipped (it fits flexion MVCs at >= 2 angles; these data have " +
+        *skipped = "thesis method: skipped (it fits flexion MVCs at >= 2 angles in the model's forearm posture; these data have " +
                    std::to_string(mvcAngles.size()) + ")";
     SynergistOptions so;
     so.noiseLevel = o.noiseLevel;

@@ -81,6 +81,13 @@ std::vector<ActivationProfile> readActivationProfiles(const ArmSetup& setup, con
 
 void IsometricTrialSettings::validate(const ArmParameters& arm) const {
     checkElbowAngle("elbow_angle_deg", elbowAngle, arm);
+    if (!std::isnan(forearmRotationDeg)) {
+        if (!arm.forearmRotation.enabled)
+            throw FieldError("forearm_rotation_deg", "= " + formatNumber(forearmRotationDeg) +
+                                                         ": the model's arm has no forearm rotation (expected none)");
+        checkField("forearm_rotation_deg", forearmRotationDeg,
+                   Bound::closed(arm.forearmRotation.minDeg, arm.forearmRotation.maxDeg, "deg, + = supination"));
+    }
     const double angleDeg = cleanDegrees(elbowAngle);
     if (angleDeg >= 180)  // the straight-line biceps passes through the joint there
         throw FieldError("elbow_angle_deg", "= " + formatNumber(angleDeg) +
@@ -139,6 +146,7 @@ IsometricTrialResult runIsometricTrial(const ArmSetup& setup, const IsometricTri
 
     State state = model.getDefaultState();
     arm.lockElbow(state, settings.elbowAngle);
+    if (!std::isnan(settings.forearmRotationDeg)) arm.lockForearmRotation(state, degToRad(settings.forearmRotationDeg));
     model.setSteadyMuscleStates(state);  // passive equilibrium at U(0) = 0
     system.realize(state, Stage::Acceleration);
 

@@ -54,6 +54,9 @@ enum class TrialSolver {
 
 struct IsometricTrialSettings {
     double elbowAngle = degToRad(90);  ///< theta, included angle [rad]
+    /// Forearm rotation the radius is locked at [deg], + = supination; NaN = the model's posture. Only
+    /// for a model with a forearm rotation (InputError otherwise).
+    double forearmRotationDeg = 0.0 / 0.0;
     double activation = 1.0;       ///< target U of the agonists during the hold [1]
     MuscleGroup effort = MuscleGroup::Flexor;  ///< which group pulls: a flexion or an extension effort
     double antagonistActivation = 0.0;  ///< target U of the other group during the hold [1]

@@ -53,6 +53,41 @@ TEST(TorqueProtocol, FileReadsBackWhatWasWritten) {
     EXPECT_EQ(describeConditions(q), "flexion MVC at 90 deg x 2; extension MVC at 45 deg x 3; flexion 30 % at 120 deg x 1");
 }
 
+// Forearm postures (issue 31): rotation_deg reads back from the protocol file and the torque CSV (NaN
+// there: the model's posture), the same angle in two postures is two conditions, and ultrasound or EMG
+// with a posture is refused with the field named.
+TEST(TorqueProtocol, ForearmPosturesReadBackAndKeepConditionsApart) {
+    TorqueProtocol p;
+    p.conditions = TorqueProtocol::makeFlexionMvcs({90, 60}, 2);
+    TorqueCondition pronated = p.conditions[0];
+    pronated.rotationDeg = -90;
+    p.conditions.push_back(pronated);
+    const TorqueProtocol q = readTorqueProtocol(writeTemp("armsim_posture_protocol.yaml", formatTorqueProtocol(p)));
+    ASSERT_EQ(q.conditions.size(), 3u);
+    EXPECT_TRUE(std::isnan(q.conditions[0].rotationDeg));
+    EXPECT_EQ(q.conditions[2].rotationDeg, -90);
+    std::vector<TorqueObservation> data(3);
+    data[0] = {90, MuscleGroup::Flexor, 1.0, 0, 60.5};
+    data[1] = {90, MuscleGroup::Flexor, 1.0, 0, 40.25};
+    data[1].rotationDeg = -90;
+    data[2] = {90, MuscleGroup::Flexor, 1.0, 1, 41.0};
+    data[2].rotationDeg = -90;
+    const std::vector<TorqueObservation> back = readTorqueData(writeTemp("armsim_posture.csv", formatTorqueData(data, false)));
+    ASSERT_EQ(back.size(), 3u);
+    EXPECT_TRUE(std::isnan(back[0].rotationDeg));
+    EXPECT_EQ(back[1].rotationDeg, -90);
+    EXPECT_FALSE(isSameCondition(back[0], back[1]));   // same angle, other posture
+    EXPECT_TRUE(isSameCondition(back[1], back[2]));
+    const std::string e = errorOf([&] {
+        readTorqueProtocol(writeTemp("armsim_bad_posture.yaml", "name: t\nkind: torque\nconditions:\n"
+                                     "  - {flexion_deg: 90, rotation_deg: 90, channels: [torque, ultrasound]}\n"));
+    });
+    EXPECT_NE(e.find("armsim_bad_posture.yaml"), std::string::npos) << e;
+    EXPECT_NE(e.find("conditions[0].channels"), std::string::npos) << e;
+    EXPECT_NE(errorOf([&] { readTorqueData(writeTemp("armsim_bad_posture.csv", "flexion_deg,torque_Nm,rotation_deg\n90,50,200\n")); })
+                  .find("'rotation_deg' = 200"), std::string::npos);
+}
+
 TEST(TorqueProtocol, BadFilesNameTheFileLineAndField) {
     const std::string head = "name: t\nkind: torque\nconditions:\n";
     auto read = [&](const std::string& body) {
