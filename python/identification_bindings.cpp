@@ -126,15 +126,16 @@ std::vector<TorqueObservation> toTorqueData(const py::object& data) {
     const std::optional<py::dict> columns = asColumns(data);
     if (!columns)
         throw InputError("data: expected a torque CSV path or a dict of columns (flexion_deg, torque_Nm, and "
-                         "optionally effort, level, repetition)");
+                         "optionally effort, level, repetition, rotation_deg)");
     return makeTorqueData(toTable(*columns, "data"), "data");
 }
 
 /// Torque data as columns with the torque data file's names (formatTorqueData with the truth).
 py::dict toDict(const std::vector<TorqueObservation>& data) {
-    std::vector<double> deg, effort, level, rep, torque, activation, clean;
+    std::vector<double> deg, effort, level, rep, torque, activation, clean, rotation;
     for (const TorqueObservation& o : data) {
         deg.push_back(o.flexionDeg);
+        rotation.push_back(o.rotationDeg);
         effort.push_back(o.effort == MuscleGroup::Flexor ? 1 : -1);
         level.push_back(o.level);
         rep.push_back(o.repetition);
@@ -148,6 +149,7 @@ py::dict toDict(const std::vector<TorqueObservation>& data) {
     d["level"] = toArray(level);
     d["repetition"] = toArray(rep);
     d["torque_Nm"] = toArray(torque);
+    d["rotation_deg"] = toArray(rotation);   // NaN: the model's forearm posture
     d["activation"] = toArray(activation);
     d["clean_torque_Nm"] = toArray(clean);
     return d;
@@ -258,6 +260,7 @@ py::dict toDict(const TorqueCondition& c) {
     d["effort"] = getEffortName(c.effort);
     d["level"] = c.level;
     d["repetitions"] = c.repetitions;
+    d["rotation_deg"] = c.rotationDeg;   // NaN: the model's forearm posture
     return d;
 }
 

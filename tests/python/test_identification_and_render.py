@@ -108,6 +108,21 @@ def test_run_protocol_torque_equals_the_cpp_api_and_feeds_identify_torque(refere
     assert [e["mass"] for e in from_dict] == pytest.approx([e["mass"] for e in from_file], rel=1e-12)
 
 
+def test_forearm_postures_reach_python_and_feed_identify_torque(tmp_path):
+    run = armsim.run_protocol("protocols/forearm_postures.yaml", out=str(tmp_path / "run"))
+    rot = np.asarray(run["data"]["rotation_deg"])
+    assert len(rot) == 27 and np.isnan(rot).sum() == 15
+    assert sorted(set(rot[~np.isnan(rot)])) == [-90.0, 90.0]
+    prior = "subjects/twin_population.yaml"
+    from_dict = armsim.identify_torque(run["data"], population=prior)
+    from_file = armsim.identify_torque(str(tmp_path / "run" / "torque_data.csv"), population=prior)
+    assert [e["mass"] for e in from_dict] == pytest.approx([e["mass"] for e in from_file], rel=1e-12)
+    # dropping the postures changes the synergist fit: the posture is read, not ignored
+    neutral = {k: np.asarray(v)[np.isnan(rot)] for k, v in run["data"].items()}
+    alone = armsim.identify_torque(neutral, population=prior)
+    assert alone[1]["mass"] != pytest.approx(from_dict[1]["mass"], rel=1e-6)
+
+
 def test_run_protocol_mvc_then_identify_recovers_the_subject(thesis):
     run = armsim.run_protocol("protocols/mvc_force_angle.yaml")
     t = run["trials"]
