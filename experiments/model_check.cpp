@@ -94,7 +94,7 @@ ModelCheckResult writeModelCheck(const ArmSetup& setup, const std::vector<Anatom
     mvc.title = "Steady MVC torque; markers: published band +/- tolerance";
     mvc.xLabel = "elbow flexion (deg)";
     mvc.yLabel = "net torque magnitude (N m)";
-    mvc.legend = PlotSpec::Legend::BottomRight;
+    mvc.legend = PlotSpec::Legend::TopLeft;  // above the data: the y range is raised below to leave it room
     const MuscleGroup groups[2] = {MuscleGroup::Flexor, MuscleGroup::Extensor};
     for (int k = 0; k < 2; ++k) {
         const SteadyMvcCurve c = calcSteadyMvcCurve(setup.muscles, g, groups[k], setup.effort);
@@ -103,6 +103,10 @@ ModelCheckResult writeModelCheck(const ArmSetup& setup, const std::vector<Anatom
         mvc.series.push_back(s);
         addBands(mvc, r.scores, TargetKind::Mvc, "", groups[k], 1, k, k == 0 ? "flexion band" : "extension band");
     }
+    double highest = 0;
+    for (const PlotSeries& c : mvc.series)
+        for (double y : c.y) highest = std::max(highest, y);
+    mvc.yMax = 1.5 * highest;
     writePlotPng(path("check_mvc.png"), mvc);
     r.files.push_back(path("check_moment_arms.png"));
     r.files.push_back(path("check_mvc.png"));
