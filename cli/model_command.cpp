@@ -161,6 +161,9 @@ const CommandRegistrar registerModel(15, addModelCommands);
 const MainJobStepRegistrar registerElbowModel(
     25, "Elbow model (the virtual subject): muscles, moment arms, steady MVC torque-angle curves",
     [](const MainJobContext& ctx) { showModel(loadModel("elbow"), ctx.outDir + "/model_elbow", 5.0, loadDefaultElbowReference()); });
+const MainJobStepRegistrar registerTwinCheck(
+    26, "Anatomical twin: scorecard against the anatomy targets (moment arms, MVC, volumes, shares, postures)",
+    [](const MainJobContext& ctx) { checkModel(loadModel("twin"), loadDefaultAnatomyTargets(), ctx.outDir + "/check_twin"); });
 
 }  // namespace
 

@@ -249,8 +249,12 @@ TEST(Cli, MainJobRunsTheThesisArmAndTheElbowSubject) {
                           "model_elbow/moment_arms.png", "model_elbow/mvc_flexion.csv", "model_elbow/mvc_flexion.png",
                           "protocol_mvc/summary.csv", "out_of_family_person/estimates.csv",
                           "out_of_family_person/channel_data.csv", "out_of_family_person/mass_estimates.png",
-                          "out_of_family_person/fascicle_length.png", "out_of_family_person/emg.png"})
+                          "out_of_family_person/fascicle_length.png", "out_of_family_person/emg.png",
+                          "check_twin/scorecard.csv", "check_twin/check_mvc.png"})
         EXPECT_TRUE(fs::exists(d / f) && fs::file_size(d / f) > 0) << f;
+    // The twin's scorecard: its moment arms all inside the published bands (README, "The anatomical twin").
+    EXPECT_NE(armsim::testing::readFileText(d / "check_twin" / "score_summary.csv").find("\nmoment_arm,,56,56,"),
+              std::string::npos);
     // The out-of-family person: one row per method, the channels fit among them.
     EXPECT_NE(armsim::testing::readFileText(d / "out_of_family_person" / "estimates.csv").find(",channels,"),
               std::string::npos);
