@@ -156,6 +156,10 @@ void runDesign(const DesignOptions& o) {
             if (x.method == "thesis") continue;
             // With channels the prediction is the channels fit's (the torque-only fits' is the reference's).
             if (channels && protocol.name == d.protocol.name && x.method != "channels") continue;
+            if (x.converged == 0)
+                std::printf("  %-9s %-13s no fit converged in %d subjects%s\n", protocol.name.c_str(), x.method.c_str(), x.subjects,
+                            x.method == "synergist-va" ? " (its twitch interpolation needs maximal efforts: the protocol has none)" : "");
+            else
             std::printf("  %-9s %-13s mass bias %+5.1f %%  RMSE %5.1f %% (predicted sd %4.1f %%)  coverage %.2f  "
                         "95 %% width %5.1f %%   L0T RMSE %5.1f mm (predicted %4.1f mm)  coverage %.2f\n",
                         protocol.name.c_str(), x.method.c_str(), 100 * x.massBias, 100 * x.massRmse,

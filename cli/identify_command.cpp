@@ -314,6 +314,11 @@ void runElbowValidate(const ValidateOptions& o) {
     std::printf("%-13s %6s %9s %17s %17s %13s %20s %20s %13s\n", "method", "noise", "converged", "mass bias",
                 "mass RMSE", "coverage", "L0T bias", "L0T RMSE", "coverage");
     for (const ElbowValidationSummary& x : summary)
+        if (x.converged == 0)
+            std::printf("%-13s %5.1f%% %5d/%-3d no fit converged: nothing to summarise%s\n", x.method.c_str(), 100 * x.noise,
+                        x.converged, x.subjects,
+                        x.method == "synergist-va" ? " (its twitch interpolation needs maximal efforts: has the protocol an MVC?)" : "");
+        else
         std::printf("%-13s %5.1f%% %5d/%-3d %+8.1f +/- %3.1f%% %8.1f +/- %3.1f%% %5.2f +/- %4.2f %+8.1f +/- %3.1f mm "
                     "%8.1f +/- %3.1f mm %5.2f +/- %4.2f\n",
                     x.method.c_str(), 100 * x.noise, x.converged, x.subjects, 100 * x.massBias, 100 * x.massBiasSe,

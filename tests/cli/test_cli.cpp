@@ -240,6 +240,21 @@ TEST(Cli, ModelShowWritesTablesAndPlots) {
 
 // armsim run on built-in defaults: the thesis arm where it reproduces the thesis, the seven-muscle
 // elbow as the virtual subject (issue 10), every result file written.
+// A protocol without maximal efforts leaves synergist-va without its twitch-interpolation measurement:
+// the validation says so instead of printing NaN summaries.
+TEST(Cli, ValidationWithoutMvcsSaysWhySynergistVaDidNotFit) {
+    const fs::path d = freshDir("no_mvc");
+    std::ofstream(d / "p.yaml") << "name: no_mvc\nkind: torque\nconditions:\n"
+                                   "  - {effort: flexion, flexion_deg: 90, level: 0.3, repetitions: 2}\n"
+                                   "  - {effort: flexion, flexion_deg: 60, level: 0.6, repetitions: 2}\n";
+    const CommandResult r = runArmsim("validate --truth elbow --protocol " + (d / "p.yaml").string() +
+                                      " --subjects 2 --jobs 2 --out " + (d / "v").string());
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    EXPECT_NE(r.output.find("no fit converged"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("twitch interpolation needs maximal efforts"), std::string::npos) << r.output;
+    EXPECT_EQ(r.output.find("nan"), std::string::npos) << r.output;
+}
+
 TEST(Cli, MainJobRunsTheThesisArmAndTheElbowSubject) {
     const fs::path d = freshDir("run");
     const CommandResult r = runArmsim("run --jobs 2 --out " + d.string());
