@@ -24,10 +24,8 @@ std::string conditionField(std::size_t k, const char* key) {
     return "conditions[" + std::to_string(k) + "]." + key;
 }
 
-// (flexion, effort, level, rotation); NaN rotation (the model's posture) as a value of its own.
-std::tuple<double, int, double, double> conditionKey(double flexionDeg, MuscleGroup effort, double level,
-                                                     double rotationDeg) {
-    return {flexionDeg, int(effort), level, std::isnan(rotationDeg) ? 1e300 : rotationDeg};
+ConditionKey conditionKey(double flexionDeg, MuscleGroup effort, double level, double rotationDeg) {
+    return {flexionDeg, int(effort), level, std::isnan(rotationDeg) ? INFINITY : rotationDeg};
 }
 
 }  // namespace
@@ -57,7 +55,7 @@ bool TorqueProtocol::hasChannels() const {
 
 void TorqueProtocol::validate() const {
     if (conditions.empty()) throw FieldError("conditions", "no conditions: expected at least one");
-    std::set<std::tuple<double, int, double, double>> seen;
+    std::set<ConditionKey> seen;
     for (std::size_t k = 0; k < conditions.size(); ++k) {
         const TorqueCondition& c = conditions[k];
         checkField(conditionField(k, "flexion_deg"), c.flexionDeg, Bound::closed(0, 180, "deg, 0 = extended"));
@@ -246,9 +244,16 @@ VirtualSubject loadTorqueProtocolSubject(const TorqueProtocol& protocol) {
 
 std::string formatPosture(double rotationDeg) { return std::isnan(rotationDeg) ? "-" : formatNumber(rotationDeg); }
 
+ConditionKey getConditionKey(const TorqueObservation& o) {
+    return conditionKey(o.flexionDeg, o.effort, o.level, o.rotationDeg);
+}
+
 bool isSameCondition(const TorqueObservation& a, const TorqueObservation& b) {
-    return conditionKey(a.flexionDeg, a.effort, a.level, a.rotationDeg) ==
-           conditionKey(b.flexionDeg, b.effort, b.level, b.rotationDeg);
+    return getConditionKey(a) == getConditionKey(b);
+}
+
+bool hasPostures(const std::vector<TorqueObservation>& data) {
+    return std::any_of(data.begin(), data.end(), [](const TorqueObservation& o) { return !std::isnan(o.rotationDeg); });
 }
 
 std::vector<TorqueObservation> synthesizeTorqueData(const VirtualSubject& subject, const TorqueProtocol& protocol,
@@ -301,7 +306,7 @@ std::vector<TorqueObservation> setTransducerNoise(std::vector<TorqueObservation>
 }
 
 std::string formatTorqueData(const std::vector<TorqueObservation>& data, bool truth) {
-    const bool postures = std::any_of(data.begin(), data.end(), [](const TorqueObservation& o) { return !std::isnan(o.rotationDeg); });
+    const bool postures = hasPostures(data);
     std::string out = "# tared elbow torque per trial; flexion_deg: 0 = extended; effort: 1 = flexion, -1 = extension;\n"
                       "# level: drive as a fraction of maximal; torque_Nm: + = flexion";
     out += postures ? "; rotation_deg: forearm posture, + = supination, NaN = the model's\n" : "\n";
@@ -334,8 +339,8 @@ std::vector<TorqueObservation> makeTorqueData(const Table& t, const std::string&
         if (!t.hasColumn(c)) throw InputError(path + ": missing column '" + std::string(c) + "'");
     if (t.getNumRows() == 0) throw InputError(path + ": no data rows");
     std::vector<TorqueObservation> data;
-    std::map<std::tuple<double, int, double, double>, int> count;
-    std::set<std::tuple<std::tuple<double, int, double, double>, int>> seen;
+    std::map<ConditionKey, int> count;
+    std::set<std::pair<ConditionKey, int>> seen;
     for (int r = 0; r < t.getNumRows(); ++r) {
         const std::string at = t.describeRow(path, r);
         auto fail = [&](const std::string& column, double v, const std::string& expected) {
@@ -362,7 +367,7 @@ std::vector<TorqueObservation> makeTorqueData(const Table& t, const std::string&
             if (std::isinf(o.rotationDeg) || std::abs(o.rotationDeg) > 180)
                 fail("rotation_deg", o.rotationDeg, "in [-180, 180] (+ = supination) or NaN (the model's posture)");
         }
-        const auto key = conditionKey(o.flexionDeg, o.effort, o.level, o.rotationDeg);
+        const ConditionKey key = getConditionKey(o);
         if (t.hasColumn("repetition")) {
             const double v = t.get(r, "repetition");
             if (!std::isfinite(v) || v != std::floor(v) || v < 0 || v > 1e6) fail("repetition", v, "an integer >= 0");

@@ -15,6 +15,7 @@
 
 #include <cmath>
 #include <string>
+#include <tuple>
 #include <vector>
 
 namespace armsim {
@@ -113,12 +114,20 @@ struct TorqueObservation {
     double fascicleLength = NAN;        ///< the primary's fascicle at the plateau, window mean (truth) [m]
     double rotationDeg = 0.0 / 0.0;  ///< forearm posture [deg], + = supination; NaN = the model's posture
     int line = 0;              ///< line in the file it was read from (0: synthesized)
-    /// A maximal flexion effort (what the thesis's method uses).
+    /// A maximal flexion effort.
     bool isFlexionMvc() const { return effort == MuscleGroup::Flexor && level == 1; }
+    /// A maximal flexion effort in the model's forearm posture: what the thesis's method uses.
+    bool isThesisMvc() const { return isFlexionMvc() && std::isnan(rotationDeg); }
 };
 
-/// true when a and b are the same condition (angle, effort, level).
+/// What makes a condition: (flexion, effort, level, rotation), the model's posture (NaN) as +inf so
+/// keys compare and sort.
+using ConditionKey = std::tuple<double, int, double, double>;
+ConditionKey getConditionKey(const TorqueObservation& o);
+/// true when a and b are the same condition (angle, effort, level, posture).
 bool isSameCondition(const TorqueObservation& a, const TorqueObservation& b);
+/// true when an observation has a forearm posture other than the model's (files then carry rotation_deg).
+bool hasPostures(const std::vector<TorqueObservation>& data);
 /// A forearm posture for tables: "-" for the model's (NaN), else the rotation in deg ("-90", "90").
 std::string formatPosture(double rotationDeg);
 

@@ -55,9 +55,8 @@ std::vector<int> findMuscles(const ArmSetup& setup, const std::vector<std::strin
 // Relative torque sd pooled over the conditions' repetitions (NaN without repetitions) and its degrees
 // of freedom.
 std::pair<double, int> estimateNoiseLevel(const std::vector<TorqueObservation>& data) {
-    std::map<std::tuple<double, int, double, double>, std::vector<double>> byCondition;
-    for (const TorqueObservation& o : data)
-        byCondition[{o.flexionDeg, int(o.effort), o.level, std::isnan(o.rotationDeg) ? INFINITY : o.rotationDeg}].push_back(o.torque);
+    std::map<ConditionKey, std::vector<double>> byCondition;
+    for (const TorqueObservation& o : data) byCondition[getConditionKey(o)].push_back(o.torque);
     double ss = 0;
     int dof = 0;
     for (const auto& [condition, v] : byCondition) {
@@ -95,12 +94,12 @@ SynergistModel::SynergistModel(const Population& prior, const SynergistOptions& 
     if (std::find(biceps_.begin(), biceps_.end(), base.primary) == biceps_.end())
         throw InputError("synergist-aware identifier: the primary muscle '" + base.muscles[base.primary].params.name +
                          "' is not in the biceps group");
-    std::vector<std::pair<double, double>> angles;   // poses: (flexion, rotation)
+    std::vector<std::pair<double, double>> poses;   // (flexion, rotation; the model's posture as +inf)
     for (const TorqueCondition& c : conditions) {
         if (!std::isnan(c.rotationDeg) && !base.arm.forearmRotation.enabled)
             throw InputError("synergist-aware identifier: a condition at forearm rotation " + formatNumber(c.rotationDeg) +
                              " deg, but the prior's model '" + base.name + "' has no forearm rotation");
-        angleOf_.push_back(findAngle(c.flexionDeg, angles, c.rotationDeg));
+        angleOf_.push_back(findPose(c.flexionDeg, poses, c.rotationDeg));
         kindOf_.push_back(findKind(c.effort, c.level));
     }
     channels_ = options.channels;
@@ -123,7 +122,7 @@ SynergistModel::SynergistModel(const Population& prior, const SynergistOptions& 
                 throw InputError(at + o.channel + " at flexion_deg " + formatNumber(o.flexionDeg) +
                                  ": expected an angle in the elbow's range [" + formatNumber(lo) + ", " +
                                  formatNumber(hi) + "] deg of model '" + base.name + "'");
-            angle = findAngle(o.flexionDeg, angles);
+            angle = findPose(o.flexionDeg, poses);
             if (o.channel == "fascicle_length" && o.level > 0) kind = findKind(o.effort, o.level);
         }
         if (o.channel == "emg" && base.muscles[m].group != MuscleGroup::Flexor && base.muscles[m].group != MuscleGroup::Extensor)
@@ -133,24 +132,22 @@ SynergistModel::SynergistModel(const Population& prior, const SynergistOptions& 
         channelKind_.push_back(kind);
     }
     // The geometry of every pose, one calcMvcGeometry per posture, rows in pose order.
-    std::map<double, std::vector<int>> byRotation;   // NaN (the model's posture) as +inf
-    for (std::size_t k = 0; k < angles.size(); ++k)
-        byRotation[std::isnan(angles[k].second) ? INFINITY : angles[k].second].push_back(int(k));
-    geometry_.flexionDeg.assign(angles.size(), 0);
-    geometry_.pathLength.assign(angles.size(), {});
-    geometry_.momentArm.assign(angles.size(), {});
-    geometry_.forearmMomentArm.assign(angles.size(), {});
-    for (const auto& [rotation, poses] : byRotation) {
+    std::map<double, std::vector<int>> byRotation;
+    for (std::size_t k = 0; k < poses.size(); ++k) byRotation[poses[k].second].push_back(int(k));
+    geometry_.flexionDeg.assign(poses.size(), 0);
+    geometry_.pathLength.assign(poses.size(), {});
+    geometry_.momentArm.assign(poses.size(), {});
+    geometry_.forearmMomentArm.assign(poses.size(), {});
+    for (const auto& [rotation, rows] : byRotation) {
         std::vector<double> flexion;
-        for (int k : poses) flexion.push_back(angles[k].first);
+        for (int k : rows) flexion.push_back(poses[k].first);
         const MvcGeometry g = calcMvcGeometry(base, flexion, std::isinf(rotation) ? NAN : rotation);
-        for (std::size_t j = 0; j < poses.size(); ++j) {
-            geometry_.flexionDeg[poses[j]] = g.flexionDeg[j];
-            geometry_.pathLength[poses[j]] = g.pathLength[j];
-            geometry_.momentArm[poses[j]] = g.momentArm[j];
-            geometry_.forearmMomentArm[poses[j]] = g.forearmMomentArm[j];
+        for (std::size_t j = 0; j < rows.size(); ++j) {
+            geometry_.flexionDeg[rows[j]] = g.flexionDeg[j];
+            geometry_.pathLength[rows[j]] = g.pathLength[j];
+            geometry_.momentArm[rows[j]] = g.momentArm[j];
+            geometry_.forearmMomentArm[rows[j]] = g.forearmMomentArm[j];
         }
-        geometry_.rotationDeg = g.rotationDeg;   // the rows' own postures differ; the field is not used here
     }
 
     const int n = getNumParameters();
@@ -215,12 +212,11 @@ std::vector<std::string> SynergistModel::getParameterNames() const {
     return names;
 }
 
-int SynergistModel::findAngle(double flexionDeg, std::vector<std::pair<double, double>>& poses, double rotationDeg) {
-    auto it = std::find_if(poses.begin(), poses.end(), [&](const std::pair<double, double>& p) {
-        return p.first == flexionDeg && (p.second == rotationDeg || (std::isnan(p.second) && std::isnan(rotationDeg)));
-    });
+int SynergistModel::findPose(double flexionDeg, std::vector<std::pair<double, double>>& poses, double rotationDeg) {
+    const std::pair<double, double> pose(flexionDeg, std::isnan(rotationDeg) ? INFINITY : rotationDeg);
+    auto it = std::find(poses.begin(), poses.end(), pose);
     if (it != poses.end()) return int(it - poses.begin());
-    poses.emplace_back(flexionDeg, rotationDeg);
+    poses.push_back(pose);
     return int(poses.size()) - 1;
 }
 

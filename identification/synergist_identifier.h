@@ -105,8 +105,8 @@ private:
     std::vector<int> channelMuscle_, channelAngle_, channelKind_;  // kind -1: relaxed
     double emgCrosstalk_ = 0;
     int findKind(MuscleGroup group, double level);
-    /// Index of the pose (flexion, forearm rotation; NaN = the model's posture), added if new.
-    int findAngle(double flexionDeg, std::vector<std::pair<double, double>>& poses, double rotationDeg = 0.0 / 0.0);
+    /// Index of the pose (flexion, forearm rotation; NaN = the model's posture, kept as +inf), added if new.
+    int findPose(double flexionDeg, std::vector<std::pair<double, double>>& poses, double rotationDeg = 0.0 / 0.0);
     std::vector<double> priorMean_, lower_, upper_;
     std::vector<std::vector<double>> priorCovariance_;
     friend MuscleEstimate identifySynergistAware(const Population&, const std::vector<TorqueObservation>&,

@@ -12,11 +12,9 @@ namespace armsim {
 MuscleEstimate identifyThesisMethod(const ArmSetup& assumed, const std::vector<TorqueObservation>& allData) {
     MuscleEstimate est;
     est.method = "thesis";
-    // The method knows flexion MVCs in one forearm posture (the model's) only.
-    auto usable = [](const TorqueObservation& o) { return o.isFlexionMvc() && std::isnan(o.rotationDeg); };
-    std::vector<TorqueObservation> data;
+    std::vector<TorqueObservation> data;  // the method knows flexion MVCs in the model's posture only
     for (const TorqueObservation& o : allData)
-        if (usable(o)) data.push_back(o);
+        if (o.isThesisMvc()) data.push_back(o);
     if (data.empty()) throw InputError("thesis method: no flexion MVC in the data (it uses those only)");
     std::vector<double> angles;
     for (const TorqueObservation& o : data) angles.push_back(o.flexionDeg);
@@ -51,8 +49,8 @@ MuscleEstimate identifyThesisMethod(const ArmSetup& assumed, const std::vector<T
     est.numParameters = 2;
     std::size_t k = 0;
     for (const TorqueObservation& o : allData) {
-        est.predictedTorque.push_back(usable(o) ? r.modelForces[k] * g.momentArm[k][assumed.primary] : NAN);
-        k += usable(o);
+        est.predictedTorque.push_back(o.isThesisMvc() ? r.modelForces[k] * g.momentArm[k][assumed.primary] : NAN);
+        k += o.isThesisMvc();
     }
     return est;
 }

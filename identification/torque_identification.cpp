@@ -79,7 +79,7 @@ std::string formatChannelFitsCsv(const std::vector<MuscleEstimate>& estimates) {
 
 std::string formatTorquePredictionsCsv(const std::vector<TorqueObservation>& data,
                                        const std::vector<MuscleEstimate>& estimates) {
-    const bool postures = std::any_of(data.begin(), data.end(), [](const TorqueObservation& d) { return !std::isnan(d.rotationDeg); });
+    const bool postures = hasPostures(data);
     std::vector<std::string> header = {"flexion_deg", "effort", "level", "repetition", "torque_Nm"};
     if (postures) header.push_back("rotation_deg");   // NaN: the model's posture
     for (const MuscleEstimate& e : estimates) header.push_back(e.method + "_Nm");
@@ -109,7 +109,7 @@ std::vector<MuscleEstimate> identifyTorqueData(const Population& prior, const st
     std::vector<MuscleEstimate> estimates;
     std::set<double> mvcAngles;
     for (const TorqueObservation& d : data)
-        if (d.isFlexionMvc() && std::isnan(d.rotationDeg)) mvcAngles.insert(d.flexionDeg);   // the thesis's posture
+        if (d.isThesisMvc()) mvcAngles.insert(d.flexionDeg);
     if (skipped) skipped->clear();
     if (mvcAngles.size() >= 2)
         estimates.push_back(identifyThesisMethod(prior.base, data));
