@@ -165,6 +165,13 @@ std::vector<TargetScore> scoreAnatomy(const ArmSetup& setup, const std::vector<A
     const SteadyMvcCurve extension = calcSteadyMvcCurve(setup.muscles, geometry, MuscleGroup::Extensor, setup.effort);
     const SteadyMvcCurve full = calcSteadyMvcCurve(setup.muscles, geometry, MuscleGroup::Flexor, SubjectEffort{1, 0});
 
+    std::vector<int> sharedMuscles;   // every muscle a share target names
+    for (int i = 0; i < setup.getNumMuscles(); ++i)
+        if (std::any_of(targets.begin(), targets.end(), [&](const AnatomyTarget& t) {
+                return t.kind == TargetKind::Share && doesFamilyCoverMuscle(t.muscle, setup.muscles[i].params.name);
+            }))
+            sharedMuscles.push_back(i);
+
     std::vector<TargetScore> out;
     auto add = [&](const AnatomyTarget& t, const std::string& muscle, double value) {
         TargetScore s;
@@ -213,9 +220,13 @@ std::vector<TargetScore> scoreAnatomy(const ArmSetup& setup, const std::vector<A
             break;
         }
         case TargetKind::Share: {
-            double s = 0;
-            for (int m : covered) s += flexion.calcFlexorShare(indexOf(t.flexionDeg), m);
-            add(t, t.muscle, s);
+            // Like-for-like with share sources (Kawakami 1994's three add up to 1): the family's flexion
+            // torque over that of every muscle a share target names.
+            const int a = indexOf(t.flexionDeg);
+            double part = 0, whole = 0;
+            for (int m : covered) part += std::max(0.0, flexion.points[a][m].torque);
+            for (int m : sharedMuscles) whole += std::max(0.0, flexion.points[a][m].torque);
+            add(t, t.muscle, whole > 0 ? part / whole : NAN);
             break;
         }
         case TargetKind::Mvc:

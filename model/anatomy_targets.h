@@ -66,7 +66,8 @@ struct TargetScore {
 /// magnitude of the steady forearm torque of a supination or pronation MVC at the angle and posture,
 /// posture_ratio the flexion MVC at the posture over that in neutral (both skipped for a model without a
 /// forearm rotation), volume = mass / density,
-/// share = the family's part of the flexors' torque at a flexion MVC, optimum angle = the flexion angle
+/// share = the family's part of the flexion torque of the muscles all share targets name (as the
+/// sources, whose shares add up to 1) at a flexion MVC, optimum angle = the flexion angle
 /// where the muscle's steady fibre length at a full flexion MVC crosses L0 (NaN: it does not within the
 /// elbow's range). Targets naming no model muscle are skipped.
 std::vector<TargetScore> scoreAnatomy(const ArmSetup& setup, const std::vector<AnatomyTarget>& targets);

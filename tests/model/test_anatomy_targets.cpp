@@ -85,6 +85,23 @@ TEST(AnatomyTargets, ScoresEqualASecondMethodAndBandsDecidePass) {
     EXPECT_NEAR(c.points[0][s.findMuscle("BICshort")].fibreLength, 1.0, kFibreLengthTol);
 }
 
+// Shares are taken among the families the share targets name (as Kawakami 1994's, which add up to 1):
+// with BIC and BRA named, the two shares add up to 1 although BRD and PT also flex; each equals its
+// torque over the pair's, from the steady flexion curve at the model's effort.
+TEST(AnatomyTargets, SharesAreAmongTheNamedFamilies) {
+    const ArmSetup twin = loadModel("twin");
+    const auto scores = scoreAnatomy(twin, loadAnatomyTargets(writeTargets(
+        "  - {kind: share, muscle: BIC, flexion_deg: 90, lower: 0, upper: 1, source: a}\n"
+        "  - {kind: share, muscle: BRA, flexion_deg: 90, lower: 0, upper: 1, source: b}\n")));
+    ASSERT_EQ(scores.size(), 2u);
+    EXPECT_NEAR(scores[0].value + scores[1].value, 1.0, 1e-12);
+    const SteadyMvcCurve c = calcSteadyMvcCurve(twin, MuscleGroup::Flexor, twin.effort, {90});
+    const double bic = c.points[0][twin.findMuscle("BIClong")].torque + c.points[0][twin.findMuscle("BICshort")].torque;
+    const double bra = c.points[0][twin.findMuscle("BRA")].torque;
+    EXPECT_GT(c.points[0][twin.findMuscle("BRD")].torque, 0.1 * bra);  // a flexor the shares leave out
+    EXPECT_NEAR(scores[0].value, bic / (bic + bra), 1e-9);
+}
+
 // Forearm efforts two ways (issue 28): the steady curve's supination torque (sum of forearm moment arm x
 // tendon force) against the torque Simbody's forearm lock must apply to hold the radius still with every
 // muscle at that steady state (gravity off), and the posture ratio against two flexion curves.
