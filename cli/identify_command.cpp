@@ -390,9 +390,9 @@ void addValidateCommand(CLI::App& app) {
     o->muscle.add(*c);
     c->add_option("--out", o->out, "output directory (validation.csv)")->capture_default_str();
     c->add_option("--truth", o->truth,
-                  "thesis: biceps-only truths (the identifier's own model); elbow: virtual subjects of the "
-                  "seven-muscle elbow drawn from --population, identified by the thesis method and the "
-                  "synergist-aware identifier")
+                  "thesis: biceps-only truths (the identifier's own model); elbow: multi-muscle virtual subjects "
+                  "drawn from --population (default: the anatomical twin's), identified by the thesis method "
+                  "and the synergist-aware identifiers")
         ->capture_default_str()
         ->check(CLI::IsMember({"thesis", "elbow"}));
     c->add_option("--population", o->population,

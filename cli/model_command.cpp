@@ -69,7 +69,7 @@ void addModelCommands(CLI::App& app) {
     });
 
     {
-        auto name = std::make_shared<std::string>("elbow");
+        auto name = std::make_shared<std::string>(kDefaultSubjectModel);
         auto out = std::make_shared<std::string>("out/model");
         auto step = std::make_shared<double>(5.0);
         auto reference = std::make_shared<std::string>();
@@ -87,7 +87,7 @@ void addModelCommands(CLI::App& app) {
     }
 
     {
-        auto name = std::make_shared<std::string>("elbow");
+        auto name = std::make_shared<std::string>(kDefaultSubjectModel);
         auto out = std::make_shared<std::string>("out/model_check");
         auto targets = std::make_shared<std::string>();
         CLI::App* c = model->add_subcommand(
@@ -158,9 +158,11 @@ void addModelCommands(CLI::App& app) {
 }
 
 const CommandRegistrar registerModel(15, addModelCommands);
-const MainJobStepRegistrar registerElbowModel(
-    25, "Elbow model (the virtual subject): muscles, moment arms, steady MVC torque-angle curves",
-    [](const MainJobContext& ctx) { showModel(loadModel("elbow"), ctx.outDir + "/model_elbow", 5.0, loadDefaultElbowReference()); });
+const MainJobStepRegistrar registerSubjectModel(
+    25, "Anatomical twin (the virtual subject): muscles, moment arms, steady MVC torque-angle curves",
+    [](const MainJobContext& ctx) {
+        showModel(loadModel(kDefaultSubjectModel), ctx.outDir + "/model_twin", 5.0, loadDefaultElbowReference());
+    });
 const MainJobStepRegistrar registerTwinCheck(
     26, "Anatomical twin: scorecard against the anatomy targets (moment arms, MVC, volumes, shares, postures)",
     [](const MainJobContext& ctx) { checkModel(loadModel("twin"), loadDefaultAnatomyTargets(), ctx.outDir + "/check_twin"); });

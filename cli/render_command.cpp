@@ -107,20 +107,20 @@ void addRenderCommand(CLI::App& app) {
     c->callback([o] { runRenderCommand(*o); });
 }
 
-/// Main job: one MVC video of the seven-muscle elbow (isometric at 90 deg, the virtual subject's
+/// Main job: one MVC video of the anatomical twin (isometric at 90 deg, the virtual subject's
 /// effort), one free-movement video of the thesis arm, and a still of the MVC.
 void runTrialVideos(const MainJobContext& ctx) {
     const ArmSetup setup = ctx.muscle.loadSetup();
-    const ArmSetup elbow = loadModel("elbow");
+    const ArmSetup subject = loadModel(kDefaultSubjectModel);
     IsometricTrialSettings iso;
     iso.elbowAngle = degToRad(90);
-    iso.activation = elbow.effort.voluntaryActivation;
-    iso.antagonistActivation = elbow.effort.coContraction;
+    iso.activation = subject.effort.voluntaryActivation;
+    iso.antagonistActivation = subject.effort.coContraction;
     const FreeMovementSettings free;
     // Two Systems, two threads.
     auto freeTable = std::async(ctx.jobs > 1 ? std::launch::async : std::launch::deferred,
                                 [&] { return runFreeMovement(setup, free); });
-    const Table mvc = runIsometricTrial(elbow, iso).series;
+    const Table mvc = runIsometricTrial(subject, iso).series;
     const Table movement = freeTable.get();
     mvc.writeCsv(ctx.outDir + "/trial_mvc_90deg.csv");
     movement.writeCsv(ctx.outDir + "/trial_free_movement.csv");
@@ -131,7 +131,7 @@ void runTrialVideos(const MainJobContext& ctx) {
     v.stillPath = ctx.outDir + "/still_mvc_90deg.png";
     v.tableName = "trial_mvc_90deg.csv";
     const RenderPlugin& render = getRenderPlugin("videos");
-    TrialVideoResult r = render.renderTrialVideo(elbow, mvc, v, [](int d, int n) { printProgress("MVC video", d, n); });
+    TrialVideoResult r = render.renderTrialVideo(subject, mvc, v, [](int d, int n) { printProgress("MVC video", d, n); });
     std::printf("  wrote %s (%d frames) and %s\n", r.videoPath.c_str(), r.frames, r.stillPath.c_str());
 
     v.videoPath = ctx.outDir + "/video_free_movement.mp4";
@@ -143,7 +143,7 @@ void runTrialVideos(const MainJobContext& ctx) {
 }
 
 const CommandRegistrar registerRender(60, addRenderCommand);
-const MainJobStepRegistrar registerVideos(40, "Videos: elbow-model MVC at 90 deg, thesis-arm free movement", runTrialVideos);
+const MainJobStepRegistrar registerVideos(40, "Videos: anatomical-twin MVC at 90 deg, thesis-arm free movement", runTrialVideos);
 
 #else
 

@@ -183,11 +183,11 @@ void runMvcAngles(const MainJobContext& ctx) {
     std::printf("  wrote %s/mvc_angles.csv, mvc_angles.png\n", ctx.outDir.c_str());
 }
 
-/// Main job: the same five-angle MVC on the seven-muscle elbow (the virtual subject: agonists at its
+/// Main job: the same five-angle MVC on the anatomical twin (the virtual subject: agonists at its
 /// voluntary activation, antagonists co-contracting), with the thesis's biceps-force estimate (tared
 /// torque over the biceps moment arm) beside every muscle's true force.
-void runElbowMvcAngles(const MainJobContext& ctx) {
-    const ArmSetup setup = loadModel("elbow");
+void runSubjectMvcAngles(const MainJobContext& ctx) {
+    const ArmSetup setup = loadModel(kDefaultSubjectModel);
     const auto& angles = kThesisMvcAnglesDeg;
     std::vector<IsometricTrialSettings> settings;
     for (double a : angles) {
@@ -198,7 +198,7 @@ void runElbowMvcAngles(const MainJobContext& ctx) {
         settings.push_back(s);
     }
     const auto results = runIsometricTrials(setup, settings, ctx.jobs,
-                                            [](int d, int n) { printProgress("elbow MVC trials", d, n); });
+                                            [](int d, int n) { printProgress("twin MVC trials", d, n); });
     const int n = setup.getNumMuscles(), primary = setup.primary;
     const std::string biceps = setup.muscles[primary].params.name;
     // The thesis's one biceps is every head the model file names (roles.biceps).
@@ -210,7 +210,7 @@ void runElbowMvcAngles(const MainJobContext& ctx) {
     for (int i = 0; i < n; ++i) columns.push_back("torque_" + setup.muscles[i].params.name + "_Nm");
     Table t(columns);
     PlotSpec spec;
-    spec.title = "Elbow model: MVC at the thesis's angles (VA " + formatNumber(setup.effort.voluntaryActivation) +
+    spec.title = "Anatomical twin: MVC at the thesis's angles (VA " + formatNumber(setup.effort.voluntaryActivation) +
                  ", co-contraction " + formatNumber(setup.effort.coContraction) + ")";
     spec.xLabel = "elbow angle (deg, thesis convention: 180 = extended)";
     spec.yLabel = "force (N)";
@@ -250,17 +250,17 @@ void runElbowMvcAngles(const MainJobContext& ctx) {
     spec.legend = PlotSpec::Legend::TopLeft;
     spec.yMin = 0;
     spec.yMax = 2.4 * *std::max_element(estimated.y.begin(), estimated.y.end());  // room for the legend
-    t.writeCsv(ctx.outDir + "/mvc_angles_elbow.csv");
-    writePlotPng(ctx.outDir + "/mvc_angles_elbow.png", spec);
+    t.writeCsv(ctx.outDir + "/mvc_angles_twin.csv");
+    writePlotPng(ctx.outDir + "/mvc_angles_twin.png", spec);
     std::printf("  the estimate credits the biceps with the brachialis' and brachioradialis' torque, less the\n"
-                "  triceps' co-contraction; wrote %s/mvc_angles_elbow.csv, mvc_angles_elbow.png\n",
+                "  triceps' co-contraction; wrote %s/mvc_angles_twin.csv, mvc_angles_twin.png\n",
                 ctx.outDir.c_str());
 }
 
 const CommandRegistrar registerTrial(20, addTrialCommand);
 const MainJobStepRegistrar registerMvc(30, "Thesis arm (biceps only): MVC at the thesis's five elbow angles", runMvcAngles);
-const MainJobStepRegistrar registerElbowMvc(32, "Elbow model (seven muscles): MVC at the thesis's five angles",
-                                            runElbowMvcAngles);
+const MainJobStepRegistrar registerSubjectMvc(32, "Anatomical twin (ten muscles): MVC at the thesis's five angles",
+                                              runSubjectMvcAngles);
 
 }  // namespace
 

@@ -65,7 +65,7 @@ struct TorqueProtocol {
     /// empty, the model `model` (name or file) with its own effort and `transducerNoise`.
     std::string population;
     int subjectIndex = 0;
-    std::string model = "elbow";
+    std::string model = kDefaultSubjectModel;
     double transducerNoise = 0.02;   ///< relative sd (model subject only) [1]
     unsigned seed = 1;               ///< population and noise seed
     /// Muscles whose volume a panoramic ultrasound scan measures (once each; names in the model).

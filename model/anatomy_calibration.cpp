@@ -35,7 +35,7 @@ bool isFitted(TargetKind k) {
 }
 
 constexpr double kMissingResidual = 3;
-constexpr double kNfMargin = 0.95;         // fraction of the nf limit a relaxed fascicle may reach
+constexpr double kNfMargin = 0.90;         // fraction of the nf limit a relaxed fascicle may reach
 constexpr double kMarginWeight = 100;      // per unit of relative excess   // a value the model does not have (no optimum in range): 3 scales out
 
 // The band as a Gaussian: centre and sd = half the band + the tolerance (a point value: its tolerance).

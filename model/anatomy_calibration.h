@@ -10,7 +10,8 @@
 // Then k = v / f, so F0' = s v F0 / f and mass' = v mass. Residuals: for each target of kind mvc,
 // forearm_mvc, posture_ratio, share, optimum_angle or volume, sqrt(weight) (value - band centre) / (half the band + tolerance): a
 // band read as a Gaussian; for each unknown ln(scale) / prior sd; a penalty when a relaxed fascicle at
-// the longest path would pass 95 % of its nf limit. Moment arms do not change with these scales and
+// the longest path would pass 90 % of its nf limit (room for the length spread of a population and of
+// the identifier's prior, whose draws must have a steady state at every angle). Moment arms do not change with these scales and
 // are not fitted. Only s v / f (F0) and v (volume) are pinned by torque and volume targets; how F0's
 // scale splits between s and f is the priors' (and the optimum angles') call.
 #pragma once

@@ -153,7 +153,11 @@ struct ArmSetup {
 /// limit, is kept). Throws std::logic_error unless there is one calibration per muscle.
 ArmSetup applyCalibration(const ArmSetup& setup, const std::vector<MuscleCalibration>& calibration);
 
-/// Loads a model: a name under assets/models/ ("thesis", "elbow") or a file path. Every error names
+/// The model virtual subjects default to (the default population's, the main job's, protocols' and
+/// `model show` / `check`'s): the anatomical twin.
+inline const char* const kDefaultSubjectModel = "twin";
+
+/// Loads a model: a name under assets/models/ ("thesis", "elbow", "twin") or a file path. Every error names
 /// the file, line, key and value. P_max of muscles with `max_path_length: range` is resolved
 /// (model/muscle_arm.h: resolveMaxPathLengths). A model loaded before is returned again without
 /// the work while its file and every file it read (arm, muscle and fibre-type files) read byte for byte

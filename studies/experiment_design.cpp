@@ -20,6 +20,7 @@ namespace {
 constexpr double kMassGoal = 0.10;     // issue 11: mass RMSE <= 10 %
 constexpr double kTendonGoal = 0.010;  // issue 11: tendon-length RMSE <= 1 cm [m]
 constexpr double kStep = 1e-4;         // central-difference step in x (ln scales and activations)
+constexpr unsigned kMaxRedraws = 100;  // prior draws tried again for one without a steady state
 
 Eigen::MatrixXd toMatrix(const std::vector<std::vector<double>>& rows) {
     Eigen::MatrixXd m(int(rows.size()), rows.empty() ? 0 : int(rows.front().size()));
@@ -66,16 +67,29 @@ std::vector<std::vector<double>> drawFromPrior(const SynergistModel& model, unsi
     const Eigen::MatrixXd L = Eigen::LLT<Eigen::MatrixXd>(freeSigma).matrixL();
     std::vector<std::vector<double>> out;
     for (int d = 0; d < draws; ++d) {
-        PortableRandom rng{seed, 0x5EED1u, unsigned(d)};
-        Eigen::VectorXd z(free.size());
-        for (int j = 0; j < z.size(); ++j) z(j) = rng.drawNormal();
-        const Eigen::VectorXd v = L * z;
-        std::vector<double> x = model.getPriorMean();
-        for (std::size_t k = 0; k < free.size(); ++k) {
-            const int j = free[k];  // kept inside the bounds by more than the difference step
-            x[j] = std::clamp(x[j] + v(k), model.getLower()[j] + 2 * kStep, model.getUpper()[j] - 2 * kStep);
+        // A draw whose person has no steady state in some condition (a fascicle past the nf limit at the
+        // longest path) is drawn again, as population draws are (experiments/population.h).
+        for (unsigned attempt = 0;; ++attempt) {
+            PortableRandom rng = attempt == 0 ? PortableRandom{seed, 0x5EED1u, unsigned(d)}
+                                              : PortableRandom{seed, 0x5EED1u, unsigned(d), attempt};
+            Eigen::VectorXd z(free.size());
+            for (int j = 0; j < z.size(); ++j) z(j) = rng.drawNormal();
+            const Eigen::VectorXd v = L * z;
+            std::vector<double> x = model.getPriorMean();
+            for (std::size_t k = 0; k < free.size(); ++k) {
+                const int j = free[k];  // kept inside the bounds by more than the difference step
+                x[j] = std::clamp(x[j] + v(k), model.getLower()[j] + 2 * kStep, model.getUpper()[j] - 2 * kStep);
+            }
+            try {
+                model.calcTorques(x.data());
+            } catch (const SimulationError&) {
+                if (attempt < kMaxRedraws) continue;
+                throw SimulationError("prior draw " + std::to_string(d) + ": no person with a steady state in every "
+                                      "condition after " + std::to_string(kMaxRedraws + 1) + " draws");
+            }
+            out.push_back(x);
+            break;
         }
-        out.push_back(x);
     }
     return out;
 }

@@ -100,7 +100,8 @@ struct DesignResult {
 std::string formatDesignStepsCsv(const DesignResult& result);
 
 /// `draws` parameter vectors of the identifier's prior (Gaussian, clipped to its bounds), seeded by
-/// (seed, draw): the draws the predictions average over.
+/// (seed, draw): the draws the predictions average over. A draw whose person has no steady state in some
+/// condition of the model is drawn again (seeded by the attempt too); SimulationError after 101 tries.
 std::vector<std::vector<double>> drawFromPrior(const SynergistModel& model, unsigned seed, int draws);
 
 /// Predicted uncertainty of the synergist-aware identifier with this protocol (with its channels when it

@@ -9,7 +9,7 @@ RuntimeError for a simulation that cannot go on. Long calls release the GIL, so 
 trials in parallel.
 
     import armsim
-    model = armsim.Model.load("elbow")
+    model = armsim.Model.load("twin")
     series, summary = armsim.arm_trial(model, angle_deg=90, activation=1.0)
     report = armsim.identify(armsim.Model.load("thesis"), "measured/thesis_measured.csv")
     armsim.render_video(model, series, "mvc.mp4")

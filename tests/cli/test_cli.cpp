@@ -255,13 +255,13 @@ TEST(Cli, ValidationWithoutMvcsSaysWhySynergistVaDidNotFit) {
     EXPECT_EQ(r.output.find("nan"), std::string::npos) << r.output;
 }
 
-TEST(Cli, MainJobRunsTheThesisArmAndTheElbowSubject) {
+TEST(Cli, MainJobRunsTheThesisArmAndTheTwinSubject) {
     const fs::path d = freshDir("run");
     const CommandResult r = runArmsim("run --jobs 2 --out " + d.string());
     ASSERT_EQ(r.exitCode, 0) << r.output;
     for (const char* f : {"force_length.csv", "force_length.png", "step_activation.csv", "mvc_angles.csv",
-                          "mvc_angles.png", "mvc_angles_elbow.csv", "mvc_angles_elbow.png", "model_elbow/muscles.csv",
-                          "model_elbow/moment_arms.png", "model_elbow/mvc_flexion.csv", "model_elbow/mvc_flexion.png",
+                          "mvc_angles.png", "mvc_angles_twin.csv", "mvc_angles_twin.png", "model_twin/muscles.csv",
+                          "model_twin/moment_arms.png", "model_twin/mvc_flexion.csv", "model_twin/mvc_flexion.png",
                           "protocol_mvc/summary.csv", "out_of_family_person/estimates.csv",
                           "out_of_family_person/channel_data.csv", "out_of_family_person/mass_estimates.png",
                           "out_of_family_person/fascicle_length.png", "out_of_family_person/emg.png",
@@ -273,7 +273,7 @@ TEST(Cli, MainJobRunsTheThesisArmAndTheElbowSubject) {
     // The out-of-family person: one row per method, the channels fit among them.
     EXPECT_NE(armsim::testing::readFileText(d / "out_of_family_person" / "estimates.csv").find(",channels,"),
               std::string::npos);
-    const armsim::Table t = armsim::Table::readCsv((d / "mvc_angles_elbow.csv").string());
+    const armsim::Table t = armsim::Table::readCsv((d / "mvc_angles_twin.csv").string());
     ASSERT_EQ(t.getNumRows(), 5);
     for (int i = 0; i < t.getNumRows(); ++i) {
         EXPECT_NEAR(t.get(i, "elbow_angle_deg") + t.get(i, "flexion_deg"), 180.0, 1e-12);
@@ -284,7 +284,7 @@ TEST(Cli, MainJobRunsTheThesisArmAndTheElbowSubject) {
         EXPECT_GT(t.get(i, "thesis_estimate_N"), t.get(i, "biceps_both_heads_N")) << i;
         EXPECT_NEAR(t.get(i, "biceps_both_heads_N"), t.get(i, "force_BIClong_N") + t.get(i, "force_BICshort_N"), 1e-6);
     }
-    EXPECT_NE(r.output.find("Elbow model (seven muscles)"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("Anatomical twin (ten muscles)"), std::string::npos) << r.output;
 
     // Issue 15: a second run (one thread, same folder: reports name their data files) writes the same
     // bytes, videos and stills included; the identification reports differ only in their wall time.

@@ -113,7 +113,7 @@ def test_forearm_postures_reach_python_and_feed_identify_torque(tmp_path):
     rot = np.asarray(run["data"]["rotation_deg"])
     assert len(rot) == 27 and np.isnan(rot).sum() == 15
     assert sorted(set(rot[~np.isnan(rot)])) == [-90.0, 90.0]
-    prior = "subjects/twin_population.yaml"
+    prior = "subjects/default_population.yaml"
     from_dict = armsim.identify_torque(run["data"], population=prior)
     from_file = armsim.identify_torque(str(tmp_path / "run" / "torque_data.csv"), population=prior)
     assert [e["mass"] for e in from_dict] == pytest.approx([e["mass"] for e in from_file], rel=1e-12)
