@@ -66,6 +66,7 @@ MapResult calcMapEstimate(const MapProblem& problem) {
     if (int(fixed.size()) == n) pr.SetParameterBlockConstant(result.x.data());
     else if (!fixed.empty()) pr.SetManifold(result.x.data(), new ceres::SubsetManifold(n, fixed));
     ceres::Solver::Options so;
+    so.logging_type = ceres::SILENT;   // failures are reported through the summary, not glog
     so.max_num_iterations = problem.maxIterations;
     so.function_tolerance = problem.functionTolerance;
     so.parameter_tolerance = 1e-10;

@@ -2,7 +2,7 @@
 
     PYTHONPATH=build/python python3 examples/validation_population.py --out out/examples --subjects 12
 
-Draws subjects of the seven-muscle elbow from assets/subjects/default_population.yaml (every muscle's
+Draws subjects of the anatomical twin from assets/subjects/default_population.yaml (every muscle's
 strength, lengths and fibre mix vary; voluntary activation and co-contraction vary per person),
 synthesizes the thesis's five-angle MVC torque data at 2 % transducer noise, and identifies the
 biceps long head's mass with the thesis's method and the synergist-aware identifiers. Writes

@@ -671,7 +671,7 @@ stop_reason, iterations, evaluations, wall_time [s].)");
             "noise"_a = py::none(), "activation_sd"_a = 0.02, "angles"_a = py::none(), "repetitions"_a = py::none(),
             "protocol"_a = py::none(), "free_slow_fraction"_a = false, "jobs"_a = 2,
             "truth_population"_a = py::none(), "prior"_a = py::none(),
-            R"(Validation on virtual subjects of the seven-muscle elbow (as `armsim validate --truth elbow`):
+            R"(Validation on multi-muscle virtual subjects (default: the anatomical twin; as `armsim validate --truth elbow`):
 `subjects` people drawn from the population (default assets/subjects/default_population.yaml),
 or out of family from `truth_population` with `prior` as the identifiers' prior (each defaults to
 `population`; as --truth-population and --prior),

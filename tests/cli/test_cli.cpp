@@ -238,8 +238,6 @@ TEST(Cli, ModelShowWritesTablesAndPlots) {
     EXPECT_NE(bad.output.find("angle step = 0"), std::string::npos) << bad.output;
 }
 
-// armsim run on built-in defaults: the thesis arm where it reproduces the thesis, the seven-muscle
-// elbow as the virtual subject (issue 10), every result file written.
 // A protocol without maximal efforts leaves synergist-va without its twitch-interpolation measurement:
 // the validation says so instead of printing NaN summaries.
 TEST(Cli, ValidationWithoutMvcsSaysWhySynergistVaDidNotFit) {
@@ -255,6 +253,8 @@ TEST(Cli, ValidationWithoutMvcsSaysWhySynergistVaDidNotFit) {
     EXPECT_EQ(r.output.find("nan"), std::string::npos) << r.output;
 }
 
+// armsim run on built-in defaults: the thesis arm where it reproduces the thesis, the anatomical
+// twin as the virtual subject, every result file written.
 TEST(Cli, MainJobRunsTheThesisArmAndTheTwinSubject) {
     const fs::path d = freshDir("run");
     const CommandResult r = runArmsim("run --jobs 2 --out " + d.string());
