@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <map>
 #include <sstream>
 
 namespace armsim {
@@ -27,8 +28,9 @@ namespace {
 constexpr int kMaxDepth = 64;              ///< nesting of mappings and lists (parameter files use a handful)
 constexpr long kMaxValues = 1000000;       ///< values with aliases expanded (a few thousand in a protocol)
 
-// Every mapping key is a plain scalar (the readers compare keys as strings); nesting and the document
-// as aliases expand it are bounded (`&a [..]`, `&b [*a, *a, ..]`, ... grows exponentially).
+// Every mapping key is a plain scalar (the readers compare keys as strings) and appears once in its
+// mapping (YAML forbids repeats; yaml-cpp would keep the first silently); nesting and the document as
+// aliases expand it are bounded (`&a [..]`, `&b [*a, *a, ..]`, ... grows exponentially).
 void checkKeysAndSize(const YAML::Node& n, const std::string& source, int depth, long& values) {
     auto where = [&](const YAML::Node& at) { return source + ":" + std::to_string(at.Mark().line + 1); };
     if (depth > kMaxDepth)
@@ -38,12 +40,17 @@ void checkKeysAndSize(const YAML::Node& n, const std::string& source, int depth,
         throw InputError(where(n) + ": more than " + std::to_string(kMaxValues) +
                          " values (with aliases expanded): expected a parameter file");
     if (n.IsMap()) {
+        std::map<std::string, int> seen;   // key -> line of its first appearance
         for (auto it = n.begin(); it != n.end(); ++it) {
             if (it->first.IsNull())
                 throw InputError(where(it->first) + ": an empty key ('~', 'null' or a bare '?'): expected a name");
             if (!it->first.IsScalar())
                 throw InputError(where(it->first) +
                                  ": a key that is a list or mapping ('? ...' or '[...]: ...'): expected a name");
+            const auto [first, isNew] = seen.emplace(it->first.Scalar(), it->first.Mark().line + 1);
+            if (!isNew)
+                throw InputError(where(it->first) + ": key '" + it->first.Scalar() + "' appears again (first at line " +
+                                 std::to_string(first->second) + "): expected each key once per mapping");
             checkKeysAndSize(it->second, source, depth + 1, values);
         }
     } else if (n.IsSequence()) {

@@ -14,6 +14,14 @@ namespace armsim {
 
 Table::Table(std::vector<std::string> columnNames) : names_(std::move(columnNames)) {}
 
+void checkUniqueColumnNames(const std::vector<std::string>& names, const std::string& where) {
+    for (std::size_t i = 0; i < names.size(); ++i)
+        for (std::size_t j = 0; j < i; ++j)
+            if (names[i] == names[j])
+                throw InputError(where + ": column '" + names[i] + "' appears twice in the header (columns " +
+                                 std::to_string(j + 1) + " and " + std::to_string(i + 1) + "): expected each name once");
+}
+
 int Table::findColumn(const std::string& name) const {
     for (int i = 0; i < getNumColumns(); ++i)
         if (names_[i] == name) return i;
@@ -114,6 +122,7 @@ Table Table::readCsv(const std::string& path) {
             continue;
         const std::vector<std::string> cells = split(line);
         if (header) {
+            checkUniqueColumnNames(cells, path + ":" + std::to_string(lineNo));
             t.names_ = cells;
             header = false;
             continue;

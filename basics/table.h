@@ -6,6 +6,10 @@
 
 namespace armsim {
 
+/// Throws InputError "<where>: column 'x' appears twice in the header (columns i and j)" when a name
+/// repeats (a reader would silently take one of them).
+void checkUniqueColumnNames(const std::vector<std::string>& names, const std::string& where);
+
 /// Named columns of doubles, one row per sample. Column names carry their unit as a suffix
 /// ("time_s", "force_N", "activation"), so a CSV header is self-describing.
 class Table {
@@ -42,7 +46,8 @@ public:
     /// Writes toCsv() to path atomically (temporary + rename).
     void writeCsv(const std::string& path, int digits = 10) const;
     /// Reads a CSV file with a header line and numeric cells (empty lines and lines starting with
-    /// '#' are skipped). Throws InputError naming file, line and column for a malformed cell.
+    /// '#' are skipped). Throws InputError naming file, line and column for a malformed cell or a
+    /// column name the header repeats.
     static Table readCsv(const std::string& path);
     /// Line in the source file of data row i (1-based), for messages; 0 when not read from a file.
     int getSourceLine(int row) const { return row < int(lines_.size()) ? lines_[row] : 0; }

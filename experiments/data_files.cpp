@@ -76,6 +76,7 @@ Table readStorage(const std::string& path, StorageHeader* header) {
     }
     if (names.front() != "time")
         throw InputError(at() + ": first column label is '" + names.front() + "': expected 'time'");
+    checkUniqueColumnNames(names, at());
     if (long(names.size()) != nColumns)
         throw InputError(at() + ": " + std::to_string(names.size()) + " column labels, header says nColumns=" +
                          std::to_string(nColumns));

@@ -95,6 +95,20 @@ TEST(ParamNode, KeysThatAreListsOrMappingsAreRefusedWithTheirLine) {
     EXPECT_TRUE(has(messageOf([] { ParamNode::loadString("a: 1\n~: 2\n", "n.yaml"); }), "n.yaml:2: an empty key"));
 }
 
+// A key given twice in one mapping (yaml-cpp would keep the first silently: a second `seed: -1` was never
+// checked) is refused with both lines, at the top level, nested and in a flow mapping; the same key in
+// two different mappings is fine.
+TEST(ParamNode, RepeatedKeysAreRefusedWithBothLines) {
+    const std::string top = messageOf([] { ParamNode::loadString("seed: 1\nname: x\nseed: -1\n", "s.yaml"); });
+    EXPECT_TRUE(has(top, "s.yaml:3: key 'seed' appears again (first at line 1)")) << top;
+    const std::string nested = messageOf([] {
+        ParamNode::loadString("muscles:\n  - name: A\n    calibration: {a: 1}\n    calibration: {a: 2}\n", "m.yaml");
+    });
+    EXPECT_TRUE(has(nested, "m.yaml:4: key 'calibration' appears again (first at line 3)")) << nested;
+    EXPECT_TRUE(has(messageOf([] { ParamNode::loadString("t: {min: 1, min: 2}\n", "f.yaml"); }), "key 'min' appears again"));
+    EXPECT_NO_THROW(ParamNode::loadString("a: {min: 1}\nb: {min: 2}\nc: [{x: 1}, {x: 2}]\n", "ok.yaml"));
+}
+
 // Aliases can expand a short file exponentially, and nesting can be arbitrarily deep: both are refused
 // when the file is loaded, before any reader walks it.
 TEST(ParamNode, ExponentialAliasesAndDeepNestingAreRefused) {

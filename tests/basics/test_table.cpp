@@ -55,5 +55,14 @@ TEST(Table, MalformedCellNamesFileLineAndColumn) {
     }
     std::ofstream(p) << "a,b\n1,2,3\n";
     EXPECT_THROW(Table::readCsv(p.string()), InputError);
+    // A repeated column name (a reader would take one of the two silently) is refused with both columns.
+    std::ofstream(p) << "# data\nangle_deg,torque_Nm,angle_deg\n90,40,30\n";
+    try {
+        Table::readCsv(p.string());
+        ADD_FAILURE() << "repeated column accepted";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find(p.string() + ":2: column 'angle_deg' appears twice in the header (columns 1 and 3)"),
+                  std::string::npos) << e.what();
+    }
     fs::remove(p);
 }
