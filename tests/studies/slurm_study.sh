@@ -1,0 +1,98 @@
+#!/usr/bin/env bash
+# ctest (label slurm): submits the docs' batch script, scripts/slurm/study.sbatch, verbatim to a
+# one-node Slurm cluster (scripts/slurm-local.sh; started here unless it runs, and then stopped) with a
+# small study, and checks the job's files byte-identical to `armsim study` run directly on threads.
+#   slurm_study.sh submit  SOURCE_DIR ARMSIM WORK_DIR   the job runs to the end (2 MPI ranks under srun)
+#   slurm_study.sh requeue SOURCE_DIR ARMSIM WORK_DIR   the job is paused mid-study, requeued
+#                                                       (`scontrol requeue`) and resumes from the journal
+# Exit 77 (ctest SKIP_RETURN_CODE) with the reason when Slurm or munge is not installed.
+set -euo pipefail
+mode=$1 src=$2 armsim=$3 work=$4
+study=$src/tests/studies/slurm_study.yaml
+tasks=16  # slurm_study.yaml: 8 subjects x 1 protocol x 1 noise level x 2 methods
+
+for b in munged slurmctld slurmd sbatch squeue scontrol; do
+    if ! command -v "$b" > /dev/null && [ ! -x "/usr/sbin/$b" ]; then
+        echo "SKIP: $b is not installed (bash scripts/setup.sh --tests installs slurm-wlm and munge)"
+        exit 77
+    fi
+done
+fail() { echo "FAIL: $*" >&2; exit 1; }
+
+rm -rf "$work"
+mkdir -p "$work"
+cd "$work"  # the job's working directory: its log lands here
+
+cluster=$src/scripts/slurm-local.sh
+started=0
+job=
+cleanup() {
+    [ -n "$job" ] && scancel "$job" 2> /dev/null || true
+    if [ $started -eq 1 ]; then bash "$cluster" stop || true; fi
+}
+trap cleanup EXIT
+if ! bash "$cluster" status > /dev/null; then
+    bash "$cluster" start
+    started=1
+fi
+eval "$(bash "$cluster" env)"
+
+# The reference: the same study on two threads, no Slurm.
+"$armsim" study "$study" --threads 2 --quiet --out "$work/threads" > threads.log 2>&1 || { cat threads.log; fail "threaded run"; }
+
+# Two ranks of one CPU each on the local node (the script's #SBATCH sizes are a real cluster's).
+job=$(ARMSIM_STUDY=$study ARMSIM_OUT=$work/slurm ARMSIM=$armsim \
+      sbatch --parsable --nodes=1 --ntasks=2 --ntasks-per-node=2 --cpus-per-task=1 --time=10:00 \
+      "$src/scripts/slurm/study.sbatch")
+echo "submitted job $job ($mode)"
+log=$work/armsim-study-$job.log
+
+job_state() { scontrol show job "$job" 2> /dev/null | sed -n 's/.*JobState=\([A-Z_]*\).*/\1/p'; }
+wait_for() {  # wait_for SECONDS WHAT COMMAND...: polls every 0.1 s
+    local seconds=$1 what=$2
+    shift 2
+    for _ in $(seq 1 $((seconds * 10))); do
+        "$@" && return 0
+        sleep 0.1
+    done
+    echo "--- job: $(scontrol show job "$job" 2>&1 | tr '\n' ' ')"
+    [ -f "$log" ] && cat "$log"
+    fail "$what: not after $seconds s"
+}
+journal_results() { echo $(($(cat "$work/slurm/journal.log" 2> /dev/null | wc -l) - 1)); }
+
+if [ "$mode" = requeue ]; then
+    # Pause the job once a group is journaled (SIGSTOP to its ranks: the test does not race the
+    # study's end), then requeue it as a preemption would.
+    wait_for 120 "a result in the job's journal" test "$(journal_results)" -ge 2
+    scontrol suspend "$job"
+    before=$(journal_results)
+    [ "$before" -lt $tasks ] || fail "the job finished before it was paused ($before results)"
+    scontrol requeue "$job"
+    # A requeued suspended job is held, and Slurm delays any requeued job by two minutes: release it
+    # and let it start now.
+    wait_for 60 "the requeued job pending" test "$(job_state)" = PENDING
+    scontrol release "$job"
+    scontrol update jobid="$job" starttime=now
+    echo "requeued job $job after $before of $tasks results"
+fi
+
+wait_for 300 "job $job finished" test "$(job_state)" = COMPLETED -o "$(job_state)" = FAILED -o \
+         "$(job_state)" = CANCELLED -o "$(job_state)" = TIMEOUT
+state=$(job_state)
+cat "$log"
+[ "$state" = COMPLETED ] || fail "job $job ended $state"
+grep -q "on 2 ranks x 1 thread" "$log" || fail "the job did not run 2 MPI ranks under srun"
+
+if [ "$mode" = requeue ]; then
+    grep -q "run 2," "$log" || fail "the job did not run a second time"
+    resumed=$(sed -n 's/.*, \([0-9]*\) resumed from the journal.*/\1/p' "$log" | tail -1)
+    [ -n "$resumed" ] && [ "$resumed" -ge "$before" ] && [ "$resumed" -lt $tasks ] ||
+        fail "the requeued run resumed '$resumed' results (journal held $before of $tasks)"
+    echo "the requeued run resumed $resumed of $tasks results"
+fi
+
+for f in results.csv summary.csv study.yaml; do
+    cmp "$work/threads/$f" "$work/slurm/$f" || fail "$f differs from the threaded run's"
+done
+echo "PASS: $mode: results.csv, summary.csv and study.yaml byte-identical to the threaded run"
