@@ -47,6 +47,11 @@ void runStudyCommand(const StudyOptions& o) {
     run.threads = o.threads;
     run.restart = o.restart;
     if (!isQuiet()) run.progress = printStudyProgress;
+    run.notice = [](const std::string& text) {  // a repaired journal, also under --quiet
+        std::fflush(stdout);
+        std::fprintf(stderr, "warning: %s\n", text.c_str());
+        std::fflush(stderr);
+    };
 
     std::optional<std::pair<Study, StudyOutcome>> done;
     if (isLaunchedByMpi()) {
@@ -67,6 +72,7 @@ void runStudyCommand(const StudyOptions& o) {
         std::printf("  task time %.1f s (synthesis %.0f %%, identification %.0f %%); %.2f tasks/s\n", r.taskTime,
                     100 * r.synthesisTime / r.taskTime, 100 * (1 - r.synthesisTime / r.taskTime),
                     double(r.computed) / r.wallTime);
+    if (!r.journalSummary.empty()) std::printf("  %s (every line in journal_repairs.log)\n", r.journalSummary.c_str());
     if (r.failed + r.notConverged > 0)
         std::printf("  %ld failed, %ld not converged: their reasons are in results.csv (status, reason)\n", r.failed,
                     r.notConverged);
@@ -82,9 +88,10 @@ void addStudyCommand(CLI::App& app) {
                  "`mpirun -n K armsim study` spreads it over MPI ranks); resumes after an interruption");
     c->add_option("study", o->file, "study file (kind: study)")->required();
     c->add_option("--out", o->out, "output folder (default: the study's `output`)");
-    c->add_option("--threads", o->threads, "worker threads per process (default: all cores, shared by the ranks "
-                                           "of a node under mpirun)")
-        ->check(CLI::Range(1, 1024));
+    c->add_option("--threads", o->threads, "worker threads per process (default: the CPUs it may use, its "
+                                           "affinity mask as set by taskset or Slurm; shared by the ranks of a "
+                                           "node under MPI when they all see the whole node)")
+        ->check(CLI::Range(1, kMaxStudyThreads));
     c->add_flag("--restart", o->restart, "discard the output folder's journal and compute every task again");
     c->callback([o] { runStudyCommand(*o); });
 }

@@ -366,6 +366,103 @@ bool parseStudyJournalLine(const std::string& line, StudyResult& r) {
     return r.status == "ok" || r.status == "not-converged" || r.status == "failed" || r.status == "skipped";
 }
 
+StudyJournal parseStudyJournal(const std::string& text, long numTasks, long firstLine) {
+    StudyJournal j;
+    std::map<long, long> lineOf;  // task -> the line that gave it
+    std::size_t begin = 0;
+    for (long number = firstLine; begin < text.size(); ++number) {
+        const std::size_t end = text.find('\n', begin);
+        const bool hasEnd = end != std::string::npos;
+        const std::string raw = text.substr(begin, (hasEnd ? end : text.size()) - begin);
+        begin = hasEnd ? end + 1 : text.size();
+        std::string line = raw;
+        while (!line.empty() && (line.back() == '\r' || line.back() == ' ' || line.back() == '\t' || line.back() == '\0'))
+            line.pop_back();  // CRLF (an editor, a Windows copy), trailing blanks, a NUL-filled tail
+        StudyJournalDrop drop;
+        drop.line = number;
+        if (line.empty()) {
+            drop.kind = "blank";
+            drop.detail = raw.find('\0') != std::string::npos ? "only NUL bytes (a write the file system never finished)"
+                                                              : "a blank line";
+            j.dropped.push_back(drop);
+            continue;
+        }
+        long task = -1;  // what the line says, trusted only when its checksum holds
+        if (line.size() > 17 && line[16] == ' ') {
+            const std::size_t comma = line.find(',', 17);
+            if (!parseLong(line.substr(17, comma == std::string::npos ? std::string::npos : comma - 17), task)) task = -1;
+        }
+        drop.task = task;
+        StudyResult r;
+        if (parseStudyJournalLine(line, r)) {
+            drop.task = r.task;
+            if (r.task < 0 || r.task >= numTasks) {
+                drop.kind = "out of range";
+                drop.detail = "task " + std::to_string(r.task) + " is outside the study's 0.." + std::to_string(numTasks - 1);
+            } else if (lineOf.count(r.task)) {
+                drop.kind = "duplicate";
+                drop.detail = "task " + std::to_string(r.task) + " is also line " + std::to_string(lineOf[r.task]) +
+                              " (that one is kept)";
+            } else {
+                lineOf[r.task] = number;
+                j.results.emplace(r.task, std::move(r));
+                j.lines.push_back(line);
+                continue;
+            }
+        } else if (!hasEnd) {
+            drop.kind = "torn";
+            drop.detail = "the last line has no line end and fails its checksum (a run stopped while writing it)";
+        } else if (line.size() > 17 && line[16] == ' ' && line.find_first_not_of("0123456789abcdef") == 16) {
+            drop.kind = "damaged";
+            drop.detail = "its checksum does not match its text (altered or partly overwritten)";
+        } else {
+            drop.kind = "unreadable";
+            drop.detail = "not a journal line (expected a 16-hex-digit checksum, a space and a result)";
+        }
+        j.dropped.push_back(drop);
+    }
+    return j;
+}
+
+std::string summarizeStudyJournalDrops(const std::vector<StudyJournalDrop>& dropped, const StudyJournal* journal) {
+    if (dropped.empty()) return "";
+    std::map<std::string, int> byKind;
+    std::vector<long> cells;
+    long unnamed = 0;
+    for (const StudyJournalDrop& d : dropped) {
+        ++byKind[d.kind];
+        if (d.kind == "duplicate" || d.kind == "out of range" || d.kind == "blank") continue;
+        if (d.task < 0) {
+            ++unnamed;
+        } else if (!(journal && journal->results.count(d.task)) &&
+                   std::find(cells.begin(), cells.end(), d.task) == cells.end()) {
+            cells.push_back(d.task);
+        }
+    }
+    std::string kinds;
+    for (const auto& [kind, n] : byKind) kinds += (kinds.empty() ? "" : ", ") + std::to_string(n) + ' ' + kind;
+    std::string text = "journal.log: " + std::to_string(dropped.size()) + " line" + (dropped.size() == 1 ? "" : "s") +
+                       " dropped (" + kinds + ")";
+    std::sort(cells.begin(), cells.end());
+    if (!cells.empty()) {
+        text += "; computed again: task" + std::string(cells.size() == 1 ? " " : "s ");
+        for (std::size_t i = 0; i < cells.size() && i < 20; ++i) text += (i ? ", " : "") + std::to_string(cells[i]);
+        if (cells.size() > 20) text += " and " + std::to_string(cells.size() - 20) + " more";
+    }
+    if (unnamed > 0)
+        text += "; " + std::to_string(unnamed) + " line" + (unnamed == 1 ? "" : "s") +
+                " named no readable task (any cell it held is computed again)";
+    return text;
+}
+
+std::string formatStudyJournalDrops(const std::vector<StudyJournalDrop>& dropped) {
+    std::string text;
+    for (const StudyJournalDrop& d : dropped)
+        text += "line " + std::to_string(d.line) + (d.task >= 0 ? " (task " + std::to_string(d.task) + ")" : "") + ": " +
+                d.kind + ": " + d.detail + '\n';
+    return text;
+}
+
 std::vector<StudySummaryRow> summarizeStudy(const Study& study, const std::vector<StudyResult>& results) {
     std::vector<StudySummaryRow> out;
     for (const StudyProtocol& p : study.protocols) {

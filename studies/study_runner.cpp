@@ -1,17 +1,21 @@
 // The study's machinery: the output folder (lock, journal, final files), the worker threads of one
 // process, the coordinator (rank 0) and the worker-rank loop. The numbers come from runStudyGroup.
+#include "basics/bound.h"
 #include "basics/errors.h"
 #include "basics/files.h"
 #include "basics/format.h"
+#include "basics/parallel.h"
 #include "basics/plot.h"
 #include "studies/study.h"
 
 #include <algorithm>
 #include <chrono>
+#include <cerrno>
 #include <cmath>
 #include <condition_variable>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <deque>
 #include <exception>
 #include <filesystem>
@@ -178,34 +182,50 @@ public:
             throw InputError("study output '" + dir_ + "': cannot create the folder" + (ec ? ": " + ec.message() : ""));
         lock_.fd = ::open((dir_ + "/.lock").c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
         if (lock_.fd < 0) throw InputError("study output '" + dir_ + "': cannot write in the folder");
-        if (::flock(lock_.fd, LOCK_EX | LOCK_NB) != 0)
-            throw InputError("study output '" + dir_ + "': another armsim study is running in this folder");
+        if (::flock(lock_.fd, LOCK_EX | LOCK_NB) != 0) {
+            if (errno == EWOULDBLOCK)
+                throw InputError("study output '" + dir_ + "': another armsim study is running in this folder");
+            throw InputError("study output '" + dir_ + "': cannot lock " + dir_ + "/.lock (" + std::strerror(errno) +
+                             "): the file system does not support flock (Lustre: mount with -o flock); use an "
+                             "output folder on another file system");
+        }
         journalPath_ = dir_ + "/journal.log";
         const std::string header = "# armsim study journal; fingerprint " + fingerprint + "; study " + study.name;
         std::string kept = header + '\n';
         if (doesPathExist(journalPath_) && !restart) {
-            std::ifstream in(journalPath_, std::ios::binary);
-            std::string first, line;
-            std::getline(in, first);
+            const std::string text = readFileText(journalPath_);
+            const std::size_t end = std::min(text.find('\n'), text.size());
+            const std::string first = text.substr(0, end);
             if (first.rfind("# armsim study journal", 0) != 0 || first.find(fingerprint) == std::string::npos)
                 throw InputError("study output '" + dir_ + "': journal.log holds results of another study or of a " +
                                  "changed study file, protocol or population (fingerprint " + fingerprint +
                                  " expected); use another output folder or --restart to discard them");
-            while (std::getline(in, line)) {
-                StudyResult r;
-                if (in.eof() || !parseStudyJournalLine(line, r) || r.task < 0 || r.task >= study.getNumTasks()) {
-                    ++dropped_;  // a torn last line (no newline) or a damaged one: recomputed
-                    continue;
-                }
-                if (done_.emplace(r.task, r).second) kept += line + '\n';
-            }
+            StudyJournal journal = parseStudyJournal(text.substr(std::min(end + 1, text.size())), study.getNumTasks());
+            for (const std::string& line : journal.lines) kept += line + '\n';
+            summary_ = summarizeStudyJournalDrops(journal.dropped, &journal);
+            done_ = std::move(journal.results);
+            dropped_ = std::move(journal.dropped);
+        } else if (restart) {
+            std::remove((dir_ + "/journal_repairs.log").c_str());  // the repairs of a discarded journal
         }
         writeFileAtomically(journalPath_, kept);  // compacted: valid lines only, so appends start on a clean line
         journal_.reset(std::fopen(journalPath_.c_str(), "ab"));
         if (!journal_) throw InputError("study output '" + dir_ + "': cannot append to journal.log");
     }
     const std::map<long, StudyResult>& getDone() const { return done_; }
-    int getDropped() const { return dropped_; }
+    const std::vector<StudyJournalDrop>& getDropped() const { return dropped_; }
+    const std::string& getDroppedSummary() const { return summary_; }
+    // Appends what the journal dropped to journal_repairs.log (one write), so the repair stays on record
+    // after the compacted journal no longer shows it.
+    void recordRepairs() const {
+        if (dropped_.empty()) return;
+        const std::string text = "# journal.log read at the start of a run\n" + summary_ + '\n' +
+                                 formatStudyJournalDrops(dropped_);
+        std::unique_ptr<std::FILE, int (*)(std::FILE*)> f(std::fopen((dir_ + "/journal_repairs.log").c_str(), "ab"),
+                                                            std::fclose);
+        if (!f || std::fwrite(text.data(), 1, text.size(), f.get()) != text.size() || std::fflush(f.get()) != 0)
+            throw InputError("study output '" + dir_ + "': cannot append to journal_repairs.log");
+    }
     // Journals results (one write and flush: a kill leaves at most one torn line).
     void append(const std::vector<StudyResult>& results) {
         std::string text;
@@ -228,7 +248,8 @@ private:
     Lock lock_;
     std::unique_ptr<std::FILE, int (*)(std::FILE*)> journal_{nullptr, std::fclose};
     std::map<long, StudyResult> done_;
-    int dropped_ = 0;
+    std::vector<StudyJournalDrop> dropped_;
+    std::string summary_;
 };
 
 // Per (protocol, method): a statistic of the summary against the noise level.
@@ -296,18 +317,26 @@ std::vector<std::string> writeStudyFiles(const Study& study, const std::string& 
     return files;
 }
 
-int defaultThreads() { return std::max(1u, std::thread::hardware_concurrency()); }
+int defaultThreads() { return getNumUsableCpus(); }
 
 }  // namespace
 
 StudyOutcome runStudy(const Study& study, const StudyRunOptions& options, StudyCoordinatorLink* link) {
     study.validate();
+    checkField("threads", options.threads, Bound::closed(0, kMaxStudyThreads, "0: every CPU this process may use"));
     const auto start = Clock::now();
     StudyOutcome outcome;
     outcome.output = options.output.empty() ? study.output : options.output;
     if (outcome.output.empty()) throw InputError("study: no output folder (set `output:` or --out)");
     const std::string fingerprint = calcStudyFingerprint(study);
     StudyFolder folder(outcome.output, fingerprint, study, options.restart);
+    outcome.journalDrops = folder.getDropped();
+    outcome.journalSummary = folder.getDroppedSummary();
+    if (!outcome.journalDrops.empty()) {
+        folder.recordRepairs();
+        if (options.notice)
+            options.notice(outcome.journalSummary + " (every line in " + outcome.output + "/journal_repairs.log)");
+    }
 
     // Missing cells, grouped, in task order.
     std::deque<GroupWork> pending;
@@ -392,6 +421,7 @@ StudyOutcome runStudy(const Study& study, const StudyRunOptions& options, StudyC
     report();
 
     outcome.files = writeStudyFiles(study, outcome.output, folder.getDone());
+    if (doesPathExist(outcome.output + "/journal_repairs.log")) outcome.files.push_back("journal_repairs.log");
     for (const auto& [task, r] : folder.getDone()) {
         outcome.failed += r.status == "failed";
         outcome.notConverged += r.status == "not-converged";

@@ -48,7 +48,7 @@ echo "submitted job $job ($mode)"
 log=$work/armsim-study-$job.log
 
 job_state() { scontrol show job "$job" 2> /dev/null | sed -n 's/.*JobState=\([A-Z_]*\).*/\1/p'; }
-wait_for() {  # wait_for SECONDS WHAT COMMAND...: polls every 0.1 s
+wait_for() {  # wait_for SECONDS WHAT PREDICATE: polls every 0.1 s
     local seconds=$1 what=$2
     shift 2
     for _ in $(seq 1 $((seconds * 10))); do
@@ -60,25 +60,27 @@ wait_for() {  # wait_for SECONDS WHAT COMMAND...: polls every 0.1 s
     fail "$what: not after $seconds s"
 }
 journal_results() { echo $(($(cat "$work/slurm/journal.log" 2> /dev/null | wc -l) - 1)); }
+has_a_group() { [ "$(journal_results)" -ge 2 ]; }
+is_pending() { [ "$(job_state)" = PENDING ]; }
+has_ended() { case "$(job_state)" in COMPLETED | FAILED | CANCELLED | TIMEOUT | NODE_FAIL | OUT_OF_MEMORY) return 0 ;; esac; return 1; }
 
 if [ "$mode" = requeue ]; then
     # Pause the job once a group is journaled (SIGSTOP to its ranks: the test does not race the
     # study's end), then requeue it as a preemption would.
-    wait_for 120 "a result in the job's journal" test "$(journal_results)" -ge 2
-    scontrol suspend "$job"
+    wait_for 120 "a group in the job's journal" has_a_group
+    scontrol suspend "$job" || fail "job $job could not be paused (state $(job_state))"
     before=$(journal_results)
     [ "$before" -lt $tasks ] || fail "the job finished before it was paused ($before results)"
     scontrol requeue "$job"
     # A requeued suspended job is held, and Slurm delays any requeued job by two minutes: release it
     # and let it start now.
-    wait_for 60 "the requeued job pending" test "$(job_state)" = PENDING
+    wait_for 60 "the requeued job pending" is_pending
     scontrol release "$job"
     scontrol update jobid="$job" starttime=now
     echo "requeued job $job after $before of $tasks results"
 fi
 
-wait_for 300 "job $job finished" test "$(job_state)" = COMPLETED -o "$(job_state)" = FAILED -o \
-         "$(job_state)" = CANCELLED -o "$(job_state)" = TIMEOUT
+wait_for 300 "job $job finished" has_ended
 state=$(job_state)
 cat "$log"
 [ "$state" = COMPLETED ] || fail "job $job ended $state"
@@ -92,7 +94,10 @@ if [ "$mode" = requeue ]; then
     echo "the requeued run resumed $resumed of $tasks results"
 fi
 
-for f in results.csv summary.csv study.yaml; do
+files=(results.csv summary.csv study.yaml)
+for f in "$work"/threads/*.png; do files+=("$(basename "$f")"); done
+[ ${#files[@]} -gt 3 ] || fail "the threaded run wrote no plot"
+for f in "${files[@]}"; do
     cmp "$work/threads/$f" "$work/slurm/$f" || fail "$f differs from the threaded run's"
 done
-echo "PASS: $mode: results.csv, summary.csv and study.yaml byte-identical to the threaded run"
+echo "PASS: $mode: ${files[*]} byte-identical to the threaded run"

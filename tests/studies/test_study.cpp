@@ -1,6 +1,7 @@
 // Population studies (issue 13): task numbering, the journal line format, a study cell against the
 // validation's own computation (a second path to the same numbers), failures recorded, resume from a
-// partial and torn journal, thread-count independence, and bad study files.
+// partial and torn journal, hand-damaged journals (CRLF, garbage, altered and duplicate lines: every
+// dropped line reported, issue 33), thread-count independence, and bad study files.
 #include "basics/errors.h"
 #include "basics/files.h"
 #include "studies/study.h"
@@ -312,3 +313,139 @@ TEST(Study, TruthAndPriorInAStudyFileAreTheOutOfFamilyValidation) {
     fs::remove_all(dir);
 }
 
+
+namespace {
+
+// A journal line of task `task` without computing it (the parser only needs a well-formed result).
+std::string makeJournalLine(long task) {
+    StudyResult r;
+    r.task = task;
+    r.protocol = "thesis";
+    r.status = "ok";
+    r.row.subject = int(task);
+    r.row.method = r.row.estimate.method = "thesis";
+    r.row.noise = 0.02;
+    r.row.estimate.mass = 0.1 + 0.01 * double(task);
+    return formatStudyJournalLine(r);
+}
+
+std::string kindsOf(const StudyJournal& j) {
+    std::string out;
+    for (const StudyJournalDrop& d : j.dropped) out += std::to_string(d.line) + ":" + std::to_string(d.task) + ":" + d.kind + " ";
+    return out;
+}
+
+}  // namespace
+
+TEST(StudyJournal, CrlfLineEndsAndTrailingBlanksLoseNothing) {
+    const std::string a = makeJournalLine(0), b = makeJournalLine(1), c = makeJournalLine(2);
+    const StudyJournal crlf = parseStudyJournal(a + "\r\n" + b + "\r\n" + c + "\r\n", 3);
+    EXPECT_EQ(crlf.results.size(), 3u);
+    EXPECT_TRUE(crlf.dropped.empty()) << kindsOf(crlf);
+    EXPECT_EQ(crlf.lines, (std::vector<std::string>{a, b, c}));  // kept without the CR
+    const StudyJournal blanks = parseStudyJournal(a + "  \t\n" + b + "\n" + c, 3);  // last line whole, no line end
+    EXPECT_EQ(blanks.results.size(), 3u);
+    EXPECT_TRUE(blanks.dropped.empty()) << kindsOf(blanks);
+    EXPECT_EQ(summarizeStudyJournalDrops(blanks.dropped), "");
+}
+
+TEST(StudyJournal, EveryDroppedLineIsListedWithItsCellAndWhy) {
+    const std::string a = makeJournalLine(0), b = makeJournalLine(1), c = makeJournalLine(2), d = makeJournalLine(3);
+    std::string altered = b;
+    altered[altered.size() / 2] = altered[altered.size() / 2] == '1' ? '2' : '1';
+    const std::string text = a + "\n" +                         // line 2: kept
+                             altered + "\n" +                   // 3: damaged, task 1
+                             "\n" +                             // 4: blank
+                             a + "\n" +                         // 5: duplicate of line 2
+                             makeJournalLine(99) + "\n" +       // 6: out of range
+                             "rm -rf / # not a journal line\n" + // 7: unreadable
+                             c + "\n" +                         // 8: kept
+                             std::string(5, '\0') + "\n" +      // 9: a NUL-filled tail
+                             d.substr(0, 40);                   // 10: torn, task 3
+    const StudyJournal j = parseStudyJournal(text, 10);
+    EXPECT_EQ(j.results.size(), 2u);
+    EXPECT_EQ(j.lines, (std::vector<std::string>{a, c}));
+    EXPECT_EQ(kindsOf(j), "3:1:damaged 4:-1:blank 5:0:duplicate 6:99:out of range 7:-1:unreadable 9:-1:blank "
+                          "10:3:torn ");
+    const std::string summary = summarizeStudyJournalDrops(j.dropped, &j);
+    EXPECT_NE(summary.find("7 lines dropped (2 blank, 1 damaged, 1 duplicate, 1 out of range, 1 torn, 1 unreadable)"),
+              std::string::npos) << summary;
+    EXPECT_NE(summary.find("computed again: tasks 1, 3"), std::string::npos) << summary;
+    EXPECT_NE(summary.find("1 line named no readable task"), std::string::npos) << summary;
+    const std::string details = formatStudyJournalDrops(j.dropped);
+    EXPECT_NE(details.find("line 3 (task 1): damaged: its checksum does not match"), std::string::npos) << details;
+    EXPECT_NE(details.find("line 5 (task 0): duplicate: task 0 is also line 2"), std::string::npos) << details;
+    EXPECT_NE(details.find("line 9: blank: only NUL bytes"), std::string::npos) << details;
+    EXPECT_NE(details.find("line 10 (task 3): torn"), std::string::npos) << details;
+}
+
+// A journal converted to CRLF and damaged by hand: the run keeps every intact cell, recomputes the
+// damaged ones, says which (notice, outcome, journal_repairs.log) and writes the uninterrupted files.
+TEST(StudyJournal, AHandDamagedJournalIsRepairedVisiblyAndEndsWithTheUninterruptedFiles) {
+    const fs::path full = freshDir("journal_full"), damaged = freshDir("journal_damaged");
+    Study s = smallStudy();
+    s.protocols.resize(1);
+    s.noiseLevels.resize(1);
+    s.methods.resize(1);  // 3 subjects x thesis x 1 % x thesis: 3 cells
+    StudyRunOptions o;
+    o.output = full.string();
+    o.threads = 2;
+    const StudyOutcome first = runStudy(s, o);
+    ASSERT_EQ(first.total, 3);
+    EXPECT_TRUE(first.journalDrops.empty());
+    EXPECT_FALSE(fs::exists(full / "journal_repairs.log"));
+
+    std::istringstream in(readText(full / "journal.log"));
+    std::string header, line;
+    std::getline(in, header);
+    std::vector<std::string> lines;
+    while (std::getline(in, line)) lines.push_back(line);
+    ASSERT_EQ(lines.size(), 3u);
+    std::sort(lines.begin(), lines.end(), [](const std::string& x, const std::string& y) {
+        return std::stol(x.substr(17)) < std::stol(y.substr(17));  // by task
+    });
+    lines[1][lines[1].size() / 2] = lines[1][lines[1].size() / 2] == '1' ? '2' : '1';  // task 1 altered
+    std::ofstream(damaged / "journal.log", std::ios::binary)
+        << header << "\r\n" << lines[0] << "\r\n" << lines[1] << "\r\n" << lines[2] << "\r\n" << "garbage\x01\x02\r\n";
+
+    std::vector<std::string> notices;
+    o.output = damaged.string();
+    o.notice = [&](const std::string& text) { notices.push_back(text); };
+    const StudyOutcome repaired = runStudy(s, o);
+    EXPECT_EQ(repaired.resumed, 2);   // tasks 0 and 2 survive the CRLF
+    EXPECT_EQ(repaired.computed, 1);  // task 1 again
+    ASSERT_EQ(repaired.journalDrops.size(), 2u);
+    EXPECT_EQ(repaired.journalDrops[0].kind, "damaged");
+    EXPECT_EQ(repaired.journalDrops[0].task, 1);
+    EXPECT_EQ(repaired.journalDrops[0].line, 3);
+    EXPECT_EQ(repaired.journalDrops[1].kind, "unreadable");
+    ASSERT_EQ(notices.size(), 1u);
+    EXPECT_NE(notices[0].find("2 lines dropped (1 damaged, 1 unreadable); computed again: task 1"), std::string::npos)
+        << notices[0];
+    const std::string record = readText(damaged / "journal_repairs.log");
+    EXPECT_NE(record.find("line 3 (task 1): damaged"), std::string::npos) << record;
+    EXPECT_NE(record.find("line 5: unreadable"), std::string::npos) << record;
+    EXPECT_EQ(readText(damaged / "results.csv") + readText(damaged / "summary.csv"),
+              readText(full / "results.csv") + readText(full / "summary.csv"));
+
+    notices.clear();
+    const StudyOutcome again = runStudy(s, o);  // the journal was compacted: nothing more to drop
+    EXPECT_TRUE(again.journalDrops.empty());
+    EXPECT_TRUE(notices.empty());
+    EXPECT_EQ(again.resumed, 3);
+    EXPECT_EQ(readText(damaged / "journal_repairs.log"), record);  // the record stays
+}
+
+TEST(StudyJournal, ThreadsOutOfRangeAreRefusedWithTheValue) {
+    StudyRunOptions o;
+    o.output = freshDir("threads").string();
+    for (int threads : {-3, 5000}) {
+        o.threads = threads;
+        try {
+            runStudy(smallStudy(), o);
+            FAIL() << "threads = " << threads << " was accepted";
+        } catch (const InputError& e) {
+            EXPECT_NE(std::string(e.what()).find("'threads' = " + std::to_string(threads)), std::string::npos) << e.what();
+        }
+    }
+}
