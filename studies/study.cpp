@@ -431,7 +431,7 @@ std::string summarizeStudyJournalDrops(const std::vector<StudyJournalDrop>& drop
     long unnamed = 0;
     for (const StudyJournalDrop& d : dropped) {
         ++byKind[d.kind];
-        if (d.kind == "duplicate" || d.kind == "out of range" || d.kind == "blank") continue;
+        if (d.kind == "duplicate" || d.kind == "out of range" || d.kind == "blank" || d.kind == "header") continue;
         if (d.task < 0) {
             ++unnamed;
         } else if (!(journal && journal->results.count(d.task)) &&

@@ -17,8 +17,10 @@
 // study, its protocols and its population) computes only the cells the journal lacks; a torn last line
 // (a kill mid-write) fails its checksum and is dropped. Every dropped line (torn, damaged, unreadable,
 // duplicate) is reported (options.notice, the outcome, OUT/journal_repairs.log) and its cell computed
-// again; CRLF line ends and trailing blanks are tolerated. A task that throws is recorded as failed with
-// the reason and never stops the study.
+// again; CRLF line ends and trailing blanks are tolerated. A damaged header is recovered when the
+// journal's first result, computed again, equals its line (the journal is then this study's); an intact
+// header of another study is refused. A task that throws is recorded as failed with the reason and
+// never stops the study.
 #pragma once
 
 #include "studies/torque_validation.h"
@@ -108,7 +110,7 @@ bool parseStudyJournalLine(const std::string& line, StudyResult& result);
 struct StudyJournalDrop {
     long line = 0;       ///< in journal.log, 1-based (the header is line 1)
     long task = -1;      ///< the cell the line names (read without trusting a damaged line); -1: none
-    std::string kind;    ///< torn, damaged, unreadable, blank, out of range, duplicate
+    std::string kind;    ///< torn, damaged, unreadable, blank, out of range, duplicate, header
     std::string detail;  ///< the why, for a person
 };
 /// A journal's results (after its header line) and the lines it dropped.
@@ -196,7 +198,8 @@ public:
 /// ask for groups as their threads free up: dynamic load balancing), journals each result as it
 /// arrives, and writes results.csv, timing.csv, summary.csv, study.yaml and plots to the output folder
 /// (each whole or not at all). Throws InputError for an output folder that cannot be used, one that
-/// holds another study's journal (unless restart), or one another run is using.
+/// holds another study's journal (unless restart; also a journal with a damaged header whose first
+/// result, computed again, differs), or one another run is using.
 StudyOutcome runStudy(const Study& study, const StudyRunOptions& options, StudyCoordinatorLink* link = nullptr);
 /// A worker rank's part: asks the coordinator for groups, computes them on `threads` threads, sends
 /// the results back, until the coordinator has no more.

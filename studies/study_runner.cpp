@@ -193,16 +193,10 @@ public:
         const std::string header = "# armsim study journal; fingerprint " + fingerprint + "; study " + study.name;
         std::string kept = header + '\n';
         if (doesPathExist(journalPath_) && !restart) {
-            const std::string text = readFileText(journalPath_);
-            const std::size_t end = std::min(text.find('\n'), text.size());
-            const std::string first = text.substr(0, end);
-            if (first.rfind("# armsim study journal", 0) != 0 || first.find(fingerprint) == std::string::npos)
-                throw InputError("study output '" + dir_ + "': journal.log holds results of another study or of a " +
-                                 "changed study file, protocol or population (fingerprint " + fingerprint +
-                                 " expected); use another output folder or --restart to discard them");
-            StudyJournal journal = parseStudyJournal(text.substr(std::min(end + 1, text.size())), study.getNumTasks());
+            StudyJournal journal = readJournal(readFileText(journalPath_), fingerprint, study);
             for (const std::string& line : journal.lines) kept += line + '\n';
             summary_ = summarizeStudyJournalDrops(journal.dropped, &journal);
+            if (!headerNote_.empty()) summary_ = (summary_.empty() ? "journal.log: " : summary_ + "; ") + headerNote_;
             done_ = std::move(journal.results);
             dropped_ = std::move(journal.dropped);
         } else if (restart) {
@@ -218,7 +212,7 @@ public:
     // Appends what the journal dropped to journal_repairs.log (one write), so the repair stays on record
     // after the compacted journal no longer shows it.
     void recordRepairs() const {
-        if (dropped_.empty()) return;
+        if (summary_.empty()) return;
         const std::string text = "# journal.log read at the start of a run\n" + summary_ + '\n' +
                                  formatStudyJournalDrops(dropped_);
         std::unique_ptr<std::FILE, int (*)(std::FILE*)> f(std::fopen((dir_ + "/journal_repairs.log").c_str(), "ab"),
@@ -238,6 +232,47 @@ public:
     }
 
 private:
+    // The journal's results. An intact header of another fingerprint is refused; a damaged header (an
+    // editor, a disk error) is recovered when the journal's first result, computed again now, is the
+    // same: the journal is then this study's, whatever its header says.
+    StudyJournal readJournal(const std::string& text, const std::string& fingerprint, const Study& study) {
+        const std::size_t end = std::min(text.find('\n'), text.size());
+        std::string first = text.substr(0, end);
+        while (!first.empty() && (first.back() == '\r' || first.back() == ' ')) first.pop_back();
+        const std::string prefix = "# armsim study journal; fingerprint ";
+        const bool intact = first.rfind(prefix, 0) == 0 && first.size() >= prefix.size() + 16 &&
+                            first.find_first_not_of("0123456789abcdef", prefix.size()) == prefix.size() + 16 &&
+                            first.compare(prefix.size() + 16, 8, "; study ") == 0;
+        if (intact) {
+            if (first.compare(prefix.size(), 16, fingerprint) != 0)
+                throw InputError("study output '" + dir_ + "': journal.log holds results of another study or of a " +
+                                 "changed study file, protocol or population (fingerprint " +
+                                 first.substr(prefix.size(), 16) + ", this study's " + fingerprint +
+                                 "); use another output folder or --restart to discard them");
+            return parseStudyJournal(text.substr(std::min(end + 1, text.size())), study.getNumTasks());
+        }
+        StudyJournal journal = parseStudyJournal(text, study.getNumTasks(), 1);  // line 1 may be a result
+        if (!journal.dropped.empty() && journal.dropped.front().line == 1) {
+            journal.dropped.front().kind = "header";
+            journal.dropped.front().detail = "the header line is damaged (expected '" + prefix + "<16 hex digits>; study <name>')";
+        }
+        if (journal.lines.empty()) {
+            headerNote_ = "the header is damaged and no line is a result: nothing to resume, every cell is computed";
+            return journal;
+        }
+        StudyResult theirs;
+        parseStudyJournalLine(journal.lines.front(), theirs);
+        const StudyTask t = getStudyTask(study, theirs.task);
+        const std::vector<StudyResult> ours = runStudyGroup(study, t.getGroup(study), {t.index});
+        if (ours.size() != 1 || formatStudyResult(ours.front()) != formatStudyResult(theirs))
+            throw InputError("study output '" + dir_ + "': journal.log's header is damaged and its results are not " +
+                             "this study's (task " + std::to_string(t.index) + " computed now differs from its " +
+                             "journal line); use another output folder or --restart to discard them");
+        headerNote_ = "the header was damaged: recovered (task " + std::to_string(t.index) +
+                      ", computed again, equals its journal line)";
+        return journal;
+    }
+
     struct Lock {  // closing the descriptor releases the lock, also when the constructor throws
         int fd = -1;
         ~Lock() {
@@ -249,7 +284,7 @@ private:
     std::unique_ptr<std::FILE, int (*)(std::FILE*)> journal_{nullptr, std::fclose};
     std::map<long, StudyResult> done_;
     std::vector<StudyJournalDrop> dropped_;
-    std::string summary_;
+    std::string summary_, headerNote_;
 };
 
 // Per (protocol, method): a statistic of the summary against the noise level.
@@ -332,7 +367,7 @@ StudyOutcome runStudy(const Study& study, const StudyRunOptions& options, StudyC
     StudyFolder folder(outcome.output, fingerprint, study, options.restart);
     outcome.journalDrops = folder.getDropped();
     outcome.journalSummary = folder.getDroppedSummary();
-    if (!outcome.journalDrops.empty()) {
+    if (!outcome.journalSummary.empty()) {
         folder.recordRepairs();
         if (options.notice)
             options.notice(outcome.journalSummary + " (every line in " + outcome.output + "/journal_repairs.log)");

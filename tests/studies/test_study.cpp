@@ -329,6 +329,15 @@ std::string makeJournalLine(long task) {
     return formatStudyJournalLine(r);
 }
 
+// 3 subjects x thesis x 1 % x thesis: 3 cells, about a second.
+Study makeTinyStudy() {
+    Study s = smallStudy();
+    s.protocols.resize(1);
+    s.noiseLevels.resize(1);
+    s.methods.resize(1);
+    return s;
+}
+
 std::string kindsOf(const StudyJournal& j) {
     std::string out;
     for (const StudyJournalDrop& d : j.dropped) out += std::to_string(d.line) + ":" + std::to_string(d.task) + ":" + d.kind + " ";
@@ -383,10 +392,7 @@ TEST(StudyJournal, EveryDroppedLineIsListedWithItsCellAndWhy) {
 // damaged ones, says which (notice, outcome, journal_repairs.log) and writes the uninterrupted files.
 TEST(StudyJournal, AHandDamagedJournalIsRepairedVisiblyAndEndsWithTheUninterruptedFiles) {
     const fs::path full = freshDir("journal_full"), damaged = freshDir("journal_damaged");
-    Study s = smallStudy();
-    s.protocols.resize(1);
-    s.noiseLevels.resize(1);
-    s.methods.resize(1);  // 3 subjects x thesis x 1 % x thesis: 3 cells
+    const Study s = makeTinyStudy();
     StudyRunOptions o;
     o.output = full.string();
     o.threads = 2;
@@ -448,4 +454,57 @@ TEST(StudyJournal, ThreadsOutOfRangeAreRefusedWithTheValue) {
             EXPECT_NE(std::string(e.what()).find("'threads' = " + std::to_string(threads)), std::string::npos) << e.what();
         }
     }
+}
+
+// A damaged header (an editor, a disk error) is recovered when the journal's first result, computed
+// again, equals its line; the same damaged journal under another seed is refused; a file with no
+// result line starts over. Each says so.
+TEST(StudyJournal, ADamagedHeaderIsRecoveredOnlyForTheStudyWhoseResultsItHolds) {
+    const Study s = makeTinyStudy();
+    const fs::path full = freshDir("header_full"), damaged = freshDir("header_damaged"), other = freshDir("header_other"),
+                   junk = freshDir("header_junk");
+    StudyRunOptions o;
+    o.output = full.string();
+    o.threads = 2;
+    runStudy(s, o);
+    const std::string journal = readText(full / "journal.log");
+    const std::string body = journal.substr(journal.find('\n') + 1);
+    const std::string broken = std::string("# armsim stu\x17\x00dy jo") + "\n" + body;  // line 1 overwritten
+    std::ofstream(damaged / "journal.log", std::ios::binary) << broken;
+    std::ofstream(other / "journal.log", std::ios::binary) << broken;
+    std::ofstream(junk / "journal.log", std::ios::binary) << "\x7f\x45garbage\n";
+
+    std::vector<std::string> notices;
+    o.notice = [&](const std::string& text) { notices.push_back(text); };
+    o.output = damaged.string();
+    const StudyOutcome recovered = runStudy(s, o);
+    EXPECT_EQ(recovered.resumed, 3);
+    EXPECT_EQ(recovered.computed, 0);
+    ASSERT_EQ(notices.size(), 1u);
+    EXPECT_NE(notices[0].find("journal.log: 1 line dropped (1 header); the header was damaged: recovered (task"),
+              std::string::npos) << notices[0];
+    EXPECT_NE(readText(damaged / "journal_repairs.log").find("line 1: header: the header line is damaged"),
+              std::string::npos);
+    EXPECT_EQ(readText(damaged / "results.csv"), readText(full / "results.csv"));
+    EXPECT_EQ(readText(damaged / "journal.log"), journal);  // compacted under a good header again
+
+    Study reseeded = s;
+    reseeded.seed = 6;
+    o.output = other.string();
+    try {
+        runStudy(reseeded, o);
+        FAIL() << "a damaged journal of another seed was accepted";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("header is damaged and its results are not this study's"), std::string::npos)
+            << e.what();
+        EXPECT_NE(std::string(e.what()).find("--restart"), std::string::npos) << e.what();
+    }
+    EXPECT_EQ(readText(other / "journal.log"), broken);  // refused: left as it was
+
+    notices.clear();
+    o.output = junk.string();
+    const StudyOutcome fresh = runStudy(s, o);
+    EXPECT_EQ(fresh.computed, 3);
+    ASSERT_EQ(notices.size(), 1u);
+    EXPECT_NE(notices[0].find("no line is a result: nothing to resume"), std::string::npos) << notices[0];
 }
