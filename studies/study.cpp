@@ -424,7 +424,8 @@ StudyJournal parseStudyJournal(const std::string& text, long numTasks, long firs
     return j;
 }
 
-std::string summarizeStudyJournalDrops(const std::vector<StudyJournalDrop>& dropped, const StudyJournal* journal) {
+std::string summarizeStudyJournalDrops(const std::vector<StudyJournalDrop>& dropped, const StudyJournal* journal,
+                                       const std::string& file) {
     if (dropped.empty()) return "";
     std::map<std::string, int> byKind;
     std::vector<long> cells;
@@ -441,7 +442,7 @@ std::string summarizeStudyJournalDrops(const std::vector<StudyJournalDrop>& drop
     }
     std::string kinds;
     for (const auto& [kind, n] : byKind) kinds += (kinds.empty() ? "" : ", ") + std::to_string(n) + ' ' + kind;
-    std::string text = "journal.log: " + std::to_string(dropped.size()) + " line" + (dropped.size() == 1 ? "" : "s") +
+    std::string text = file + ": " + std::to_string(dropped.size()) + " line" + (dropped.size() == 1 ? "" : "s") +
                        " dropped (" + kinds + ")";
     std::sort(cells.begin(), cells.end());
     if (!cells.empty()) {
@@ -458,7 +459,7 @@ std::string summarizeStudyJournalDrops(const std::vector<StudyJournalDrop>& drop
 std::string formatStudyJournalDrops(const std::vector<StudyJournalDrop>& dropped) {
     std::string text;
     for (const StudyJournalDrop& d : dropped)
-        text += "line " + std::to_string(d.line) + (d.task >= 0 ? " (task " + std::to_string(d.task) + ")" : "") + ": " +
+        text += (d.file.empty() ? "" : d.file + " ") + "line " + std::to_string(d.line) + (d.task >= 0 ? " (task " + std::to_string(d.task) + ")" : "") + ": " +
                 d.kind + ": " + d.detail + '\n';
     return text;
 }

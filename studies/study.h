@@ -112,6 +112,7 @@ struct StudyJournalDrop {
     long task = -1;      ///< the cell the line names (read without trusting a damaged line); -1: none
     std::string kind;    ///< torn, damaged, unreadable, blank, out of range, duplicate, header
     std::string detail;  ///< the why, for a person
+    std::string file;    ///< the journal it is in when not journal.log (a shard's)
 };
 /// A journal's results (after its header line) and the lines it dropped.
 struct StudyJournal {
@@ -126,7 +127,8 @@ struct StudyJournal {
 /// or a duplicate of an earlier line (the earlier is kept).
 StudyJournal parseStudyJournal(const std::string& text, long numTasks, long firstLine = 2);
 /// One line: the number of lines dropped, by kind, and the cells computed again; "" when none.
-std::string summarizeStudyJournalDrops(const std::vector<StudyJournalDrop>& dropped, const StudyJournal* journal = nullptr);
+std::string summarizeStudyJournalDrops(const std::vector<StudyJournalDrop>& dropped, const StudyJournal* journal = nullptr,
+                                       const std::string& file = "journal.log");
 /// Every dropped line, one per text line: "line 5 (task 4): damaged: ...".
 std::string formatStudyJournalDrops(const std::vector<StudyJournalDrop>& dropped);
 
@@ -161,6 +163,10 @@ struct StudyRunOptions {
     bool restart = false;        ///< discard a journal (of this or another study) and start over
     std::function<void(const StudyProgress&)> progress;  ///< about once a second and at the end
     std::function<void(const std::string&)> notice;      ///< at the start: what a repaired journal dropped
+    /// A share of a job array: groups g with g % shards == shard, journaled in
+    /// journal-shard-I-of-N.log (no final files). shards 0: the whole study, merging any shard journals.
+    int shard = 0, shards = 0;
+    bool merge = false;          ///< assemble the journals into the final files; refuse when cells are missing
 };
 
 /// What a finished run did and wrote.
@@ -173,6 +179,9 @@ struct StudyOutcome {
     int ranks = 1, threads = 1;        ///< workers: ranks x threads per rank
     std::vector<std::string> files;    ///< written, in the folder
     std::vector<StudyJournalDrop> journalDrops;  ///< journal lines dropped at the start (also in journal_repairs.log)
+    long merged = 0;                   ///< of resumed: cells taken from shard journals
+    int shardJournals = 0;             ///< shard journals merged (and removed)
+    int shard = 0, shards = 0;         ///< a shard's run: total, resumed and computed count its cells only
     std::string journalSummary;        ///< summarizeStudyJournalDrops of them; "" when none
 };
 

@@ -1,7 +1,8 @@
 // Population studies (issue 13): task numbering, the journal line format, a study cell against the
 // validation's own computation (a second path to the same numbers), failures recorded, resume from a
 // partial and torn journal, hand-damaged journals (CRLF, garbage, altered and duplicate lines: every
-// dropped line reported, issue 33), thread-count independence, and bad study files.
+// dropped line reported, issue 33), shards of a job array merged, thread-count independence, and bad
+// study files.
 #include "basics/errors.h"
 #include "basics/files.h"
 #include "studies/study.h"
@@ -13,6 +14,9 @@
 #include <fstream>
 #include <set>
 #include <sstream>
+
+#include <fcntl.h>
+#include <sys/file.h>
 #include <unistd.h>
 
 using namespace armsim;
@@ -507,4 +511,63 @@ TEST(StudyJournal, ADamagedHeaderIsRecoveredOnlyForTheStudyWhoseResultsItHolds) 
     EXPECT_EQ(fresh.computed, 3);
     ASSERT_EQ(notices.size(), 1u);
     EXPECT_NE(notices[0].find("no line is a result: nothing to resume"), std::string::npos) << notices[0];
+}
+
+// Job arrays (--shard I/N): each shard computes its groups (g % N == I) into its own journal and writes
+// no files; --merge takes the finished shards' journals into journal.log but refuses to write files
+// while cells are missing; a shard still running blocks the merge; the merge after the last shard
+// computes nothing and writes the uninterrupted run's files.
+TEST(StudyShards, ShardsThenAPlainRunWriteTheUninterruptedFiles) {
+    const fs::path d = freshDir("shards");
+    StudyRunOptions o;
+    o.output = d.string();
+    o.threads = 1;
+    o.shards = 3;
+    long computed = 0;
+    for (int shard : {0, 1}) {
+        o.shard = shard;
+        const StudyOutcome r = runStudy(smallStudy(), o);
+        EXPECT_EQ(r.total, 8);  // 2 of the 6 groups x 4 cells
+        EXPECT_EQ(r.computed, 8);
+        EXPECT_EQ(r.files, std::vector<std::string>{"journal-shard-" + std::to_string(shard) + "-of-3.log"});
+        computed += r.computed;
+    }
+    EXPECT_FALSE(fs::exists(d / "results.csv"));
+    EXPECT_THROW(runStudy(smallStudy(), StudyRunOptions{o.output, 1, false, {}, {}, 3, 3}), InputError);  // no shard 3/3
+
+    StudyRunOptions merge;
+    merge.output = d.string();
+    merge.merge = true;
+    try {
+        runStudy(smallStudy(), merge);
+        FAIL() << "--merge with shard 2/3 missing was accepted";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("--merge: 8 of 24 cells are in no journal"), std::string::npos) << e.what();
+    }
+    o.shard = 2;
+    computed += runStudy(smallStudy(), o).computed;
+    EXPECT_EQ(computed, 24);
+
+    {  // shard 2 running again (its lock held): the merge waits for it
+        const int fd = ::open((d / ".lock-shard-2-of-3").c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+        ASSERT_GE(fd, 0);
+        ASSERT_EQ(::flock(fd, LOCK_EX | LOCK_NB), 0);
+        try {
+            runStudy(smallStudy(), merge);
+            FAIL() << "a merge while a shard runs was accepted";
+        } catch (const InputError& e) {
+            EXPECT_NE(std::string(e.what()).find("shard 2-of-3 is still running"), std::string::npos) << e.what();
+        }
+        ::close(fd);
+    }
+    const StudyOutcome merged = runStudy(smallStudy(), merge);
+    EXPECT_EQ(merged.computed, 0);
+    EXPECT_EQ(merged.resumed, 24);
+    EXPECT_EQ(merged.merged, 8);  // shard 2's; the first --merge took shards 0 and 1 into journal.log
+    EXPECT_EQ(merged.shardJournals, 1);
+    EXPECT_EQ(readText(d / "results.csv") + readText(d / "summary.csv"), referenceResults());
+    for (int shard : {0, 1, 2}) EXPECT_FALSE(fs::exists(d / ("journal-shard-" + std::to_string(shard) + "-of-3.log")));
+    const StudyOutcome again = runStudy(smallStudy(), StudyRunOptions{o.output, 1});  // all in journal.log now
+    EXPECT_EQ(again.resumed, 24);
+    EXPECT_EQ(again.merged, 0);
 }

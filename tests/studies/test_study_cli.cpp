@@ -187,3 +187,14 @@ TEST(StudyCli, AnMpiStudyWithOneRankKilledFinishesWhenStartedAgain) {
     EXPECT_EQ(results(out), results(d / "full"));
 }
 #endif
+
+TEST(StudyCli, ABadShardIsRefusedNamingTheValue) {
+    const fs::path d = freshDir("bad_shard");
+    for (const std::string shard : {"3/2", "x", "1/0", "-1/2", "1/2x", "/2"}) {
+        const CommandResult r = runArmsim("study " + (d / "none.yaml").string() + " --shard '" + shard + "' --out " +
+                                          (d / "out").string());
+        EXPECT_NE(r.exitCode, 0) << shard;
+        EXPECT_NE(r.output.find("--shard '" + shard + "': expected I/N"), std::string::npos) << r.output;
+    }
+    EXPECT_FALSE(fs::exists(d / "out"));
+}
