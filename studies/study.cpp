@@ -47,6 +47,30 @@ bool parseLong(const std::string& s, long& v) {
     return !s.empty() && r.ec == std::errc() && r.ptr == b + s.size();
 }
 
+// Strict UTF-8: no overlong forms, surrogates or code points past U+10FFFF.
+bool isValidUtf8(const std::string& text) {
+    const auto* p = reinterpret_cast<const unsigned char*>(text.data());
+    const auto* end = p + text.size();
+    while (p < end) {
+        const unsigned char c = *p;
+        int n = 0;
+        unsigned long cp = 0, min = 0;
+        if (c < 0x80) { ++p; continue; }
+        if ((c & 0xe0) == 0xc0) n = 1, cp = c & 0x1f, min = 0x80;
+        else if ((c & 0xf0) == 0xe0) n = 2, cp = c & 0x0f, min = 0x800;
+        else if ((c & 0xf8) == 0xf0) n = 3, cp = c & 0x07, min = 0x10000;
+        else return false;
+        if (end - p <= n) return false;
+        for (int k = 1; k <= n; ++k) {
+            if ((p[k] & 0xc0) != 0x80) return false;
+            cp = (cp << 6) | (p[k] & 0x3f);
+        }
+        if (cp < min || cp > 0x10ffff || (cp >= 0xd800 && cp <= 0xdfff)) return false;
+        p += n + 1;
+    }
+    return true;
+}
+
 // Resolves a file named in the study: relative to the study file's folder, then as given.
 std::string resolveStudyFile(const ParamNode& n, const std::string& field, const std::string& value, const char* what) {
     namespace fs = std::filesystem;
@@ -84,12 +108,19 @@ void Study::validate() const {
                                  "= '" + protocols[i].reference + "': its name '" + protocols[i].protocol.name +
                                      "' is also protocols[" + std::to_string(j) + "]'s: expected unique protocol names");
     }
-    // Names go into CSV cells and journal lines: no control characters (they would not round-trip).
+    // Names go into CSV cells, journal lines and plot legends: no control characters (they would not
+    // round-trip) and UTF-8 (PLplot cannot draw other bytes). The message shows bytes as \xNN.
     auto checkName = [](const std::string& field, const std::string& name) {
         for (unsigned char c : name)
             if (c < 0x20 || c == 0x7f)
                 throw FieldError(field, "= '" + name + "': expected a name without tabs, newlines or control characters");
+        if (!isValidUtf8(name)) {
+            std::string shown;
+            for (unsigned char c : name) shown += c < 0x80 ? std::string(1, char(c)) : fmt::format("\\x{:02x}", c);
+            throw FieldError(field, "= '" + shown + "': not UTF-8 text (save the file as UTF-8)");
+        }
     };
+    checkName("name", name);
     for (std::size_t i = 0; i < protocols.size(); ++i)
         checkName("protocols[" + std::to_string(i) + "].name", protocols[i].protocol.name);
     for (std::size_t i = 0; i < methods.size(); ++i) checkName("methods[" + std::to_string(i) + "].label", methods[i].label);

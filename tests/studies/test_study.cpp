@@ -233,9 +233,10 @@ TEST(Study, ReadsAStudyFileAndNamesTheFileLineAndFieldOfEveryError) {
     const fs::path d = freshDir("files");
     std::ofstream(d / "one.yaml") << "kind: torque\nname: one\nconditions:\n  - {flexion_deg: 90}\n";
     const std::string good = "kind: study\nname: s\nsubjects: 2\nprotocols: [thesis, one.yaml]\nnoise_levels: [0.02]\n"
-                             "methods:\n  - {method: thesis}\n  - {method: synergist-va, label: va, activation_sd: 0.03}\n";
+                             "methods:\n  - {method: thesis, label: th\u00e9se \u03bc\U0001F4AA}\n  - {method: synergist-va, label: va, activation_sd: 0.03}\n";
     std::ofstream(d / "good.yaml") << good;
     const Study s = readStudy((d / "good.yaml").string());
+    EXPECT_EQ(s.methods[0].label, "th\u00e9se \u03bc\U0001F4AA");  // UTF-8 of 2, 2 and 4 bytes
     EXPECT_EQ(s.subjects, 2);
     ASSERT_EQ(s.protocols.size(), 2u);
     EXPECT_EQ(s.protocols[1].protocol.name, "one");
@@ -263,6 +264,11 @@ TEST(Study, ReadsAStudyFileAndNamesTheFileLineAndFieldOfEveryError) {
         {"kind: study\nsubjects: 2\nprotocols: []\nmethods:\n  - {method: thesis}\n", "protocols"},
         {"kind: study\nsubjects: 2\nprotocols: [thesis]\nmethods:\n  - {method: thesis, label: \"a\\tb\"}\n",
          "methods[0].label"},
+        // Latin-1 bytes (a file not saved as UTF-8): PLplot would print "malformed" and draw nothing.
+        {"kind: study\nsubjects: 2\nprotocols: [thesis]\nmethods:\n  - {method: thesis, label: caf\xe9}\n",
+         "field 'methods[0].label' = 'caf\\xe9': not UTF-8 text"},
+        {"kind: study\nname: r\xe9sum\xe9\nsubjects: 2\nprotocols: [thesis]\nmethods:\n  - {method: thesis}\n",
+         "field 'name' = 'r\\xe9sum\\xe9': not UTF-8 text"},
     };
     for (std::size_t i = 0; i < cases.size(); ++i) {
         const fs::path p = d / ("bad" + std::to_string(i) + ".yaml");
