@@ -10,6 +10,8 @@
 #include <thread>
 #include <vector>
 
+#include <sched.h>
+
 namespace armsim {
 
 void runParallel(int n, int jobs, const std::function<void(int)>& task,
@@ -63,6 +65,23 @@ void runParallel(int n, int jobs, const std::function<void(int)>& task,
     }
     for (auto& t : threads) t.join();
     if (error) std::rethrow_exception(error);
+}
+
+int getNumUsableCpus() {
+    cpu_set_t mask;
+    CPU_ZERO(&mask);
+    if (sched_getaffinity(0, sizeof mask, &mask) == 0) {
+        const int n = CPU_COUNT(&mask);
+        if (n > 0) return n;
+    }
+    return int(std::max(1u, std::thread::hardware_concurrency()));
+}
+
+int calcThreadsPerRank(int usableCpus, int nodeCpus, int localRanks) {
+    usableCpus = std::max(1, usableCpus);
+    localRanks = std::max(1, localRanks);
+    const int share = std::max(1, std::max(nodeCpus, usableCpus) / localRanks);
+    return usableCpus < nodeCpus ? std::min(usableCpus, share) : share;
 }
 
 }  // namespace armsim

@@ -56,6 +56,10 @@ void finishPng(const std::string& tmp, const std::string& path) {
         fs::remove(tmp, ec);
         throw InputError(path + ": the plot could not be written (PLplot pngcairo driver failed)");
     }
+    if (!isWholePng(tmp)) {  // cairo does not report a failed write: a full disk leaves a cut-off file
+        fs::remove(tmp, ec);
+        throw InputError(path + ": the plot was cut off while being written (is the disk full?); no file written");
+    }
     fs::rename(tmp, path, ec);
     if (ec) {
         fs::remove(tmp, ec);
@@ -74,6 +78,20 @@ void startStream(const std::string& tmp, int width, int height) {
 }
 
 }  // namespace
+
+bool isWholePng(const std::string& path) {
+    std::ifstream in(path, std::ios::binary | std::ios::ate);
+    const std::streamoff size = in ? std::streamoff(in.tellg()) : 0;
+    if (size < 8 + 12) return false;
+    char head[8], tail[12];
+    in.seekg(0);
+    in.read(head, 8);
+    in.seekg(size - 12);
+    in.read(tail, 12);
+    static const char signature[8] = {'\x89', 'P', 'N', 'G', '\r', '\n', '\x1a', '\n'};
+    static const char iend[12] = {0, 0, 0, 0, 'I', 'E', 'N', 'D', '\xae', '\x42', '\x60', '\x82'};
+    return in && std::equal(head, head + 8, signature) && std::equal(tail, tail + 12, iend);
+}
 
 void writePlotPng(const std::string& path, const PlotSpec& spec) {
     if (spec.series.empty()) throw std::invalid_argument("plot '" + spec.title + "': no series");

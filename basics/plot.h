@@ -31,6 +31,10 @@ struct PlotSpec {
 /// the path if it cannot be written, std::invalid_argument for an empty or malformed spec.
 void writePlotPng(const std::string& path, const PlotSpec& spec);
 
+/// true when the file is a PNG written to its end: the PNG signature first, the IEND chunk last. A
+/// write cut off by a full disk fails it.
+bool isWholePng(const std::string& path);
+
 /// A heat map of z over a regular grid of cells (e.g. force over slow x fast motor-unit counts).
 struct HeatMapSpec {
     std::string title;

@@ -21,7 +21,28 @@ struct StudyOptions {
     std::string out;
     int threads = 0;
     bool restart = false;
+    std::string shard;  ///< I/N
+    bool merge = false;
 };
+
+// --shard I/N: an InputError naming the value unless 0 <= I < N.
+void parseShard(const std::string& text, int& shard, int& shards) {
+    const std::size_t slash = text.find('/');
+    std::size_t used = 0, usedN = 0;
+    bool ok = slash != std::string::npos && slash > 0;
+    try {
+        if (ok) {
+            shard = std::stoi(text.substr(0, slash), &used);
+            shards = std::stoi(text.substr(slash + 1), &usedN);
+        }
+    } catch (const std::exception&) {
+        ok = false;
+    }
+    ok = ok && used == slash && usedN == text.size() - slash - 1 && shards >= 1 && shards <= 1000000 && shard >= 0 &&
+         shard < shards;
+    if (!ok)
+        throw InputError("--shard '" + text + "': expected I/N, shard I of N with 0 <= I < N (e.g. 0/4 .. 3/4)");
+}
 
 std::string formatDuration(double seconds) {
     if (!std::isfinite(seconds)) return "?";
@@ -46,7 +67,17 @@ void runStudyCommand(const StudyOptions& o) {
     run.output = o.out;
     run.threads = o.threads;
     run.restart = o.restart;
+    run.merge = o.merge;
+    if (!o.shard.empty()) parseShard(o.shard, run.shard, run.shards);
+    if (run.shards > 0 && o.merge) throw InputError("--shard '" + o.shard + "' with --merge: expected one of them");
+    if (run.shards > 0 && isLaunchedByMpi())
+        throw InputError("--shard '" + o.shard + "' under MPI: a shard runs on threads (job arrays without MPI)");
     if (!isQuiet()) run.progress = printStudyProgress;
+    run.notice = [](const std::string& text) {  // a repaired journal, also under --quiet
+        std::fflush(stdout);
+        std::fprintf(stderr, "warning: %s\n", text.c_str());
+        std::fflush(stderr);
+    };
 
     std::optional<std::pair<Study, StudyOutcome>> done;
     if (isLaunchedByMpi()) {
@@ -58,6 +89,8 @@ void runStudyCommand(const StudyOptions& o) {
     }
     const Study& study = done->first;
     const StudyOutcome& r = done->second;
+    if (r.shards > 0)
+        std::printf("shard %d/%d: ", r.shard, r.shards);
     std::printf("study '%s': %ld tasks (%d subjects x %zu protocols x %zu noise levels x %zu methods); %ld computed "
                 "in %.1f s on %d rank%s x %d thread%s, %ld resumed from the journal\n",
                 study.name.c_str(), r.total, study.subjects, study.protocols.size(), study.noiseLevels.size(),
@@ -67,9 +100,13 @@ void runStudyCommand(const StudyOptions& o) {
         std::printf("  task time %.1f s (synthesis %.0f %%, identification %.0f %%); %.2f tasks/s\n", r.taskTime,
                     100 * r.synthesisTime / r.taskTime, 100 * (1 - r.synthesisTime / r.taskTime),
                     double(r.computed) / r.wallTime);
+    if (r.shardJournals > 0)
+        std::printf("  %d shard journal%s merged into journal.log: %ld of the resumed tasks\n", r.shardJournals,
+                    r.shardJournals == 1 ? "" : "s", r.merged);
+    if (!r.journalSummary.empty()) std::printf("  %s (every line in journal_repairs.log)\n", r.journalSummary.c_str());
     if (r.failed + r.notConverged > 0)
-        std::printf("  %ld failed, %ld not converged: their reasons are in results.csv (status, reason)\n", r.failed,
-                    r.notConverged);
+        std::printf("  %ld failed, %ld not converged: their reasons are in results.csv (status, reason)%s\n", r.failed,
+                    r.notConverged, r.shards > 0 ? " once the shards are merged" : "");
     std::printf("wrote to %s:", r.output.c_str());
     for (const std::string& f : r.files) std::printf(" %s", f.c_str());
     std::printf("\n");
@@ -82,10 +119,16 @@ void addStudyCommand(CLI::App& app) {
                  "`mpirun -n K armsim study` spreads it over MPI ranks); resumes after an interruption");
     c->add_option("study", o->file, "study file (kind: study)")->required();
     c->add_option("--out", o->out, "output folder (default: the study's `output`)");
-    c->add_option("--threads", o->threads, "worker threads per process (default: all cores, shared by the ranks "
-                                           "of a node under mpirun)")
-        ->check(CLI::Range(1, 1024));
+    c->add_option("--threads", o->threads, "worker threads per process (default: the CPUs it may use, its "
+                                           "affinity mask as set by taskset or Slurm; shared by the ranks of a "
+                                           "node under MPI when they all see the whole node)")
+        ->check(CLI::Range(1, kMaxStudyThreads));
     c->add_flag("--restart", o->restart, "discard the output folder's journal and compute every task again");
+    c->add_option("--shard", o->shard, "I/N: compute shard I of N (0 <= I < N; the groups g with g % N == I) "
+                                       "into its own journal, for job arrays; the next run without --shard "
+                                       "merges the shards' journals and writes the files");
+    c->add_flag("--merge", o->merge, "only assemble the journals (the shards') into the files; an error when "
+                                     "cells are missing");
     c->callback([o] { runStudyCommand(*o); });
 }
 

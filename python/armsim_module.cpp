@@ -230,6 +230,7 @@ PYBIND11_MODULE(_armsim, mod) {
     mod.def(
         "run_study",
         [](const std::string& file, int threads, const std::string& out, bool restart) {
+            checkField("threads", threads, Bound::closed(0, kMaxStudyThreads, "0: every CPU this process may use"));
             if (!isRegularFile(file)) throwFileNotFound(file, "study file");
             const Study study = readStudy(file);
             StudyRunOptions o;
@@ -249,12 +250,17 @@ PYBIND11_MODULE(_armsim, mod) {
             d["failed"] = r.failed;
             d["not_converged"] = r.notConverged;
             d["wall_time"] = r.wallTime;
+            d["journal_dropped"] = r.journalDrops.size();
+            d["journal_summary"] = r.journalSummary;
             d["files"] = r.files;
             return d;
         },
         py::arg("study_file"), py::arg("threads") = 0, py::arg("out") = "", py::arg("restart") = false,
-        "Runs a population study file (as `armsim study`, on threads) and returns what it did: output\n"
-        "folder, total, computed, resumed, failed and not_converged task counts, wall_time [s], files.\n"
+        "Runs a population study file (as `armsim study`, on threads: 1 .. 1024, or 0 for every CPU this\n"
+        "process may use) and returns what it did: output\n"
+        "folder, total, computed, resumed, failed and not_converged task counts, wall_time [s], files,\n"
+        "journal_dropped (journal lines the run could not use; their cells were computed again) and\n"
+        "journal_summary (what they were; also in the folder's journal_repairs.log).\n"
         "Resumes from the folder's journal like the command. Releases the GIL.");
 
     addIdentificationBindings(mod);

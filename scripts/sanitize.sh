@@ -4,8 +4,8 @@
 # Builds build-sanitize/ with clang (-O1, both sanitizers, UB fatal; no Python module or benchmarks:
 # about 4 min on two cores) and runs every test (about 6 min). Leaks that third-party libraries never
 # free (Simbody's CPodes, fontconfig, Mesa, OpenMPI) are suppressed by tests/sanitizers/lsan.supp; the
-# mpirun tests run without leak detection (OpenMPI's dlopen-ed components leak from unloaded modules),
-# every other check stays on.
+# mpirun and Slurm (srun) tests run without leak detection (OpenMPI's dlopen-ed components leak from
+# unloaded modules), every other check stays on.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 flags="-fsanitize=address,undefined"
@@ -15,7 +15,7 @@ cmake -S . -B build-sanitize -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_COMPILER=clang
   -DARMSIM_BENCHMARKS=OFF -DARMSIM_PYTHON=OFF >/dev/null
 cmake --build build-sanitize -j2
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
-mpi_tests="Mpi|TwoRanks"
+mpi_tests="Mpi|TwoRanks|slurm[.]"  # the Slurm tests run MPI ranks under srun
 LSAN_OPTIONS=suppressions=$PWD/tests/sanitizers/lsan.supp \
   ctest --test-dir build-sanitize --output-on-failure -j2 --timeout 900 -E "$mpi_tests"
 ASAN_OPTIONS=detect_leaks=0 ctest --test-dir build-sanitize --output-on-failure -j2 --timeout 900 -R "$mpi_tests"

@@ -1,7 +1,17 @@
 #!/usr/bin/env bash
-# Installs the Debian 12 packages armsim builds and runs with. Idempotent: packages already present
-# are skipped; a held dpkg lock is waited for instead of failing; sudo is used when not root.
+# Installs the Debian 12 packages armsim builds and runs with; `--tests` also those only the tests
+# need (clang for scripts/sanitize.sh and scripts/fuzz.sh; Slurm and munge for the local cluster of
+# scripts/slurm-local.sh). Idempotent: packages already present are skipped; a held dpkg lock is waited
+# for instead of failing; sudo is used when not root.
 set -euo pipefail
+
+with_tests=0
+for arg in "$@"; do
+  case "$arg" in
+    --tests) with_tests=1 ;;
+    *) echo "setup: unknown option '$arg': expected --tests or nothing" >&2; exit 2 ;;
+  esac
+done
 
 packages=(
   build-essential cmake pkg-config
@@ -10,8 +20,12 @@ packages=(
   libplplot-dev plplot-driver-cairo libfftw3-dev libfmt-dev
   libopenmpi-dev openmpi-bin
   pybind11-dev python3-dev python3-numpy python3-pytest python3-matplotlib
-  clang libclang-rt-14-dev
 )
+test_packages=(
+  clang libclang-rt-14-dev
+  slurm-wlm munge
+)
+[ $with_tests -eq 1 ] && packages+=("${test_packages[@]}")
 
 missing=()
 for p in "${packages[@]}"; do

@@ -47,6 +47,30 @@ bool parseLong(const std::string& s, long& v) {
     return !s.empty() && r.ec == std::errc() && r.ptr == b + s.size();
 }
 
+// Strict UTF-8: no overlong forms, surrogates or code points past U+10FFFF.
+bool isValidUtf8(const std::string& text) {
+    const auto* p = reinterpret_cast<const unsigned char*>(text.data());
+    const auto* end = p + text.size();
+    while (p < end) {
+        const unsigned char c = *p;
+        int n = 0;
+        unsigned long cp = 0, min = 0;
+        if (c < 0x80) { ++p; continue; }
+        if ((c & 0xe0) == 0xc0) n = 1, cp = c & 0x1f, min = 0x80;
+        else if ((c & 0xf0) == 0xe0) n = 2, cp = c & 0x0f, min = 0x800;
+        else if ((c & 0xf8) == 0xf0) n = 3, cp = c & 0x07, min = 0x10000;
+        else return false;
+        if (end - p <= n) return false;
+        for (int k = 1; k <= n; ++k) {
+            if ((p[k] & 0xc0) != 0x80) return false;
+            cp = (cp << 6) | (p[k] & 0x3f);
+        }
+        if (cp < min || cp > 0x10ffff || (cp >= 0xd800 && cp <= 0xdfff)) return false;
+        p += n + 1;
+    }
+    return true;
+}
+
 // Resolves a file named in the study: relative to the study file's folder, then as given.
 std::string resolveStudyFile(const ParamNode& n, const std::string& field, const std::string& value, const char* what) {
     namespace fs = std::filesystem;
@@ -84,12 +108,19 @@ void Study::validate() const {
                                  "= '" + protocols[i].reference + "': its name '" + protocols[i].protocol.name +
                                      "' is also protocols[" + std::to_string(j) + "]'s: expected unique protocol names");
     }
-    // Names go into CSV cells and journal lines: no control characters (they would not round-trip).
+    // Names go into CSV cells, journal lines and plot legends: no control characters (they would not
+    // round-trip) and UTF-8 (PLplot cannot draw other bytes). The message shows bytes as \xNN.
     auto checkName = [](const std::string& field, const std::string& name) {
         for (unsigned char c : name)
             if (c < 0x20 || c == 0x7f)
                 throw FieldError(field, "= '" + name + "': expected a name without tabs, newlines or control characters");
+        if (!isValidUtf8(name)) {
+            std::string shown;
+            for (unsigned char c : name) shown += c < 0x80 ? std::string(1, char(c)) : fmt::format("\\x{:02x}", c);
+            throw FieldError(field, "= '" + shown + "': not UTF-8 text (save the file as UTF-8)");
+        }
     };
+    checkName("name", name);
     for (std::size_t i = 0; i < protocols.size(); ++i)
         checkName("protocols[" + std::to_string(i) + "].name", protocols[i].protocol.name);
     for (std::size_t i = 0; i < methods.size(); ++i) checkName("methods[" + std::to_string(i) + "].label", methods[i].label);
@@ -364,6 +395,104 @@ bool parseStudyJournalLine(const std::string& line, StudyResult& r) {
     e.numParameters = int(parameters);
     r.rank = int(rank);
     return r.status == "ok" || r.status == "not-converged" || r.status == "failed" || r.status == "skipped";
+}
+
+StudyJournal parseStudyJournal(const std::string& text, long numTasks, long firstLine) {
+    StudyJournal j;
+    std::map<long, long> lineOf;  // task -> the line that gave it
+    std::size_t begin = 0;
+    for (long number = firstLine; begin < text.size(); ++number) {
+        const std::size_t end = text.find('\n', begin);
+        const bool hasEnd = end != std::string::npos;
+        const std::string raw = text.substr(begin, (hasEnd ? end : text.size()) - begin);
+        begin = hasEnd ? end + 1 : text.size();
+        std::string line = raw;
+        while (!line.empty() && (line.back() == '\r' || line.back() == ' ' || line.back() == '\t' || line.back() == '\0'))
+            line.pop_back();  // CRLF (an editor, a Windows copy), trailing blanks, a NUL-filled tail
+        StudyJournalDrop drop;
+        drop.line = number;
+        if (line.empty()) {
+            drop.kind = "blank";
+            drop.detail = raw.find('\0') != std::string::npos ? "only NUL bytes (a write the file system never finished)"
+                                                              : "a blank line";
+            j.dropped.push_back(drop);
+            continue;
+        }
+        long task = -1;  // what the line says, trusted only when its checksum holds
+        if (line.size() > 17 && line[16] == ' ') {
+            const std::size_t comma = line.find(',', 17);
+            if (!parseLong(line.substr(17, comma == std::string::npos ? std::string::npos : comma - 17), task)) task = -1;
+        }
+        drop.task = task;
+        StudyResult r;
+        if (parseStudyJournalLine(line, r)) {
+            drop.task = r.task;
+            if (r.task < 0 || r.task >= numTasks) {
+                drop.kind = "out of range";
+                drop.detail = "task " + std::to_string(r.task) + " is outside the study's 0.." + std::to_string(numTasks - 1);
+            } else if (lineOf.count(r.task)) {
+                drop.kind = "duplicate";
+                drop.detail = "task " + std::to_string(r.task) + " is also line " + std::to_string(lineOf[r.task]) +
+                              " (that one is kept)";
+            } else {
+                lineOf[r.task] = number;
+                j.results.emplace(r.task, std::move(r));
+                j.lines.push_back(line);
+                continue;
+            }
+        } else if (!hasEnd) {
+            drop.kind = "torn";
+            drop.detail = "the last line has no line end and fails its checksum (a run stopped while writing it)";
+        } else if (line.size() > 17 && line[16] == ' ' && line.find_first_not_of("0123456789abcdef") == 16) {
+            drop.kind = "damaged";
+            drop.detail = "its checksum does not match its text (altered or partly overwritten)";
+        } else {
+            drop.kind = "unreadable";
+            drop.detail = "not a journal line (expected a 16-hex-digit checksum, a space and a result)";
+        }
+        j.dropped.push_back(drop);
+    }
+    return j;
+}
+
+std::string summarizeStudyJournalDrops(const std::vector<StudyJournalDrop>& dropped, const StudyJournal* journal,
+                                       const std::string& file) {
+    if (dropped.empty()) return "";
+    std::map<std::string, int> byKind;
+    std::vector<long> cells;
+    long unnamed = 0;
+    for (const StudyJournalDrop& d : dropped) {
+        ++byKind[d.kind];
+        if (d.kind == "duplicate" || d.kind == "out of range" || d.kind == "blank" || d.kind == "header") continue;
+        if (d.task < 0) {
+            ++unnamed;
+        } else if (!(journal && journal->results.count(d.task)) &&
+                   std::find(cells.begin(), cells.end(), d.task) == cells.end()) {
+            cells.push_back(d.task);
+        }
+    }
+    std::string kinds;
+    for (const auto& [kind, n] : byKind) kinds += (kinds.empty() ? "" : ", ") + std::to_string(n) + ' ' + kind;
+    std::string text = file + ": " + std::to_string(dropped.size()) + " line" + (dropped.size() == 1 ? "" : "s") +
+                       " dropped (" + kinds + ")";
+    std::sort(cells.begin(), cells.end());
+    if (!cells.empty()) {
+        text += "; computed again: task" + std::string(cells.size() == 1 ? " " : "s ");
+        for (std::size_t i = 0; i < cells.size() && i < 20; ++i) text += (i ? ", " : "") + std::to_string(cells[i]);
+        if (cells.size() > 20) text += " and " + std::to_string(cells.size() - 20) + " more";
+    }
+    if (unnamed > 0)
+        text += "; " + std::to_string(unnamed) + " line" + (unnamed == 1 ? "" : "s") +
+                " named no readable task (any cell it held is computed again)";
+    return text;
+}
+
+std::string formatStudyJournalDrops(const std::vector<StudyJournalDrop>& dropped) {
+    std::string text;
+    for (const StudyJournalDrop& d : dropped)
+        text += (d.file.empty() ? "" : d.file + " ") + "line " + std::to_string(d.line) + (d.task >= 0 ? " (task " + std::to_string(d.task) + ")" : "") + ": " +
+                d.kind + ": " + d.detail + '\n';
+    return text;
 }
 
 std::vector<StudySummaryRow> summarizeStudy(const Study& study, const std::vector<StudyResult>& results) {

@@ -15,14 +15,19 @@
 // Resume: finished cells are appended to OUT/journal.log as they complete (one line per cell with a
 // checksum, flushed per group). A run that finds a journal of the same study (same fingerprint: the
 // study, its protocols and its population) computes only the cells the journal lacks; a torn last line
-// (a kill mid-write) fails its checksum and is dropped. A task that throws is recorded as failed with
-// the reason and never stops the study.
+// (a kill mid-write) fails its checksum and is dropped. Every dropped line (torn, damaged, unreadable,
+// duplicate) is reported (options.notice, the outcome, OUT/journal_repairs.log) and its cell computed
+// again; CRLF line ends and trailing blanks are tolerated. A damaged header is recovered when the
+// journal's first result, computed again, equals its line (the journal is then this study's); an intact
+// header of another study is refused. A task that throws is recorded as failed with the reason and
+// never stops the study.
 #pragma once
 
 #include "studies/torque_validation.h"
 
 #include <cstdint>
 #include <functional>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -101,6 +106,32 @@ std::string formatStudyResult(const StudyResult& result);
 std::string formatStudyJournalLine(const StudyResult& result);
 bool parseStudyJournalLine(const std::string& line, StudyResult& result);
 
+/// A journal line a run could not use; its cell, if it names one, is computed again.
+struct StudyJournalDrop {
+    long line = 0;       ///< in journal.log, 1-based (the header is line 1)
+    long task = -1;      ///< the cell the line names (read without trusting a damaged line); -1: none
+    std::string kind;    ///< torn, damaged, unreadable, blank, out of range, duplicate, header
+    std::string detail;  ///< the why, for a person
+    std::string file;    ///< the journal it is in when not journal.log (a shard's)
+};
+/// A journal's results (after its header line) and the lines it dropped.
+struct StudyJournal {
+    std::map<long, StudyResult> results;  ///< by task
+    std::vector<std::string> lines;       ///< the valid lines, in journal order, without line ends
+    std::vector<StudyJournalDrop> dropped;
+};
+/// Reads the result lines of a journal (its text after the header; firstLine: the number of the first).
+/// CRLF line ends and trailing blanks or NUL bytes are tolerated; a last line without its line end is
+/// kept when its checksum holds. Every other line that is not a valid result of a task in
+/// 0 .. numTasks-1 is listed in `dropped`: torn, damaged (checksum), unreadable, blank, out of range,
+/// or a duplicate of an earlier line (the earlier is kept).
+StudyJournal parseStudyJournal(const std::string& text, long numTasks, long firstLine = 2);
+/// One line: the number of lines dropped, by kind, and the cells computed again; "" when none.
+std::string summarizeStudyJournalDrops(const std::vector<StudyJournalDrop>& dropped, const StudyJournal* journal = nullptr,
+                                       const std::string& file = "journal.log");
+/// Every dropped line, one per text line: "line 5 (task 4): damaged: ...".
+std::string formatStudyJournalDrops(const std::vector<StudyJournalDrop>& dropped);
+
 /// One cell of the summary: a protocol, method and noise level over the subjects.
 struct StudySummaryRow {
     std::string protocol;
@@ -123,11 +154,19 @@ struct StudyProgress {
     double remaining = 0; ///< [s] estimated; NaN before the first task
 };
 
+/// Worker threads of one process at most (the command line's --threads bound).
+constexpr int kMaxStudyThreads = 1024;
+
 struct StudyRunOptions {
     std::string output;          ///< "" : the study's
-    int threads = 0;             ///< worker threads of this process; 0: every core
+    int threads = 0;             ///< worker threads of this process (0 .. kMaxStudyThreads); 0: every CPU it may use
     bool restart = false;        ///< discard a journal (of this or another study) and start over
     std::function<void(const StudyProgress&)> progress;  ///< about once a second and at the end
+    std::function<void(const std::string&)> notice;      ///< at the start: what a repaired journal dropped
+    /// A share of a job array: groups g with g % shards == shard, journaled in
+    /// journal-shard-I-of-N.log (no final files). shards 0: the whole study, merging any shard journals.
+    int shard = 0, shards = 0;
+    bool merge = false;          ///< assemble the journals into the final files; refuse when cells are missing
 };
 
 /// What a finished run did and wrote.
@@ -139,6 +178,11 @@ struct StudyOutcome {
     double synthesisTime = 0;          ///< [s] of taskTime
     int ranks = 1, threads = 1;        ///< workers: ranks x threads per rank
     std::vector<std::string> files;    ///< written, in the folder
+    std::vector<StudyJournalDrop> journalDrops;  ///< journal lines dropped at the start (also in journal_repairs.log)
+    long merged = 0;                   ///< of resumed: cells taken from shard journals
+    int shardJournals = 0;             ///< shard journals merged (and removed)
+    int shard = 0, shards = 0;         ///< a shard's run: total, resumed and computed count its cells only
+    std::string journalSummary;        ///< summarizeStudyJournalDrops of them; "" when none
 };
 
 /// Byte transport from the coordinator to worker ranks (MPI in study_mpi.cpp).
@@ -163,7 +207,8 @@ public:
 /// ask for groups as their threads free up: dynamic load balancing), journals each result as it
 /// arrives, and writes results.csv, timing.csv, summary.csv, study.yaml and plots to the output folder
 /// (each whole or not at all). Throws InputError for an output folder that cannot be used, one that
-/// holds another study's journal (unless restart), or one another run is using.
+/// holds another study's journal (unless restart; also a journal with a damaged header whose first
+/// result, computed again, differs), or one another run is using.
 StudyOutcome runStudy(const Study& study, const StudyRunOptions& options, StudyCoordinatorLink* link = nullptr);
 /// A worker rank's part: asks the coordinator for groups, computes them on `threads` threads, sends
 /// the results back, until the coordinator has no more.

@@ -1,6 +1,7 @@
 #include "studies/study_mpi.h"
 
 #include "basics/errors.h"
+#include "basics/parallel.h"
 
 #include <mpi.h>
 
@@ -9,6 +10,8 @@
 #include <cstdlib>
 #include <stdexcept>
 #include <thread>
+
+#include <unistd.h>
 
 namespace armsim {
 
@@ -72,11 +75,6 @@ private:
     int rank_;
 };
 
-int getEnvInt(const char* name, int fallback) {
-    const char* v = std::getenv(name);
-    return v && *v ? std::atoi(v) : fallback;
-}
-
 }  // namespace
 
 std::optional<std::pair<Study, StudyOutcome>> runStudyOnMpi(const std::string& studyFile, const StudyRunOptions& options) {
@@ -93,9 +91,14 @@ std::optional<std::pair<Study, StudyOutcome>> runStudyOnMpi(const std::string& s
     MPI_Comm_rank(MPI_COMM_WORLD, &rank);
     MPI_Comm_size(MPI_COMM_WORLD, &size);
     StudyRunOptions o = options;
-    if (o.threads <= 0) {
-        const int cores = int(std::max(1u, std::thread::hardware_concurrency()));
-        o.threads = std::max(1, cores / std::max(1, getEnvInt("OMPI_COMM_WORLD_LOCAL_SIZE", 1)));
+    if (o.threads <= 0) {  // this rank's CPUs (mpirun's or srun's binding), shared with its node's ranks
+        MPI_Comm node;
+        int localRanks = 1;
+        check(MPI_Comm_split_type(MPI_COMM_WORLD, MPI_COMM_TYPE_SHARED, rank, MPI_INFO_NULL, &node),
+              "MPI_Comm_split_type");
+        MPI_Comm_size(node, &localRanks);
+        MPI_Comm_free(&node);
+        o.threads = calcThreadsPerRank(getNumUsableCpus(), int(sysconf(_SC_NPROCESSORS_ONLN)), localRanks);
     }
     std::optional<std::pair<Study, StudyOutcome>> outcome;
     try {

@@ -1,17 +1,21 @@
 // The study's machinery: the output folder (lock, journal, final files), the worker threads of one
 // process, the coordinator (rank 0) and the worker-rank loop. The numbers come from runStudyGroup.
+#include "basics/bound.h"
 #include "basics/errors.h"
 #include "basics/files.h"
 #include "basics/format.h"
+#include "basics/parallel.h"
 #include "basics/plot.h"
 #include "studies/study.h"
 
 #include <algorithm>
 #include <chrono>
+#include <cerrno>
 #include <cmath>
 #include <condition_variable>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <deque>
 #include <exception>
 #include <filesystem>
@@ -168,44 +172,64 @@ private:
 };
 
 // The output folder: an exclusive lock for this run (released by the kernel when the process dies) and
-// the journal of finished cells.
+// the journal of finished cells. A shard (--shard I/N) has its own lock and journal
+// (journal-shard-I-of-N.log), so the shards of a job array run side by side; a plain run merges every
+// shard journal of the study into journal.log and removes them.
 class StudyFolder {
 public:
-    StudyFolder(const std::string& dir, const std::string& fingerprint, const Study& study, bool restart) : dir_(dir) {
+    StudyFolder(const std::string& dir, const std::string& fingerprint, const Study& study, bool restart,
+                int shard = 0, int shards = 0)
+        : dir_(dir) {
         std::error_code ec;
         fs::create_directories(dir_, ec);
         if (ec || !fs::is_directory(dir_, ec))
             throw InputError("study output '" + dir_ + "': cannot create the folder" + (ec ? ": " + ec.message() : ""));
-        lock_.fd = ::open((dir_ + "/.lock").c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
-        if (lock_.fd < 0) throw InputError("study output '" + dir_ + "': cannot write in the folder");
-        if (::flock(lock_.fd, LOCK_EX | LOCK_NB) != 0)
-            throw InputError("study output '" + dir_ + "': another armsim study is running in this folder");
-        journalPath_ = dir_ + "/journal.log";
+        const std::string suffix = shards > 0 ? "-shard-" + std::to_string(shard) + "-of-" + std::to_string(shards) : "";
+        if (!lockFile(".lock" + suffix, lock_))
+            throw InputError("study output '" + dir_ + "': another armsim study" +
+                             (shards > 0 ? " of shard " + std::to_string(shard) + "/" + std::to_string(shards) : "") +
+                             " is running in this folder");
+        journalName_ = shards > 0 ? "journal" + suffix + ".log" : "journal.log";
+        journalPath_ = dir_ + "/" + journalName_;
         const std::string header = "# armsim study journal; fingerprint " + fingerprint + "; study " + study.name;
         std::string kept = header + '\n';
         if (doesPathExist(journalPath_) && !restart) {
-            std::ifstream in(journalPath_, std::ios::binary);
-            std::string first, line;
-            std::getline(in, first);
-            if (first.rfind("# armsim study journal", 0) != 0 || first.find(fingerprint) == std::string::npos)
-                throw InputError("study output '" + dir_ + "': journal.log holds results of another study or of a " +
-                                 "changed study file, protocol or population (fingerprint " + fingerprint +
-                                 " expected); use another output folder or --restart to discard them");
-            while (std::getline(in, line)) {
-                StudyResult r;
-                if (in.eof() || !parseStudyJournalLine(line, r) || r.task < 0 || r.task >= study.getNumTasks()) {
-                    ++dropped_;  // a torn last line (no newline) or a damaged one: recomputed
-                    continue;
-                }
-                if (done_.emplace(r.task, r).second) kept += line + '\n';
-            }
+            StudyJournal journal = readJournal(readFileText(journalPath_), fingerprint, study);
+            for (const std::string& line : journal.lines) kept += line + '\n';
+            summary_ = summarizeStudyJournalDrops(journal.dropped, &journal, journalName_);
+            if (!headerNote_.empty()) summary_ = (summary_.empty() ? journalName_ + ": " : summary_ + "; ") + headerNote_;
+            done_ = std::move(journal.results);
+            dropped_ = std::move(journal.dropped);
+        } else if (restart) {
+            std::remove((dir_ + "/journal_repairs.log").c_str());  // the repairs of a discarded journal
         }
+        const std::vector<std::string> merged = shards > 0 ? std::vector<std::string>() : mergeShards(fingerprint, study, restart, kept);
         writeFileAtomically(journalPath_, kept);  // compacted: valid lines only, so appends start on a clean line
+        for (const std::string& name : merged) {  // now in journal.log
+            std::remove((dir_ + "/" + name).c_str());
+            std::remove((dir_ + "/.lock" + name.substr(7, name.size() - 11)).c_str());
+        }
+        shardLocks_.clear();
         journal_.reset(std::fopen(journalPath_.c_str(), "ab"));
-        if (!journal_) throw InputError("study output '" + dir_ + "': cannot append to journal.log");
+        if (!journal_) throw InputError("study output '" + dir_ + "': cannot append to " + journalName_);
     }
     const std::map<long, StudyResult>& getDone() const { return done_; }
-    int getDropped() const { return dropped_; }
+    const std::vector<StudyJournalDrop>& getDropped() const { return dropped_; }
+    const std::string& getDroppedSummary() const { return summary_; }
+    long getNumMerged() const { return merged_; }
+    int getNumShardJournals() const { return shardJournals_; }
+    const std::string& getJournalName() const { return journalName_; }
+    // Appends what the journal dropped to journal_repairs.log (one write), so the repair stays on record
+    // after the compacted journal no longer shows it.
+    void recordRepairs() const {
+        if (summary_.empty()) return;
+        const std::string text = "# " + journalName_ + " read at the start of a run\n" + summary_ + '\n' +
+                                 formatStudyJournalDrops(dropped_);
+        std::unique_ptr<std::FILE, int (*)(std::FILE*)> f(std::fopen((dir_ + "/journal_repairs.log").c_str(), "ab"),
+                                                            std::fclose);
+        if (!f || std::fwrite(text.data(), 1, text.size(), f.get()) != text.size() || std::fflush(f.get()) != 0)
+            throw InputError("study output '" + dir_ + "': cannot append to journal_repairs.log");
+    }
     // Journals results (one write and flush: a kill leaves at most one torn line).
     void append(const std::vector<StudyResult>& results) {
         std::string text;
@@ -214,21 +238,136 @@ public:
             done_.emplace(r.task, r);
         }
         if (std::fwrite(text.data(), 1, text.size(), journal_.get()) != text.size() || std::fflush(journal_.get()) != 0)
-            throw InputError("study output '" + dir_ + "': cannot append to journal.log");
+            throw InputError("study output '" + dir_ + "': cannot append to " + journalName_);
     }
 
 private:
     struct Lock {  // closing the descriptor releases the lock, also when the constructor throws
         int fd = -1;
+        Lock() = default;
+        Lock(Lock&& o) noexcept : fd(o.fd) { o.fd = -1; }
+        Lock& operator=(Lock&&) = delete;
         ~Lock() {
             if (fd >= 0) ::close(fd);
         }
     };
-    std::string dir_, journalPath_;
+
+    // Takes the lock file `name` in the folder: false when another process holds it.
+    bool lockFile(const std::string& name, Lock& lock) const {
+        lock.fd = ::open((dir_ + "/" + name).c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+        if (lock.fd < 0) throw InputError("study output '" + dir_ + "': cannot write in the folder");
+        if (::flock(lock.fd, LOCK_EX | LOCK_NB) == 0) return true;
+        if (errno == EWOULDBLOCK) return false;
+        throw InputError("study output '" + dir_ + "': cannot lock " + dir_ + "/" + name + " (" + std::strerror(errno) +
+                         "): the file system does not support flock (Lustre: mount with -o flock); use an "
+                         "output folder on another file system");
+    }
+
+    // The header: "intact" (with its fingerprint in `theirs`) or damaged.
+    static bool readHeader(const std::string& text, std::size_t& end, std::string& theirs) {
+        end = std::min(text.find('\n'), text.size());
+        std::string first = text.substr(0, end);
+        while (!first.empty() && (first.back() == '\r' || first.back() == ' ')) first.pop_back();
+        const std::string prefix = "# armsim study journal; fingerprint ";
+        const bool intact = first.rfind(prefix, 0) == 0 && first.size() >= prefix.size() + 16 &&
+                            first.find_first_not_of("0123456789abcdef", prefix.size()) == prefix.size() + 16 &&
+                            first.compare(prefix.size() + 16, 8, "; study ") == 0;
+        if (intact) theirs = first.substr(prefix.size(), 16);
+        return intact;
+    }
+
+    // The journal's results. An intact header of another fingerprint is refused; a damaged header (an
+    // editor, a disk error) is recovered when the journal's first result, computed again now, is the
+    // same: the journal is then this study's, whatever its header says.
+    StudyJournal readJournal(const std::string& text, const std::string& fingerprint, const Study& study) {
+        std::size_t end = 0;
+        std::string theirs;
+        if (readHeader(text, end, theirs)) {
+            if (theirs != fingerprint)
+                throw InputError("study output '" + dir_ + "': " + journalName_ + " holds results of another study or " +
+                                 "of a changed study file, protocol or population (fingerprint " + theirs +
+                                 ", this study's " + fingerprint + "); use another output folder or --restart to "
+                                 "discard them");
+            return parseStudyJournal(text.substr(std::min(end + 1, text.size())), study.getNumTasks());
+        }
+        StudyJournal journal = parseStudyJournal(text, study.getNumTasks(), 1);  // line 1 may be a result
+        if (!journal.dropped.empty() && journal.dropped.front().line == 1) {
+            journal.dropped.front().kind = "header";
+            journal.dropped.front().detail =
+                "the header line is damaged (expected '# armsim study journal; fingerprint <16 hex digits>; study <name>')";
+        }
+        if (journal.lines.empty()) {
+            headerNote_ = "the header is damaged and no line is a result: nothing to resume, every cell is computed";
+            return journal;
+        }
+        StudyResult mine;
+        parseStudyJournalLine(journal.lines.front(), mine);
+        const StudyTask t = getStudyTask(study, mine.task);
+        const std::vector<StudyResult> ours = runStudyGroup(study, t.getGroup(study), {t.index});
+        if (ours.size() != 1 || formatStudyResult(ours.front()) != formatStudyResult(mine))
+            throw InputError("study output '" + dir_ + "': " + journalName_ + "'s header is damaged and its results " +
+                             "are not this study's (task " + std::to_string(t.index) + " computed now differs from " +
+                             "its journal line); use another output folder or --restart to discard them");
+        headerNote_ = "the header was damaged: recovered (task " + std::to_string(t.index) +
+                      ", computed again, equals its journal line)";
+        return journal;
+    }
+
+    // Adds the cells of every shard journal (journal-shard-I-of-N.log) to done_ and `kept`; returns their
+    // names (removed once journal.log holds them). A shard still running, or a shard journal of another
+    // study or with a damaged header, is refused. restart: shard journals are discarded.
+    std::vector<std::string> mergeShards(const std::string& fingerprint, const Study& study, bool restart,
+                                         std::string& kept) {
+        std::vector<std::string> names;
+        for (const fs::directory_entry& e : fs::directory_iterator(dir_)) {
+            const std::string name = e.path().filename().string();
+            if (name.size() > 18 && name.rfind("journal-shard-", 0) == 0 && name.compare(name.size() - 4, 4, ".log") == 0)
+                names.push_back(name);
+        }
+        std::sort(names.begin(), names.end());
+        for (const std::string& name : names) {
+            const std::string shard = name.substr(14, name.size() - 18);  // I-of-N
+            shardLocks_.emplace_back();
+            if (!lockFile(".lock-shard-" + shard, shardLocks_.back()))
+                throw InputError("study output '" + dir_ + "': shard " + shard + " is still running in this folder (" +
+                                 name + " is in use): wait for the job array to end");
+            if (restart) continue;
+            const std::string text = readFileText(dir_ + "/" + name);
+            std::size_t end = 0;
+            std::string theirs;
+            if (!readHeader(text, end, theirs) || theirs != fingerprint)
+                throw InputError("study output '" + dir_ + "': " + name + (theirs.empty() ? " has a damaged header" :
+                                 " holds results of another study (fingerprint " + theirs + ", this study's " + fingerprint + ")") +
+                                 ": remove it (its cells are computed again) or use --restart to discard every journal");
+            StudyJournal journal = parseStudyJournal(text.substr(std::min(end + 1, text.size())), study.getNumTasks());
+            ++shardJournals_;
+            for (const std::string& line : journal.lines) {
+                StudyResult r;
+                parseStudyJournalLine(line, r);
+                if (done_.count(r.task)) continue;  // also in journal.log or an earlier shard: the same cell
+                done_.emplace(r.task, std::move(r));
+                kept += line + '\n';
+                ++merged_;
+            }
+            if (!journal.dropped.empty()) {
+                const std::string s = summarizeStudyJournalDrops(journal.dropped, &journal, name);
+                summary_ += (summary_.empty() ? "" : "; ") + s;
+                for (StudyJournalDrop& d : journal.dropped) d.file = name;
+                dropped_.insert(dropped_.end(), journal.dropped.begin(), journal.dropped.end());
+            }
+        }
+        return names;
+    }
+
+    std::string dir_, journalName_, journalPath_;
     Lock lock_;
+    std::vector<Lock> shardLocks_;  // held while their journals are merged
     std::unique_ptr<std::FILE, int (*)(std::FILE*)> journal_{nullptr, std::fclose};
     std::map<long, StudyResult> done_;
-    int dropped_ = 0;
+    std::vector<StudyJournalDrop> dropped_;
+    std::string summary_, headerNote_;
+    long merged_ = 0;
+    int shardJournals_ = 0;
 };
 
 // Per (protocol, method): a statistic of the summary against the noise level.
@@ -296,35 +435,63 @@ std::vector<std::string> writeStudyFiles(const Study& study, const std::string& 
     return files;
 }
 
-int defaultThreads() { return std::max(1u, std::thread::hardware_concurrency()); }
+int defaultThreads() { return getNumUsableCpus(); }
 
 }  // namespace
 
 StudyOutcome runStudy(const Study& study, const StudyRunOptions& options, StudyCoordinatorLink* link) {
     study.validate();
+    checkField("threads", options.threads, Bound::closed(0, kMaxStudyThreads, "0: every CPU this process may use"));
     const auto start = Clock::now();
     StudyOutcome outcome;
     outcome.output = options.output.empty() ? study.output : options.output;
     if (outcome.output.empty()) throw InputError("study: no output folder (set `output:` or --out)");
     const std::string fingerprint = calcStudyFingerprint(study);
-    StudyFolder folder(outcome.output, fingerprint, study, options.restart);
+    const bool sharded = options.shards > 0;
+    if (sharded && (options.shard < 0 || options.shard >= options.shards))
+        throw InputError("study: shard " + std::to_string(options.shard) + "/" + std::to_string(options.shards) +
+                         ": expected I/N with 0 <= I < N");
+    if (sharded && (options.merge || link))
+        throw InputError("study: a shard (--shard) runs on its own threads: not with --merge or MPI ranks");
+    StudyFolder folder(outcome.output, fingerprint, study, options.restart, options.shard, options.shards);
+    outcome.journalDrops = folder.getDropped();
+    outcome.journalSummary = folder.getDroppedSummary();
+    outcome.merged = folder.getNumMerged();
+    outcome.shardJournals = folder.getNumShardJournals();
+    outcome.shard = options.shard;
+    outcome.shards = options.shards;
+    if (!outcome.journalSummary.empty()) {
+        folder.recordRepairs();
+        if (options.notice)
+            options.notice(outcome.journalSummary + " (every line in " + outcome.output + "/journal_repairs.log)");
+    }
 
-    // Missing cells, grouped, in task order.
+    // Missing cells, grouped, in task order (a shard's: its groups only).
     std::deque<GroupWork> pending;
     const int cells = study.getCellsPerGroup();
-    for (long g = 0; g < study.getNumGroups(); ++g) {
+    for (long g = sharded ? options.shard : 0; g < study.getNumGroups(); g += sharded ? options.shards : 1) {
         GroupWork w{g, {}};
-        for (long t = g * cells; t < (g + 1) * cells; ++t)
+        for (long t = g * cells; t < (g + 1) * cells; ++t) {
             if (!folder.getDone().count(t)) w.tasks.push_back(t);
+            else ++outcome.resumed;
+            ++outcome.total;
+        }
         if (!w.tasks.empty()) pending.push_back(std::move(w));
     }
-    outcome.total = study.getNumTasks();
-    outcome.resumed = long(folder.getDone().size());
+    if (options.merge && !pending.empty()) {
+        long missing = 0;
+        for (const GroupWork& w : pending) missing += long(w.tasks.size());
+        throw InputError("study output '" + outcome.output + "': --merge: " + std::to_string(missing) + " of " +
+                         std::to_string(outcome.total) + " cells are in no journal (a shard failed or has not run; " +
+                         "first missing: task " + std::to_string(pending.front().tasks.front()) + "); run the " +
+                         "study without --merge to compute them");
+    }
 
     StudyProgress progress;
     progress.total = outcome.total;
     progress.resumed = progress.done = outcome.resumed;
-    for (const auto& [task, r] : folder.getDone()) progress.failed += r.status == "failed";
+    for (const auto& [task, r] : folder.getDone())
+        progress.failed += r.status == "failed" && (!sharded || getStudyTask(study, task).getGroup(study) % options.shards == options.shard);
     auto record = [&](const std::vector<StudyResult>& results) {
         if (results.empty()) return;
         folder.append(results);
@@ -391,8 +558,14 @@ StudyOutcome runStudy(const Study& study, const StudyRunOptions& options, StudyC
     }
     report();
 
-    outcome.files = writeStudyFiles(study, outcome.output, folder.getDone());
+    if (sharded) {  // the plain run (or --merge) after the job array writes the files
+        outcome.files = {folder.getJournalName()};
+    } else {
+        outcome.files = writeStudyFiles(study, outcome.output, folder.getDone());
+    }
+    if (doesPathExist(outcome.output + "/journal_repairs.log")) outcome.files.push_back("journal_repairs.log");
     for (const auto& [task, r] : folder.getDone()) {
+        if (sharded && getStudyTask(study, task).getGroup(study) % options.shards != options.shard) continue;
         outcome.failed += r.status == "failed";
         outcome.notConverged += r.status == "not-converged";
     }

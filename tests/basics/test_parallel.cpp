@@ -6,7 +6,10 @@
 #include <atomic>
 #include <csignal>
 #include <stdexcept>
+#include <thread>
 #include <vector>
+
+#include <sched.h>
 
 using namespace armsim;
 
@@ -48,4 +51,31 @@ TEST(RunParallel, InterruptionStopsBeforeTheNextTask) {
     requestInterruption(0);
     EXPECT_EQ(started.load(), 1);  // checked before task 1
     EXPECT_EQ(getInterruption(), 0);
+}
+
+// The default thread count follows the affinity mask (taskset, Slurm's binding), not the machine.
+TEST(UsableCpus, CountTheAffinityMask) {
+    cpu_set_t mask;
+    ASSERT_EQ(sched_getaffinity(0, sizeof mask, &mask), 0);
+    EXPECT_EQ(getNumUsableCpus(), CPU_COUNT(&mask));
+    int first = 0;
+    while (!CPU_ISSET(first, &mask)) ++first;
+    int restricted = 0;
+    std::thread([&] {  // the mask is per thread: narrow this one to a single CPU, as `taskset -c` does
+        cpu_set_t one;
+        CPU_ZERO(&one);
+        CPU_SET(first, &one);
+        if (sched_setaffinity(0, sizeof one, &one) == 0) restricted = getNumUsableCpus();
+    }).join();
+    EXPECT_EQ(restricted, 1);
+}
+
+TEST(UsableCpus, RanksShareTheNodeUnlessBoundToTheirOwnCpus) {
+    EXPECT_EQ(calcThreadsPerRank(2, 2, 1), 2);    // one rank, the whole node
+    EXPECT_EQ(calcThreadsPerRank(2, 2, 2), 1);    // two unbound ranks share two CPUs
+    EXPECT_EQ(calcThreadsPerRank(64, 64, 4), 16);
+    EXPECT_EQ(calcThreadsPerRank(1, 2, 2), 1);    // mpirun's bind-to-core
+    EXPECT_EQ(calcThreadsPerRank(8, 64, 2), 8);   // srun --cpus-per-task=8 with task binding
+    EXPECT_EQ(calcThreadsPerRank(32, 64, 8), 8);  // bound to a socket shared by four ranks: its share
+    EXPECT_EQ(calcThreadsPerRank(4, 2, 3), 1);    // never below one
 }

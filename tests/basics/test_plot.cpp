@@ -3,8 +3,13 @@
 
 #include <gtest/gtest.h>
 
+#include <csignal>
 #include <filesystem>
 #include <fstream>
+
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 using namespace armsim;
 namespace fs = std::filesystem;
@@ -47,4 +52,50 @@ TEST(Plot, UnwritablePathOrEmptySpecFailsAndLeavesNoFile) {
     PlotSpec empty;
     EXPECT_THROW(writePlotPng("/tmp/armsim_empty.png", empty), std::invalid_argument);
     EXPECT_FALSE(fs::exists("/tmp/armsim_empty.png"));
+}
+
+TEST(Plot, ACutOffPngIsNotAWholePng) {
+    const fs::path p = fs::temp_directory_path() / ("armsim_whole_" + std::to_string(::getpid()) + ".png");
+    PlotSpec spec;
+    spec.series.push_back({"line", {0, 1, 2}, {0, 1, 4}});
+    writePlotPng(p.string(), spec);
+    EXPECT_TRUE(isWholePng(p.string()));
+    const auto size = fs::file_size(p);
+    fs::resize_file(p, size / 2);
+    EXPECT_FALSE(isWholePng(p.string()));
+    fs::remove(p);
+    EXPECT_FALSE(isWholePng(p.string()));  // no file
+}
+
+// A full disk, simulated by a file-size limit of 4 kB on a child process: the plot's write is cut off;
+// the error names this plot and no file is left (the check of isWholePng, not PLplot, catches it).
+TEST(Plot, AWriteCutOffByAFullDiskLeavesNoFileAndNamesThePlot) {
+    const fs::path p = fs::temp_directory_path() / ("armsim_full_" + std::to_string(::getpid()) + ".png");
+    const pid_t child = fork();
+    ASSERT_GE(child, 0);
+    if (child == 0) {
+        std::signal(SIGXFSZ, SIG_IGN);  // writes past the limit fail with EFBIG, as on a full disk
+        const rlimit limit{4096, 4096};
+        setrlimit(RLIMIT_FSIZE, &limit);
+        PlotSpec spec;
+        spec.series.push_back({"line", {0, 1, 2}, {0, 1, 4}});
+        int code = 1;
+        try {
+            writePlotPng(p.string(), spec);
+            code = 2;  // no error: the cut-off file was taken for a plot
+        } catch (const InputError& e) {
+            const std::string what = e.what();
+            code = what.find(p.string()) != std::string::npos && what.find("cut off") != std::string::npos ? 0 : 3;
+        } catch (...) {
+            code = 4;
+        }
+        _exit(code);
+    }
+    int status = 0;
+    ASSERT_EQ(waitpid(child, &status, 0), child);
+    ASSERT_TRUE(WIFEXITED(status));
+    EXPECT_EQ(WEXITSTATUS(status), 0) << "2: no error (a cut-off file left), 3: another message, 4: another error";
+    EXPECT_FALSE(fs::exists(p));
+    for (const auto& e : fs::directory_iterator(fs::temp_directory_path()))  // nor its temporary
+        EXPECT_EQ(e.path().filename().string().find(p.filename().string() + ".tmp"), std::string::npos) << e.path();
 }

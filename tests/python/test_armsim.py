@@ -81,6 +81,8 @@ def test_run_study_writes_the_commands_files(tmp_path):
     (lambda m: armsim.arm_trial(m, angle_deg=400), ValueError, "400"),
     (lambda m: armsim.arm_trial(m, effort="sideways"), ValueError, "expected flexion or extension"),
     (lambda m: armsim.run_study("/no/such/study.yaml"), FileNotFoundError, "/no/such/study.yaml"),
+    (lambda m: armsim.run_study("/no/such/study.yaml", threads=-3), ValueError, "field 'threads' = -3: expected in [0, 1024]"),
+    (lambda m: armsim.run_study("/no/such/study.yaml", threads=5000), ValueError, "field 'threads' = 5000"),
 ])
 def test_bad_arguments_raise_with_the_message(thesis, call, error, message):
     with pytest.raises(error) as e:

@@ -1,6 +1,8 @@
 // Population studies (issue 13): task numbering, the journal line format, a study cell against the
 // validation's own computation (a second path to the same numbers), failures recorded, resume from a
-// partial and torn journal, thread-count independence, and bad study files.
+// partial and torn journal, hand-damaged journals (CRLF, garbage, altered and duplicate lines: every
+// dropped line reported, issue 33), shards of a job array merged, thread-count independence, and bad
+// study files.
 #include "basics/errors.h"
 #include "basics/files.h"
 #include "studies/study.h"
@@ -12,6 +14,9 @@
 #include <fstream>
 #include <set>
 #include <sstream>
+
+#include <fcntl.h>
+#include <sys/file.h>
 #include <unistd.h>
 
 using namespace armsim;
@@ -228,9 +233,10 @@ TEST(Study, ReadsAStudyFileAndNamesTheFileLineAndFieldOfEveryError) {
     const fs::path d = freshDir("files");
     std::ofstream(d / "one.yaml") << "kind: torque\nname: one\nconditions:\n  - {flexion_deg: 90}\n";
     const std::string good = "kind: study\nname: s\nsubjects: 2\nprotocols: [thesis, one.yaml]\nnoise_levels: [0.02]\n"
-                             "methods:\n  - {method: thesis}\n  - {method: synergist-va, label: va, activation_sd: 0.03}\n";
+                             "methods:\n  - {method: thesis, label: th\u00e9se \u03bc\U0001F4AA}\n  - {method: synergist-va, label: va, activation_sd: 0.03}\n";
     std::ofstream(d / "good.yaml") << good;
     const Study s = readStudy((d / "good.yaml").string());
+    EXPECT_EQ(s.methods[0].label, "th\u00e9se \u03bc\U0001F4AA");  // UTF-8 of 2, 2 and 4 bytes
     EXPECT_EQ(s.subjects, 2);
     ASSERT_EQ(s.protocols.size(), 2u);
     EXPECT_EQ(s.protocols[1].protocol.name, "one");
@@ -258,6 +264,11 @@ TEST(Study, ReadsAStudyFileAndNamesTheFileLineAndFieldOfEveryError) {
         {"kind: study\nsubjects: 2\nprotocols: []\nmethods:\n  - {method: thesis}\n", "protocols"},
         {"kind: study\nsubjects: 2\nprotocols: [thesis]\nmethods:\n  - {method: thesis, label: \"a\\tb\"}\n",
          "methods[0].label"},
+        // Latin-1 bytes (a file not saved as UTF-8): PLplot would print "malformed" and draw nothing.
+        {"kind: study\nsubjects: 2\nprotocols: [thesis]\nmethods:\n  - {method: thesis, label: caf\xe9}\n",
+         "field 'methods[0].label' = 'caf\\xe9': not UTF-8 text"},
+        {"kind: study\nname: r\xe9sum\xe9\nsubjects: 2\nprotocols: [thesis]\nmethods:\n  - {method: thesis}\n",
+         "field 'name' = 'r\\xe9sum\\xe9': not UTF-8 text"},
     };
     for (std::size_t i = 0; i < cases.size(); ++i) {
         const fs::path p = d / ("bad" + std::to_string(i) + ".yaml");
@@ -312,3 +323,257 @@ TEST(Study, TruthAndPriorInAStudyFileAreTheOutOfFamilyValidation) {
     fs::remove_all(dir);
 }
 
+
+namespace {
+
+// A journal line of task `task` without computing it (the parser only needs a well-formed result).
+std::string makeJournalLine(long task) {
+    StudyResult r;
+    r.task = task;
+    r.protocol = "thesis";
+    r.status = "ok";
+    r.row.subject = int(task);
+    r.row.method = r.row.estimate.method = "thesis";
+    r.row.noise = 0.02;
+    r.row.estimate.mass = 0.1 + 0.01 * double(task);
+    return formatStudyJournalLine(r);
+}
+
+// 3 subjects x thesis x 1 % x thesis: 3 cells, about a second.
+Study makeTinyStudy() {
+    Study s = smallStudy();
+    s.protocols.resize(1);
+    s.noiseLevels.resize(1);
+    s.methods.resize(1);
+    return s;
+}
+
+std::string kindsOf(const StudyJournal& j) {
+    std::string out;
+    for (const StudyJournalDrop& d : j.dropped) out += std::to_string(d.line) + ":" + std::to_string(d.task) + ":" + d.kind + " ";
+    return out;
+}
+
+}  // namespace
+
+TEST(StudyJournal, CrlfLineEndsAndTrailingBlanksLoseNothing) {
+    const std::string a = makeJournalLine(0), b = makeJournalLine(1), c = makeJournalLine(2);
+    const StudyJournal crlf = parseStudyJournal(a + "\r\n" + b + "\r\n" + c + "\r\n", 3);
+    EXPECT_EQ(crlf.results.size(), 3u);
+    EXPECT_TRUE(crlf.dropped.empty()) << kindsOf(crlf);
+    EXPECT_EQ(crlf.lines, (std::vector<std::string>{a, b, c}));  // kept without the CR
+    const StudyJournal blanks = parseStudyJournal(a + "  \t\n" + b + "\n" + c, 3);  // last line whole, no line end
+    EXPECT_EQ(blanks.results.size(), 3u);
+    EXPECT_TRUE(blanks.dropped.empty()) << kindsOf(blanks);
+    EXPECT_EQ(summarizeStudyJournalDrops(blanks.dropped), "");
+}
+
+TEST(StudyJournal, EveryDroppedLineIsListedWithItsCellAndWhy) {
+    const std::string a = makeJournalLine(0), b = makeJournalLine(1), c = makeJournalLine(2), d = makeJournalLine(3);
+    std::string altered = b;
+    altered[altered.size() / 2] = altered[altered.size() / 2] == '1' ? '2' : '1';
+    const std::string text = a + "\n" +                         // line 2: kept
+                             altered + "\n" +                   // 3: damaged, task 1
+                             "\n" +                             // 4: blank
+                             a + "\n" +                         // 5: duplicate of line 2
+                             makeJournalLine(99) + "\n" +       // 6: out of range
+                             "rm -rf / # not a journal line\n" + // 7: unreadable
+                             c + "\n" +                         // 8: kept
+                             std::string(5, '\0') + "\n" +      // 9: a NUL-filled tail
+                             d.substr(0, 40);                   // 10: torn, task 3
+    const StudyJournal j = parseStudyJournal(text, 10);
+    EXPECT_EQ(j.results.size(), 2u);
+    EXPECT_EQ(j.lines, (std::vector<std::string>{a, c}));
+    EXPECT_EQ(kindsOf(j), "3:1:damaged 4:-1:blank 5:0:duplicate 6:99:out of range 7:-1:unreadable 9:-1:blank "
+                          "10:3:torn ");
+    const std::string summary = summarizeStudyJournalDrops(j.dropped, &j);
+    EXPECT_NE(summary.find("7 lines dropped (2 blank, 1 damaged, 1 duplicate, 1 out of range, 1 torn, 1 unreadable)"),
+              std::string::npos) << summary;
+    EXPECT_NE(summary.find("computed again: tasks 1, 3"), std::string::npos) << summary;
+    EXPECT_NE(summary.find("1 line named no readable task"), std::string::npos) << summary;
+    const std::string details = formatStudyJournalDrops(j.dropped);
+    EXPECT_NE(details.find("line 3 (task 1): damaged: its checksum does not match"), std::string::npos) << details;
+    EXPECT_NE(details.find("line 5 (task 0): duplicate: task 0 is also line 2"), std::string::npos) << details;
+    EXPECT_NE(details.find("line 9: blank: only NUL bytes"), std::string::npos) << details;
+    EXPECT_NE(details.find("line 10 (task 3): torn"), std::string::npos) << details;
+}
+
+// A journal converted to CRLF and damaged by hand: the run keeps every intact cell, recomputes the
+// damaged ones, says which (notice, outcome, journal_repairs.log) and writes the uninterrupted files.
+TEST(StudyJournal, AHandDamagedJournalIsRepairedVisiblyAndEndsWithTheUninterruptedFiles) {
+    const fs::path full = freshDir("journal_full"), damaged = freshDir("journal_damaged");
+    const Study s = makeTinyStudy();
+    StudyRunOptions o;
+    o.output = full.string();
+    o.threads = 2;
+    const StudyOutcome first = runStudy(s, o);
+    ASSERT_EQ(first.total, 3);
+    EXPECT_TRUE(first.journalDrops.empty());
+    EXPECT_FALSE(fs::exists(full / "journal_repairs.log"));
+
+    std::istringstream in(readText(full / "journal.log"));
+    std::string header, line;
+    std::getline(in, header);
+    std::vector<std::string> lines;
+    while (std::getline(in, line)) lines.push_back(line);
+    ASSERT_EQ(lines.size(), 3u);
+    std::sort(lines.begin(), lines.end(), [](const std::string& x, const std::string& y) {
+        return std::stol(x.substr(17)) < std::stol(y.substr(17));  // by task
+    });
+    lines[1][lines[1].size() / 2] = lines[1][lines[1].size() / 2] == '1' ? '2' : '1';  // task 1 altered
+    std::ofstream(damaged / "journal.log", std::ios::binary)
+        << header << "\r\n" << lines[0] << "\r\n" << lines[1] << "\r\n" << lines[2] << "\r\n" << "garbage\x01\x02\r\n";
+
+    std::vector<std::string> notices;
+    o.output = damaged.string();
+    o.notice = [&](const std::string& text) { notices.push_back(text); };
+    const StudyOutcome repaired = runStudy(s, o);
+    EXPECT_EQ(repaired.resumed, 2);   // tasks 0 and 2 survive the CRLF
+    EXPECT_EQ(repaired.computed, 1);  // task 1 again
+    ASSERT_EQ(repaired.journalDrops.size(), 2u);
+    EXPECT_EQ(repaired.journalDrops[0].kind, "damaged");
+    EXPECT_EQ(repaired.journalDrops[0].task, 1);
+    EXPECT_EQ(repaired.journalDrops[0].line, 3);
+    EXPECT_EQ(repaired.journalDrops[1].kind, "unreadable");
+    ASSERT_EQ(notices.size(), 1u);
+    EXPECT_NE(notices[0].find("2 lines dropped (1 damaged, 1 unreadable); computed again: task 1"), std::string::npos)
+        << notices[0];
+    const std::string record = readText(damaged / "journal_repairs.log");
+    EXPECT_NE(record.find("line 3 (task 1): damaged"), std::string::npos) << record;
+    EXPECT_NE(record.find("line 5: unreadable"), std::string::npos) << record;
+    EXPECT_EQ(readText(damaged / "results.csv") + readText(damaged / "summary.csv"),
+              readText(full / "results.csv") + readText(full / "summary.csv"));
+
+    notices.clear();
+    const StudyOutcome again = runStudy(s, o);  // the journal was compacted: nothing more to drop
+    EXPECT_TRUE(again.journalDrops.empty());
+    EXPECT_TRUE(notices.empty());
+    EXPECT_EQ(again.resumed, 3);
+    EXPECT_EQ(readText(damaged / "journal_repairs.log"), record);  // the record stays
+}
+
+TEST(StudyJournal, ThreadsOutOfRangeAreRefusedWithTheValue) {
+    StudyRunOptions o;
+    o.output = freshDir("threads").string();
+    for (int threads : {-3, 5000}) {
+        o.threads = threads;
+        try {
+            runStudy(smallStudy(), o);
+            FAIL() << "threads = " << threads << " was accepted";
+        } catch (const InputError& e) {
+            EXPECT_NE(std::string(e.what()).find("'threads' = " + std::to_string(threads)), std::string::npos) << e.what();
+        }
+    }
+}
+
+// A damaged header (an editor, a disk error) is recovered when the journal's first result, computed
+// again, equals its line; the same damaged journal under another seed is refused; a file with no
+// result line starts over. Each says so.
+TEST(StudyJournal, ADamagedHeaderIsRecoveredOnlyForTheStudyWhoseResultsItHolds) {
+    const Study s = makeTinyStudy();
+    const fs::path full = freshDir("header_full"), damaged = freshDir("header_damaged"), other = freshDir("header_other"),
+                   junk = freshDir("header_junk");
+    StudyRunOptions o;
+    o.output = full.string();
+    o.threads = 2;
+    runStudy(s, o);
+    const std::string journal = readText(full / "journal.log");
+    const std::string body = journal.substr(journal.find('\n') + 1);
+    const std::string broken = std::string("# armsim stu\x17\x00dy jo") + "\n" + body;  // line 1 overwritten
+    std::ofstream(damaged / "journal.log", std::ios::binary) << broken;
+    std::ofstream(other / "journal.log", std::ios::binary) << broken;
+    std::ofstream(junk / "journal.log", std::ios::binary) << "\x7f\x45garbage\n";
+
+    std::vector<std::string> notices;
+    o.notice = [&](const std::string& text) { notices.push_back(text); };
+    o.output = damaged.string();
+    const StudyOutcome recovered = runStudy(s, o);
+    EXPECT_EQ(recovered.resumed, 3);
+    EXPECT_EQ(recovered.computed, 0);
+    ASSERT_EQ(notices.size(), 1u);
+    EXPECT_NE(notices[0].find("journal.log: 1 line dropped (1 header); the header was damaged: recovered (task"),
+              std::string::npos) << notices[0];
+    EXPECT_NE(readText(damaged / "journal_repairs.log").find("line 1: header: the header line is damaged"),
+              std::string::npos);
+    EXPECT_EQ(readText(damaged / "results.csv"), readText(full / "results.csv"));
+    EXPECT_EQ(readText(damaged / "journal.log"), journal);  // compacted under a good header again
+
+    Study reseeded = s;
+    reseeded.seed = 6;
+    o.output = other.string();
+    try {
+        runStudy(reseeded, o);
+        FAIL() << "a damaged journal of another seed was accepted";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("header is damaged and its results are not this study's"), std::string::npos)
+            << e.what();
+        EXPECT_NE(std::string(e.what()).find("--restart"), std::string::npos) << e.what();
+    }
+    EXPECT_EQ(readText(other / "journal.log"), broken);  // refused: left as it was
+
+    notices.clear();
+    o.output = junk.string();
+    const StudyOutcome fresh = runStudy(s, o);
+    EXPECT_EQ(fresh.computed, 3);
+    ASSERT_EQ(notices.size(), 1u);
+    EXPECT_NE(notices[0].find("no line is a result: nothing to resume"), std::string::npos) << notices[0];
+}
+
+// Job arrays (--shard I/N): each shard computes its groups (g % N == I) into its own journal and writes
+// no files; --merge takes the finished shards' journals into journal.log but refuses to write files
+// while cells are missing; a shard still running blocks the merge; the merge after the last shard
+// computes nothing and writes the uninterrupted run's files.
+TEST(StudyShards, ShardsThenAPlainRunWriteTheUninterruptedFiles) {
+    const fs::path d = freshDir("shards");
+    StudyRunOptions o;
+    o.output = d.string();
+    o.threads = 1;
+    o.shards = 3;
+    long computed = 0;
+    for (int shard : {0, 1}) {
+        o.shard = shard;
+        const StudyOutcome r = runStudy(smallStudy(), o);
+        EXPECT_EQ(r.total, 8);  // 2 of the 6 groups x 4 cells
+        EXPECT_EQ(r.computed, 8);
+        EXPECT_EQ(r.files, std::vector<std::string>{"journal-shard-" + std::to_string(shard) + "-of-3.log"});
+        computed += r.computed;
+    }
+    EXPECT_FALSE(fs::exists(d / "results.csv"));
+    EXPECT_THROW(runStudy(smallStudy(), StudyRunOptions{o.output, 1, false, {}, {}, 3, 3}), InputError);  // no shard 3/3
+
+    StudyRunOptions merge;
+    merge.output = d.string();
+    merge.merge = true;
+    try {
+        runStudy(smallStudy(), merge);
+        FAIL() << "--merge with shard 2/3 missing was accepted";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("--merge: 8 of 24 cells are in no journal"), std::string::npos) << e.what();
+    }
+    o.shard = 2;
+    computed += runStudy(smallStudy(), o).computed;
+    EXPECT_EQ(computed, 24);
+
+    {  // shard 2 running again (its lock held): the merge waits for it
+        const int fd = ::open((d / ".lock-shard-2-of-3").c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+        ASSERT_GE(fd, 0);
+        ASSERT_EQ(::flock(fd, LOCK_EX | LOCK_NB), 0);
+        try {
+            runStudy(smallStudy(), merge);
+            FAIL() << "a merge while a shard runs was accepted";
+        } catch (const InputError& e) {
+            EXPECT_NE(std::string(e.what()).find("shard 2-of-3 is still running"), std::string::npos) << e.what();
+        }
+        ::close(fd);
+    }
+    const StudyOutcome merged = runStudy(smallStudy(), merge);
+    EXPECT_EQ(merged.computed, 0);
+    EXPECT_EQ(merged.resumed, 24);
+    EXPECT_EQ(merged.merged, 8);  // shard 2's; the first --merge took shards 0 and 1 into journal.log
+    EXPECT_EQ(merged.shardJournals, 1);
+    EXPECT_EQ(readText(d / "results.csv") + readText(d / "summary.csv"), referenceResults());
+    for (int shard : {0, 1, 2}) EXPECT_FALSE(fs::exists(d / ("journal-shard-" + std::to_string(shard) + "-of-3.log")));
+    const StudyOutcome again = runStudy(smallStudy(), StudyRunOptions{o.output, 1});  // all in journal.log now
+    EXPECT_EQ(again.resumed, 24);
+    EXPECT_EQ(again.merged, 0);
+}

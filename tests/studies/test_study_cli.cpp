@@ -1,6 +1,7 @@
 // armsim study end to end: threads, one MPI rank and two MPI ranks write byte-identical results; a
 // study killed with SIGKILL (the whole process, or one MPI rank) and started again with the same command
-// finishes with the files of an uninterrupted run.
+// finishes with the files of an uninterrupted run; the default thread count follows the affinity mask;
+// a repaired journal is reported on stderr and in the run's summary.
 #include "tests/support/temp_files.h"
 #include "tests/support/run_armsim.h"
 
@@ -11,6 +12,7 @@
 #include <regex>
 #include <set>
 #include <sstream>
+#include <sched.h>
 #include <unistd.h>
 
 namespace fs = std::filesystem;
@@ -94,6 +96,52 @@ TEST(StudyCli, ThreadsOneRankAndTwoRanksWriteByteIdenticalResults) {
 #endif
 }
 
+// Without --threads a study uses the CPUs its process may use: taskset -c 0 gives one thread.
+TEST(StudyCli, DefaultThreadsAreTheCpusOfTheAffinityMask) {
+    const fs::path d = freshDir("affinity");
+    std::ofstream(d / "one.yaml") << "kind: study\nname: one\nsubjects: 1\nprotocols: [thesis]\nnoise_levels: [0.02]\n"
+                                     "methods:\n  - {method: thesis}\n";
+    cpu_set_t mask;
+    ASSERT_EQ(sched_getaffinity(0, sizeof mask, &mask), 0);
+    const int cpus = CPU_COUNT(&mask);
+    auto threadsOf = [](const std::string& output) {
+        std::smatch m;
+        return std::regex_search(output, m, std::regex("rank x (\\d+) thread")) ? std::stoi(m[1]) : -1;
+    };
+    const CommandResult all = runArmsim("study " + (d / "one.yaml").string() + " --quiet --out " + (d / "all").string());
+    ASSERT_EQ(all.exitCode, 0) << all.output;
+    EXPECT_EQ(threadsOf(all.output), cpus) << all.output;
+    if (runScript(d, "command -v taskset\n").exitCode != 0) GTEST_SKIP() << "taskset (util-linux) not installed";
+    const CommandResult one = runScript(d, "taskset -c 0 " + std::string(ARMSIM_EXE) + " study " +
+                                               (d / "one.yaml").string() + " --quiet --out " + (d / "one").string() + "\n");
+    ASSERT_EQ(one.exitCode, 0) << one.output;
+    EXPECT_EQ(threadsOf(one.output), 1) << one.output;
+}
+
+// A journal copied through Windows (CRLF) with junk appended: every result is kept, the junk line is
+// reported (stderr warning and the summary) and the files are the first run's.
+TEST(StudyCli, ARepairedJournalIsReportedOnStderrAndInTheSummary) {
+    const fs::path d = freshDir("journal");
+    std::ofstream(d / "two.yaml") << "kind: study\nname: two\nsubjects: 2\nprotocols: [thesis]\nnoise_levels: [0.02]\n"
+                                     "methods:\n  - {method: thesis}\n";
+    const std::string command = "study " + (d / "two.yaml").string() + " --threads 1 --quiet --out " + (d / "out").string();
+    const CommandResult first = runArmsim(command);
+    ASSERT_EQ(first.exitCode, 0) << first.output;
+    const std::string reference = results(d / "out");
+    const std::string journal = readText(d / "out" / "journal.log");
+    std::string crlf;
+    for (char c : journal) crlf += c == '\n' ? std::string("\r\n") : std::string(1, c);
+    std::ofstream(d / "out" / "journal.log", std::ios::binary) << crlf << "junk after a crash\r\n";
+    const CommandResult again = runArmsim(command);
+    ASSERT_EQ(again.exitCode, 0) << again.output;
+    EXPECT_EQ(resumedCount(again.output), 2) << again.output;
+    EXPECT_NE(again.output.find("warning: journal.log: 1 line dropped (1 unreadable)"), std::string::npos) << again.output;
+    EXPECT_NE(again.output.find("  journal.log: 1 line dropped (1 unreadable); 1 line named no readable task"),
+              std::string::npos) << again.output;
+    EXPECT_NE(readText(d / "out" / "journal_repairs.log").find("line 4: unreadable"), std::string::npos);
+    EXPECT_EQ(results(d / "out"), reference);
+}
+
 TEST(StudyCli, AStudyKilledMidwayAndStartedAgainFinishesWithTheUninterruptedFiles) {
     const fs::path d = freshDir("kill");
     const fs::path study = writeStudy(d);
@@ -139,3 +187,14 @@ TEST(StudyCli, AnMpiStudyWithOneRankKilledFinishesWhenStartedAgain) {
     EXPECT_EQ(results(out), results(d / "full"));
 }
 #endif
+
+TEST(StudyCli, ABadShardIsRefusedNamingTheValue) {
+    const fs::path d = freshDir("bad_shard");
+    for (const std::string shard : {"3/2", "x", "1/0", "-1/2", "1/2x", "/2"}) {
+        const CommandResult r = runArmsim("study " + (d / "none.yaml").string() + " --shard '" + shard + "' --out " +
+                                          (d / "out").string());
+        EXPECT_NE(r.exitCode, 0) << shard;
+        EXPECT_NE(r.output.find("--shard '" + shard + "': expected I/N"), std::string::npos) << r.output;
+    }
+    EXPECT_FALSE(fs::exists(d / "out"));
+}
