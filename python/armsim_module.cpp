@@ -77,6 +77,7 @@ MuscleGroup parseEffort(const std::string& effort) {
 
 PYBIND11_MODULE(_armsim, mod) {
     mod.doc() = "armsim: a musculoskeletal arm simulator with Virtual Muscle force elements (C++ core).";
+    mod.attr("__version__") = ARMSIM_VERSION;   // the CMake project's version
 
     py::register_exception_translator([](std::exception_ptr p) {
         try {
@@ -190,9 +191,11 @@ PYBIND11_MODULE(_armsim, mod) {
     mod.def(
         "arm_trial",
         [](const Model& m, double angleDeg, double activation, const std::string& effort, double antagonist,
-           double rest, double rise, double hold, double rate, double window) {
+           double rest, double rise, double hold, double rate, std::optional<double> window,
+           std::optional<double> rotationDeg) {
             IsometricTrialSettings s;
             s.elbowAngle = degToRad(angleDeg);
+            if (rotationDeg) s.forearmRotationDeg = *rotationDeg;
             s.activation = activation;
             s.effort = parseEffort(effort);
             s.antagonistActivation = antagonist;
@@ -200,7 +203,7 @@ PYBIND11_MODULE(_armsim, mod) {
             s.riseTime = rise;
             s.holdDuration = hold;
             s.sampleRate = rate;
-            s.averagingWindow = window;
+            s.averagingWindow = window ? *window : std::min(1.0, hold);   // as a trial file's default
             IsometricTrialResult r;
             {
                 py::gil_scoped_release release;
@@ -218,14 +221,16 @@ PYBIND11_MODULE(_armsim, mod) {
         },
         py::arg("model"), py::arg("angle_deg") = 90.0, py::arg("activation") = 1.0, py::arg("effort") = "flexion",
         py::arg("antagonist_activation") = 0.0, py::arg("rest") = 0.5, py::arg("rise") = 0.0, py::arg("hold") = 3.0,
-        py::arg("rate") = 1000.0, py::arg("averaging_window") = 1.0,
-        "An isometric arm trial with the elbow locked at angle_deg (included angle, as `armsim trial`):\n"
+        py::arg("rate") = 1000.0, py::arg("averaging_window") = py::none(), py::arg("rotation_deg") = py::none(),
+        "An isometric arm trial with the elbow locked at angle_deg (included angle, as `armsim trial`) and,\n"
+        "on a model whose forearm rotates (the twin), the forearm locked at rotation_deg (+ = supination;\n"
+        "None: the model's posture):\n"
         "rest [s] relaxed (the transducer is tared), then the agonists of `effort` ('flexion' or\n"
         "'extension') rise to `activation` over `rise` [s] and hold for `hold` [s]; the antagonists go to\n"
         "antagonist_activation. Returns (series, summary): series a dict of float64 arrays (time_s,\n"
         "activation, elbow_angle_deg, muscle_force_N, holding_torque_Nm, muscle_torque_Nm, strap_force_N,\n"
         "per-muscle force_<muscle>_N with several muscles, states); summary the means over the last\n"
-        "averaging_window [s]. Releases the GIL.");
+        "averaging_window [s] (None: 1 s, or the whole hold when shorter). Releases the GIL.");
 
     mod.def(
         "run_study",

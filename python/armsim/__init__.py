@@ -15,7 +15,7 @@ trials in parallel.
     armsim.render_video(model, series, "mvc.mp4")
 """
 from ._armsim import (Model, arm_trial, design_protocol, identify, identify_torque, muscle_trial, read_torque_data,
-                      run_protocol, run_study, steady_state, validate, validate_elbow)
+                      run_protocol, run_study, steady_state, validate, validate_elbow, __version__)
 
 
 def render_video(model, series, path, fps=30.0, width=1280, height=720, playback_speed=1.0, overlay=True,
@@ -40,5 +40,5 @@ def render_frame(model, series, time, width=640, height=360, overlay=True, super
     return _render.render_frame(model, series, time, width, height, overlay, supersample, color_by)
 
 
-__all__ = ["Model", "arm_trial", "design_protocol", "identify", "identify_torque", "muscle_trial", "read_torque_data", "render_frame",
+__all__ = ["__version__", "Model", "arm_trial", "design_protocol", "identify", "identify_torque", "muscle_trial", "read_torque_data", "render_frame",
            "render_video", "run_protocol", "run_study", "steady_state", "validate", "validate_elbow"]

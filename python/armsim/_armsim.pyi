@@ -7,6 +7,8 @@ import numpy.typing as npt
 
 Array = npt.NDArray[np.float64]
 
+__version__: str
+
 class Model:
     """An arm with its muscles (a model file of assets/models/ or your own)."""
     @staticmethod
@@ -28,7 +30,8 @@ def muscle_trial(model: Model, path_length: float = 0.375, activation: float = 1
                  muscle: Optional[str] = None) -> Dict[str, Array]: ...
 def arm_trial(model: Model, angle_deg: float = 90.0, activation: float = 1.0, effort: str = "flexion",
               antagonist_activation: float = 0.0, rest: float = 0.5, rise: float = 0.0, hold: float = 3.0,
-              rate: float = 1000.0, averaging_window: float = 1.0) -> Tuple[Dict[str, Array], Dict[str, Any]]: ...
+              rate: float = 1000.0, averaging_window: Optional[float] = None,
+              rotation_deg: Optional[float] = None) -> Tuple[Dict[str, Array], Dict[str, Any]]: ...
 def run_study(study_file: str, threads: int = 0, out: str = "", restart: bool = False) -> Dict[str, Any]: ...
 
 def identify(model: Model, data: Union[str, "os.PathLike[str]", Mapping[str, Any]], method: str = "lm",

@@ -1,6 +1,9 @@
 """The Python module (issue 12): every bound function called, results equal to the C++ API's
 (tests/python/reference.cpp, 17 digits) to 1e-12 relative, numpy dtypes and shapes, errors with the
 command line's messages, and the GIL released during long calls."""
+import pathlib
+import re
+
 import numpy as np
 import pytest
 
@@ -103,3 +106,21 @@ def test_docstrings_name_units_and_arguments():
     for f in (armsim.steady_state, armsim.muscle_trial, armsim.arm_trial, armsim.run_study, armsim.Model.load):
         assert f.__doc__ and len(f.__doc__) > 80
     assert "path_length" in armsim.steady_state.__doc__ and "[N]" in armsim.steady_state.__doc__
+
+
+def test_version_is_the_projects():
+    # second source: the CMake project's VERSION
+    cmake = (pathlib.Path(__file__).resolve().parents[2] / "CMakeLists.txt").read_text()
+    assert re.search(r"project\(armsim VERSION ([0-9.]+)", cmake).group(1) == armsim.__version__
+
+
+def test_arm_trial_takes_a_forearm_posture_and_a_short_hold(elbow):
+    twin = armsim.Model.load("twin")
+    kw = dict(angle_deg=90, activation=1.0, hold=0.5, rate=200)   # a 0.5 s hold averages the whole hold
+    _, neutral = armsim.arm_trial(twin, rotation_deg=0.0, **kw)
+    _, default = armsim.arm_trial(twin, **kw)                      # the twin's posture is neutral
+    _, pronated = armsim.arm_trial(twin, rotation_deg=-90.0, **kw)
+    assert default["mean_muscle_torque"] == neutral["mean_muscle_torque"]
+    assert pronated["mean_muscle_torque"] < 0.99 * neutral["mean_muscle_torque"]
+    with pytest.raises(ValueError, match="forearm_rotation_deg"):
+        armsim.arm_trial(elbow, rotation_deg=-90.0, **kw)          # the elbow's forearm does not rotate

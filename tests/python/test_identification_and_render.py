@@ -254,7 +254,7 @@ def test_type_stubs_name_every_public_function_with_its_arguments():
     import re
     stubs = _stub_functions()
     for name in armsim.__all__:
-        if name == "Model":
+        if name in ("Model", "__version__"):   # a class and a string, not functions
             continue
         f = getattr(armsim, name)
         assert name in stubs, name
