@@ -50,13 +50,26 @@ void applyOverrides(ArmSetup& s, int i, const py::kwargs& kw) {
     MuscleParameters& p = s.muscles[i].params;
     for (auto item : kw) {
         const std::string k = item.first.cast<std::string>();
-        if (k == "mass") p.mass = item.second.cast<double>();
-        else if (k == "optimal_fascicle_length") p.optimalFascicleLength = item.second.cast<double>();
-        else if (k == "optimal_tendon_length") p.optimalTendonLength = item.second.cast<double>();
-        else if (k == "max_path_length") p.maxPathLength = item.second.cast<double>(), s.muscles[i].maxPathFromRange = false;
-        else if (k == "slow_fraction") p.slowFraction = item.second.cast<double>();
-        else if (k == "slow_units") p.numSlowUnits = item.second.cast<int>();
-        else if (k == "fast_units") p.numFastUnits = item.second.cast<int>();
+        // A value of the wrong type is a TypeError naming the parameter (not pybind11's cast error).
+        auto number = [&]() -> double {
+            if (!py::isinstance<py::float_>(item.second) && !py::isinstance<py::int_>(item.second))
+                throw py::type_error("muscle parameter '" + k + "' = " + py::repr(item.second).cast<std::string>() +
+                                     ": expected a number");
+            return item.second.cast<double>();
+        };
+        auto whole = [&]() -> int {
+            if (!py::isinstance<py::int_>(item.second))
+                throw py::type_error("muscle parameter '" + k + "' = " + py::repr(item.second).cast<std::string>() +
+                                     ": expected a whole number");
+            return item.second.cast<int>();
+        };
+        if (k == "mass") p.mass = number();
+        else if (k == "optimal_fascicle_length") p.optimalFascicleLength = number();
+        else if (k == "optimal_tendon_length") p.optimalTendonLength = number();
+        else if (k == "max_path_length") p.maxPathLength = number(), s.muscles[i].maxPathFromRange = false;
+        else if (k == "slow_fraction") p.slowFraction = number();
+        else if (k == "slow_units") p.numSlowUnits = whole();
+        else if (k == "fast_units") p.numFastUnits = whole();
         else
             throw InputError("unknown muscle parameter '" + k + "': expected mass, optimal_fascicle_length, "
                              "optimal_tendon_length, max_path_length, slow_fraction, slow_units or fast_units");
@@ -92,10 +105,17 @@ PYBIND11_MODULE(_armsim, mod) {
                       "arm; 'elbow': seven muscles on wrapped paths) or your own. Immutable: with_muscle returns a\n"
                       "changed copy. Pass it to the trial, identification and render functions.")
         .def_static(
-            "load", [](const std::string& nameOrFile) { return Model{loadModelChecked(nameOrFile)}; }, py::arg("name_or_file"),
-            "Loads a model: a name under assets/models/ ('thesis', 'elbow') or a model file path.\n"
+            "load",
+            [](const py::object& nameOrFile) {   // str or os.PathLike (pathlib.Path)
+                return Model{loadModelChecked(py::module_::import("os").attr("fspath")(nameOrFile).cast<std::string>())};
+            },
+            py::arg("name_or_file"),
+            "Loads a model: a name under assets/models/ ('thesis', 'elbow', 'twin') or a model file path (str or\n"
+            "pathlib.Path).\n"
             "Raises FileNotFoundError for a missing file, ValueError (the CLI's message) for a bad one.")
         .def_property_readonly("name", [](const Model& m) { return m.setup.name; }, "the model's name")
+        .def("__copy__", [](const Model& m) { return m; })
+        .def("__deepcopy__", [](const Model& m, const py::dict&) { return m; }, py::arg("memo"))
         .def_property_readonly(
             "muscles", [](const Model& m) {
                 std::vector<std::string> names;

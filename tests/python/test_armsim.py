@@ -124,3 +124,15 @@ def test_arm_trial_takes_a_forearm_posture_and_a_short_hold(elbow):
     assert pronated["mean_muscle_torque"] < 0.99 * neutral["mean_muscle_torque"]
     with pytest.raises(ValueError, match="forearm_rotation_deg"):
         armsim.arm_trial(elbow, rotation_deg=-90.0, **kw)          # the elbow's forearm does not rotate
+
+
+def test_model_takes_a_path_copies_and_types_its_overrides(elbow):
+    import copy
+    twin = armsim.Model.load(pathlib.Path(__file__).resolve().parents[2] / "assets" / "models" / "twin.yaml")
+    assert twin.muscles == armsim.Model.load("twin").muscles
+    twin_copy = copy.deepcopy(twin)
+    assert twin_copy.parameters("BIClong") == twin.parameters("BIClong")
+    with pytest.raises(TypeError, match="muscle parameter 'mass' = 'heavy': expected a number"):
+        elbow.with_muscle(mass="heavy")
+    with pytest.raises(TypeError, match="'slow_units' = 2.5: expected a whole number"):
+        elbow.with_muscle(slow_units=2.5)
