@@ -86,7 +86,7 @@ void MuscleCoefficients::validate(const std::string& p) const {
 }
 
 void MuscleParameters::validate() const {
-    checkField("mass", mass, Bound::positive("kg"));
+    checkField("mass", mass, Bound{0, 10, true, false, "kg"});   // the volume's bound, 10 L (the largest muscles: ~1 kg)
     checkField("optimal_fascicle_length", optimalFascicleLength, Bound::positive("m"));
     checkField("optimal_tendon_length", optimalTendonLength, Bound::positive("m"));
     checkField("max_path_length", maxPathLength, Bound::positive("m"));

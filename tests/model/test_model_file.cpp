@@ -355,6 +355,14 @@ TEST(ModelFile, SpecificTensionAndVolumeSetF0AndMass) {
     msg = messageOf(writeTemp("sigma_two.yaml", "name: sigma\narm: arm/default_male.yaml\nmuscles:\n" +
                                                     muscle("m", "    volume: 80.0e-6\n    mass: 0.1\n")));
     EXPECT_NE(msg.find("not 2"), std::string::npos) << msg;
+    // Bounds in files as on the command line: F0 up to 1e5 N, mass up to 10 kg (the volume's 10 L).
+    msg = messageOf(writeTemp("f0_huge.yaml", "name: sigma\narm: arm/default_male.yaml\nmuscles:\n" +
+                                                  muscle("m", "    max_isometric_force: 1e9\n")));
+    EXPECT_NE(msg.find("max_isometric_force' = 1e+09: expected in (0, 1e+05] (N)"), std::string::npos) << msg;
+    msg = messageOf(writeTemp("mass_huge.yaml", "name: sigma\narm: arm/default_male.yaml\nmuscles:\n" +
+                                                    muscle("m", "    mass: 50\n")));
+    EXPECT_NE(msg.find("mass"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("50"), std::string::npos) << msg;
 }
 
 // loadModel reuses a model while its files are unchanged: the reused model equals a fresh load, and an

@@ -82,7 +82,7 @@ TEST(MuscleFile, ShippedFilesLoad) {
 TEST(MuscleFile, NegativeMassNamesFileLineFieldAndBound) {
     const std::string path = writeVariant("mass: 0.33599", "mass: -0.3");
     const std::string msg = loadError(path);
-    expectMentions(msg, {"biceps_long_head.yaml:6:", "'mass'", "-0.3", "> 0"});
+    expectMentions(msg, {"biceps_long_head.yaml:6:", "'mass'", "-0.3", "in (0, 10] (kg)"});
 }
 
 TEST(MuscleFile, ZeroLengthsAreRejected) {

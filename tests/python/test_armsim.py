@@ -76,7 +76,7 @@ def test_run_study_writes_the_commands_files(tmp_path):
 @pytest.mark.parametrize("call, error, message", [
     (lambda m: armsim.Model.load("/no/such/model.yaml"), FileNotFoundError, "/no/such/model.yaml"),
     (lambda m: armsim.Model.load("no_such_model"), ValueError, "no_such_model"),
-    (lambda m: m.with_muscle(mass=-1), ValueError, "field 'mass' = -1: expected > 0 (kg)"),
+    (lambda m: m.with_muscle(mass=-1), ValueError, "field 'mass' = -1: expected in (0, 10] (kg)"),
     (lambda m: m.with_muscle(weight=1), ValueError, "unknown muscle parameter 'weight'"),
     (lambda m: m.parameters("triceps"), ValueError, "triceps"),
     (lambda m: armsim.steady_state(m, 0.40, 2.0), ValueError, "field 'activation' = 2: expected in [0, 1]"),
