@@ -223,7 +223,7 @@ PYBIND11_MODULE(_armsim, mod) {
             s.riseTime = rise;
             s.holdDuration = hold;
             s.sampleRate = rate;
-            s.averagingWindow = window ? *window : std::min(1.0, hold);   // as a trial file's default
+            s.averagingWindow = window ? *window : std::min(s.averagingWindow, s.holdDuration);   // as a trial file's default
             IsometricTrialResult r;
             {
                 py::gil_scoped_release release;
