@@ -19,7 +19,9 @@ namespace {
 
 const TorqueCondition* findCondition(const TorqueProtocol& p, const TorqueObservation& o) {
     for (const TorqueCondition& c : p.conditions)
-        if (c.flexionDeg == o.flexionDeg && c.effort == o.effort && c.level == o.level) return &c;
+        if (c.flexionDeg == o.flexionDeg && c.effort == o.effort && c.level == o.level &&
+            (std::isnan(c.rotationDeg) ? std::isnan(o.rotationDeg) : c.rotationDeg == o.rotationDeg))
+            return &c;
     return nullptr;
 }
 
@@ -76,7 +78,7 @@ std::vector<ChannelObservation> synthesizeChannelData(const VirtualSubject& subj
             for (int m : s.surfaceEmg) {
                 const MuscleGroup g = s.muscles[m].group;
                 if (g != MuscleGroup::Flexor && g != MuscleGroup::Extensor) continue;
-                const bool agonist = g == t.effort;
+                const bool agonist = isAgonistOf(t.effort, g, 0.0);
                 const double own = agonist ? t.activation : t.antagonistActivation;
                 const double other = agonist ? t.antagonistActivation : t.activation;
                 o.muscle = s.muscles[m].params.name;
@@ -114,7 +116,7 @@ std::string formatChannelData(const std::vector<ChannelObservation>& data, bool 
     CsvText csv(header);
     for (const ChannelObservation& o : data) {
         CsvRow r;
-        r.addText(o.channel).addText(o.muscle).addNumber(o.flexionDeg).addInteger(o.effort == MuscleGroup::Flexor ? 1 : -1);
+        r.addText(o.channel).addText(o.muscle).addNumber(o.flexionDeg).addInteger(o.effort == Effort::Flexion ? 1 : -1);
         r.addNumber(o.level).addInteger(o.repetition).addNumber(o.value).addNumber(o.sd);
         if (truth) r.addNumber(o.cleanValue);
         csv.addRow(r);
@@ -190,7 +192,7 @@ std::vector<ChannelObservation> readChannelData(const std::string& path) {
             fail("flexion_deg", formatNumber(o.flexionDeg), "in [0, 180] (0 = extended) for " + o.channel);
         const double effort = number("effort", 1);
         if (effort != 1 && effort != -1) fail("effort", formatNumber(effort), "1 (flexion) or -1 (extension)");
-        o.effort = effort == 1 ? MuscleGroup::Flexor : MuscleGroup::Extensor;
+        o.effort = effort == 1 ? Effort::Flexion : Effort::Extension;
         o.level = number("level", 0);
         if (!(o.level >= 0 && o.level <= 1)) fail("level", formatNumber(o.level), "in [0, 1] (0: relaxed)");
         if (o.channel == "emg" && o.level == 0) fail("level", "0", "> 0 for emg (an effort's EMG)");
@@ -231,7 +233,7 @@ std::vector<std::string> writeChannelPlots(const std::string& dir, const std::ve
             s.x.push_back(o.flexionDeg);
             s.y.push_back(100 * o.value);
         } else if (o.channel == "emg") {
-            PlotSeries& s = seriesOf(emg, o.muscle + (o.effort == MuscleGroup::Flexor ? " in flexion" : " in extension"));
+            PlotSeries& s = seriesOf(emg, o.muscle + (o.effort == Effort::Flexion ? " in flexion" : " in extension"));
             s.x.push_back(o.flexionDeg);
             s.y.push_back(o.value);
         }

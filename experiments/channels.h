@@ -27,7 +27,7 @@ struct ChannelObservation {
     std::string channel;        ///< fascicle_length, volume, emg or upper_arm_length
     std::string muscle;         ///< the muscle measured (empty for upper_arm_length)
     double flexionDeg = 0.0 / 0.0;  ///< elbow flexion during the measurement [deg] (NaN: volume, anthropometry)
-    MuscleGroup effort = MuscleGroup::Flexor;  ///< the effort it was recorded in
+    Effort effort = Effort::Flexion;  ///< the effort it was recorded in (flexion or extension)
     double level = 0;           ///< the effort's drive [1]; 0: relaxed (fascicle at rest)
     int repetition = 0;
     double value = 0;           ///< the measurement [m, m^3 or 1]

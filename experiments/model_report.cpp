@@ -167,7 +167,7 @@ Table formatMvcCurve(const ArmSetup& setup, const SteadyMvcCurve& curve) {
     for (const std::string& m : curve.muscles) cols.push_back("torque_" + m + "_Nm");
     for (const std::string& m : curve.muscles) cols.push_back("force_" + m + "_N");
     for (const std::string& m : curve.muscles) cols.push_back("fibre_length_" + m);
-    const bool flexion = curve.effort == MuscleGroup::Flexor;
+    const bool flexion = curve.effort == Effort::Flexion;
     if (flexion) cols.push_back("primary_share");
     Table t(cols);
     for (std::size_t a = 0; a < curve.flexionDeg.size(); ++a) {

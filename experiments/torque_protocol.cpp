@@ -24,17 +24,30 @@ std::string conditionField(std::size_t k, const char* key) {
     return "conditions[" + std::to_string(k) + "]." + key;
 }
 
-ConditionKey conditionKey(double flexionDeg, MuscleGroup effort, double level, double rotationDeg) {
+ConditionKey conditionKey(double flexionDeg, Effort effort, double level, double rotationDeg) {
     return {flexionDeg, int(effort), level, std::isnan(rotationDeg) ? INFINITY : rotationDeg};
+}
+
+Effort parseEffortName(const std::string& name) {
+    return name == "flexion" ? Effort::Flexion : name == "extension" ? Effort::Extension
+         : name == "supination" ? Effort::Supination : Effort::Pronation;
 }
 
 }  // namespace
 
-const char* getEffortName(MuscleGroup effort) { return effort == MuscleGroup::Flexor ? "flexion" : "extension"; }
+int getEffortCode(Effort e) {
+    switch (e) {
+        case Effort::Flexion: return 1;
+        case Effort::Extension: return -1;
+        case Effort::Supination: return 2;
+        case Effort::Pronation: return -2;
+    }
+    return 0;
+}
 
 std::vector<TorqueCondition> TorqueProtocol::makeFlexionMvcs(const std::vector<double>& flexionDeg, int repetitions) {
     std::vector<TorqueCondition> out;
-    for (double q : flexionDeg) out.push_back({q, MuscleGroup::Flexor, 1.0, repetitions});
+    for (double q : flexionDeg) out.push_back({q, Effort::Flexion, 1.0, repetitions});
     return out;
 }
 
@@ -46,6 +59,11 @@ int TorqueProtocol::getNumTrials() const {
 
 bool TorqueProtocol::usesEmg() const {
     return std::any_of(conditions.begin(), conditions.end(), [](const TorqueCondition& c) { return c.level < 1; });
+}
+
+bool TorqueProtocol::readsForearmTorque() const {
+    return forearmTorque ||
+           std::any_of(conditions.begin(), conditions.end(), [](const TorqueCondition& c) { return isForearmEffort(c.effort); });
 }
 
 bool TorqueProtocol::hasChannels() const {
@@ -61,6 +79,11 @@ void TorqueProtocol::validate() const {
         checkField(conditionField(k, "flexion_deg"), c.flexionDeg, Bound::closed(0, 180, "deg, 0 = extended"));
         checkField(conditionField(k, "level"), c.level, Bound{0, 1, true, false, "fraction of maximal, in (0, 1]"});
         checkField(conditionField(k, "repetitions"), c.repetitions, Bound::closed(1, 100));
+        if (isForearmEffort(c.effort) && (c.ultrasound || c.emg))
+            throw FieldError(conditionField(k, "channels"),
+                             std::string("a ") + getEffortName(c.effort) +
+                                 " effort is read by the transducer alone: expected ultrasound and EMG in flexion "
+                                 "or extension efforts only");
         if (!std::isnan(c.rotationDeg)) {
             checkField(conditionField(k, "rotation_deg"), c.rotationDeg, Bound::closed(-180, 180, "deg, + = supination"));
             if (c.ultrasound || c.emg)
@@ -104,7 +127,7 @@ std::string describeConditions(const TorqueProtocol& protocol) {
     std::string out;
     for (const auto& key : groups) {
         const auto [effort, level, repetitions, channels] = key;
-        out += (out.empty() ? "" : "; ") + std::string(getEffortName(MuscleGroup(effort))) + " " +
+        out += (out.empty() ? "" : "; ") + std::string(getEffortName(Effort(effort))) + " " +
                (level == 1 ? std::string("MVC") : formatNumber(100 * level) + " %") + " at " + angles[key] +
                " deg x " + std::to_string(repetitions);
         if (channels) out += std::string(" with ") + (channels & 1 ? "ultrasound" : "") + (channels == 3 ? " and " : "") +
@@ -112,6 +135,7 @@ std::string describeConditions(const TorqueProtocol& protocol) {
     }
     if (!protocol.volumeScan.empty()) out += "; volume scan of " + formatList(protocol.volumeScan);
     if (protocol.anthropometry) out += "; anthropometry";
+    if (protocol.readsForearmTorque()) out += "; forearm torque read";
     return out;
 }
 
@@ -147,6 +171,7 @@ TorqueProtocol readTorqueProtocol(const std::string& path) {
         const ParamNode m = root.child("measurements");
         if (m.has("volume_scan")) p.volumeScan = m.getStrings("volume_scan");
         p.anthropometry = m.getBool("anthropometry", false);
+        p.forearmTorque = m.getBool("forearm_torque", false);
         m.finish();
     }
     if (root.has("channel_noise")) {
@@ -163,8 +188,7 @@ TorqueProtocol readTorqueProtocol(const std::string& path) {
     for (const ParamNode& c : root.children("conditions")) {
         TorqueCondition tc;
         tc.flexionDeg = c.getNumber("flexion_deg", Bound::closed(0, 180, "deg, 0 = extended"));
-        tc.effort = c.getChoice("effort", {"flexion", "extension"}, "flexion") == "flexion" ? MuscleGroup::Flexor
-                                                                                            : MuscleGroup::Extensor;
+        tc.effort = parseEffortName(c.getChoice("effort", {"flexion", "extension", "supination", "pronation"}, "flexion"));
         tc.level = c.getNumber("level", Bound{0, 1, true, false, "fraction of maximal, in (0, 1]"}, 1.0);
         tc.repetitions = c.getInt("repetitions", 1, 100, 1);
         if (c.has("rotation_deg")) tc.rotationDeg = c.getNumber("rotation_deg", Bound::closed(-180, 180, "deg, + = supination"));
@@ -203,12 +227,15 @@ std::string formatTorqueProtocol(const TorqueProtocol& p) {
         out += "  population: " + p.population + "\n  index: " + std::to_string(p.subjectIndex) + "\n";
     else
         out += "  model: " + p.model + "\n  transducer_noise: " + formatNumber(p.transducerNoise) + "\n";
-    if (p.hasChannels()) {
-        const ChannelNoise& n = p.channelNoise;
+    if (p.hasChannels() || p.forearmTorque) {
         std::string names;
         for (const std::string& v : p.volumeScan) names += (names.empty() ? "" : ", ") + v;
         out += "measurements: {volume_scan: [" + names + "]" +
-               ", anthropometry: " + (p.anthropometry ? "true" : "false") + "}\n";
+               ", anthropometry: " + (p.anthropometry ? "true" : "false") +
+               (p.forearmTorque ? ", forearm_torque: true" : "") + "}\n";
+    }
+    if (p.hasChannels()) {
+        const ChannelNoise& n = p.channelNoise;
         out += "channel_noise: {fascicle_length: " + formatNumber(n.fascicleLength) + ", volume: " + formatNumber(n.volume) +
                ", emg: " + formatNumber(n.emg) + ", emg_crosstalk: " + formatNumber(n.emgCrosstalk) +
                ", upper_arm_length: " + formatNumber(n.upperArmLength) + "}  # relative sd; upper_arm_length in m\n";
@@ -260,6 +287,12 @@ std::vector<TorqueObservation> synthesizeTorqueData(const VirtualSubject& subjec
                                                     unsigned noiseSeed, int jobs) {
     protocol.validate();
     PortableRandom rng{noiseSeed, subject.seed, unsigned(subject.index)};
+    // The forearm axis's noise from a stream of its own: the flexion axis's draws stay what they were.
+    PortableRandom forearmRng{noiseSeed, subject.seed, unsigned(subject.index), 2u};
+    const bool forearm = protocol.readsForearmTorque();
+    if (forearm && !subject.setup.arm.forearmRotation.enabled)
+        throw InputError("protocol '" + protocol.name + "' reads the forearm axis (a rotation effort or measurements." +
+                         "forearm_torque), but model '" + subject.setup.name + "' has no forearm rotation");
     const SubjectEffort& e = subject.setup.effort;
     int maxRepetitions = 0;
     for (const TorqueCondition& c : protocol.conditions) maxRepetitions = std::max(maxRepetitions, c.repetitions);
@@ -288,11 +321,13 @@ std::vector<TorqueObservation> synthesizeTorqueData(const VirtualSubject& subjec
             o.activation = s.activation;
             o.antagonistActivation = s.antagonistActivation;
             o.noiseDraw = rng.drawNormal();
+            if (forearm) o.forearmNoiseDraw = forearmRng.drawNormal();
             data.push_back(o);
         }
     const std::vector<IsometricTrialResult> results = runIsometricTrials(subject.setup, trials, jobs);
     for (std::size_t k = 0; k < data.size(); ++k) {
         data[k].cleanTorque = results[k].summary.meanMuscleTorque;
+        if (forearm) data[k].cleanForearmTorque = results[k].summary.meanForearmTorque;
         data[k].restFascicleLength = results[k].summary.restFascicleLength;
         data[k].fascicleLength = results[k].summary.meanFascicleLength;
     }
@@ -301,23 +336,40 @@ std::vector<TorqueObservation> synthesizeTorqueData(const VirtualSubject& subjec
 
 std::vector<TorqueObservation> setTransducerNoise(std::vector<TorqueObservation> data, double sd) {
     checkField("transducer noise", sd, Bound{0, 0.5, false, true, "relative sd"});
-    for (TorqueObservation& o : data) o.torque = o.cleanTorque * (1 + sd * o.noiseDraw);
+    for (TorqueObservation& o : data) {
+        if (!std::isfinite(o.cleanForearmTorque)) {  // one axis
+            o.torque = o.cleanTorque * (1 + sd * o.noiseDraw);
+            continue;
+        }
+        const double load = std::hypot(o.cleanTorque, o.cleanForearmTorque);
+        o.torque = o.cleanTorque + sd * load * o.noiseDraw;
+        o.forearmTorque = o.cleanForearmTorque + sd * load * o.forearmNoiseDraw;
+    }
     return data;
 }
 
 std::string formatTorqueData(const std::vector<TorqueObservation>& data, bool truth) {
     const bool postures = hasPostures(data);
-    std::string out = "# tared elbow torque per trial; flexion_deg: 0 = extended; effort: 1 = flexion, -1 = extension;\n"
-                      "# level: drive as a fraction of maximal; torque_Nm: + = flexion";
-    out += postures ? "; rotation_deg: forearm posture, + = supination, NaN = the model's\n" : "\n";
+    const bool forearm = std::any_of(data.begin(), data.end(), [](const TorqueObservation& o) {
+        return std::isfinite(o.forearmTorque) || std::isfinite(o.cleanForearmTorque);
+    });
+    std::string out = std::string("# tared elbow torque per trial; flexion_deg: 0 = extended; effort: 1 = flexion, -1 = extension") +
+                      (forearm ? ", 2 = supination, -2 = pronation" : "") + ";\n# level: drive as a fraction of maximal; torque_Nm: + = flexion";
+    out += postures ? "; rotation_deg: forearm posture, + = supination, NaN = the model's" : "";
+    out += forearm ? ";\n# forearm_torque_Nm: the transducer's forearm axis, + = supination\n" : "\n";
     out += "flexion_deg,effort,level,repetition,torque_Nm";
     out += postures ? ",rotation_deg" : "";
-    out += truth ? ",activation,clean_torque_Nm\n" : "\n";
+    out += forearm ? ",forearm_torque_Nm" : "";
+    out += truth ? ",activation,clean_torque_Nm" : "";
+    out += truth && forearm ? ",clean_forearm_torque_Nm\n" : "\n";
+    auto number = [](double v) { return std::isnan(v) ? std::string("NaN") : formatNumber(v); };
     for (const TorqueObservation& o : data) {
-        out += formatNumber(o.flexionDeg) + "," + (o.effort == MuscleGroup::Flexor ? "1" : "-1") + "," +
+        out += formatNumber(o.flexionDeg) + "," + std::to_string(getEffortCode(o.effort)) + "," +
                formatNumber(o.level) + "," + std::to_string(o.repetition) + "," + formatNumber(o.torque);
-        if (postures) out += "," + (std::isnan(o.rotationDeg) ? std::string("NaN") : formatNumber(o.rotationDeg));
+        if (postures) out += "," + number(o.rotationDeg);
+        if (forearm) out += "," + number(o.forearmTorque);
         if (truth) out += "," + formatNumber(o.activation) + "," + formatNumber(o.cleanTorque);
+        if (truth && forearm) out += "," + number(o.cleanForearmTorque);
         out += "\n";
     }
     return out;
@@ -329,12 +381,14 @@ std::vector<TorqueObservation> readTorqueData(const std::string& path) {
 
 std::vector<TorqueObservation> makeTorqueData(const Table& t, const std::string& path) {
     static const std::set<std::string> known = {"flexion_deg", "effort", "level", "repetition", "torque_Nm",
-                                                "rotation_deg", "activation", "clean_torque_Nm"};
+                                                "rotation_deg", "forearm_torque_Nm", "activation", "clean_torque_Nm",
+                                                "clean_forearm_torque_Nm"};
     for (const std::string& c : t.getColumnNames())
         if (!known.count(c))
             throw InputError(path + ": unknown column '" + c +
-                             "': expected flexion_deg, torque_Nm and optionally effort, level, repetition, rotation_deg "
-                             "(activation, clean_torque_Nm: truth of synthetic data, ignored)");
+                             "': expected flexion_deg, torque_Nm and optionally effort, level, repetition, rotation_deg, "
+                             "forearm_torque_Nm (activation, clean_torque_Nm, clean_forearm_torque_Nm: truth of "
+                             "synthetic data, ignored)");
     for (const char* c : {"flexion_deg", "torque_Nm"})
         if (!t.hasColumn(c)) throw InputError(path + ": missing column '" + std::string(c) + "'");
     if (t.getNumRows() == 0) throw InputError(path + ": no data rows");
@@ -355,8 +409,9 @@ std::vector<TorqueObservation> makeTorqueData(const Table& t, const std::string&
         if (!std::isfinite(o.torque)) fail("torque_Nm", o.torque, "a finite number");
         if (t.hasColumn("effort")) {
             const double e = t.get(r, "effort");
-            if (e != 1 && e != -1) fail("effort", e, "1 (flexion) or -1 (extension)");
-            o.effort = e == 1 ? MuscleGroup::Flexor : MuscleGroup::Extensor;
+            if (e != 1 && e != -1 && e != 2 && e != -2)
+                fail("effort", e, "1 (flexion), -1 (extension), 2 (supination) or -2 (pronation)");
+            o.effort = e == 1 ? Effort::Flexion : e == -1 ? Effort::Extension : e == 2 ? Effort::Supination : Effort::Pronation;
         }
         if (t.hasColumn("level")) {
             o.level = t.get(r, "level");
@@ -367,6 +422,13 @@ std::vector<TorqueObservation> makeTorqueData(const Table& t, const std::string&
             if (std::isinf(o.rotationDeg) || std::abs(o.rotationDeg) > 180)
                 fail("rotation_deg", o.rotationDeg, "in [-180, 180] (+ = supination) or NaN (the model's posture)");
         }
+        if (t.hasColumn("forearm_torque_Nm")) {
+            o.forearmTorque = t.get(r, "forearm_torque_Nm");  // NaN: not read in this trial
+            if (std::isinf(o.forearmTorque)) fail("forearm_torque_Nm", o.forearmTorque, "a finite number or NaN (not read)");
+        }
+        if (isForearmEffort(o.effort) && !std::isfinite(o.forearmTorque))
+            throw InputError(at + ": a " + getEffortName(o.effort) + " effort without its forearm torque: expected a "
+                             "column forearm_torque_Nm with a finite value (+ = supination)");
         const ConditionKey key = getConditionKey(o);
         if (t.hasColumn("repetition")) {
             const double v = t.get(r, "repetition");
@@ -381,10 +443,14 @@ std::vector<TorqueObservation> makeTorqueData(const Table& t, const std::string&
                              " at " + formatNumber(o.flexionDeg) + " deg, level " + formatNumber(o.level) +
                              (std::isnan(o.rotationDeg) ? std::string() : ", rotation " + formatNumber(o.rotationDeg) + " deg") +
                              " appears earlier: expected each trial once");
-        if (o.effort == MuscleGroup::Flexor ? o.torque < 0 : o.torque > 0)
-            fail("torque_Nm", o.torque,
-                 std::string(o.effort == MuscleGroup::Flexor ? ">= 0 for a flexion effort" : "<= 0 for an extension effort") +
-                     " (+ = flexion; a tared transducer)");
+        if (o.effort == Effort::Flexion && o.torque < 0)
+            fail("torque_Nm", o.torque, ">= 0 for a flexion effort (+ = flexion; a tared transducer)");
+        if (o.effort == Effort::Extension && o.torque > 0)
+            fail("torque_Nm", o.torque, "<= 0 for an extension effort (+ = flexion; a tared transducer)");
+        if (o.effort == Effort::Supination && o.forearmTorque < 0)
+            fail("forearm_torque_Nm", o.forearmTorque, ">= 0 for a supination effort (+ = supination; a tared transducer)");
+        if (o.effort == Effort::Pronation && o.forearmTorque > 0)
+            fail("forearm_torque_Nm", o.forearmTorque, "<= 0 for a pronation effort (+ = supination; a tared transducer)");
         data.push_back(o);
     }
     return data;
@@ -394,7 +460,8 @@ void writeTorquePlot(const std::string& path, const std::vector<TorqueObservatio
     PlotSpec plot;
     plot.title = title;
     plot.xLabel = "elbow flexion (deg, 0 = extended)";
-    plot.yLabel = "tared torque (N m, + = flexion)";
+    const bool rotation = std::any_of(data.begin(), data.end(), [](const TorqueObservation& o) { return isForearmEffort(o.effort); });
+    plot.yLabel = rotation ? "tared torque about the effort's axis (N m, + = flexion, supination)" : "tared torque (N m, + = flexion)";
     std::vector<std::pair<int, double>> kinds;
     for (const TorqueObservation& o : data) {
         const std::pair<int, double> k{int(o.effort), o.level};
@@ -408,7 +475,7 @@ void writeTorquePlot(const std::string& path, const std::vector<TorqueObservatio
         }
         PlotSeries& series = plot.series[it - kinds.begin()];
         series.x.push_back(o.flexionDeg);
-        series.y.push_back(o.torque);
+        series.y.push_back(o.getEffortTorque());
     }
     writePlotPng(path, plot);
 }

@@ -1,14 +1,18 @@
 // Torque protocols (issue 11): isometric efforts of a (virtual) subject at elbow angles, read by a
 // tared joint-torque transducer. A condition is one effort kind at one angle: a flexion or an extension
-// effort, maximal (level 1) or held at a fraction of the agonists' MVC EMG by EMG feedback (level < 1),
-// repeated. The thesis's protocol is five flexion MVCs x 3. Protocol files (kind: torque) are what
+// effort, or on a model with a forearm rotation a supination or a pronation effort, maximal (level 1)
+// or held at a fraction of the agonists' MVC EMG by EMG feedback (level < 1), repeated. A two-axis
+// transducer (measurements.forearm_torque, implied by a rotation effort) also reads the torque about
+// the forearm axis in every trial. The thesis's protocol is five flexion MVCs x 3. Protocol files (kind: torque) are what
 // `armsim design` writes and `armsim protocol` and `armsim validate --protocol` run; torque data files
 // (CSV) are what a run writes and the identifiers read.
 //
 // Efforts: at level l the agonists get U = l VA (1 + cv z) (clipped to [0, 1]) and the antagonists
 // l CC, with VA the subject's voluntary activation, CC its co-contraction, cv its trial-to-trial
 // variation and z ~ N(0, 1) per trial. Each trial's tared torque is averaged over the end of the hold,
-// then multiplied by (1 + noise z') for the transducer.
+// then multiplied by (1 + sd z') for a one-axis transducer (z' ~ N(0, 1)). A two-axis transducer adds
+// sd |T| z' to each axis it reads, |T| the magnitude of the clean torque vector (both axes): a load
+// cell's error scales with its load, cross-talk between the axes included.
 #pragma once
 
 #include "experiments/population.h"
@@ -26,7 +30,7 @@ struct ChannelObservation;
 /// One condition of a torque protocol.
 struct TorqueCondition {
     double flexionDeg = 90;                     ///< elbow flexion [deg], 0 = extended
-    MuscleGroup effort = MuscleGroup::Flexor;   ///< which group the subject drives
+    Effort effort = Effort::Flexion;            ///< what the subject does (agonists: model/model_file.h)
     double level = 1.0;                         ///< drive as a fraction of maximal (1 = MVC) [1]
     int repetitions = 3;                        ///< trials of this condition
     /// Channels recorded in each trial besides torque (experiments/channels.h): ultrasound images the
@@ -48,8 +52,9 @@ struct ChannelNoise {
     double upperArmLength = 0.01;   ///< sd of the anthropometric upper-arm length [m]
 };
 
-/// "flexion" or "extension".
-const char* getEffortName(MuscleGroup effort);
+
+/// The effort column's code in data files: 1 flexion, -1 extension, 2 supination, -2 pronation.
+int getEffortCode(Effort e);
 
 /// A protocol of isometric efforts read by a tared torque transducer.
 struct TorqueProtocol {
@@ -71,6 +76,9 @@ struct TorqueProtocol {
     /// Muscles whose volume a panoramic ultrasound scan measures (once each; names in the model).
     std::vector<std::string> volumeScan;
     bool anthropometry = false;      ///< the upper-arm length measured
+    /// A two-axis transducer: every trial also reads the torque about the forearm axis (a model with a
+    /// forearm rotation). Rotation efforts imply it (readsForearmTorque).
+    bool forearmTorque = false;
     ChannelNoise channelNoise;       ///< errors of the channels besides torque
 
     /// Flexion MVCs at the angles, each repeated.
@@ -80,6 +88,8 @@ struct TorqueProtocol {
     bool usesEmg() const;
     /// true when some condition or measurement records a channel besides torque.
     bool hasChannels() const;
+    /// true when the trials read the forearm axis too: forearmTorque or a rotation effort.
+    bool readsForearmTorque() const;
     /// FieldError naming the field ("conditions[2].level", ...) unless every value is in range.
     void validate() const;
 };
@@ -102,7 +112,7 @@ VirtualSubject loadTorqueProtocolSubject(const TorqueProtocol& protocol);
 /// One measured effort.
 struct TorqueObservation {
     double flexionDeg = 0;     ///< [deg], 0 = extended
-    MuscleGroup effort = MuscleGroup::Flexor;
+    Effort effort = Effort::Flexion;
     double level = 1.0;        ///< drive as a fraction of maximal [1]
     int repetition = 0;
     double torque = 0;         ///< tared elbow torque, + = flexion [N m] (with transducer noise)
@@ -113,9 +123,19 @@ struct TorqueObservation {
     double restFascicleLength = NAN;    ///< the primary's fascicle at rest before the effort (truth) [m]
     double fascicleLength = NAN;        ///< the primary's fascicle at the plateau, window mean (truth) [m]
     double rotationDeg = 0.0 / 0.0;  ///< forearm posture [deg], + = supination; NaN = the model's posture
+    /// Tared torque about the forearm axis, + = supination [N m] (with transducer noise); NaN: not read.
+    double forearmTorque = 0.0 / 0.0;
+    double cleanForearmTorque = 0.0 / 0.0;  ///< the same before transducer noise (truth) [N m]
+    double forearmNoiseDraw = 0.0 / 0.0;    ///< its standard normal noise draw
     int line = 0;              ///< line in the file it was read from (0: synthesized)
+    /// The reading about the effort's own axis: torque for flexion and extension, forearmTorque for
+    /// supination and pronation [N m].
+    double getEffortTorque() const { return isForearmEffort(effort) ? forearmTorque : torque; }
+    /// The magnitude of the torque the transducer reads [N m]: |torque| on one axis, the length of the
+    /// (torque, forearmTorque) vector on two. The transducer noise's sd is proportional to it.
+    double getLoad() const { return std::isfinite(forearmTorque) ? std::hypot(torque, forearmTorque) : std::abs(torque); }
     /// A maximal flexion effort.
-    bool isFlexionMvc() const { return effort == MuscleGroup::Flexor && level == 1; }
+    bool isFlexionMvc() const { return effort == Effort::Flexion && level == 1; }
     /// A maximal flexion effort in the model's forearm posture: what the thesis's method uses.
     bool isThesisMvc() const { return isFlexionMvc() && std::isnan(rotationDeg); }
 };
@@ -141,12 +161,15 @@ std::vector<TorqueObservation> synthesizeTorqueData(const VirtualSubject& subjec
 /// common random numbers across noise levels).
 std::vector<TorqueObservation> setTransducerNoise(std::vector<TorqueObservation> data, double sd);
 
-/// Torque data as CSV: flexion_deg, effort (1 = flexion, -1 = extension), level, repetition, torque_Nm;
-/// with truth=true also activation, clean_torque_Nm (synthetic data).
+/// Torque data as CSV: flexion_deg, effort (1 = flexion, -1 = extension, 2 = supination, -2 = pronation),
+/// level, repetition, torque_Nm; rotation_deg when a trial has a posture; forearm_torque_Nm (+ =
+/// supination, NaN where not read) when a trial reads the forearm axis; with truth=true also activation,
+/// clean_torque_Nm (and clean_forearm_torque_Nm) (synthetic data).
 std::string formatTorqueData(const std::vector<TorqueObservation>& data, bool truth);
 /// Reads a torque data file (Table::readCsv: '#' comments, header line). Required columns flexion_deg
-/// and torque_Nm; effort (default 1), level (default 1), repetition (default: count per condition)
-/// optional; other columns are errors. Errors name file, line, column, value and the expected range.
+/// and torque_Nm; effort (default 1), level (default 1), repetition (default: count per condition),
+/// rotation_deg and forearm_torque_Nm optional (a rotation effort needs its forearm torque); other
+/// columns are errors. Errors name file, line, column, value and the expected range.
 std::vector<TorqueObservation> readTorqueData(const std::string& path);
 /// The same from a table already in memory; `source` names it in messages.
 std::vector<TorqueObservation> makeTorqueData(const Table& table, const std::string& source);

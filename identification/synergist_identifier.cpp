@@ -28,6 +28,16 @@ double sumTaredTorque(const SteadyMvcCurve& active, const SteadyMvcCurve& relaxe
     return t;
 }
 
+// The same about the forearm axis (+ = supination).
+double sumTaredForearmTorque(const SteadyMvcCurve& active, const SteadyMvcCurve& relaxed, std::size_t a,
+                             const std::vector<int>& leftOut = {}) {
+    double t = 0;
+    for (std::size_t i = 0; i < active.points[a].size(); ++i)
+        if (std::find(leftOut.begin(), leftOut.end(), int(i)) == leftOut.end())
+            t += active.points[a][i].forearmTorque - relaxed.points[a][i].forearmTorque;
+    return t;
+}
+
 SteadyMvcCurve calcRelaxedCurve(const std::vector<MuscleSpec>& muscles, const MvcGeometry& g) {
     return calcSteadyMvcCurve(muscles, g, MuscleGroup::Flexor, SubjectEffort{0, 0});
 }
@@ -53,19 +63,29 @@ std::vector<int> findMuscles(const ArmSetup& setup, const std::vector<std::strin
 }
 
 // Relative torque sd pooled over the conditions' repetitions (NaN without repetitions) and its degrees
-// of freedom.
+// of freedom: each axis's scatter about its mean, relative to the mean load (TorqueObservation::getLoad).
 std::pair<double, int> estimateNoiseLevel(const std::vector<TorqueObservation>& data) {
-    std::map<ConditionKey, std::vector<double>> byCondition;
-    for (const TorqueObservation& o : data) byCondition[getConditionKey(o)].push_back(o.torque);
+    std::map<ConditionKey, std::vector<const TorqueObservation*>> byCondition;
+    for (const TorqueObservation& o : data) byCondition[getConditionKey(o)].push_back(&o);
     double ss = 0;
     int dof = 0;
     for (const auto& [condition, v] : byCondition) {
         if (v.size() < 2) continue;
-        double m = 0;
-        for (double x : v) m += x;
-        m /= double(v.size());
-        for (double x : v) ss += (x / m - 1) * (x / m - 1);
-        dof += int(v.size()) - 1;
+        const bool forearm = std::all_of(v.begin(), v.end(), [](const TorqueObservation* o) { return std::isfinite(o->forearmTorque); });
+        double t = 0, f = 0, load = 0;
+        for (const TorqueObservation* o : v) {
+            t += o->torque;
+            f += forearm ? o->forearmTorque : 0.0;
+            load += o->getLoad();
+        }
+        const double n = double(v.size());
+        t /= n, f /= n, load /= n;
+        if (!(load > 0)) continue;
+        for (const TorqueObservation* o : v) {
+            ss += std::pow((o->torque - t) / load, 2);
+            if (forearm) ss += std::pow((o->forearmTorque - f) / load, 2);
+        }
+        dof += (forearm ? 2 : 1) * (int(v.size()) - 1);
     }
     return {dof > 0 ? std::sqrt(ss / dof) : NAN, dof};
 }
@@ -89,8 +109,12 @@ SynergistModel::SynergistModel(const Population& prior, const SynergistOptions& 
     biceps_ = options.biceps.empty() ? base.getBicepsHeads() : findMuscles(base, options.biceps, "biceps");
     synergists_ = options.synergists.empty() ? base.synergists : findMuscles(base, options.synergists, "synergists");
     if (!options.includeSynergists) leftOut_ = synergists_;
-    for (int i = 0; i < base.getNumMuscles(); ++i)
+    for (int i = 0; i < base.getNumMuscles(); ++i) {
+        const bool named = std::find(biceps_.begin(), biceps_.end(), i) != biceps_.end() ||
+                           std::find(synergists_.begin(), synergists_.end(), i) != synergists_.end();
         if (base.muscles[i].group == MuscleGroup::Extensor) extensors_.push_back(i);
+        else if (!named) rotators_.push_back(i);
+    }
     if (std::find(biceps_.begin(), biceps_.end(), base.primary) == biceps_.end())
         throw InputError("synergist-aware identifier: the primary muscle '" + base.muscles[base.primary].params.name +
                          "' is not in the biceps group");
@@ -100,6 +124,9 @@ SynergistModel::SynergistModel(const Population& prior, const SynergistOptions& 
             throw InputError("synergist-aware identifier: a condition at forearm rotation " + formatNumber(c.rotationDeg) +
                              " deg, but the prior's model '" + base.name + "' has no forearm rotation");
         angleOf_.push_back(findPose(c.flexionDeg, poses, c.rotationDeg));
+        if (isForearmEffort(c.effort) && !base.arm.forearmRotation.enabled)
+            throw InputError(std::string("synergist-aware identifier: a ") + getEffortName(c.effort) +
+                             " effort, but the prior's model '" + base.name + "' has no forearm rotation");
         kindOf_.push_back(findKind(c.effort, c.level));
     }
     channels_ = options.channels;
@@ -149,6 +176,9 @@ SynergistModel::SynergistModel(const Population& prior, const SynergistOptions& 
             geometry_.forearmMomentArm[rows[j]] = g.forearmMomentArm[j];
         }
     }
+    // Each kind's agonists from the prior's geometry: a rotation effort's set stays put when the size
+    // scale moves a moment arm across kForearmAgonistMomentArm (the residuals stay smooth in x).
+    for (const EffortKind& k : kinds_) agonists_.push_back(findAgonists(base.muscles, geometry_, k.effort));
 
     const int n = getNumParameters();
     const double s2 = prior.strengthSubjectSd * prior.strengthSubjectSd;
@@ -156,7 +186,7 @@ SynergistModel::SynergistModel(const Population& prior, const SynergistOptions& 
     auto uniformSd = [](const UniformRange& r) { return std::max((r.max - r.min) / std::sqrt(12.0), 1e-4); };
     priorCovariance_.assign(n, std::vector<double>(n, 0.0));
     auto& cov = priorCovariance_;
-    std::vector<int> masses = {kExtensorMass};
+    std::vector<int> masses = {kExtensorMass, kRotatorMass};
     for (int a = kFirstMass; a < n; ++a) masses.push_back(a);
     for (int a : masses)
         for (int b : masses) cov[a][b] = s2;
@@ -164,6 +194,7 @@ SynergistModel::SynergistModel(const Population& prior, const SynergistOptions& 
     cov[kSigma][kSigma] = std::pow(prior.specificTensionSd, 2);
     cov[kSize][kSize] = std::pow(prior.geometryScaleSd, 2);
     cov[kExtensorMass][kExtensorMass] += m2 / double(std::max<std::size_t>(extensors_.size(), 1));
+    cov[kRotatorMass][kRotatorMass] += m2 / double(std::max<std::size_t>(rotators_.size(), 1));
     for (int a = kFirstMass; a < n; ++a) cov[a][a] += m2;
     cov[kTendon][kTendon] = cov[kSynergistTendon][kSynergistTendon] = std::pow(prior.tendonLengthSd, 2);
     cov[kFascicle][kFascicle] = cov[kSynergistFascicle][kSynergistFascicle] = std::pow(prior.fascicleLengthSd, 2);
@@ -194,6 +225,12 @@ SynergistModel::SynergistModel(const Population& prior, const SynergistOptions& 
     // Person-level scales the prior does not vary are known: held at their mean.
     if (prior.specificTensionSd == 0) lower_[kSigma] = upper_[kSigma] = priorMean_[kSigma];
     if (prior.geometryScaleSd == 0) lower_[kSize] = upper_[kSize] = priorMean_[kSize];
+    // Held (freeRotatorMass frees it): out of the prior's coupling too, or holding it at its mean would
+    // condition the other masses on the person-level strength it shares with them.
+    lower_[kRotatorMass] = upper_[kRotatorMass] = priorMean_[kRotatorMass];
+    rotatorCovariance_ = cov[kRotatorMass];
+    for (int j = 0; j < n; ++j)
+        if (j != kRotatorMass) cov[kRotatorMass][j] = cov[j][kRotatorMass] = 0;
     lower_[kActivation] = inside(prior.voluntaryActivation.min);
     upper_[kActivation] = inside(prior.voluntaryActivation.max);
     lower_[kCoContraction] = inside(prior.coContraction.min);
@@ -206,7 +243,7 @@ std::vector<std::string> SynergistModel::getParameterNames() const {
                                       "ln_biceps_fascicle_scale", "ln_synergist_tendon_scale",
                                       "ln_synergist_fascicle_scale", "ln_extensor_mass_scale",
                                       "biceps_slow_fraction_shift", "synergist_slow_fraction_shift",
-                                      "ln_specific_tension_scale", "ln_size_scale"};
+                                      "ln_specific_tension_scale", "ln_size_scale", "ln_rotator_mass_scale"};
     for (int i : biceps_) names.push_back("ln_" + base_->muscles[i].params.name + "_mass_scale");
     for (int i : synergists_) names.push_back("ln_" + base_->muscles[i].params.name + "_mass_scale");
     return names;
@@ -220,11 +257,19 @@ int SynergistModel::findPose(double flexionDeg, std::vector<std::pair<double, do
     return int(poses.size()) - 1;
 }
 
-int SynergistModel::findKind(MuscleGroup group, double level) {
-    auto it = std::find_if(kinds_.begin(), kinds_.end(), [&](const EffortKind& k) { return k.group == group && k.level == level; });
+int SynergistModel::findKind(Effort effort, double level) {
+    auto it = std::find_if(kinds_.begin(), kinds_.end(), [&](const EffortKind& k) { return k.effort == effort && k.level == level; });
     if (it != kinds_.end()) return int(it - kinds_.begin());
-    kinds_.push_back({group, level});
+    kinds_.push_back({effort, level});
     return int(kinds_.size()) - 1;
+}
+
+void SynergistModel::freeRotatorMass() {
+    if (rotators_.empty()) return;
+    lower_[kRotatorMass] = lower_[kExtensorMass];
+    upper_[kRotatorMass] = upper_[kExtensorMass];
+    for (std::size_t j = 0; j < rotatorCovariance_.size(); ++j)
+        priorCovariance_[kRotatorMass][j] = priorCovariance_[j][kRotatorMass] = rotatorCovariance_[j];
 }
 
 int SynergistModel::findMassIndex(int muscle) const {
@@ -260,6 +305,7 @@ std::vector<MuscleSpec> SynergistModel::makeMuscles(const double* x) const {
         q.slowFraction = std::clamp(q.slowFraction + x[kSynergistSlow], 0.05, 0.95);
     }
     for (int i : extensors_) m[i].params.mass *= std::exp(x[kExtensorMass]);
+    for (int i : rotators_) m[i].params.mass *= std::exp(x[kRotatorMass]);
     const double sigma = std::exp(x[kSigma]), g = std::exp(x[kSize]);
     for (MuscleSpec& spec : m) {
         MuscleParameters& q = spec.params;
@@ -278,6 +324,12 @@ std::vector<double> SynergistModel::calcTorques(const double* x) const {
 }
 
 void SynergistModel::calcPredictions(const double* x, std::vector<double>& torques, std::vector<double>& channels) const {
+    std::vector<double> forearm;
+    calcPredictions(x, torques, forearm, channels);
+}
+
+void SynergistModel::calcPredictions(const double* x, std::vector<double>& torques, std::vector<double>& forearmTorques,
+                                     std::vector<double>& channels) const {
     // Guard: the bounds keep difference probes inside [0, 1].
     const double va = std::clamp(x[kActivation], 0.0, 1.0), cc = std::clamp(x[kCoContraction], 0.0, 1.0);
     const std::vector<MuscleSpec> muscles = makeMuscles(x);
@@ -292,11 +344,14 @@ void SynergistModel::calcPredictions(const double* x, std::vector<double>& torqu
     const MvcGeometry& geometry = g != 1 ? scaled : geometry_;
     const SteadyMvcCurve relaxed = calcRelaxedCurve(muscles, geometry);
     std::vector<SteadyMvcCurve> active;
-    for (const EffortKind& k : kinds_)
-        active.push_back(calcSteadyMvcCurve(muscles, geometry, k.group, makeEffort(k.level, va, cc)));
+    for (std::size_t j = 0; j < kinds_.size(); ++j)
+        active.push_back(calcSteadyMvcCurve(muscles, geometry, kinds_[j].effort, agonists_[j],
+                                            makeEffort(kinds_[j].level, va, cc)));
     torques.clear();
+    forearmTorques.clear();
     for (std::size_t c = 0; c < angleOf_.size(); ++c) {
         torques.push_back(sumTaredTorque(active[kindOf_[c]], relaxed, std::size_t(angleOf_[c]), leftOut_));
+        forearmTorques.push_back(sumTaredForearmTorque(active[kindOf_[c]], relaxed, std::size_t(angleOf_[c]), leftOut_));
     }
     channels.clear();
     for (std::size_t k = 0; k < channels_.size(); ++k) {
@@ -309,7 +364,7 @@ void SynergistModel::calcPredictions(const double* x, std::vector<double>& torqu
         } else if (o.channel == "volume") {
             v = muscles[m].params.mass / muscles[m].params.coefficients.density;
         } else if (o.channel == "emg") {
-            const bool agonist = muscles[m].group == o.effort;
+            const bool agonist = isAgonistOf(o.effort, muscles[m].group, 0.0);
             const double own = o.level * (agonist ? va : cc), other = o.level * (agonist ? cc : va);
             v = (own + emgCrosstalk_ * other) / (va + emgCrosstalk_ * cc);
         } else {  // upper_arm_length
@@ -329,14 +384,32 @@ MuscleEstimate identifySynergistAware(const Population& prior, const std::vector
     }
     // One condition per observation: the model computes each distinct angle and effort kind once.
     std::vector<TorqueCondition> conditions;
-    std::vector<double> torque;
+    bool readsForearm = false;
     for (const TorqueObservation& o : data) {
         TorqueCondition c{o.flexionDeg, o.effort, o.level, 1};
         c.rotationDeg = o.rotationDeg;
         conditions.push_back(c);
-        torque.push_back(o.torque);
+        readsForearm = readsForearm || std::isfinite(o.forearmTorque);
+        if (isForearmEffort(o.effort) && !std::isfinite(o.forearmTorque))
+            throw InputError(std::string("synergist-aware identifier: a ") + getEffortName(o.effort) + " effort at " +
+                             formatNumber(o.flexionDeg) + " deg without its forearm torque");
     }
-    const SynergistModel model(prior, options, conditions);
+    // The transducer's rows: the flexion axis of every flexion and extension effort, then the forearm
+    // axis wherever it was read. A rotation effort's flexion axis is left out: it is the flexors'
+    // co-contraction, whose motor-unit recruitment steps (a unit starts at its minimum firing rate)
+    // make the steady prediction jump at the low activations that carry it.
+    struct Row {
+        std::size_t observation;
+        bool forearm;
+    };
+    std::vector<Row> rows;
+    for (std::size_t k = 0; k < data.size(); ++k)
+        if (!isForearmEffort(data[k].effort)) rows.push_back({k, false});
+    const std::size_t nFlexion = rows.size();
+    for (std::size_t k = 0; k < data.size(); ++k)
+        if (std::isfinite(data[k].forearmTorque)) rows.push_back({k, true});
+    SynergistModel model(prior, options, conditions);
+    if (readsForearm) model.freeRotatorMass();
     const std::vector<ChannelObservation>& channels = options.channels;
     for (const ChannelObservation& o : channels)
         if (!(o.sd > 0) || !std::isfinite(o.value))
@@ -357,11 +430,16 @@ MuscleEstimate identifySynergistAware(const Population& prior, const std::vector
         est.noiseDegreesOfFreedom = 0;
     }
     est.noiseLevel = std::max(est.noiseLevel, 0.002);  // floor: the scatter of few repetitions can be ~0
-    std::vector<double> sd;
-    for (double t : torque) sd.push_back(est.noiseLevel * std::max(std::abs(t), 1.0));
+    // Each axis's sd: the noise level times the transducer's load (1 N m at least; TorqueObservation::getLoad).
+    std::vector<double> torque, sd;
+    for (const Row& row : rows) {
+        const TorqueObservation& o = data[row.observation];
+        torque.push_back(row.forearm ? o.forearmTorque : o.torque);
+        sd.push_back(est.noiseLevel * std::max(o.getLoad(), 1.0));
+    }
 
     using P = SynergistModel;
-    const std::size_t nt = torque.size(), nc = channels.size();
+    const std::size_t nt = rows.size(), nc = channels.size();
     MapProblem map;
     map.priorMean = model.getPriorMean();
     map.priorCovariance = model.getPriorCovariance();
@@ -370,9 +448,12 @@ MuscleEstimate identifySynergistAware(const Population& prior, const std::vector
     map.numResiduals = int(nt + nc) + (measured ? 1 : 0);
     // Residuals: torques, then channels, then the measured activation.
     auto calcResiduals = [&](const double* x, double* r) {
-        std::vector<double> t, c;
-        model.calcPredictions(x, t, c);
-        for (std::size_t k = 0; k < nt; ++k) r[k] = (t[k] - torque[k]) / sd[k];
+        std::vector<double> t, f, c;
+        model.calcPredictions(x, t, f, c);
+        for (std::size_t k = 0; k < nt; ++k) {
+            const Row& row = rows[k];
+            r[k] = ((row.forearm ? f : t)[row.observation] - torque[k]) / sd[k];
+        }
         for (std::size_t k = 0; k < nc; ++k) r[nt + k] = (c[k] - channels[k].value) / channels[k].sd;
         if (measured) r[nt + nc] = (x[P::kActivation] - options.measuredActivation) / options.activationSd;
         return t;
@@ -414,6 +495,10 @@ MuscleEstimate identifySynergistAware(const Population& prior, const std::vector
         est.nuisanceNames.push_back("size_scale");
         est.nuisance.push_back(std::exp(x[P::kSize]));
     }
+    if (model.getLower()[P::kRotatorMass] < model.getUpper()[P::kRotatorMass]) {
+        est.nuisanceNames.push_back("rotator_mass_scale");
+        est.nuisance.push_back(std::exp(x[P::kRotatorMass]));
+    }
     for (int i = 0; i < base.getNumMuscles(); ++i) {
         const int k = model.findMassIndex(i);
         if (k < 0 || i == base.primary) continue;
@@ -427,11 +512,9 @@ MuscleEstimate identifySynergistAware(const Population& prior, const std::vector
     try {
         const std::vector<double> t = calcResiduals(x.data(), r.data());
         double ss = 0;
-        for (std::size_t k = 0; k < nt; ++k) {
-            est.predictedTorque.push_back(t[k]);
-            ss += std::pow(t[k] - torque[k], 2);
-        }
-        est.rmsResidual = std::sqrt(ss / double(nt));
+        for (std::size_t k = 0; k < nFlexion; ++k) ss += std::pow(t[rows[k].observation] - torque[k], 2);
+        est.predictedTorque = t;
+        est.rmsResidual = std::sqrt(ss / double(std::max<std::size_t>(nFlexion, 1)));
     } catch (const std::exception& e) {
         est.converged = false;
         est.message += "; no steady state at the estimate: " + std::string(e.what());
@@ -455,11 +538,17 @@ MuscleEstimate identifySynergistAware(const Population& prior, const std::vector
             it->worst = what;
         }
     };
-    auto describe = [](double flexionDeg, MuscleGroup effort, double level) {
+    auto describe = [](double flexionDeg, Effort effort, double level) {
         return std::string(getEffortName(effort)) + (level == 1 ? " MVC" : level == 0 ? " (at rest)" : " " + formatNumber(100 * level) + " %") +
                " at " + formatNumber(flexionDeg) + " deg";
     };
-    for (std::size_t k = 0; k < nt; ++k) addFit("torque", k, describe(data[k].flexionDeg, data[k].effort, data[k].level));
+    auto posture = [](const TorqueObservation& o) {
+        return std::isnan(o.rotationDeg) ? std::string() : ", forearm at " + formatNumber(o.rotationDeg) + " deg";
+    };
+    for (std::size_t k = 0; k < nt; ++k) {
+        const TorqueObservation& o = data[rows[k].observation];
+        addFit(rows[k].forearm ? "forearm_torque" : "torque", k, describe(o.flexionDeg, o.effort, o.level) + posture(o));
+    }
     for (std::size_t k = 0; k < nc; ++k) {
         const ChannelObservation& o = channels[k];
         addFit(o.channel, nt + k,

@@ -11,7 +11,10 @@
 // (Satterthwaite; channels and prior have known sds, so f -> 0 gives the normal quantile). With VA
 // measured by twitch interpolation it has one more residual ("synergist-va"); with the channels of
 // experiments/channels.h (ultrasound fascicle length and volume, EMG, anthropometry) one residual per
-// measurement, each divided by its own sd ("channels").
+// measurement, each divided by its own sd ("channels"). A two-axis transducer's forearm torque (the
+// observations' forearmTorque, supination and pronation efforts included) adds one residual per
+// reading, with the same relative noise of the effort's own axis; the rotators (the muscles in no
+// other group: pronators, supinator) then get a mass scale of their own.
 #pragma once
 
 #include "experiments/channels.h"
@@ -50,9 +53,11 @@ struct SynergistOptions {
 
 /// The synergist-aware identifier's model: its parameters x, their prior and bounds, and the tared
 /// steady torque it predicts for a list of effort conditions (also used by experiment design).
-/// x = [ln t_b, VA, CC, ln f_b, ln t_s, ln f_s, ln s_e, d_b, d_s, ln sigma, ln g, then ln s_m for every
-/// biceps head and synergist m]: t tendon, f fascicle length and s mass scales; b the biceps heads (one
-/// tendon and one fascicle scale), s the synergists, e the extensors (one mass scale); d the change of
+/// x = [ln t_b, VA, CC, ln f_b, ln t_s, ln f_s, ln s_e, d_b, d_s, ln sigma, ln g, ln s_r, then ln s_m for
+/// every biceps head and synergist m]: t tendon, f fascicle length and s mass scales; b the biceps heads
+/// (one tendon and one fascicle scale), s the synergists, e the extensors and r the rotators (the
+/// muscles in none of those groups; one mass scale each, s_r held at the prior's mean unless the data
+/// read the forearm axis); d the change of
 /// the slow-fibre fraction F_slow (added, biceps heads and synergists; held at 0 unless
 /// freeSlowFraction); sigma the person's specific-tension scale (every muscle; F0 = sigma M / (rho L0))
 /// and g the person's size (every length; moment arms and path lengths scale with it), each held at the
@@ -76,6 +81,7 @@ public:
     static constexpr int getFascicleIndex() { return kFascicle; }      ///< ln f_b
     static constexpr int getSpecificTensionIndex() { return kSigma; }  ///< ln sigma
     static constexpr int getSizeIndex() { return kSize; }              ///< ln g
+    static constexpr int getRotatorMassIndex() { return kRotatorMass; }  ///< ln s_r
     const std::vector<double>& getPriorMean() const { return priorMean_; }
     const std::vector<std::vector<double>>& getPriorCovariance() const { return priorCovariance_; }
     const std::vector<double>& getLower() const { return lower_; }
@@ -84,31 +90,38 @@ public:
     std::vector<double> calcTorques(const double* x) const;
     /// Tared torques and every channel measurement's predicted value (options.channels' order) at x.
     void calcPredictions(const double* x, std::vector<double>& torques, std::vector<double>& channels) const;
+    /// The same and every condition's tared torque about the forearm axis (+ = supination) [N m].
+    void calcPredictions(const double* x, std::vector<double>& torques, std::vector<double>& forearmTorques,
+                         std::vector<double>& channels) const;
     /// The population's model with x's muscles.
     std::vector<MuscleSpec> makeMuscles(const double* x) const;
 
 private:
     static constexpr int kTendon = 0, kActivation = 1, kCoContraction = 2, kFascicle = 3, kSynergistTendon = 4,
                          kSynergistFascicle = 5, kExtensorMass = 6, kBicepsSlow = 7, kSynergistSlow = 8,
-                         kSigma = 9, kSize = 10, kFirstMass = 11;
+                         kSigma = 9, kSize = 10, kRotatorMass = 11, kFirstMass = 12;
     struct EffortKind {
-        MuscleGroup group;
+        Effort effort;
         double level;
     };
     int findMassIndex(int muscle) const;
     const ArmSetup* base_;
-    std::vector<int> biceps_, synergists_, extensors_, leftOut_;
+    std::vector<int> biceps_, synergists_, extensors_, rotators_, leftOut_;
     MvcGeometry geometry_;                    // one row per pose (flexion angle, forearm posture)
     std::vector<EffortKind> kinds_;
+    std::vector<std::vector<std::vector<bool>>> agonists_;  // [kind][pose][muscle], of the prior's geometry
     std::vector<int> angleOf_, kindOf_;       // condition -> pose index, effort kind
     std::vector<ChannelObservation> channels_;
     std::vector<int> channelMuscle_, channelAngle_, channelKind_;  // kind -1: relaxed
     double emgCrosstalk_ = 0;
-    int findKind(MuscleGroup group, double level);
+    int findKind(Effort effort, double level);
+    /// Frees s_r within the mass scales' bounds (the data read the forearm axis).
+    void freeRotatorMass();
     /// Index of the pose (flexion, forearm rotation; NaN = the model's posture, kept as +inf), added if new.
     int findPose(double flexionDeg, std::vector<std::pair<double, double>>& poses, double rotationDeg = 0.0 / 0.0);
     std::vector<double> priorMean_, lower_, upper_;
     std::vector<std::vector<double>> priorCovariance_;
+    std::vector<double> rotatorCovariance_;  // s_r's prior row, coupled (freeRotatorMass)
     friend MuscleEstimate identifySynergistAware(const Population&, const std::vector<TorqueObservation>&,
                                                  const SynergistOptions&);
 };

@@ -87,7 +87,7 @@ std::string formatTorquePredictionsCsv(const std::vector<TorqueObservation>& dat
     for (std::size_t k = 0; k < data.size(); ++k) {
         const TorqueObservation& d = data[k];
         CsvRow row;
-        row.addNumber(d.flexionDeg).addInteger(d.effort == MuscleGroup::Flexor ? 1 : -1).addNumber(d.level);
+        row.addNumber(d.flexionDeg).addInteger(getEffortCode(d.effort)).addNumber(d.level);
         row.addInteger(d.repetition).addNumber(d.torque);
         if (postures) row.addNumber(d.rotationDeg);
         for (const MuscleEstimate& e : estimates) row.addNumber(e.predictedTorque[k]);

@@ -19,6 +19,15 @@ namespace armsim {
 const char* getMuscleGroupName(MuscleGroup g) {
     return g == MuscleGroup::Flexor ? "flexor" : g == MuscleGroup::Extensor ? "extensor" : "forearm";
 }
+const char* getEffortName(Effort e) {
+    switch (e) {
+        case Effort::Flexion: return "flexion";
+        case Effort::Extension: return "extension";
+        case Effort::Supination: return "supination";
+        case Effort::Pronation: return "pronation";
+    }
+    return "?";
+}
 const char* getArmBodyName(ArmBody b) {
     return b == ArmBody::UpperArm ? "upper_arm" : b == ArmBody::Forearm ? "forearm" : "radius";
 }

@@ -52,6 +52,29 @@ namespace armsim {
 enum class MuscleGroup { Flexor, Extensor, Forearm };
 const char* getMuscleGroupName(MuscleGroup g);
 
+/// What a subject tries to do in an isometric effort. Its agonists: the flexors (Flexion), the
+/// extensors (Extension), or the muscles whose moment arm about the forearm axis in the pose turns the
+/// forearm that way by more than kForearmAgonistMomentArm (Supination, Pronation; models with a
+/// forearm rotation). Everything else acts at the co-contraction level.
+enum class Effort { Flexion, Extension, Supination, Pronation };
+/// "flexion", "extension", "supination" or "pronation".
+const char* getEffortName(Effort e);
+/// true for Supination and Pronation (the forearm axis is the effort's own).
+inline bool isForearmEffort(Effort e) { return e == Effort::Supination || e == Effort::Pronation; }
+/// Smallest moment arm about the forearm axis that makes a muscle an agonist of a rotation effort [m].
+inline constexpr double kForearmAgonistMomentArm = 1e-3;
+/// true when a muscle of `group` with moment arm `forearmMomentArm` about the forearm axis in the
+/// effort's pose [m, + = supinates] is one of the effort's agonists.
+inline bool isAgonistOf(Effort e, MuscleGroup group, double forearmMomentArm) {
+    switch (e) {
+        case Effort::Flexion: return group == MuscleGroup::Flexor;
+        case Effort::Extension: return group == MuscleGroup::Extensor;
+        case Effort::Supination: return forearmMomentArm > kForearmAgonistMomentArm;
+        case Effort::Pronation: return forearmMomentArm < -kForearmAgonistMomentArm;
+    }
+    return false;
+}
+
 /// The bodies a path element can sit on (the radius only in arms with a forearm rotation).
 enum class ArmBody { UpperArm, Forearm, Radius };
 const char* getArmBodyName(ArmBody b);

@@ -5,6 +5,7 @@
 #include "model/muscle_arm.h"
 
 #include <cmath>
+#include <stdexcept>
 
 namespace armsim {
 
@@ -93,22 +94,52 @@ SteadyMvcCurve calcSteadyCurve(const std::vector<MuscleSpec>& muscles, const Mvc
 
 }  // namespace
 
-SteadyMvcCurve calcSteadyMvcCurve(const std::vector<MuscleSpec>& muscles, const MvcGeometry& geometry,
-                                  MuscleGroup effort, const SubjectEffort& subject) {
+Effort getEffortOf(MuscleGroup group) {
+    if (group == MuscleGroup::Forearm) throw std::logic_error("getEffortOf: the forearm group drives no elbow effort");
+    return group == MuscleGroup::Flexor ? Effort::Flexion : Effort::Extension;
+}
+
+std::vector<std::vector<bool>> findAgonists(const std::vector<MuscleSpec>& muscles, const MvcGeometry& geometry,
+                                            Effort effort) {
+    std::vector<std::vector<bool>> out(geometry.flexionDeg.size());
+    for (std::size_t a = 0; a < out.size(); ++a)
+        for (std::size_t i = 0; i < muscles.size(); ++i) {
+            const double r = geometry.forearmMomentArm.empty() || geometry.forearmMomentArm[a].empty()
+                                 ? 0.0 : geometry.forearmMomentArm[a][i];
+            out[a].push_back(isAgonistOf(effort, muscles[i].group, r));
+        }
+    return out;
+}
+
+SteadyMvcCurve calcSteadyMvcCurve(const std::vector<MuscleSpec>& muscles, const MvcGeometry& geometry, Effort effort,
+                                  const std::vector<std::vector<bool>>& agonists, const SubjectEffort& subject) {
+    if (agonists.size() != geometry.flexionDeg.size())
+        throw std::logic_error("calcSteadyMvcCurve: one agonist row per angle expected");
     SteadyMvcCurve c = calcSteadyCurve(muscles, geometry, subject,
-                                       [&](std::size_t, std::size_t i) { return muscles[i].group == effort; });
+                                       [&](std::size_t a, std::size_t i) { return bool(agonists[a].at(i)); });
     c.effort = effort;
     return c;
 }
 
+SteadyMvcCurve calcSteadyMvcCurve(const std::vector<MuscleSpec>& muscles, const MvcGeometry& geometry, Effort effort,
+                                  const SubjectEffort& subject) {
+    return calcSteadyMvcCurve(muscles, geometry, effort, findAgonists(muscles, geometry, effort), subject);
+}
+
+SteadyMvcCurve calcSteadyMvcCurve(const std::vector<MuscleSpec>& muscles, const MvcGeometry& geometry,
+                                  MuscleGroup effort, const SubjectEffort& subject) {
+    return calcSteadyMvcCurve(muscles, geometry, getEffortOf(effort), subject);
+}
+
 SteadyMvcCurve calcSteadyForearmMvc(const std::vector<MuscleSpec>& muscles, const MvcGeometry& geometry,
                                     ForearmEffort effort, const SubjectEffort& subject) {
-    const double sign = effort == ForearmEffort::Supination ? 1.0 : -1.0;
-    SteadyMvcCurve c = calcSteadyCurve(muscles, geometry, subject, [&](std::size_t a, std::size_t i) {
-        return !geometry.forearmMomentArm.empty() && sign * geometry.forearmMomentArm[a][i] > kForearmAgonistMomentArm;
-    });
-    c.effort = MuscleGroup::Forearm;
-    return c;
+    return calcSteadyMvcCurve(muscles, geometry, effort == ForearmEffort::Supination ? Effort::Supination : Effort::Pronation,
+                              subject);
+}
+
+SteadyMvcCurve calcSteadyMvcCurve(const ArmSetup& setup, Effort effort, const SubjectEffort& subject,
+                                  const std::vector<double>& flexionDeg, double rotationDeg) {
+    return calcSteadyMvcCurve(setup.muscles, calcMvcGeometry(setup, flexionDeg, rotationDeg), effort, subject);
 }
 
 SteadyMvcCurve calcSteadyMvcCurve(const ArmSetup& setup, MuscleGroup effort, const SubjectEffort& subject,

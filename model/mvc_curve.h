@@ -23,7 +23,7 @@ struct SteadyMusclePoint {
 
 /// The steady MVC torque-angle curve of a model: rows = angles, columns = muscles.
 struct SteadyMvcCurve {
-    MuscleGroup effort = MuscleGroup::Flexor;
+    Effort effort = Effort::Flexion;
     std::vector<std::string> muscles;
     std::vector<double> flexionDeg;                       ///< 0 = full extension
     std::vector<std::vector<SteadyMusclePoint>> points;   ///< [angle][muscle]
@@ -50,9 +50,23 @@ MvcGeometry calcMvcGeometry(const ArmSetup& setup, const std::vector<double>& fl
                             double rotationDeg = 0.0 / 0.0);
 
 /// The curve of `muscles` (setup.muscles, or the same muscles with other parameters) on a geometry
-/// computed for them; as calcSteadyMvcCurve below.
+/// computed for them; as calcSteadyMvcCurve below. A rotation effort's agonists are found per angle by
+/// their forearm moment arm (isAgonistOf); without a forearm rotation it has none.
+SteadyMvcCurve calcSteadyMvcCurve(const std::vector<MuscleSpec>& muscles, const MvcGeometry& geometry,
+                                  Effort effort, const SubjectEffort& subject);
+/// Which muscles are the effort's agonists at each angle of the geometry: [angle][muscle].
+std::vector<std::vector<bool>> findAgonists(const std::vector<MuscleSpec>& muscles, const MvcGeometry& geometry,
+                                            Effort effort);
+/// The curve with the agonists given per angle (findAgonists, perhaps of another geometry: a fit that
+/// scales the moment arms keeps its agonists).
+SteadyMvcCurve calcSteadyMvcCurve(const std::vector<MuscleSpec>& muscles, const MvcGeometry& geometry, Effort effort,
+                                  const std::vector<std::vector<bool>>& agonists, const SubjectEffort& subject);
+/// The same with the agonists of a muscle group: Flexor a flexion effort, Extensor an extension effort.
 SteadyMvcCurve calcSteadyMvcCurve(const std::vector<MuscleSpec>& muscles, const MvcGeometry& geometry,
                                   MuscleGroup effort, const SubjectEffort& subject);
+/// The effort that drives a group's muscles (Flexor: Flexion, Extensor: Extension; Forearm has none:
+/// std::logic_error).
+Effort getEffortOf(MuscleGroup group);
 
 /// Every muscle of `setup` at its steady isometric state at each flexion angle [deg], the agonists of
 /// `effort` at subject.voluntaryActivation and the others at subject.coContraction (both in [0, 1]; 0 and 0
@@ -63,15 +77,18 @@ SteadyMvcCurve calcSteadyMvcCurve(const std::vector<MuscleSpec>& muscles, const 
 SteadyMvcCurve calcSteadyMvcCurve(const ArmSetup& setup, MuscleGroup effort, const SubjectEffort& subject,
                                   const std::vector<double>& flexionDeg);
 
+/// The same for an effort (a rotation effort's agonists by their forearm moment arm) in forearm posture
+/// rotationDeg (NaN: the model's).
+SteadyMvcCurve calcSteadyMvcCurve(const ArmSetup& setup, Effort effort, const SubjectEffort& subject,
+                                  const std::vector<double>& flexionDeg, double rotationDeg = 0.0 / 0.0);
+
 /// A maximal forearm-rotation effort.
 enum class ForearmEffort { Supination, Pronation };
-/// Smallest moment arm about the forearm axis that makes a muscle an agonist of a rotation effort [m].
-inline constexpr double kForearmAgonistMomentArm = 1e-3;
 
 /// The steady state of every muscle during a maximal forearm-rotation effort at each angle of the
 /// geometry: agonists (muscles whose forearm moment arm there turns the way of the effort by more than
 /// kForearmAgonistMomentArm) at subject.voluntaryActivation, the others at subject.coContraction. The
-/// curve's effort is MuscleGroup::Forearm; totalForearmTorque is the effort's torque (+ = supination).
+/// curve's effort is Supination or Pronation; totalForearmTorque is the effort's torque (+ = supination).
 SteadyMvcCurve calcSteadyForearmMvc(const std::vector<MuscleSpec>& muscles, const MvcGeometry& geometry,
                                     ForearmEffort effort, const SubjectEffort& subject);
 

@@ -93,6 +93,9 @@ void IsometricTrialSettings::validate(const ArmParameters& arm) const {
         throw FieldError("elbow_angle_deg", "= " + formatNumber(angleDeg) +
                                                 ": an isometric trial reads the biceps force as torque / moment arm, and the "
                                                 "moment arm vanishes at full extension: expected an angle below 180 deg");
+    if (isForearmEffort(effort) && !arm.forearmRotation.enabled)
+        throw FieldError("effort", std::string("= ") + getEffortName(effort) +
+                                       ": the model's arm has no forearm rotation (expected flexion or extension)");
     checkField("activation", activation, Bound::closed(0, 1));
     checkField("antagonist_activation", antagonistActivation, Bound::closed(0, 1));
     checkField("rest", restDuration, Bound::positive("s"));
@@ -115,10 +118,28 @@ ActivationProfile riseTo(const IsometricTrialSettings& s, double U) {
 
 ActivationProfile IsometricTrialSettings::calcActivationProfile() const { return riseTo(*this, activation); }
 
+std::vector<bool> IsometricTrialSettings::findAgonists(const ArmSetup& setup) const {
+    std::vector<double> r(setup.muscles.size(), 0.0);
+    if (isForearmEffort(effort)) {
+        if (!setup.arm.forearmRotation.enabled)
+            throw FieldError("effort", std::string("= ") + getEffortName(effort) + ": model '" + setup.name +
+                                           "' has no forearm rotation (expected flexion or extension)");
+        ArmGeometry g(setup);
+        g.setForearmRotation(degToRad(std::isnan(forearmRotationDeg) ? setup.arm.forearmRotation.postureDeg
+                                                                     : forearmRotationDeg));
+        g.setElbowAngle(elbowAngle);
+        for (int i = 0; i < setup.getNumMuscles(); ++i) r[i] = g.calcForearmMomentArm(i);
+    }
+    std::vector<bool> agonist;
+    for (std::size_t i = 0; i < setup.muscles.size(); ++i) agonist.push_back(isAgonistOf(effort, setup.muscles[i].group, r[i]));
+    return agonist;
+}
+
 std::vector<ActivationProfile> IsometricTrialSettings::calcActivationProfiles(const ArmSetup& setup) const {
+    const std::vector<bool> agonist = findAgonists(setup);
     std::vector<ActivationProfile> profiles;
-    for (const MuscleSpec& m : setup.muscles)
-        profiles.push_back(riseTo(*this, m.group == effort ? activation : antagonistActivation));
+    for (std::size_t i = 0; i < setup.muscles.size(); ++i)
+        profiles.push_back(riseTo(*this, agonist[i] ? activation : antagonistActivation));
     return profiles;
 }
 
@@ -154,9 +175,11 @@ IsometricTrialResult runIsometricTrial(const ArmSetup& setup, const IsometricTri
     IsometricSummary& sum = result.summary;
     sum.elbowAngle = settings.elbowAngle;
     std::vector<double> restForces(n);
+    const bool forearm = ap.forearmRotation.enabled;
     for (int i = 0; i < n; ++i) {
         sum.pathLengths.push_back(model.calcPathLength(state, i));
         sum.momentArms.push_back(model.calcMomentArm(state, i));
+        sum.forearmMomentArms.push_back(forearm ? model.calcForearmMomentArm(state, i) : 0.0);
         restForces[i] = model.getMuscleForce(i).getForce(state);
     }
     sum.pathLength = sum.pathLengths[primary];
@@ -166,12 +189,17 @@ IsometricTrialResult runIsometricTrial(const ArmSetup& setup, const IsometricTri
     // Locked: gravity and the stop are constant, so the lock's torque is G - sum_i h_i F_i exactly.
     double G = sum.tareTorque;
     for (int i = 0; i < n; ++i) G += sum.momentArms[i] * restForces[i];
+    // The same about the forearm axis (the radius is locked too): its lock holds Gf - sum_i r_i F_i.
+    const double forearmTare = forearm ? arm.calcForearmHoldingTorque(state) : 0.0;
+    double Gf = forearmTare;
+    for (int i = 0; i < n; ++i) Gf += sum.forearmMomentArms[i] * restForces[i];
+    std::vector<std::string> columns = {"time_s", "activation", "elbow_angle_deg", "elbow_velocity_degps", "muscle_force_N",
+                                        "fascicle_length_m", "fascicle_velocity_mps", "holding_torque_Nm",
+                                        "muscle_torque_Nm", "strap_force_N", "saturated", "force_moment_arm_N",
+                                        "force_fixed_ratio_N", "error_moment_arm_pct", "error_fixed_ratio_pct"};
+    if (forearm) columns.push_back("forearm_torque_Nm");
 
-    result.series = Table(withMuscleColumns(
-        {"time_s", "activation", "elbow_angle_deg", "elbow_velocity_degps", "muscle_force_N", "fascicle_length_m",
-         "fascicle_velocity_mps", "holding_torque_Nm", "muscle_torque_Nm", "strap_force_N", "saturated",
-         "force_moment_arm_N", "force_fixed_ratio_N", "error_moment_arm_pct", "error_fixed_ratio_pct"},
-        model));
+    result.series = Table(withMuscleColumns(columns, model));
     result.series.reserveRows(int(std::lround(settings.getDuration() * settings.sampleRate)) + 1);
     const double h = sum.momentArm;
     const double L0 = model.getMuscle(primary).getParameters().optimalFascicleLength;
@@ -192,16 +220,19 @@ IsometricTrialResult runIsometricTrial(const ArmSetup& setup, const IsometricTri
 
     // One sample from y = [q u z]; s is the realized-per-sample reference's State (else null).
     auto sample = [&](double t, const double* y, const State* s) {
-        double torque;
+        double torque, forearmTorque = 0;
         if (s) {
             system.realize(*s, Stage::Acceleration);
             for (int i = 0; i < n; ++i) forces[i] = model.getMuscleForce(i).getForce(*s);
             torque = arm.calcHoldingTorque(*s);
+            if (forearm) forearmTorque = arm.calcForearmHoldingTorque(*s);
         } else {  // the paths are fixed: the pure model gives Fse from the interpolated states
             torque = G;
+            forearmTorque = Gf;
             for (int i = 0; i < n; ++i) {
                 forces[i] = muscles[i]->calcForce(sum.pathLengths[i], y + firstState[i]);
                 torque -= sum.momentArms[i] * forces[i];
+                forearmTorque -= sum.forearmMomentArms[i] * forces[i];
             }
         }
         const double F = forces[primary];
@@ -213,6 +244,7 @@ IsometricTrialResult runIsometricTrial(const ArmSetup& setup, const IsometricTri
         row.assign({t, profile.getValue(t), radToDeg(settings.elbowAngle), 0.0, F, yp[VirtualMuscle::kL] * L0,
                     yp[VirtualMuscle::kV] * L0, torque, muscleTorque, r.strapForce, r.saturated ? 1.0 : 0.0,
                     r.forceMomentArm, r.forceFixedRatio, r.errorMomentArmPct, r.errorFixedRatioPct});
+        if (forearm) row.push_back(forearmTare - forearmTorque);  // tared, + = supination
         appendMuscleForces(row, activations, forces, t);
         for (int i = 0; i < n; ++i) row.insert(row.end(), y + firstState[i], y + firstState[i] + muscles[i]->getNumStates());
         result.series.appendRow(row);
@@ -271,6 +303,7 @@ IsometricTrialResult runIsometricTrial(const ArmSetup& setup, const IsometricTri
     sum.meanForceMomentArm = mean(t.getColumn("force_moment_arm_N"), first);
     sum.meanForceFixedRatio = mean(t.getColumn("force_fixed_ratio_N"), first);
     sum.meanMuscleTorque = mean(t.getColumn("muscle_torque_Nm"), first);
+    if (forearm) sum.meanForearmTorque = mean(t.getColumn("forearm_torque_Nm"), first);
     for (int i = 0; i < n; ++i)
         sum.meanForces.push_back(n == 1 ? sum.meanForce : mean(t.getColumn("force_" + model.getMuscleName(i) + "_N"), first));
     return result;
@@ -350,8 +383,9 @@ IsometricTrialSettings readIsometricTrialSettings(const ParamNode& n, const ArmP
     const Bound any = Bound::any();
     s.elbowAngle = degToRad(n.getNumber("elbow_angle_deg", any, radToDeg(s.elbowAngle)));
     s.activation = n.getNumber("activation", any, s.activation);
-    s.effort = n.getChoice("effort", {"flexion", "extension"}, "flexion") == "flexion" ? MuscleGroup::Flexor
-                                                                                     : MuscleGroup::Extensor;
+    const std::string effort = n.getChoice("effort", {"flexion", "extension", "supination", "pronation"}, "flexion");
+    s.effort = effort == "flexion" ? Effort::Flexion : effort == "extension" ? Effort::Extension
+             : effort == "supination" ? Effort::Supination : Effort::Pronation;
     s.antagonistActivation = n.getNumber("antagonist_activation", any, s.antagonistActivation);
     s.restDuration = n.getNumber("rest", any, s.restDuration);
     s.riseTime = n.getNumber("rise", any, s.riseTime);

@@ -58,7 +58,9 @@ struct IsometricTrialSettings {
     /// for a model with a forearm rotation (InputError otherwise).
     double forearmRotationDeg = 0.0 / 0.0;
     double activation = 1.0;       ///< target U of the agonists during the hold [1]
-    MuscleGroup effort = MuscleGroup::Flexor;  ///< which group pulls: a flexion or an extension effort
+    /// What the subject does: a flexion or an extension effort, or (a model with a forearm rotation) a
+    /// supination or a pronation effort, whose agonists turn the forearm that way in the pose.
+    Effort effort = Effort::Flexion;
     double antagonistActivation = 0.0;  ///< target U of the other group during the hold [1]
     double restDuration = 0.5;     ///< muscle inactive; the transducer is tared at its start [s]
     double riseTime = 0.0;         ///< ramp from 0 to the target; 0 = step [s]
@@ -79,6 +81,8 @@ struct IsometricTrialSettings {
     ActivationProfile calcActivationProfile() const;
     /// One profile per muscle of setup: agonists to `activation`, antagonists to antagonistActivation.
     std::vector<ActivationProfile> calcActivationProfiles(const ArmSetup& setup) const;
+    /// Which muscles of setup are the effort's agonists (in the trial's pose).
+    std::vector<bool> findAgonists(const ArmSetup& setup) const;
     double getDuration() const { return restDuration + riseTime + holdDuration; }
 };
 
@@ -94,6 +98,10 @@ struct IsometricSummary {
     double restFascicleLength = 0;  ///< fascicle length L of the primary muscle at rest (first sample) [m]
     double meanFascicleLength = 0;  ///< fascicle length of the primary muscle, window mean [m]
     double meanMuscleTorque = 0;    ///< tared elbow torque (what the transducer sees), window mean [N m]
+    /// Tared torque about the forearm axis, + = supination (a two-axis transducer's second axis), window
+    /// mean [N m]; 0 without a forearm rotation.
+    double meanForearmTorque = 0;
+    std::vector<double> forearmMomentArms;  ///< per muscle [m], + = supinates (0 without a forearm rotation)
     std::vector<double> pathLengths;     ///< per muscle [m]
     std::vector<double> momentArms;      ///< per muscle [m], + = flexor
     std::vector<double> meanForces;      ///< per muscle, window mean [N]
@@ -110,8 +118,9 @@ struct IsometricTrialResult {
     /// holding_torque_Nm (raw lock torque, + = flexion), muscle_torque_Nm (tared, + = flexion),
     /// strap_force_N (transducer reading, clipped to its range), saturated (0/1),
     /// force_moment_arm_N, force_fixed_ratio_N, error_moment_arm_pct, error_fixed_ratio_pct
-    /// (errors of the estimates against the true force of the primary muscle), with several muscles
-    /// force_<muscle>_N and activation_<muscle> per muscle, then the muscle states.
+    /// (errors of the estimates against the true force of the primary muscle), on a model with a forearm
+    /// rotation forearm_torque_Nm (tared, + = supination), with several muscles force_<muscle>_N and
+    /// activation_<muscle> per muscle, then the muscle states.
     Table series;
     IsometricSummary summary;
 };

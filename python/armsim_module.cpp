@@ -80,10 +80,10 @@ VirtualMuscle buildMuscle(const Model& m, const py::object& muscle) {
     return VirtualMuscle(m.setup.calcMuscleParameters(findMuscleIndex(m.setup, muscle)));
 }
 
-MuscleGroup parseEffort(const std::string& effort) {
-    if (effort == "flexion") return MuscleGroup::Flexor;
-    if (effort == "extension") return MuscleGroup::Extensor;
-    throw InputError("effort = '" + effort + "': expected flexion or extension");
+Effort parseEffort(const std::string& effort) {
+    for (Effort e : {Effort::Flexion, Effort::Extension, Effort::Supination, Effort::Pronation})
+        if (effort == getEffortName(e)) return e;
+    throw InputError("effort = '" + effort + "': expected flexion, extension, supination or pronation");
 }
 
 }  // namespace

@@ -132,11 +132,13 @@ std::vector<TorqueObservation> toTorqueData(const py::object& data) {
 
 /// Torque data as columns with the torque data file's names (formatTorqueData with the truth).
 py::dict toDict(const std::vector<TorqueObservation>& data) {
-    std::vector<double> deg, effort, level, rep, torque, activation, clean, rotation;
+    std::vector<double> deg, effort, level, rep, torque, activation, clean, rotation, forearm, cleanForearm;
     for (const TorqueObservation& o : data) {
         deg.push_back(o.flexionDeg);
         rotation.push_back(o.rotationDeg);
-        effort.push_back(o.effort == MuscleGroup::Flexor ? 1 : -1);
+        forearm.push_back(o.forearmTorque);
+        cleanForearm.push_back(o.cleanForearmTorque);
+        effort.push_back(getEffortCode(o.effort));
         level.push_back(o.level);
         rep.push_back(o.repetition);
         torque.push_back(o.torque);
@@ -150,8 +152,10 @@ py::dict toDict(const std::vector<TorqueObservation>& data) {
     d["repetition"] = toArray(rep);
     d["torque_Nm"] = toArray(torque);
     d["rotation_deg"] = toArray(rotation);   // NaN: the model's forearm posture
+    d["forearm_torque_Nm"] = toArray(forearm);   // NaN: the forearm axis not read
     d["activation"] = toArray(activation);
     d["clean_torque_Nm"] = toArray(clean);
+    d["clean_forearm_torque_Nm"] = toArray(cleanForearm);
     return d;
 }
 
@@ -163,7 +167,7 @@ py::dict toDict(const std::vector<ChannelObservation>& data) {
         channel.append(o.channel);
         muscle.append(o.muscle);
         flexion.push_back(o.flexionDeg);
-        effort.push_back(o.effort == MuscleGroup::Flexor ? 1 : -1);
+        effort.push_back(o.effort == Effort::Flexion ? 1 : -1);
         level.push_back(o.level);
         repetition.push_back(o.repetition);
         value.push_back(o.value);

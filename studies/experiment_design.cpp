@@ -242,15 +242,15 @@ std::vector<TorqueCondition> makeCandidates(const DesignSettings& settings) {
     std::vector<TorqueCondition> out;
     std::vector<double> levels = {1.0};
     levels.insert(levels.end(), settings.levels.begin(), settings.levels.end());
-    for (MuscleGroup effort : {MuscleGroup::Flexor, MuscleGroup::Extensor}) {
-        if (effort == MuscleGroup::Extensor && !settings.extension) continue;
+    for (Effort effort : {Effort::Flexion, Effort::Extension}) {
+        if (effort == Effort::Extension && !settings.extension) continue;
         for (double level : levels)
             for (double q : settings.flexionDeg) out.push_back({q, effort, level, 1});
     }
     return out;
 }
 
-ChannelObservation makeRow(const char* channel, const std::string& muscle, double flexionDeg, MuscleGroup effort,
+ChannelObservation makeRow(const char* channel, const std::string& muscle, double flexionDeg, Effort effort,
                            double level) {
     ChannelObservation o;
     o.channel = channel;
@@ -317,11 +317,11 @@ ProtocolPrediction predictProtocol(const Population& prior, const TorqueProtocol
             counts.push_back(c.repetitions);
         }
     for (const std::string& m : protocol.volumeScan) {
-        rows.push_back(makeRow("volume", m, 0.0 / 0.0, MuscleGroup::Flexor, 0));
+        rows.push_back(makeRow("volume", m, 0.0 / 0.0, Effort::Flexion, 0));
         counts.push_back(1);
     }
     if (protocol.anthropometry) {
-        rows.push_back(makeRow("upper_arm_length", "", 0.0 / 0.0, MuscleGroup::Flexor, 0));
+        rows.push_back(makeRow("upper_arm_length", "", 0.0 / 0.0, Effort::Flexion, 0));
         counts.push_back(1);
     }
     const Sensitivities s = calcSensitivities(prior, protocol.conditions, settings, {}, rows, protocol.channelNoise);
@@ -367,10 +367,10 @@ DesignResult designChannelProtocol(const Population& prior, const DesignSettings
     for (int m : base.surfaceEmg)
         if (base.muscles[m].group == MuscleGroup::Flexor) {
             volumeRows.push_back({base.muscles[m].params.name, nc + int(rows.size())});
-            rows.push_back(makeRow("volume", base.muscles[m].params.name, 0.0 / 0.0, MuscleGroup::Flexor, 0));
+            rows.push_back(makeRow("volume", base.muscles[m].params.name, 0.0 / 0.0, Effort::Flexion, 0));
         }
     const int armRow = nc + int(rows.size());
-    rows.push_back(makeRow("upper_arm_length", "", 0.0 / 0.0, MuscleGroup::Flexor, 0));
+    rows.push_back(makeRow("upper_arm_length", "", 0.0 / 0.0, Effort::Flexion, 0));
     const ChannelNoise noise = reference.channelNoise;
     const int total = 2 * settings.draws + 1;
     Sensitivities s = calcSensitivities(prior, result.candidates, settings, [&](int done, int) {
@@ -426,7 +426,7 @@ DesignResult designChannelProtocol(const Population& prior, const DesignSettings
                 consider(ch, cost.ultrasoundAngle, "ultrasound", result.candidates[c]);
             }
         }
-        const TorqueCondition none{0.0 / 0.0, MuscleGroup::Flexor, 0, 0};
+        const TorqueCondition none{0.0 / 0.0, Effort::Flexion, 0, 0};
         if (!chosen.emg && std::any_of(chosen.torque.begin(), chosen.torque.end(), [](int n) { return n > 0; })) {
             Choice ch = chosen;
             ch.emg = true;

@@ -291,7 +291,8 @@ TEST(Cli, MainJobRunsTheThesisArmAndTheTwinSubject) {
     const fs::path again = freshDir("run_first");
     fs::remove_all(again);
     fs::rename(d, again);
-    ASSERT_EQ(runArmsim("run --jobs 1 --out " + d.string()).exitCode, 0);
+    const CommandResult second = runArmsim("run --jobs 1 --out " + d.string());
+    ASSERT_EQ(second.exitCode, 0) << second.output;
     auto withoutWallTime = [](const std::string& text) {
         std::istringstream in(text);
         std::string line, out;

@@ -27,8 +27,8 @@ template <class F> std::string errorOf(F&& f) { return armsim::testing::getInput
 TorqueProtocol makeChannelProtocol(double noise) {
     TorqueProtocol p;
     p.name = "channels";
-    p.conditions = {{30, MuscleGroup::Flexor, 1.0, 2, true, true}, {90, MuscleGroup::Flexor, 1.0, 1, true, true},
-                    {120, MuscleGroup::Flexor, 0.4, 1, false, true}};
+    p.conditions = {{30, Effort::Flexion, 1.0, 2, true, true}, {90, Effort::Flexion, 1.0, 1, true, true},
+                    {120, Effort::Flexion, 0.4, 1, false, true}};
     p.holdDuration = 2.0;
     p.averagingWindow = 0.5;
     p.volumeScan = {"BIClong", "BRA"};

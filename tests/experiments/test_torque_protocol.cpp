@@ -2,6 +2,7 @@
 // with file, line and field, and synthesized trials follow the stated effort model.
 #include "basics/errors.h"
 #include "experiments/torque_protocol.h"
+#include "muscles/muscle_file.h"
 
 #include "tests/support/temp_files.h"
 
@@ -23,8 +24,8 @@ TorqueProtocol makeMixedProtocol() {
     TorqueProtocol p;
     p.name = "mixed";
     p.description = "flexion, extension and submaximal";
-    p.conditions = {{90, MuscleGroup::Flexor, 1.0, 2}, {45, MuscleGroup::Extensor, 1.0, 3},
-                    {120, MuscleGroup::Flexor, 0.3, 1}};
+    p.conditions = {{90, Effort::Flexion, 1.0, 2}, {45, Effort::Extension, 1.0, 3},
+                    {120, Effort::Flexion, 0.3, 1}};
     p.holdDuration = 1.5;
     p.averagingWindow = 0.5;
     p.seed = 11;
@@ -67,10 +68,10 @@ TEST(TorqueProtocol, ForearmPosturesReadBackAndKeepConditionsApart) {
     EXPECT_TRUE(std::isnan(q.conditions[0].rotationDeg));
     EXPECT_EQ(q.conditions[2].rotationDeg, -90);
     std::vector<TorqueObservation> data(3);
-    data[0] = {90, MuscleGroup::Flexor, 1.0, 0, 60.5};
-    data[1] = {90, MuscleGroup::Flexor, 1.0, 0, 40.25};
+    data[0] = {90, Effort::Flexion, 1.0, 0, 60.5};
+    data[1] = {90, Effort::Flexion, 1.0, 0, 40.25};
     data[1].rotationDeg = -90;
-    data[2] = {90, MuscleGroup::Flexor, 1.0, 1, 41.0};
+    data[2] = {90, Effort::Flexion, 1.0, 1, 41.0};
     data[2].rotationDeg = -90;
     const std::vector<TorqueObservation> back = readTorqueData(writeTemp("armsim_posture.csv", formatTorqueData(data, false)));
     ASSERT_EQ(back.size(), 3u);
@@ -111,9 +112,9 @@ TEST(TorqueProtocol, BadFilesNameTheFileLineAndField) {
 
 TEST(TorqueData, FileReadsBackAndBadRowsNameLineAndColumn) {
     std::vector<TorqueObservation> data(3);
-    data[0] = {90, MuscleGroup::Flexor, 1.0, 0, 60.5};
-    data[1] = {90, MuscleGroup::Flexor, 1.0, 1, 58.25};
-    data[2] = {45, MuscleGroup::Extensor, 0.5, 0, -20.125};
+    data[0] = {90, Effort::Flexion, 1.0, 0, 60.5};
+    data[1] = {90, Effort::Flexion, 1.0, 1, 58.25};
+    data[2] = {45, Effort::Extension, 0.5, 0, -20.125};
     const std::vector<TorqueObservation> back = readTorqueData(writeTemp("armsim_torque.csv", formatTorqueData(data, false)));
     ASSERT_EQ(back.size(), 3u);
     for (std::size_t k = 0; k < 3; ++k) {
@@ -131,8 +132,21 @@ TEST(TorqueData, FileReadsBackAndBadRowsNameLineAndColumn) {
     std::string e = read("flexion_deg,torque_Nm\n90,50\n90,-5\n");
     EXPECT_NE(e.find("armsim_bad_torque.csv:3"), std::string::npos) << e;
     EXPECT_NE(e.find("torque_Nm"), std::string::npos) << e;
+    e = read("flexion_deg,effort,torque_Nm\n90,3,50\n");
+    EXPECT_NE(e.find("'effort' = 3"), std::string::npos) << e;
+    // A rotation effort needs its forearm torque, of its own sign; the forearm axis is NaN where not read.
     e = read("flexion_deg,effort,torque_Nm\n90,2,50\n");
-    EXPECT_NE(e.find("'effort' = 2"), std::string::npos) << e;
+    EXPECT_NE(e.find("supination effort without its forearm torque"), std::string::npos) << e;
+    e = read("flexion_deg,effort,torque_Nm,forearm_torque_Nm\n90,1,50,NaN\n90,-2,5,3\n");
+    EXPECT_NE(e.find("armsim_bad_torque.csv:3: column 'forearm_torque_Nm' = 3: expected <= 0 for a pronation effort"),
+              std::string::npos) << e;
+    const std::vector<TorqueObservation> twoAxis = readTorqueData(
+        writeTemp("armsim_two_axis.csv", "flexion_deg,effort,torque_Nm,forearm_torque_Nm\n90,1,50,NaN\n90,2,20,9.5\n"));
+    ASSERT_EQ(twoAxis.size(), 2u);
+    EXPECT_TRUE(std::isnan(twoAxis[0].forearmTorque));
+    EXPECT_EQ(twoAxis[1].effort, Effort::Supination);
+    EXPECT_EQ(twoAxis[1].getEffortTorque(), 9.5);
+    EXPECT_NEAR(twoAxis[1].getLoad(), std::hypot(20.0, 9.5), 1e-12);
     e = read("flexion_deg,torque,repetition\n90,50,0\n");
     EXPECT_NE(e.find("unknown column 'torque'"), std::string::npos) << e;
     e = read("flexion_deg,torque_Nm,repetition\n90,50,0\n90,51,0\n");
@@ -152,7 +166,7 @@ TEST(TorqueProtocol, SynthesizedEffortsFollowTheStatedModel) {
     const double va = v.setup.effort.voluntaryActivation, cv = v.setup.effort.trialCv;
     for (std::size_t k = 0; k < a.size(); ++k) {
         EXPECT_EQ(a[k].torque, b[k].torque) << "threads changed the data";
-        EXPECT_EQ(a[k].effort == MuscleGroup::Flexor, a[k].torque > 0) << k;
+        EXPECT_EQ(a[k].effort == Effort::Flexion, a[k].torque > 0) << k;
         EXPECT_NEAR(a[k].activation / (a[k].level * va), 1.0, 4 * cv) << k;  // |z| < 4
         EXPECT_NEAR(a[k].torque, a[k].cleanTorque * (1 + v.transducerNoise * a[k].noiseDraw), 1e-12);
     }
@@ -160,5 +174,59 @@ TEST(TorqueProtocol, SynthesizedEffortsFollowTheStatedModel) {
     EXPECT_EQ(a[0].repetition, 0);
     EXPECT_EQ(a[3].repetition, 1);
     EXPECT_EQ(a[5].repetition, 2);
-    EXPECT_EQ(a[5].effort, MuscleGroup::Extensor);
+    EXPECT_EQ(a[5].effort, Effort::Extension);
+}
+
+// The two-axis transducer (issue 31): a protocol with a supination effort reads the forearm axis in
+// every trial, the file reads back with the rotation effort and the measurement, each axis carries
+// noise sd |T| z (|T| the load on both axes, its own draw), a supination effort supinates, and the
+// same protocol on a model without a forearm rotation, or channels in a rotation effort, are refused.
+TEST(TorqueProtocol, TwoAxisTrialsReadTheForearmAxis) {
+    const Population population = loadDefaultPopulation();
+    const VirtualSubject v = drawSubject(population, 3, 1);
+    TorqueProtocol p;
+    p.name = "two_axis";
+    p.conditions = {{90, Effort::Flexion, 1.0, 2}, {90, Effort::Supination, 1.0, 2}};
+    p.conditions[1].rotationDeg = -60;
+    p.holdDuration = 1.5;
+    p.averagingWindow = 0.5;
+    ASSERT_TRUE(p.readsForearmTorque());
+    const TorqueProtocol back = readTorqueProtocol(writeTemp("armsim_two_axis.yaml", formatTorqueProtocol(p)));
+    ASSERT_EQ(back.conditions.size(), 2u);
+    EXPECT_EQ(back.conditions[1].effort, Effort::Supination);
+    EXPECT_TRUE(back.readsForearmTorque());
+    TorqueProtocol flexionOnly = p;
+    flexionOnly.conditions.resize(1);
+    EXPECT_FALSE(flexionOnly.readsForearmTorque());
+    flexionOnly.forearmTorque = true;
+    EXPECT_TRUE(readTorqueProtocol(writeTemp("armsim_fa.yaml", formatTorqueProtocol(flexionOnly))).forearmTorque);
+
+    const std::vector<TorqueObservation> a = synthesizeTorqueData(v, p, 5, 2);
+    ASSERT_EQ(a.size(), 4u);
+    for (const TorqueObservation& o : a) {
+        ASSERT_TRUE(std::isfinite(o.forearmTorque));
+        const double load = std::hypot(o.cleanTorque, o.cleanForearmTorque);
+        EXPECT_NEAR(o.torque, o.cleanTorque + v.transducerNoise * load * o.noiseDraw, 1e-12);
+        EXPECT_NEAR(o.forearmTorque, o.cleanForearmTorque + v.transducerNoise * load * o.forearmNoiseDraw, 1e-12);
+        EXPECT_NE(o.noiseDraw, o.forearmNoiseDraw);
+    }
+    EXPECT_GT(a[1].cleanForearmTorque, 5.0);  // N m: the supination effort (repetition-major: trial 1)
+    EXPECT_GT(a[0].cleanTorque, 20.0);        // the flexion effort flexes
+    // The flexion axis's draws are those of a one-axis protocol: its data do not move.
+    TorqueProtocol oneAxis = p;
+    oneAxis.conditions.resize(1);
+    const std::vector<TorqueObservation> one = synthesizeTorqueData(v, oneAxis, 5, 1);
+    EXPECT_EQ(one[0].noiseDraw, a[0].noiseDraw);
+    EXPECT_TRUE(std::isnan(one[0].forearmTorque));
+    // CSV: effort 2 and the forearm column read back.
+    const std::vector<TorqueObservation> csv = readTorqueData(writeTemp("armsim_two_axis.csv", formatTorqueData(a, true)));
+    ASSERT_EQ(csv.size(), a.size());
+    EXPECT_EQ(csv[1].effort, Effort::Supination);
+    EXPECT_NEAR(csv[1].forearmTorque, a[1].forearmTorque, 1e-9 * std::abs(a[1].forearmTorque));
+
+    Population elbow = loadPopulation(findAsset("subjects/elbow_population.yaml"));
+    EXPECT_THROW(synthesizeTorqueData(drawSubject(elbow, 3, 1), p, 5, 1), InputError);
+    TorqueProtocol withEmg = p;
+    withEmg.conditions[1].emg = true;
+    EXPECT_THROW(withEmg.validate(), InputError);
 }

@@ -206,7 +206,7 @@ TEST(ModelFile, ElbowIsometricTorqueMatchesTheLockReaction) {
     ASSERT_TRUE(fast.series.hasColumn("state_BIClong_L"));
     EXPECT_NEAR(fast.series.get(fast.series.getNumRows() - 1, "activation_TRIlong"), 0.1, kExactTol);
 
-    s.effort = MuscleGroup::Extensor;
+    s.effort = Effort::Extension;
     s.solver = TrialSolver::LockedOde;
     EXPECT_LT(runIsometricTrial(elbow(), s).summary.meanMuscleTorque, 0);  // an extension effort
 }
@@ -249,7 +249,7 @@ TEST(MvcCurve, SteadyTorqueMatchesTimeIntegration) {
     SubjectEffort rest;
     rest.voluntaryActivation = 0;
     rest.coContraction = 0;
-    for (MuscleGroup g : {MuscleGroup::Flexor, MuscleGroup::Extensor})
+    for (Effort g : {Effort::Flexion, Effort::Extension})
         for (double deg : {45.0, 100.0}) {
             const double steady = calcSteadyMvcCurve(elbow(), g, elbow().effort, {deg}).totalTorque[0] -
                                   calcSteadyMvcCurve(elbow(), g, rest, {deg}).totalTorque[0];
@@ -262,8 +262,40 @@ TEST(MvcCurve, SteadyTorqueMatchesTimeIntegration) {
             s.averagingWindow = 0.2;
             s.sampleRate = 100;
             const double integrated = runIsometricTrial(elbow(), s).summary.meanMuscleTorque;
-            EXPECT_NEAR(integrated, steady, kRelTol * std::abs(steady)) << getMuscleGroupName(g) << " " << deg;
+            EXPECT_NEAR(integrated, steady, kRelTol * std::abs(steady)) << getEffortName(g) << " " << deg;
         }
+}
+
+// The same on the twin's forearm axis (issue 31, the two-axis transducer): a supination and a pronation
+// effort in two postures, steady forearm torque (agonists by their forearm moment arm in the pose)
+// against the locked arm's integration, both tared at rest; and a flexion effort's forearm axis.
+TEST(MvcCurve, SteadyForearmTorqueMatchesTimeIntegration) {
+    constexpr double kRelTol = 0.015;  // as above: 2 s holds
+    static const ArmSetup twin = loadModel("twin");
+    const SubjectEffort rest{0, 0};
+    struct Case {
+        Effort effort;
+        double deg, rotationDeg;
+    };
+    for (const Case& c : {Case{Effort::Supination, 90, -30}, Case{Effort::Pronation, 60, 30}, Case{Effort::Flexion, 90, 0}}) {
+        const MvcGeometry g = calcMvcGeometry(twin, {c.deg}, c.rotationDeg);
+        const double steady = calcSteadyMvcCurve(twin.muscles, g, c.effort, twin.effort).totalForearmTorque[0] -
+                              calcSteadyMvcCurve(twin.muscles, g, c.effort, rest).totalForearmTorque[0];
+        IsometricTrialSettings s;
+        s.elbowAngle = degToRad(180 - c.deg);
+        s.forearmRotationDeg = c.rotationDeg;
+        s.effort = c.effort;
+        s.activation = twin.effort.voluntaryActivation;
+        s.antagonistActivation = twin.effort.coContraction;
+        s.holdDuration = 2.0;
+        s.averagingWindow = 0.2;
+        s.sampleRate = 100;
+        const double integrated = runIsometricTrial(twin, s).summary.meanForearmTorque;
+        EXPECT_GT(std::abs(steady), 1.0) << getEffortName(c.effort);  // N m: the axis carries torque
+        EXPECT_NEAR(integrated, steady, kRelTol * std::abs(steady)) << getEffortName(c.effort) << " " << c.deg;
+        if (c.effort == Effort::Supination) EXPECT_GT(steady, 0);
+        if (c.effort == Effort::Pronation) EXPECT_LT(steady, 0);
+    }
 }
 
 TEST(ModelFile, BadCalibrationNamesTheField) {

@@ -247,6 +247,48 @@ TEST(IsometricTrial, StepTorqueInterpolationEqualsPerSampleFindMotionForces) {
     }
 }
 
+// Issue 31: the two-axis transducer's forearm axis. The locked ODE reads it as sum_i r_i (F_i - F_i,rest)
+// from the moment arms at the pose; the per-sample Simbody reference reads the radius lock's torque by
+// findMotionForces: the same to 1e-6 of its largest value, in flexion, supination and pronation efforts
+// of the twin at two postures. A supination effort supinates and a pronation effort pronates.
+TEST(IsometricTrial, ForearmTorqueIsTheRadiusLocksTorque) {
+    constexpr double kRelTol = 1e-6;
+    static const ArmSetup twin = loadModel("twin");
+    struct Case {
+        double deg, rotationDeg;
+        Effort effort;
+    };
+    for (const Case& c : {Case{90, 0.0 / 0.0, Effort::Flexion}, Case{90, -60, Effort::Supination},
+                          Case{60, 30, Effort::Pronation}}) {
+        IsometricTrialSettings s = mvcAt(c.deg);
+        s.forearmRotationDeg = c.rotationDeg;
+        s.effort = c.effort;
+        s.activation = 0.9;
+        s.antagonistActivation = 0.05;
+        s.riseTime = 0.05;
+        s.holdDuration = 0.5;
+        s.averagingWindow = 0.25;
+        s.sampleRate = 200;
+        s.bandedNewton = false;  // the dense solve takes the Simbody integrator's steps (LockedOdeMatchesTheSimbodySystem)
+        const IsometricTrialResult fast = runIsometricTrial(twin, s);
+        s.solver = TrialSolver::SimbodyPerSample;
+        const IsometricTrialResult reference = runIsometricTrial(twin, s);
+        const auto a = fast.series.getColumn("forearm_torque_Nm"), b = reference.series.getColumn("forearm_torque_Nm");
+        ASSERT_EQ(a.size(), b.size());
+        double scale = 0;
+        for (double v : b) scale = std::max(scale, std::abs(v));
+        ASSERT_GT(scale, 0.5) << getEffortName(c.effort);  // N m: the axis is loaded
+        for (std::size_t i = 0; i < a.size(); ++i) ASSERT_NEAR(a[i], b[i], kRelTol * scale) << getEffortName(c.effort) << " row " << i;
+        if (c.effort == Effort::Supination) EXPECT_GT(fast.summary.meanForearmTorque, 1.0);
+        if (c.effort == Effort::Pronation) EXPECT_LT(fast.summary.meanForearmTorque, -1.0);
+        EXPECT_NEAR(fast.summary.meanForearmTorque, reference.summary.meanForearmTorque, kRelTol * scale);
+    }
+    // A model without a forearm rotation has no rotation efforts.
+    IsometricTrialSettings s = mvcAt(90);
+    s.effort = Effort::Supination;
+    EXPECT_THROW(s.validate(loadModel("elbow").arm), InputError);
+}
+
 namespace {
 
 // Largest difference between two trial tables, column by column, relative to the column's largest
@@ -282,15 +324,15 @@ TEST(IsometricTrial, LockedOdeMatchesTheSimbodySystem) {
     struct Case {
         const ArmSetup* setup;
         double deg, U, co;
-        MuscleGroup effort;
+        Effort effort;
         double rise;
     };
     static const ArmSetup elbow = loadModel("elbow");
-    const Case cases[] = {{&subject(), 45, 1.0, 0, MuscleGroup::Flexor, 0},
-                          {&subject(), 150, 0.3, 0, MuscleGroup::Flexor, 0.2},
-                          {&elbow, 60, 0.95, 0.1, MuscleGroup::Flexor, 0},
-                          {&elbow, 150, 0.5, 0.05, MuscleGroup::Flexor, 0.1},
-                          {&elbow, 90, 0.95, 0.1, MuscleGroup::Extensor, 0}};
+    const Case cases[] = {{&subject(), 45, 1.0, 0, Effort::Flexion, 0},
+                          {&subject(), 150, 0.3, 0, Effort::Flexion, 0.2},
+                          {&elbow, 60, 0.95, 0.1, Effort::Flexion, 0},
+                          {&elbow, 150, 0.5, 0.05, Effort::Flexion, 0.1},
+                          {&elbow, 90, 0.95, 0.1, Effort::Extension, 0}};
     for (const Case& c : cases) {
         IsometricTrialSettings s = mvcAt(c.deg);
         s.activation = c.U;
@@ -324,7 +366,7 @@ TEST(IsometricTrial, BandedNewtonAgreesWithTheSimbodySystem) {
     constexpr double kAccuracy = 1e-8;   // both integrations
     static const ArmSetup elbow = loadModel("elbow"), twin = loadModel("twin");
     for (const ArmSetup* setup : {&elbow, &twin})
-        for (MuscleGroup effort : {MuscleGroup::Flexor, MuscleGroup::Extensor}) {
+        for (Effort effort : {Effort::Flexion, Effort::Extension}) {
             IsometricTrialSettings s = mvcAt(100);
             s.activation = 0.95;
             s.antagonistActivation = 0.1;
@@ -347,7 +389,7 @@ TEST(IsometricTrial, BandedNewtonAgreesWithTheSimbodySystem) {
                     scale = std::max(scale, std::abs(y[i]));
                     diff = std::max(diff, std::abs(x[i] - y[i]));
                 }
-                EXPECT_LE(diff, kRelTol * scale) << setup->name << (effort == MuscleGroup::Flexor ? " flexion" : " extension") << ": column " << c;
+                EXPECT_LE(diff, kRelTol * scale) << setup->name << " " << getEffortName(effort) << ": column " << c;
             }
         }
 }

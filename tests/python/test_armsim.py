@@ -82,7 +82,7 @@ def test_run_study_writes_the_commands_files(tmp_path):
     (lambda m: armsim.steady_state(m, 0.40, 2.0), ValueError, "field 'activation' = 2: expected in [0, 1]"),
     (lambda m: armsim.muscle_trial(m, rise=-1), ValueError, "rise"),
     (lambda m: armsim.arm_trial(m, angle_deg=400), ValueError, "400"),
-    (lambda m: armsim.arm_trial(m, effort="sideways"), ValueError, "expected flexion or extension"),
+    (lambda m: armsim.arm_trial(m, effort="sideways"), ValueError, "expected flexion, extension, supination or pronation"),
     (lambda m: armsim.run_study("/no/such/study.yaml"), FileNotFoundError, "/no/such/study.yaml"),
     (lambda m: armsim.run_study("/no/such/study.yaml", threads=-3), ValueError, "field 'threads' = -3: expected in [0, 1024]"),
     (lambda m: armsim.run_study("/no/such/study.yaml", threads=5000), ValueError, "field 'threads' = 5000"),

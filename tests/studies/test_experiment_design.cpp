@@ -124,8 +124,8 @@ TEST(ExperimentDesign, FreedSlowFractionsAreInformedBySubmaximalEfforts) {
     options.freeSlowFraction = true;
     options.noiseLevel = 0.01;
     std::vector<TorqueCondition> conditions;
-    for (double q : {30.0, 75.0, 120.0}) conditions.push_back({q, MuscleGroup::Flexor, 1.0, 3});
-    for (double q : {15.0, 45.0, 75.0, 105.0, 135.0}) conditions.push_back({q, MuscleGroup::Flexor, 0.3, 3});
+    for (double q : {30.0, 75.0, 120.0}) conditions.push_back({q, Effort::Flexion, 1.0, 3});
+    for (double q : {15.0, 45.0, 75.0, 105.0, 135.0}) conditions.push_back({q, Effort::Flexion, 0.3, 3});
     const SynergistModel model(prior, options, conditions);
     const std::vector<std::string> names = model.getParameterNames();
     auto index = [&](const std::string& n) { return int(std::find(names.begin(), names.end(), n) - names.begin()); };
