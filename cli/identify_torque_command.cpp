@@ -67,23 +67,27 @@ void runIdentifyTorque(const IdentifyTorqueOptions& o) {
     std::printf("verdict: 'noise' = residuals consistent with the measurement noise (chi-square p >= 0.05), "
                 "'misfit' = larger than the noise explains\n");
     for (const MuscleEstimate& e : estimates) {
-        if (e.method != "channels") continue;
-        std::printf("channels fit: F0 %.0f N [%.0f, %.0f] at specific tension %.1f N/cm^2\n", e.maxForce, e.maxForceLower,
-                    e.maxForceUpper, 1e-4 * e.specificTension);
+        if (e.channelFits.size() < 2) continue;  // torque alone: the table above
+        if (e.method == "channels")
+            std::printf("channels fit: F0 %.0f N [%.0f, %.0f] at specific tension %.1f N/cm^2\n", e.maxForce,
+                        e.maxForceLower, e.maxForceUpper, 1e-4 * e.specificTension);
+        else
+            std::printf("%s fit, each channel:\n", e.method.c_str());
         std::printf("%-17s %4s %10s %7s %8s   %s\n", "channel", "n", "chi2", "p", "verdict", "largest residual (sd): where");
         for (const ChannelFit& f : e.channelFits)
             std::printf("%-17s %4d %10.1f %7.3f %8s   %+.1f: %s\n", f.channel.c_str(), f.n, f.chiSquare, f.p,
                         f.p >= 0.05 ? "noise" : "misfit", f.worstResidual, f.worst.c_str());
     }
-    std::printf("%-9s %6s %7s %6s %4s %11s", "effort", "angle", "forearm", "level", "rep", "measured");
+    std::printf("%-10s %6s %7s %6s %4s %11s", "effort", "angle", "forearm", "level", "rep", "measured");
     for (const MuscleEstimate& e : estimates) std::printf(" %13s", e.method.c_str());
     std::printf("   (predicted torque, N m)\n");
     for (std::size_t k = 0; k < data.size(); ++k) {
         const TorqueObservation& d = data[k];
-        std::printf("%-9s %6.1f %7s %6.2f %4d %11.2f", getEffortName(d.effort), d.flexionDeg, formatPosture(d.rotationDeg).c_str(),
+        std::printf("%-10s %6.1f %7s %6.2f %4d %11.2f", getEffortName(d.effort), d.flexionDeg, formatPosture(d.rotationDeg).c_str(),
                     d.level, d.repetition, d.torque);
         for (const MuscleEstimate& e : estimates) {
-            std::printf(" %13.2f", e.predictedTorque[k]);
+            if (std::isfinite(e.predictedTorque[k])) std::printf(" %13.2f", e.predictedTorque[k]);
+            else std::printf(" %13s", "-");  // not fitted (the thesis method's other efforts, a rotation effort)
         }
         std::printf("\n");
     }

@@ -130,10 +130,15 @@ void runTorqueProtocolCommand(const ProtocolOptions& o, const std::string& file)
                                             : (protocol.population + " person " + std::to_string(protocol.subjectIndex)).c_str());
     std::fflush(stdout);
     const std::vector<TorqueObservation> data = synthesizeTorqueData(subject, protocol, protocol.seed, o.jobs);
-    std::printf("  %-9s %6s %7s %6s %4s %12s\n", "effort", "angle", "forearm", "level", "rep", "torque (N m)");
-    for (const TorqueObservation& d : data)
-        std::printf("  %-9s %6.1f %7s %6.2f %4d %12.2f\n", getEffortName(d.effort), d.flexionDeg,
+    const bool twoAxis = protocol.readsForearmTorque();
+    std::printf("  %-10s %6s %7s %6s %4s %12s%s\n", "effort", "angle", "forearm", "level", "rep", "torque (N m)",
+                twoAxis ? "  forearm axis (N m, + = supination)" : "");
+    for (const TorqueObservation& d : data) {
+        std::printf("  %-10s %6.1f %7s %6.2f %4d %12.2f", getEffortName(d.effort), d.flexionDeg,
                     formatPosture(d.rotationDeg).c_str(), d.level, d.repetition, d.torque);
+        if (twoAxis) std::printf("  %12.2f", d.forearmTorque);
+        std::printf("\n");
+    }
     const std::vector<ChannelObservation> channels =
         protocol.hasChannels() ? synthesizeChannelData(subject, protocol, data, protocol.seed) : std::vector<ChannelObservation>{};
     if (!channels.empty()) std::printf("  channels besides torque: %zu measurements (channel_data.csv)\n", channels.size());

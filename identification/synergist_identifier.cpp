@@ -18,23 +18,13 @@ namespace armsim {
 namespace {
 
 // Tared steady torque at angle a: the active curve less the relaxed one, summed over the muscles not
-// left out.
+// left out; about the elbow (axis = &SteadyMusclePoint::torque) or the forearm axis (::forearmTorque).
 double sumTaredTorque(const SteadyMvcCurve& active, const SteadyMvcCurve& relaxed, std::size_t a,
-                      const std::vector<int>& leftOut = {}) {
+                      const std::vector<int>& leftOut = {}, double SteadyMusclePoint::*axis = &SteadyMusclePoint::torque) {
     double t = 0;
     for (std::size_t i = 0; i < active.points[a].size(); ++i)
         if (std::find(leftOut.begin(), leftOut.end(), int(i)) == leftOut.end())
-            t += active.points[a][i].torque - relaxed.points[a][i].torque;
-    return t;
-}
-
-// The same about the forearm axis (+ = supination).
-double sumTaredForearmTorque(const SteadyMvcCurve& active, const SteadyMvcCurve& relaxed, std::size_t a,
-                             const std::vector<int>& leftOut = {}) {
-    double t = 0;
-    for (std::size_t i = 0; i < active.points[a].size(); ++i)
-        if (std::find(leftOut.begin(), leftOut.end(), int(i)) == leftOut.end())
-            t += active.points[a][i].forearmTorque - relaxed.points[a][i].forearmTorque;
+            t += active.points[a][i].*axis - relaxed.points[a][i].*axis;
     return t;
 }
 
@@ -186,7 +176,7 @@ SynergistModel::SynergistModel(const Population& prior, const SynergistOptions& 
     auto uniformSd = [](const UniformRange& r) { return std::max((r.max - r.min) / std::sqrt(12.0), 1e-4); };
     priorCovariance_.assign(n, std::vector<double>(n, 0.0));
     auto& cov = priorCovariance_;
-    std::vector<int> masses = {kExtensorMass, kRotatorMass};
+    std::vector<int> masses = {kExtensorMass};
     for (int a = kFirstMass; a < n; ++a) masses.push_back(a);
     for (int a : masses)
         for (int b : masses) cov[a][b] = s2;
@@ -194,7 +184,6 @@ SynergistModel::SynergistModel(const Population& prior, const SynergistOptions& 
     cov[kSigma][kSigma] = std::pow(prior.specificTensionSd, 2);
     cov[kSize][kSize] = std::pow(prior.geometryScaleSd, 2);
     cov[kExtensorMass][kExtensorMass] += m2 / double(std::max<std::size_t>(extensors_.size(), 1));
-    cov[kRotatorMass][kRotatorMass] += m2 / double(std::max<std::size_t>(rotators_.size(), 1));
     for (int a = kFirstMass; a < n; ++a) cov[a][a] += m2;
     cov[kTendon][kTendon] = cov[kSynergistTendon][kSynergistTendon] = std::pow(prior.tendonLengthSd, 2);
     cov[kFascicle][kFascicle] = cov[kSynergistFascicle][kSynergistFascicle] = std::pow(prior.fascicleLengthSd, 2);
@@ -225,12 +214,14 @@ SynergistModel::SynergistModel(const Population& prior, const SynergistOptions& 
     // Person-level scales the prior does not vary are known: held at their mean.
     if (prior.specificTensionSd == 0) lower_[kSigma] = upper_[kSigma] = priorMean_[kSigma];
     if (prior.geometryScaleSd == 0) lower_[kSize] = upper_[kSize] = priorMean_[kSize];
-    // Held (freeRotatorMass frees it): out of the prior's coupling too, or holding it at its mean would
-    // condition the other masses on the person-level strength it shares with them.
-    lower_[kRotatorMass] = upper_[kRotatorMass] = priorMean_[kRotatorMass];
-    rotatorCovariance_ = cov[kRotatorMass];
-    for (int j = 0; j < n; ++j)
-        if (j != kRotatorMass) cov[kRotatorMass][j] = cov[j][kRotatorMass] = 0;
+    // The rotators' scales are held (freeRotatorMass frees them) and out of the prior's coupling too, or
+    // holding them at their mean would condition the other masses on the person-level strength they share.
+    coupledCovariance_ = cov;
+    for (int a = getFirstRotatorIndex(); a < n; ++a) {
+        lower_[a] = upper_[a] = priorMean_[a];
+        for (int j = 0; j < n; ++j)
+            if (j != a) cov[a][j] = cov[j][a] = 0;
+    }
     lower_[kActivation] = inside(prior.voluntaryActivation.min);
     upper_[kActivation] = inside(prior.voluntaryActivation.max);
     lower_[kCoContraction] = inside(prior.coContraction.min);
@@ -243,9 +234,10 @@ std::vector<std::string> SynergistModel::getParameterNames() const {
                                       "ln_biceps_fascicle_scale", "ln_synergist_tendon_scale",
                                       "ln_synergist_fascicle_scale", "ln_extensor_mass_scale",
                                       "biceps_slow_fraction_shift", "synergist_slow_fraction_shift",
-                                      "ln_specific_tension_scale", "ln_size_scale", "ln_rotator_mass_scale"};
+                                      "ln_specific_tension_scale", "ln_size_scale"};
     for (int i : biceps_) names.push_back("ln_" + base_->muscles[i].params.name + "_mass_scale");
     for (int i : synergists_) names.push_back("ln_" + base_->muscles[i].params.name + "_mass_scale");
+    for (int i : rotators_) names.push_back("ln_" + base_->muscles[i].params.name + "_mass_scale");
     return names;
 }
 
@@ -265,11 +257,11 @@ int SynergistModel::findKind(Effort effort, double level) {
 }
 
 void SynergistModel::freeRotatorMass() {
-    if (rotators_.empty()) return;
-    lower_[kRotatorMass] = lower_[kExtensorMass];
-    upper_[kRotatorMass] = upper_[kExtensorMass];
-    for (std::size_t j = 0; j < rotatorCovariance_.size(); ++j)
-        priorCovariance_[kRotatorMass][j] = priorCovariance_[j][kRotatorMass] = rotatorCovariance_[j];
+    for (int a = getFirstRotatorIndex(); a < getNumParameters(); ++a) {
+        lower_[a] = lower_[kExtensorMass];
+        upper_[a] = upper_[kExtensorMass];
+    }
+    priorCovariance_ = coupledCovariance_;
 }
 
 int SynergistModel::findMassIndex(int muscle) const {
@@ -277,6 +269,8 @@ int SynergistModel::findMassIndex(int muscle) const {
         if (biceps_[k] == muscle) return kFirstMass + int(k);
     for (std::size_t k = 0; k < synergists_.size(); ++k)
         if (synergists_[k] == muscle) return kFirstMass + int(biceps_.size() + k);
+    for (std::size_t k = 0; k < rotators_.size(); ++k)
+        if (rotators_[k] == muscle) return getFirstRotatorIndex() + int(k);
     return -1;
 }
 
@@ -305,7 +299,7 @@ std::vector<MuscleSpec> SynergistModel::makeMuscles(const double* x) const {
         q.slowFraction = std::clamp(q.slowFraction + x[kSynergistSlow], 0.05, 0.95);
     }
     for (int i : extensors_) m[i].params.mass *= std::exp(x[kExtensorMass]);
-    for (int i : rotators_) m[i].params.mass *= std::exp(x[kRotatorMass]);
+    for (std::size_t k = 0; k < rotators_.size(); ++k) m[rotators_[k]].params.mass *= std::exp(x[getFirstRotatorIndex() + k]);
     const double sigma = std::exp(x[kSigma]), g = std::exp(x[kSize]);
     for (MuscleSpec& spec : m) {
         MuscleParameters& q = spec.params;
@@ -351,7 +345,8 @@ void SynergistModel::calcPredictions(const double* x, std::vector<double>& torqu
     forearmTorques.clear();
     for (std::size_t c = 0; c < angleOf_.size(); ++c) {
         torques.push_back(sumTaredTorque(active[kindOf_[c]], relaxed, std::size_t(angleOf_[c]), leftOut_));
-        forearmTorques.push_back(sumTaredForearmTorque(active[kindOf_[c]], relaxed, std::size_t(angleOf_[c]), leftOut_));
+        forearmTorques.push_back(sumTaredTorque(active[kindOf_[c]], relaxed, std::size_t(angleOf_[c]), leftOut_,
+                                                &SteadyMusclePoint::forearmTorque));
     }
     channels.clear();
     for (std::size_t k = 0; k < channels_.size(); ++k) {
@@ -495,13 +490,9 @@ MuscleEstimate identifySynergistAware(const Population& prior, const std::vector
         est.nuisanceNames.push_back("size_scale");
         est.nuisance.push_back(std::exp(x[P::kSize]));
     }
-    if (model.getLower()[P::kRotatorMass] < model.getUpper()[P::kRotatorMass]) {
-        est.nuisanceNames.push_back("rotator_mass_scale");
-        est.nuisance.push_back(std::exp(x[P::kRotatorMass]));
-    }
     for (int i = 0; i < base.getNumMuscles(); ++i) {
         const int k = model.findMassIndex(i);
-        if (k < 0 || i == base.primary) continue;
+        if (k < 0 || i == base.primary || model.getLower()[k] == model.getUpper()[k]) continue;  // held: a rotator
         est.nuisanceNames.push_back(base.muscles[i].params.name + "_mass_scale");
         est.nuisance.push_back(std::exp(x[k]));
     }
@@ -513,7 +504,9 @@ MuscleEstimate identifySynergistAware(const Population& prior, const std::vector
         const std::vector<double> t = calcResiduals(x.data(), r.data());
         double ss = 0;
         for (std::size_t k = 0; k < nFlexion; ++k) ss += std::pow(t[rows[k].observation] - torque[k], 2);
-        est.predictedTorque = t;
+        est.predictedTorque = t;  // the flexion axis; NaN where it is not fitted (rotation efforts)
+        for (std::size_t k = 0; k < data.size(); ++k)
+            if (isForearmEffort(data[k].effort)) est.predictedTorque[k] = NAN;
         est.rmsResidual = std::sqrt(ss / double(std::max<std::size_t>(nFlexion, 1)));
     } catch (const std::exception& e) {
         est.converged = false;

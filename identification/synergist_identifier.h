@@ -13,8 +13,8 @@
 // experiments/channels.h (ultrasound fascicle length and volume, EMG, anthropometry) one residual per
 // measurement, each divided by its own sd ("channels"). A two-axis transducer's forearm torque (the
 // observations' forearmTorque, supination and pronation efforts included) adds one residual per
-// reading, with the same relative noise of the effort's own axis; the rotators (the muscles in no
-// other group: pronators, supinator) then get a mass scale of their own.
+// reading, with the sd of its trial's load; the rotators (the muscles in no other group: pronators,
+// supinator) then get a mass scale each.
 #pragma once
 
 #include "experiments/channels.h"
@@ -53,11 +53,11 @@ struct SynergistOptions {
 
 /// The synergist-aware identifier's model: its parameters x, their prior and bounds, and the tared
 /// steady torque it predicts for a list of effort conditions (also used by experiment design).
-/// x = [ln t_b, VA, CC, ln f_b, ln t_s, ln f_s, ln s_e, d_b, d_s, ln sigma, ln g, ln s_r, then ln s_m for
-/// every biceps head and synergist m]: t tendon, f fascicle length and s mass scales; b the biceps heads
-/// (one tendon and one fascicle scale), s the synergists, e the extensors and r the rotators (the
-/// muscles in none of those groups; one mass scale each, s_r held at the prior's mean unless the data
-/// read the forearm axis); d the change of
+/// x = [ln t_b, VA, CC, ln f_b, ln t_s, ln f_s, ln s_e, d_b, d_s, ln sigma, ln g, then ln s_m for every
+/// biceps head, synergist and rotator m]: t tendon, f fascicle length and s mass scales; b the biceps
+/// heads (one tendon and one fascicle scale), s the synergists, e the extensors (one mass scale), the
+/// rotators the muscles in none of those groups (pronators, supinator: held at the prior's mean unless
+/// the data read the forearm axis); d the change of
 /// the slow-fibre fraction F_slow (added, biceps heads and synergists; held at 0 unless
 /// freeSlowFraction); sigma the person's specific-tension scale (every muscle; F0 = sigma M / (rho L0))
 /// and g the person's size (every length; moment arms and path lengths scale with it), each held at the
@@ -72,7 +72,7 @@ public:
     /// options.channels are the measurements calcChannels predicts.
     SynergistModel(const Population& prior, const SynergistOptions& options,
                    const std::vector<TorqueCondition>& conditions);
-    int getNumParameters() const { return kFirstMass + int(biceps_.size() + synergists_.size()); }
+    int getNumParameters() const { return getFirstRotatorIndex() + int(rotators_.size()); }
     std::vector<std::string> getParameterNames() const;
     int getMassIndex() const;                 ///< ln M of the primary muscle
     std::vector<int> getFlexorMassIndices() const;  ///< the biceps heads' and synergists' ln mass scales
@@ -81,7 +81,10 @@ public:
     static constexpr int getFascicleIndex() { return kFascicle; }      ///< ln f_b
     static constexpr int getSpecificTensionIndex() { return kSigma; }  ///< ln sigma
     static constexpr int getSizeIndex() { return kSize; }              ///< ln g
-    static constexpr int getRotatorMassIndex() { return kRotatorMass; }  ///< ln s_r
+    /// The first rotator's ln mass scale (the rotators follow in model order).
+    int getFirstRotatorIndex() const { return kFirstMass + int(biceps_.size() + synergists_.size()); }
+    /// ln s of muscle i (a biceps head, a synergist or a rotator), -1 for an extensor.
+    int findMassIndex(int muscle) const;
     const std::vector<double>& getPriorMean() const { return priorMean_; }
     const std::vector<std::vector<double>>& getPriorCovariance() const { return priorCovariance_; }
     const std::vector<double>& getLower() const { return lower_; }
@@ -99,12 +102,11 @@ public:
 private:
     static constexpr int kTendon = 0, kActivation = 1, kCoContraction = 2, kFascicle = 3, kSynergistTendon = 4,
                          kSynergistFascicle = 5, kExtensorMass = 6, kBicepsSlow = 7, kSynergistSlow = 8,
-                         kSigma = 9, kSize = 10, kRotatorMass = 11, kFirstMass = 12;
+                         kSigma = 9, kSize = 10, kFirstMass = 11;
     struct EffortKind {
         Effort effort;
         double level;
     };
-    int findMassIndex(int muscle) const;
     const ArmSetup* base_;
     std::vector<int> biceps_, synergists_, extensors_, rotators_, leftOut_;
     MvcGeometry geometry_;                    // one row per pose (flexion angle, forearm posture)
@@ -121,7 +123,7 @@ private:
     int findPose(double flexionDeg, std::vector<std::pair<double, double>>& poses, double rotationDeg = 0.0 / 0.0);
     std::vector<double> priorMean_, lower_, upper_;
     std::vector<std::vector<double>> priorCovariance_;
-    std::vector<double> rotatorCovariance_;  // s_r's prior row, coupled (freeRotatorMass)
+    std::vector<std::vector<double>> coupledCovariance_;  // with the rotators coupled (freeRotatorMass)
     friend MuscleEstimate identifySynergistAware(const Population&, const std::vector<TorqueObservation>&,
                                                  const SynergistOptions&);
 };

@@ -145,7 +145,7 @@ TorqueResidualCheck checkTorqueResiduals(const std::vector<TorqueObservation>& d
     for (std::size_t k = 0; k < data.size() && k < e.predictedTorque.size(); ++k) {
         if (!std::isfinite(e.predictedTorque[k])) continue;
         const double residual = e.predictedTorque[k] - data[k].torque;
-        const double sd = noise * std::max(std::abs(data[k].torque), 1.0);
+        const double sd = noise * std::max(data[k].getLoad(), 1.0);
         sum += residual * residual;
         chi += std::pow(residual / sd, 2);
         ++c.n;

@@ -232,6 +232,7 @@ PYBIND11_MODULE(_armsim, mod) {
             py::dict summary;
             summary["mean_force"] = r.summary.meanForce;
             summary["mean_muscle_torque"] = r.summary.meanMuscleTorque;
+            summary["mean_forearm_torque"] = r.summary.meanForearmTorque;   // 0 without a forearm rotation
             summary["mean_strap_force"] = r.summary.meanStrapForce;
             summary["path_length"] = r.summary.pathLength;
             summary["moment_arm"] = r.summary.momentArm;
@@ -245,8 +246,9 @@ PYBIND11_MODULE(_armsim, mod) {
         "An isometric arm trial with the elbow locked at angle_deg (included angle, as `armsim trial`) and,\n"
         "on a model whose forearm rotates (the twin), the forearm locked at rotation_deg (+ = supination;\n"
         "None: the model's posture):\n"
-        "rest [s] relaxed (the transducer is tared), then the agonists of `effort` ('flexion' or\n"
-        "'extension') rise to `activation` over `rise` [s] and hold for `hold` [s]; the antagonists go to\n"
+        "rest [s] relaxed (the transducer is tared), then the agonists of `effort` ('flexion',\n"
+        "'extension', or on a rotating forearm 'supination' or 'pronation') rise to `activation` over `rise`\n"
+        "[s] and hold for `hold` [s]; the antagonists go to\n"
         "antagonist_activation. Returns (series, summary): series a dict of float64 arrays (time_s,\n"
         "activation, elbow_angle_deg, muscle_force_N, holding_torque_Nm, muscle_torque_Nm, strap_force_N,\n"
         "per-muscle force_<muscle>_N with several muscles, states); summary the means over the last\n"

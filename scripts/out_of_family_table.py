@@ -1,13 +1,14 @@
 #!/usr/bin/env python3
 """The README's out-of-family table (issue 31): every mismatch population (and the default, in family)
-as the truth, the default population as the prior, identified from assets/protocols/recommended.yaml.
-Its torques are the thesis's five flexion MVCs x 3, so the torque-only methods (synergist,
-synergist-va) on the same data are the five-angle MVC contrast; "channels" fits every channel. Runs
+as the truth, the default population as the prior, identified from assets/protocols/recommended.yaml
+(or --protocol, e.g. two_axis.yaml). The recommended protocol's torques are the thesis's five flexion
+MVCs x 3, so the torque-only methods (synergist, synergist-va) on the same data are the five-angle MVC
+contrast; "channels" fits every channel. Runs
 `armsim validate` per truth (a truth whose summary exists in OUT is reused) and prints one Markdown
 row per (truth, method) with bias, RMSE and coverage (+/- one standard error), and writes the rows to
 OUT/out_of_family.csv.
 
-usage: scripts/out_of_family_table.py [--armsim build/armsim] [--subjects 100] [--out out/out_of_family]
+usage: scripts/out_of_family_table.py [--armsim build/armsim] [--subjects 100] [--protocol FILE] [--out out/out_of_family]
 """
 import argparse, csv, glob, os, subprocess, sys
 
@@ -16,8 +17,10 @@ def main():
     ap.add_argument("--armsim", default="build/armsim")
     ap.add_argument("--subjects", type=int, default=100)
     ap.add_argument("--jobs", type=int, default=2)
+    ap.add_argument("--protocol", default="assets/protocols/recommended.yaml")
     ap.add_argument("--out", default="out/out_of_family")
     a = ap.parse_args()
+    protocol = os.path.splitext(os.path.basename(a.protocol))[0]
     truths = ["assets/subjects/default_population.yaml"] + sorted(glob.glob("assets/subjects/mismatch/*.yaml"))
     rows = []
     for truth in truths:
@@ -26,7 +29,7 @@ def main():
         summary = os.path.join(out, "elbow_validation_summary.csv")
         if not os.path.exists(summary):
             cmd = [a.armsim, "validate", "--truth", "elbow", "--truth-population", truth, "--prior",
-                   "assets/subjects/default_population.yaml", "--protocol", "assets/protocols/recommended.yaml",
+                   "assets/subjects/default_population.yaml", "--protocol", a.protocol,
                    "--subjects", str(a.subjects), "--jobs", str(a.jobs), "--out", out]
             print(" ".join(cmd), file=sys.stderr, flush=True)
             subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL)
@@ -34,6 +37,8 @@ def main():
             if r["method"] == "thesis":
                 continue
             label = "every channel" if r["method"] == "channels" else "torque only"
+            if protocol != "recommended":
+                label += " (" + protocol + ")"
             rows.append(dict(r, truth=name, protocol=label))
     keys = ["truth", "protocol", "method", "subjects", "converged", "mass_bias_pct", "mass_bias_se_pct", "mass_rmse_pct",
             "mass_rmse_se_pct", "mass_coverage", "mass_coverage_se", "tendon_bias_mm", "tendon_rmse_mm",

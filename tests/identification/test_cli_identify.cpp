@@ -266,6 +266,35 @@ TEST(CliDesign, DesignedProtocolRunsAndItsDataAreIdentified) {
     EXPECT_NE(r.output.find("missing.csv"), std::string::npos) << r.output;
 }
 
+// The two-axis protocol (docs/channels.md): its run writes the forearm axis and the supination efforts,
+// and identify-torque fits the forearm readings as a channel of their own, for every synergist-aware
+// method, each judged consistent with the noise on this person of the protocol's population.
+TEST(CliIdentifyTorque, TwoAxisProtocolReadsAndFitsTheForearmAxis) {
+    const fs::path d = freshDir("two_axis");
+    const std::string protocol = std::string(ARMSIM_ASSET_DIR) + "/protocols/two_axis.yaml";
+    CommandResult r = runArmsim("protocol " + protocol + " --out " + (d / "run").string());
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    EXPECT_NE(r.output.find("supination"), std::string::npos) << r.output;
+    std::ifstream data(d / "run" / "torque_data.csv");
+    std::string header, line;
+    while (std::getline(data, header) && header.rfind("#", 0) == 0) {}
+    EXPECT_EQ(header, "flexion_deg,effort,level,repetition,torque_Nm,rotation_deg,forearm_torque_Nm,activation,"
+                      "clean_torque_Nm,clean_forearm_torque_Nm");
+    r = runArmsim("identify-torque " + (d / "run" / "torque_data.csv").string() + " --channels " +
+                  (d / "run" / "channel_data.csv").string() + " --activation 0.93 --out " + (d / "fit").string());
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    std::ifstream in(d / "fit" / "channel_fits.csv");
+    std::getline(in, header);
+    int forearm = 0;
+    while (std::getline(in, line)) {
+        if (line.find(",forearm_torque,") == std::string::npos) continue;
+        ++forearm;
+        EXPECT_NE(line.find(",noise,"), std::string::npos) << line;
+        EXPECT_NE(line.find(",25,"), std::string::npos) << line;  // 15 flexion and 10 supination trials
+    }
+    EXPECT_EQ(forearm, 3);  // synergist, synergist-va, channels
+}
+
 // docs/channels.md's worked example: the recommended protocol writes every channel beside the torque,
 // and identify-torque --channels fits them, prints the per-channel check and writes channel_fits.csv
 // and the F0 columns. A bad channel file names its line.

@@ -321,8 +321,8 @@ TEST(ElbowIdentification, TwoAxisConditionsPredictBothAxesOfTheTrial) {
 }
 
 // The forearm axis identifies: torque data of both axes made by the identifier's own model at a known x
-// (biceps long head 20 % heavier, rotators 15 % stronger than the prior's mean; no noise, 2 % assumed)
-// are fitted within their noise, with the mass inside its interval and the rotators' scale moved from
+// (biceps long head 20 % heavier, supinator 15 % stronger than the prior's mean; no noise, 2 % assumed)
+// are fitted within their noise, with the mass inside its interval and the supinator's scale moved from
 // the prior's mean toward the truth; each axis is judged as its own channel, and one supination
 // reading 10 sd off is named. The rotators' scale is held at the prior's mean without forearm readings
 // (the torque-only fit of before), and a rotation effort without its forearm torque is refused.
@@ -340,7 +340,9 @@ TEST(ElbowIdentification, ForearmAxisDataRecoverAKnownPerson) {
     const SynergistModel model(prior, SynergistOptions{}, conditions);
     std::vector<double> x = model.getPriorMean();
     x[model.getMassIndex()] += 0.2;
-    x[SynergistModel::getRotatorMassIndex()] += std::log(1.15);
+    const int sup = model.findMassIndex(prior.base.findMuscle("SUP"));
+    ASSERT_GE(sup, model.getFirstRotatorIndex());
+    x[sup] += std::log(1.15);
     std::vector<double> torque, forearm, channels;
     model.calcPredictions(x.data(), torque, forearm, channels);
     std::vector<TorqueObservation> data;
@@ -360,7 +362,7 @@ TEST(ElbowIdentification, ForearmAxisDataRecoverAKnownPerson) {
     const MuscleParameters truth = model.makeMuscles(x.data())[prior.base.primary].params;
     EXPECT_LT(e.massLower, truth.mass);
     EXPECT_GT(e.massUpper, truth.mass);
-    const auto it = std::find(e.nuisanceNames.begin(), e.nuisanceNames.end(), "rotator_mass_scale");
+    const auto it = std::find(e.nuisanceNames.begin(), e.nuisanceNames.end(), "SUP_mass_scale");
     ASSERT_NE(it, e.nuisanceNames.end());
     EXPECT_GT(e.nuisance[it - e.nuisanceNames.begin()], 1.05);  // from 1 toward 1.15
     ASSERT_EQ(e.channelFits.size(), 2u);
@@ -381,7 +383,7 @@ TEST(ElbowIdentification, ForearmAxisDataRecoverAKnownPerson) {
     std::vector<TorqueObservation> flexionOnly(data.begin(), data.begin() + 5);
     for (TorqueObservation& t : flexionOnly) t.forearmTorque = NAN;
     const MuscleEstimate f = identifySynergistAware(prior, flexionOnly, options);
-    EXPECT_EQ(std::find(f.nuisanceNames.begin(), f.nuisanceNames.end(), "rotator_mass_scale"), f.nuisanceNames.end());
+    EXPECT_EQ(std::find(f.nuisanceNames.begin(), f.nuisanceNames.end(), "SUP_mass_scale"), f.nuisanceNames.end());
     std::vector<TorqueObservation> unread = data;
     unread[5].forearmTorque = NAN;
     EXPECT_THROW(identifySynergistAware(prior, unread, options), armsim::InputError);

@@ -124,6 +124,14 @@ def test_arm_trial_takes_a_forearm_posture_and_a_short_hold(elbow):
     assert pronated["mean_muscle_torque"] < 0.99 * neutral["mean_muscle_torque"]
     with pytest.raises(ValueError, match="forearm_rotation_deg"):
         armsim.arm_trial(elbow, rotation_deg=-90.0, **kw)          # the elbow's forearm does not rotate
+    # the second axis: a flexion effort's biceps supinates, a supination effort more, a pronation effort pronates
+    series, sup = armsim.arm_trial(twin, effort="supination", rotation_deg=-60.0, **kw)
+    _, pro = armsim.arm_trial(twin, effort="pronation", rotation_deg=30.0, **kw)
+    assert 0 < neutral["mean_forearm_torque"] < sup["mean_forearm_torque"]
+    assert pro["mean_forearm_torque"] < 0
+    assert series["forearm_torque_Nm"][-1] > 0
+    with pytest.raises(ValueError, match="no forearm rotation"):
+        armsim.arm_trial(elbow, effort="supination", **kw)
 
 
 def test_model_takes_a_path_copies_and_types_its_overrides(elbow):
