@@ -104,9 +104,13 @@ void runDesign(const DesignOptions& o) {
     printPrediction(reference);
     printPrediction(d.predicted);
     if (channels) {
-        const TorqueProtocol recommended = readTorqueProtocol(findAsset("protocols/recommended.yaml"));
-        std::printf("  (recommended.yaml, %s lab minutes:)\n", formatNumber(s.costs.calcMinutes(recommended)).c_str());
-        printPrediction(predictProtocol(population, recommended, s));
+        // The shipped protocols beside the design; two_axis.yaml on a prior whose forearm rotates.
+        for (const char* name : {"recommended.yaml", "two_axis.yaml"}) {
+            const TorqueProtocol shipped = readTorqueProtocol(findAsset(std::string("protocols/") + name));
+            if (shipped.readsForearmTorque() && !population.base.arm.forearmRotation.enabled) continue;
+            std::printf("  (%s, %.0f lab minutes:)\n", name, s.costs.calcMinutes(shipped));
+            printPrediction(predictProtocol(population, shipped, s));
+        }
     }
 
     OutputFolder out(o.out, OutputFolder::Mode::AddFiles);

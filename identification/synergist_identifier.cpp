@@ -227,6 +227,9 @@ SynergistModel::SynergistModel(const Population& prior, const SynergistOptions& 
     lower_[kCoContraction] = inside(prior.coContraction.min);
     upper_[kCoContraction] = inside(prior.coContraction.max);
     for (int j : {kActivation, kCoContraction}) priorMean_[j] = std::clamp(priorMean_[j], lower_[j], upper_[j]);
+    if (options.readsForearmTorque ||
+        std::any_of(conditions.begin(), conditions.end(), [](const TorqueCondition& c) { return isForearmEffort(c.effort); }))
+        freeRotatorMass();
 }
 
 std::vector<std::string> SynergistModel::getParameterNames() const {
@@ -403,8 +406,9 @@ MuscleEstimate identifySynergistAware(const Population& prior, const std::vector
     const std::size_t nFlexion = rows.size();
     for (std::size_t k = 0; k < data.size(); ++k)
         if (std::isfinite(data[k].forearmTorque)) rows.push_back({k, true});
-    SynergistModel model(prior, options, conditions);
-    if (readsForearm) model.freeRotatorMass();
+    SynergistOptions modelOptions = options;
+    modelOptions.readsForearmTorque = options.readsForearmTorque || readsForearm;
+    const SynergistModel model(prior, modelOptions, conditions);
     const std::vector<ChannelObservation>& channels = options.channels;
     for (const ChannelObservation& o : channels)
         if (!(o.sd > 0) || !std::isfinite(o.value))

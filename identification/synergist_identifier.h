@@ -49,6 +49,9 @@ struct SynergistOptions {
     /// Measurements besides torque (experiments/channels.h), each a residual (model - value) / sd.
     std::vector<ChannelObservation> channels;
     double emgCrosstalk = 0.10;  ///< c of the EMG measurement model (ChannelNoise::emgCrosstalk) [1]
+    /// The data read the forearm axis (a two-axis transducer): the rotators' mass scales are free.
+    /// identifySynergistAware sets it from the data; a rotation effort among the conditions implies it.
+    bool readsForearmTorque = false;
 };
 
 /// The synergist-aware identifier's model: its parameters x, their prior and bounds, and the tared
@@ -117,7 +120,7 @@ private:
     std::vector<int> channelMuscle_, channelAngle_, channelKind_;  // kind -1: relaxed
     double emgCrosstalk_ = 0;
     int findKind(Effort effort, double level);
-    /// Frees s_r within the mass scales' bounds (the data read the forearm axis).
+    /// Frees the rotators' scales within the mass scales' bounds (the data read the forearm axis).
     void freeRotatorMass();
     /// Index of the pose (flexion, forearm rotation; NaN = the model's posture, kept as +inf), added if new.
     int findPose(double flexionDeg, std::vector<std::pair<double, double>>& poses, double rotationDeg = 0.0 / 0.0);

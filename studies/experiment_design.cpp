@@ -40,8 +40,9 @@ struct DrawSensitivity {
 struct Sensitivities {
     std::vector<std::string> names;
     int massIndex = 0, tendonIndex = 0, activationIndex = 0, sizeIndex = 0;
-    int numTorqueRows = 0;           // rows 0..numTorqueRows-1 are torques, the rest channels
+    int numTorqueRows = 0;           // rows 0..numTorqueRows-1 are torques, then channels, then forearm torques
     std::vector<ChannelObservation> channels;
+    bool forearm = false;            // a forearm-axis row per condition after the channels
     ChannelNoise noise;
     Eigen::VectorXd flexorMean;    // weights of the mean of the flexors' ln mass scales
     Eigen::MatrixXd priorPrecision;
@@ -110,8 +111,10 @@ double calcRowSd(const Sensitivities& s, int r, double v) {
 
 Sensitivities calcSensitivities(const Population& prior, const std::vector<TorqueCondition>& conditions,
                                 const DesignSettings& settings, const std::function<void(int, int)>& progress,
-                                const std::vector<ChannelObservation>& channels = {}, const ChannelNoise& noise = {}) {
+                                const std::vector<ChannelObservation>& channels = {}, const ChannelNoise& noise = {},
+                                bool forearm = false) {
     SynergistOptions options;
+    options.readsForearmTorque = forearm;
     options.freeSlowFraction = settings.freeSlowFraction;
     options.channels = channels;
     options.emgCrosstalk = noise.emgCrosstalk;
@@ -126,6 +129,7 @@ Sensitivities calcSensitivities(const Population& prior, const std::vector<Torqu
     s.numTorqueRows = int(conditions.size());
     s.channels = channels;
     s.noise = noise;
+    s.forearm = forearm;
     const Eigen::MatrixXd sigma = toMatrix(model.getPriorCovariance());
     s.priorPrecision = sigma.inverse();
     s.flexorMean = Eigen::VectorXd::Zero(n);
@@ -140,11 +144,13 @@ Sensitivities calcSensitivities(const Population& prior, const std::vector<Torqu
     s.activationSd = settings.activationSd;
 
     const std::vector<std::vector<double>> xs = drawFromPrior(model, settings.seed, settings.draws);
-    const int rows = int(conditions.size() + channels.size());
+    const int nt = int(conditions.size()), nch = int(channels.size());
+    const int rows = nt + nch + (forearm ? nt : 0);
     auto predict = [&](const double* x) {
-        std::vector<double> t, c;
-        model.calcPredictions(x, t, c);
+        std::vector<double> t, f, c;
+        model.calcPredictions(x, t, f, c);
         t.insert(t.end(), c.begin(), c.end());
+        if (forearm) t.insert(t.end(), f.begin(), f.end());
         return t;
     };
     s.draws.resize(xs.size());
@@ -167,7 +173,16 @@ Sensitivities calcSensitivities(const Population& prior, const std::vector<Torqu
                 x[j] = x0;
                 for (int r = 0; r < rows; ++r) out.jacobian(r, j) = (up[r] - down[r]) / (2 * kStep);
             }
-            for (int r = 0; r < rows; ++r) out.jacobian.row(r) /= calcRowSd(s, r, out.prediction[r]);
+            // Transducer rows as the identifier weights them: sd relative to the trial's load (both axes
+            // when the forearm axis is read); a rotation effort's flexion axis is not fitted.
+            for (int r = 0; r < rows; ++r) {
+                const bool axis = r < nt || r >= nt + nch;
+                const int c = r < nt ? r : r - nt - nch;
+                double v = out.prediction[r];
+                if (axis && forearm) v = std::hypot(out.prediction[c], out.prediction[nt + nch + c]);
+                out.jacobian.row(r) /= calcRowSd(s, axis ? 0 : r, axis ? v : out.prediction[r]);
+                if (r < nt && isForearmEffort(conditions[c].effort)) out.jacobian.row(r).setZero();
+            }
             out.ok = true;
         } catch (const SimulationError&) {
             out.ok = false;  // no steady state for this draw: left out of the averages
@@ -324,7 +339,13 @@ ProtocolPrediction predictProtocol(const Population& prior, const TorqueProtocol
         rows.push_back(makeRow("upper_arm_length", "", 0.0 / 0.0, Effort::Flexion, 0));
         counts.push_back(1);
     }
-    const Sensitivities s = calcSensitivities(prior, protocol.conditions, settings, {}, rows, protocol.channelNoise);
+    const bool forearm = protocol.readsForearmTorque();
+    if (forearm && !prior.base.arm.forearmRotation.enabled)
+        throw InputError("protocol '" + protocol.name + "' reads the forearm axis, but the prior's model '" +
+                         prior.base.name + "' has no forearm rotation");
+    if (forearm)
+        for (const TorqueCondition& c : protocol.conditions) counts.push_back(c.repetitions);
+    const Sensitivities s = calcSensitivities(prior, protocol.conditions, settings, {}, rows, protocol.channelNoise, forearm);
     return evaluate(s, counts, protocol.name);
 }
 
