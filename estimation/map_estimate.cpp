@@ -1,10 +1,13 @@
 #include "estimation/map_estimate.h"
 
 #include <ceres/ceres.h>
+#include <glog/logging.h>
 #include <Eigen/Cholesky>
 #include <Eigen/Dense>
 
+#include <algorithm>
 #include <stdexcept>
+#include <string>
 
 namespace armsim {
 
@@ -26,9 +29,51 @@ struct MapCost {
     }
 };
 
+constexpr double kSmoothStep = 1e-3;  // on x: ln scales and activations
+
+// The Laplace covariance (J^T J)^{-1} of every residual, data and prior, with J by central differences
+// of step kSmoothStep (one-sided at a bound), the fixed coordinates left out (zero rows and columns).
+// Empty when a probe fails or the Hessian is not positive definite.
+std::vector<std::vector<double>> calcSmoothedCovariance(const MapProblem& problem, const MapCost& cost,
+                                                        const std::vector<double>& x, const std::vector<int>& fixed) {
+    const int n = int(x.size()), m = problem.numResiduals + n;
+    std::vector<int> free;
+    for (int j = 0; j < n; ++j)
+        if (std::find(fixed.begin(), fixed.end(), j) == fixed.end()) free.push_back(j);
+    Eigen::MatrixXd J(m, free.size());
+    Eigen::VectorXd up(m), down(m);
+    std::vector<double> probe = x;
+    for (std::size_t k = 0; k < free.size(); ++k) {
+        const int j = free[k];
+        const double hi = problem.upper.empty() ? x[j] + kSmoothStep : std::min(x[j] + kSmoothStep, problem.upper[j]);
+        const double lo = problem.lower.empty() ? x[j] - kSmoothStep : std::max(x[j] - kSmoothStep, problem.lower[j]);
+        const double* p = probe.data();
+        probe[j] = hi;
+        if (!cost(&p, up.data())) return {};
+        probe[j] = lo;
+        if (!cost(&p, down.data())) return {};
+        probe[j] = x[j];
+        if (!(hi > lo)) return {};
+        J.col(Eigen::Index(k)) = (up - down) / (hi - lo);
+    }
+    const Eigen::MatrixXd H = J.transpose() * J;
+    const Eigen::LLT<Eigen::MatrixXd> llt(H);
+    if (llt.info() != Eigen::Success) return {};
+    const Eigen::MatrixXd C = llt.solve(Eigen::MatrixXd::Identity(H.rows(), H.cols()));
+    std::vector<std::vector<double>> out(n, std::vector<double>(n, 0.0));
+    for (std::size_t a = 0; a < free.size(); ++a)
+        for (std::size_t b = 0; b < free.size(); ++b) out[free[a]][free[b]] = C(Eigen::Index(a), Eigen::Index(b));
+    return out;
+}
+
 }  // namespace
 
 MapResult calcMapEstimate(const MapProblem& problem) {
+    // Ceres reports a singular covariance through glog's stderr as well as through Compute's result;
+    // armsim reports it in the message (and falls back on the smoothed Jacobian): glog stays quiet
+    // below FATAL.
+    static const bool quietGlog = (FLAGS_minloglevel = google::GLOG_FATAL, true);
+    (void)quietGlog;
     const int n = int(problem.priorMean.size());
     if (n == 0 || int(problem.priorCovariance.size()) != n)
         throw std::invalid_argument("calcMapEstimate: prior mean and covariance sizes differ");
@@ -94,6 +139,11 @@ MapResult calcMapEstimate(const MapProblem& problem) {
         result.covariance.assign(n, std::vector<double>(n));
         for (int i = 0; i < n; ++i)
             for (int j = 0; j < n; ++j) result.covariance[i][j] = c[std::size_t(i) * n + j];
+    } else if (!(result.covariance = calcSmoothedCovariance(problem, functor, result.x, fixed)).empty()) {
+        // Ceres's Jacobian (relative steps of 1e-6) straddled a step of a piecewise model (a motor
+        // unit's recruitment): its Hessian is near singular in that direction. The slope over a wider
+        // step is the model's average one.
+        result.message += "; posterior covariance from a smoothed Jacobian (step 1e-3)";
     } else {
         result.message += "; no posterior covariance (singular Hessian)";
     }

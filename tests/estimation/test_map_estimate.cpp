@@ -54,3 +54,29 @@ TEST(MapEstimate, LinearGaussianPosteriorMatchesTheClosedFormAndCovers95Percent)
     const double tolerance = 3 * std::sqrt(0.95 * 0.05 / kDraws);  // three binomial standard errors
     for (int j = 0; j < 2; ++j) EXPECT_NEAR(covered[j] / double(kDraws), 0.95, tolerance) << j;
 }
+
+// A model with a step (a motor unit's recruitment) where the estimate sits: Ceres's Jacobian, with
+// steps of 1e-6, sees a slope of ~1e9 there and its covariance is near singular; the smoothed
+// Jacobian's (step 1e-3) is not. The smooth coordinate keeps its closed-form variance: y = x1 + e with
+// a flat prior, so var(x1) = s^2; the step coordinate's variance is below its prior's.
+TEST(MapEstimate, AStepAtTheEstimateKeepsTheCovariance) {
+    constexpr double kNoiseSd = 0.1, kJump = 1e3, kRelTol = 1e-6;
+    MapProblem p;
+    p.numResiduals = 2;
+    p.priorMean = {0.0, 0.0};
+    p.priorCovariance = {{1e6, 0.0}, {0.0, 1e6}};
+    p.residuals = [](const double* x, double* r) {
+        r[0] = (x[0] - 0.3) / kNoiseSd;
+        r[1] = (x[1] - 0.5) / kNoiseSd + (x[1] > 0.5 ? kJump : 0.0);  // the step just right of the optimum
+        return true;
+    };
+    const MapResult m = calcMapEstimate(p);
+    ASSERT_TRUE(m.converged) << m.message;
+    ASSERT_FALSE(m.covariance.empty()) << m.message;
+    EXPECT_NE(m.message.find("smoothed Jacobian"), std::string::npos) << m.message;
+    EXPECT_NEAR(m.x[1], 0.5, 1e-4);
+    EXPECT_NEAR(m.covariance[0][0], kNoiseSd * kNoiseSd, kRelTol * kNoiseSd * kNoiseSd + 1e-12);
+    EXPECT_GT(m.covariance[1][1], 0);
+    EXPECT_LT(m.covariance[1][1], 1e6);
+    EXPECT_NEAR(m.covariance[0][1], 0, 1e-12);
+}
