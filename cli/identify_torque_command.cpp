@@ -100,7 +100,8 @@ void runIdentifyTorque(const IdentifyTorqueOptions& o) {
     plot.xLabel = "elbow flexion (deg, 0 = extended)";
     plot.yLabel = "tared torque (N m, + = flexion)";
     PlotSeries measured{"measured", {}, {}, true, 7};
-    for (const TorqueObservation& d : data) measured.x.push_back(d.flexionDeg), measured.y.push_back(d.torque);
+    for (const TorqueObservation& d : data)  // the flexion axis of flexion and extension efforts (what is fitted)
+        if (!isForearmEffort(d.effort)) measured.x.push_back(d.flexionDeg), measured.y.push_back(d.torque);
     plot.series.push_back(measured);
     for (std::size_t m = 0; m < estimates.size(); ++m) {
         PlotSeries s{estimates[m].method, {}, {}, true, int(m)};
@@ -119,7 +120,9 @@ void addIdentifyTorqueCommand(CLI::App& app) {
     CLI::App* c = app.add_subcommand("identify-torque",
                                      "biceps mass and tendon length from tared elbow torque data with the thesis, "
                                      "synergist and (with --activation) synergist-va methods");
-    c->add_option("data", o->data, "torque CSV: flexion_deg, torque_Nm [, effort, level, repetition, rotation_deg]")->required();
+    c->add_option("data", o->data,
+                  "torque CSV: flexion_deg, torque_Nm [, effort, level, repetition, rotation_deg, forearm_torque_Nm]")
+        ->required();
     c->add_option("--population", o->population, "prior population (default assets/subjects/default_population.yaml)");
     c->add_option("--noise-level", o->noiseLevel,
                   "relative sd of one trial's torque (default: estimated from repeated trials)")
