@@ -8,6 +8,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <sstream>
@@ -88,11 +89,23 @@ std::vector<ValidationRow> runValidation(const ArmParameters& arm, const MuscleP
     const int total = int(truths.size() * settings.noiseLevels.size() * methods.size());
     int done = 0;
     std::vector<ValidationRow> rows;
-    for (const Truth& truth : truths) {
+    for (std::size_t i = 0; i < truths.size(); ++i) {
+        Truth& truth = truths[i];
         MuscleParameters muscle = base;
         muscle.mass = truth.mass;
         muscle.optimalTendonLength = truth.tendon;
-        const std::vector<double> y0 = reference.calcForces(muscle, clean.points);
+        std::vector<double> y0 = reference.calcForces(muscle, clean.points);
+        // A random truth that pulls nothing at some angle (a tendon so long that the fascicle is slack
+        // there) cannot be measured with relative noise: it is drawn again from a stream of its own, so
+        // the truths that can keep their values.
+        for (unsigned attempt = 1; i > 0 && std::any_of(y0.begin(), y0.end(), [](double f) { return !(f > 0); }); ++attempt) {
+            if (attempt > 100)
+                throw SimulationError("validation: " + truth.name + " pulls nothing at some angle after 100 draws");
+            PortableRandom redraw{unsigned(settings.seed), unsigned(i), attempt};
+            truth.mass = muscle.mass = redraw.drawUniform(kValidationMassLow, kValidationMassHigh);
+            truth.tendon = muscle.optimalTendonLength = redraw.drawUniform(kValidationTendonLow, kValidationTendonHigh);
+            y0 = reference.calcForces(muscle, clean.points);
+        }
         std::vector<double> eps;
         for (std::size_t k = 0; k < y0.size(); ++k) eps.push_back(rng.drawNormal());
         for (double sd : settings.noiseLevels) {
