@@ -12,6 +12,7 @@
 #include "muscles/muscle_file.h"
 
 #include <algorithm>
+#include <iterator>
 #include <map>
 #include <set>
 #include <tuple>
@@ -26,11 +27,6 @@ std::string conditionField(std::size_t k, const char* key) {
 
 ConditionKey conditionKey(double flexionDeg, Effort effort, double level, double rotationDeg) {
     return {flexionDeg, int(effort), level, std::isnan(rotationDeg) ? INFINITY : rotationDeg};
-}
-
-Effort parseEffortName(const std::string& name) {
-    return name == "flexion" ? Effort::Flexion : name == "extension" ? Effort::Extension
-         : name == "supination" ? Effort::Supination : Effort::Pronation;
 }
 
 }  // namespace
@@ -409,9 +405,11 @@ std::vector<TorqueObservation> makeTorqueData(const Table& t, const std::string&
         if (!std::isfinite(o.torque)) fail("torque_Nm", o.torque, "a finite number");
         if (t.hasColumn("effort")) {
             const double e = t.get(r, "effort");
-            if (e != 1 && e != -1 && e != 2 && e != -2)
+            const Effort* found = std::find_if(std::begin(kEfforts), std::end(kEfforts),
+                                               [&](Effort k) { return getEffortCode(k) == e; });
+            if (found == std::end(kEfforts))
                 fail("effort", e, "1 (flexion), -1 (extension), 2 (supination) or -2 (pronation)");
-            o.effort = e == 1 ? Effort::Flexion : e == -1 ? Effort::Extension : e == 2 ? Effort::Supination : Effort::Pronation;
+            o.effort = *found;
         }
         if (t.hasColumn("level")) {
             o.level = t.get(r, "level");

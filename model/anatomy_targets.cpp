@@ -65,7 +65,7 @@ std::string describeTargetCondition(const AnatomyTarget& t) {
     switch (t.kind) {
     case TargetKind::Mvc: return t.direction == MuscleGroup::Flexor ? "flexion" : "extension";
     case TargetKind::ForearmMvc:
-        return std::string(t.forearmEffort == ForearmEffort::Supination ? "supination" : "pronation") +
+        return std::string(getEffortName(t.forearmEffort)) +
                " at rotation " + formatNumber(t.rotationDeg) + " deg";
     case TargetKind::PostureRatio: return "flexion at rotation " + formatNumber(t.rotationDeg) + " deg / neutral";
     default: return "";
@@ -88,8 +88,7 @@ std::vector<AnatomyTarget> loadAnatomyTargets(const std::string& path) {
         const bool forearm = t.kind == TargetKind::ForearmMvc || t.kind == TargetKind::PostureRatio;
         if (t.kind != TargetKind::Mvc && !forearm) t.muscle = n.getString("muscle");
         if (t.kind == TargetKind::ForearmMvc)
-            t.forearmEffort = n.getChoice("direction", {"supination", "pronation"}, "") == "supination"
-                                  ? ForearmEffort::Supination : ForearmEffort::Pronation;
+            t.forearmEffort = parseEffortName(n.getChoice("direction", {"supination", "pronation"}, ""));
         if (forearm) t.rotationDeg = n.getNumber("rotation_deg", Bound::closed(-120, 120, "deg"));
         if (t.kind == TargetKind::Mvc)
             t.direction = n.getChoice("direction", {"flexion", "extension"}, "") == "flexion" ? MuscleGroup::Flexor
@@ -189,7 +188,7 @@ std::vector<TargetScore> scoreAnatomy(const ArmSetup& setup, const std::vector<A
             const MvcGeometry& g = sweep.byRotation.at(t.rotationDeg);
             const std::size_t a = std::lower_bound(g.flexionDeg.begin(), g.flexionDeg.end(), t.flexionDeg) - g.flexionDeg.begin();
             if (t.kind == TargetKind::ForearmMvc) {
-                const SteadyMvcCurve c = calcSteadyForearmMvc(setup.muscles, g, t.forearmEffort, setup.effort);
+                const SteadyMvcCurve c = calcSteadyMvcCurve(setup.muscles, g, t.forearmEffort, setup.effort);
                 add(t, "", std::abs(c.totalForearmTorque[a]));
             } else {
                 const double at = calcSteadyMvcCurve(setup.muscles, g, MuscleGroup::Flexor, setup.effort).totalTorque[a];

@@ -34,7 +34,7 @@ struct AnatomyTarget {
     TargetKind kind = TargetKind::MomentArm;
     std::string muscle;           ///< family or muscle name; empty for mvc
     MuscleGroup direction = MuscleGroup::Flexor;   ///< mvc: flexion or extension effort
-    ForearmEffort forearmEffort = ForearmEffort::Supination;   ///< forearm_mvc: supination or pronation
+    Effort forearmEffort = Effort::Supination;   ///< forearm_mvc: supination or pronation
     double rotationDeg = 0;       ///< forearm posture [deg] (forearm_mvc, posture_ratio; + = supinated)
     double flexionDeg = 0.0 / 0.0;///< angle [deg] (moment_arm, mvc, share); NaN for volume, optimum_angle
     double lower = 0, upper = 0;  ///< published band, SI (m, N m, m^3, 1, deg)

@@ -28,6 +28,11 @@ const char* getEffortName(Effort e) {
     }
     return "?";
 }
+Effort parseEffortName(const std::string& name) {
+    for (Effort e : kEfforts)
+        if (name == getEffortName(e)) return e;
+    throw InputError("effort = '" + name + "': expected flexion, extension, supination or pronation");
+}
 const char* getArmBodyName(ArmBody b) {
     return b == ArmBody::UpperArm ? "upper_arm" : b == ArmBody::Forearm ? "forearm" : "radius";
 }

@@ -57,8 +57,13 @@ const char* getMuscleGroupName(MuscleGroup g);
 /// forearm that way by more than kForearmAgonistMomentArm (Supination, Pronation; models with a
 /// forearm rotation). Everything else acts at the co-contraction level.
 enum class Effort { Flexion, Extension, Supination, Pronation };
+/// Every effort, in enum order.
+inline constexpr Effort kEfforts[] = {Effort::Flexion, Effort::Extension, Effort::Supination, Effort::Pronation};
 /// "flexion", "extension", "supination" or "pronation".
 const char* getEffortName(Effort e);
+/// The effort getEffortName names; InputError "effort = 'x': expected flexion, extension, supination
+/// or pronation" otherwise.
+Effort parseEffortName(const std::string& name);
 /// true for Supination and Pronation (the forearm axis is the effort's own).
 inline bool isForearmEffort(Effort e) { return e == Effort::Supination || e == Effort::Pronation; }
 /// Smallest moment arm about the forearm axis that makes a muscle an agonist of a rotation effort [m].

@@ -131,12 +131,6 @@ SteadyMvcCurve calcSteadyMvcCurve(const std::vector<MuscleSpec>& muscles, const 
     return calcSteadyMvcCurve(muscles, geometry, getEffortOf(effort), subject);
 }
 
-SteadyMvcCurve calcSteadyForearmMvc(const std::vector<MuscleSpec>& muscles, const MvcGeometry& geometry,
-                                    ForearmEffort effort, const SubjectEffort& subject) {
-    return calcSteadyMvcCurve(muscles, geometry, effort == ForearmEffort::Supination ? Effort::Supination : Effort::Pronation,
-                              subject);
-}
-
 SteadyMvcCurve calcSteadyMvcCurve(const ArmSetup& setup, Effort effort, const SubjectEffort& subject,
                                   const std::vector<double>& flexionDeg, double rotationDeg) {
     return calcSteadyMvcCurve(setup.muscles, calcMvcGeometry(setup, flexionDeg, rotationDeg), effort, subject);

@@ -82,14 +82,4 @@ SteadyMvcCurve calcSteadyMvcCurve(const ArmSetup& setup, MuscleGroup effort, con
 SteadyMvcCurve calcSteadyMvcCurve(const ArmSetup& setup, Effort effort, const SubjectEffort& subject,
                                   const std::vector<double>& flexionDeg, double rotationDeg = 0.0 / 0.0);
 
-/// A maximal forearm-rotation effort.
-enum class ForearmEffort { Supination, Pronation };
-
-/// The steady state of every muscle during a maximal forearm-rotation effort at each angle of the
-/// geometry: agonists (muscles whose forearm moment arm there turns the way of the effort by more than
-/// kForearmAgonistMomentArm) at subject.voluntaryActivation, the others at subject.coContraction. The
-/// curve's effort is Supination or Pronation; totalForearmTorque is the effort's torque (+ = supination).
-SteadyMvcCurve calcSteadyForearmMvc(const std::vector<MuscleSpec>& muscles, const MvcGeometry& geometry,
-                                    ForearmEffort effort, const SubjectEffort& subject);
-
 }  // namespace armsim

@@ -383,9 +383,7 @@ IsometricTrialSettings readIsometricTrialSettings(const ParamNode& n, const ArmP
     const Bound any = Bound::any();
     s.elbowAngle = degToRad(n.getNumber("elbow_angle_deg", any, radToDeg(s.elbowAngle)));
     s.activation = n.getNumber("activation", any, s.activation);
-    const std::string effort = n.getChoice("effort", {"flexion", "extension", "supination", "pronation"}, "flexion");
-    s.effort = effort == "flexion" ? Effort::Flexion : effort == "extension" ? Effort::Extension
-             : effort == "supination" ? Effort::Supination : Effort::Pronation;
+    s.effort = parseEffortName(n.getChoice("effort", {"flexion", "extension", "supination", "pronation"}, "flexion"));
     s.antagonistActivation = n.getNumber("antagonist_activation", any, s.antagonistActivation);
     s.restDuration = n.getNumber("rest", any, s.restDuration);
     s.riseTime = n.getNumber("rise", any, s.riseTime);

@@ -80,12 +80,6 @@ VirtualMuscle buildMuscle(const Model& m, const py::object& muscle) {
     return VirtualMuscle(m.setup.calcMuscleParameters(findMuscleIndex(m.setup, muscle)));
 }
 
-Effort parseEffort(const std::string& effort) {
-    for (Effort e : {Effort::Flexion, Effort::Extension, Effort::Supination, Effort::Pronation})
-        if (effort == getEffortName(e)) return e;
-    throw InputError("effort = '" + effort + "': expected flexion, extension, supination or pronation");
-}
-
 }  // namespace
 
 PYBIND11_MODULE(_armsim, mod) {
@@ -217,7 +211,7 @@ PYBIND11_MODULE(_armsim, mod) {
             s.elbowAngle = degToRad(angleDeg);
             if (rotationDeg) s.forearmRotationDeg = *rotationDeg;
             s.activation = activation;
-            s.effort = parseEffort(effort);
+            s.effort = parseEffortName(effort);
             s.antagonistActivation = antagonist;
             s.restDuration = rest;
             s.riseTime = rise;

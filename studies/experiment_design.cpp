@@ -97,11 +97,13 @@ std::vector<std::vector<double>> drawFromPrior(const SynergistModel& model, unsi
 
 namespace {
 
-// The sd of row r whose prediction is v: torques as the identifier weights them (transducer and trial
-// variation), channels as their measurement models (experiments/channels.h).
+// The sd of row r whose prediction is v: torques of either axis as the identifier weights them
+// (transducer and trial variation; v the trial's load), channels as their measurement models
+// (experiments/channels.h).
 double calcRowSd(const Sensitivities& s, int r, double v) {
     v = std::abs(v);
-    if (r < s.numTorqueRows) return s.relativeSd * std::max(v, 1.0);
+    const int nc = int(s.channels.size());
+    if (r < s.numTorqueRows || r >= s.numTorqueRows + nc) return s.relativeSd * std::max(v, 1.0);  // either axis
     const std::string& channel = s.channels[r - s.numTorqueRows].channel;
     if (channel == "fascicle_length") return s.noise.fascicleLength * v;
     if (channel == "volume") return s.noise.volume * v;
@@ -180,7 +182,7 @@ Sensitivities calcSensitivities(const Population& prior, const std::vector<Torqu
                 const int c = r < nt ? r : r - nt - nch;
                 double v = out.prediction[r];
                 if (axis && forearm) v = std::hypot(out.prediction[c], out.prediction[nt + nch + c]);
-                out.jacobian.row(r) /= calcRowSd(s, axis ? 0 : r, axis ? v : out.prediction[r]);
+                out.jacobian.row(r) /= calcRowSd(s, r, v);
                 if (r < nt && isForearmEffort(conditions[c].effort)) out.jacobian.row(r).setZero();
             }
             out.ok = true;

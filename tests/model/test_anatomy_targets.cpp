@@ -110,9 +110,9 @@ TEST(AnatomyTargets, ForearmTorqueEqualsTheForearmLockReaction) {
     ArmSetup twin = loadModel("twin");
     twin.arm.gravity = 0;
     const double flexion = 90;
-    for (const auto& [effort, rotation] : {std::pair{ForearmEffort::Supination, -67.5}, std::pair{ForearmEffort::Pronation, 0.0}}) {
+    for (const auto& [effort, rotation] : {std::pair{Effort::Supination, -67.5}, std::pair{Effort::Pronation, 0.0}}) {
         const MvcGeometry g = calcMvcGeometry(twin, {flexion}, rotation);
-        const SteadyMvcCurve c = calcSteadyForearmMvc(twin.muscles, g, effort, twin.effort);
+        const SteadyMvcCurve c = calcSteadyMvcCurve(twin.muscles, g, effort, twin.effort);
         std::vector<ActivationProfile> U;
         for (const SteadyMusclePoint& p : c.points[0]) U.push_back(ActivationProfile::constant(p.activation));
         MuscleArm arm(twin, U);
@@ -124,9 +124,9 @@ TEST(AnatomyTargets, ForearmTorqueEqualsTheForearmLockReaction) {
         arm.getSystem().realize(s, SimTK::Stage::Acceleration);
         const double reaction = arm.getArm().calcForearmHoldingTorque(s);
         EXPECT_NEAR(-reaction, c.totalForearmTorque[0], kReactionTol * std::abs(c.totalForearmTorque[0]));
-        EXPECT_GT((effort == ForearmEffort::Supination ? 1 : -1) * c.totalForearmTorque[0], 1.0);
+        EXPECT_GT((effort == Effort::Supination ? 1 : -1) * c.totalForearmTorque[0], 1.0);
         for (const SteadyMusclePoint& p : c.points[0])   // agonists at the subject's voluntary activation
-            EXPECT_EQ(p.activation, (effort == ForearmEffort::Supination ? 1 : -1) * p.forearmMomentArm > kForearmAgonistMomentArm
+            EXPECT_EQ(p.activation, (effort == Effort::Supination ? 1 : -1) * p.forearmMomentArm > kForearmAgonistMomentArm
                                         ? twin.effort.voluntaryActivation : twin.effort.coContraction);
     }
     AnatomyTarget ratio;

@@ -293,8 +293,8 @@ TEST(MvcCurve, SteadyForearmTorqueMatchesTimeIntegration) {
         const double integrated = runIsometricTrial(twin, s).summary.meanForearmTorque;
         EXPECT_GT(std::abs(steady), 1.0) << getEffortName(c.effort);  // N m: the axis carries torque
         EXPECT_NEAR(integrated, steady, kRelTol * std::abs(steady)) << getEffortName(c.effort) << " " << c.deg;
-        if (c.effort == Effort::Supination) EXPECT_GT(steady, 0);
-        if (c.effort == Effort::Pronation) EXPECT_LT(steady, 0);
+        if (c.effort == Effort::Supination) { EXPECT_GT(steady, 0); }
+        if (c.effort == Effort::Pronation) { EXPECT_LT(steady, 0); }
     }
 }
 

@@ -279,8 +279,8 @@ TEST(IsometricTrial, ForearmTorqueIsTheRadiusLocksTorque) {
         for (double v : b) scale = std::max(scale, std::abs(v));
         ASSERT_GT(scale, 0.5) << getEffortName(c.effort);  // N m: the axis is loaded
         for (std::size_t i = 0; i < a.size(); ++i) ASSERT_NEAR(a[i], b[i], kRelTol * scale) << getEffortName(c.effort) << " row " << i;
-        if (c.effort == Effort::Supination) EXPECT_GT(fast.summary.meanForearmTorque, 1.0);
-        if (c.effort == Effort::Pronation) EXPECT_LT(fast.summary.meanForearmTorque, -1.0);
+        if (c.effort == Effort::Supination) { EXPECT_GT(fast.summary.meanForearmTorque, 1.0); }
+        if (c.effort == Effort::Pronation) { EXPECT_LT(fast.summary.meanForearmTorque, -1.0); }
         EXPECT_NEAR(fast.summary.meanForearmTorque, reference.summary.meanForearmTorque, kRelTol * scale);
     }
     // A model without a forearm rotation has no rotation efforts.

@@ -58,7 +58,7 @@ TEST(Validation, ARandomTruthThatPullsNothingIsDrawnAgain) {
     for (std::size_t k = 0; k < rows.size(); ++k) {
         EXPECT_LT(std::abs(rows[k].massError), kSteadyTol) << rows[k].truth;
         EXPECT_LT(std::abs(rows[k].tendonLengthError), kSteadyTol) << rows[k].truth;
-        if (k < two.size()) EXPECT_EQ(rows[k].trueMass, two[k].trueMass) << rows[k].truth;  // kept
+        if (k < two.size()) { EXPECT_EQ(rows[k].trueMass, two[k].trueMass) << rows[k].truth; }  // kept
     }
 }
 
