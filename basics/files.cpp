@@ -2,9 +2,11 @@
 
 #include "basics/errors.h"
 
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <stdexcept>
 #include <unistd.h>
 
 namespace armsim {
@@ -84,25 +86,51 @@ bool areFilesUnchanged(const std::vector<FileSnapshot>& files) {
 }
 
 void writeFileAtomically(const std::string& path, const std::string& text) {
+    AtomicFileWriter out(path);
+    out.write(text);
+    out.commit();
+}
+
+AtomicFileWriter::AtomicFileWriter(const std::string& path) : path_(path) {
     namespace fs = std::filesystem;
     const fs::path target(path);
     std::error_code ec;
     if (target.has_parent_path()) fs::create_directories(target.parent_path(), ec);
-    const fs::path tmp = target.string() + ".tmp." + std::to_string(::getpid());
-    {
-        std::ofstream out(tmp, std::ios::binary);
-        if (!out) throw InputError(path + ": cannot write (is the directory writable?)");
-        out << text;
-        out.flush();
-        if (!out) {
-            fs::remove(tmp, ec);
-            throw InputError(path + ": write failed (disk full?)");
-        }
+    tmp_ = path + ".tmp." + std::to_string(::getpid());
+    file_ = std::fopen(tmp_.c_str(), "wb");
+    if (!file_) throw InputError(path + ": cannot write (is the directory writable?)");
+}
+
+AtomicFileWriter::~AtomicFileWriter() {
+    if (!file_) return;
+    std::fclose(file_);
+    std::remove(tmp_.c_str());
+}
+
+void AtomicFileWriter::write(const std::string& text) {
+    if (!file_) throw std::logic_error("AtomicFileWriter: write after commit");
+    if (std::fwrite(text.data(), 1, text.size(), file_) != text.size()) {
+        std::fclose(file_);
+        file_ = nullptr;
+        std::remove(tmp_.c_str());
+        throw InputError(path_ + ": write failed (disk full?)");
     }
-    fs::rename(tmp, target, ec);
+}
+
+void AtomicFileWriter::commit() {
+    if (!file_) throw std::logic_error("AtomicFileWriter: commit twice");
+    const bool flushed = std::fflush(file_) == 0;
+    const bool closed = std::fclose(file_) == 0;
+    file_ = nullptr;
+    if (!flushed || !closed) {
+        std::remove(tmp_.c_str());
+        throw InputError(path_ + ": write failed (disk full?)");
+    }
+    std::error_code ec;
+    std::filesystem::rename(tmp_, path_, ec);
     if (ec) {
-        fs::remove(tmp, ec);
-        throw InputError(path + ": cannot replace file: " + ec.message());
+        std::remove(tmp_.c_str());
+        throw InputError(path_ + ": cannot replace file: " + ec.message());
     }
 }
 

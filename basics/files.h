@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstdint>
+#include <cstdio>
 #include <string>
 #include <vector>
 
@@ -60,5 +61,22 @@ bool areFilesUnchanged(const std::vector<FileSnapshot>& files);
 /// Writes text to path atomically: to a temporary beside it, then rename. Throws InputError naming
 /// the path when it cannot be written. Parent directories are created.
 void writeFileAtomically(const std::string& path, const std::string& text);
+
+/// A file written piece by piece and put in place whole: the pieces go to a temporary beside the
+/// target, commit() renames it over the target; destroyed uncommitted, the temporary is removed and
+/// the target is untouched. Throws InputError naming the path when a write fails (disk full).
+class AtomicFileWriter {
+public:
+    explicit AtomicFileWriter(const std::string& path);
+    ~AtomicFileWriter();
+    AtomicFileWriter(const AtomicFileWriter&) = delete;
+    AtomicFileWriter& operator=(const AtomicFileWriter&) = delete;
+    void write(const std::string& text);
+    void commit();
+
+private:
+    std::string path_, tmp_;
+    std::FILE* file_ = nullptr;
+};
 
 }  // namespace armsim

@@ -11,6 +11,8 @@
 #include <charconv>
 #include <chrono>
 #include <cmath>
+#include <functional>
+#include <memory>
 #include <cstdio>
 #include <filesystem>
 #include <map>
@@ -397,48 +399,61 @@ bool parseStudyJournalLine(const std::string& line, StudyResult& r) {
     return r.status == "ok" || r.status == "not-converged" || r.status == "failed" || r.status == "skipped";
 }
 
-StudyJournal parseStudyJournal(const std::string& text, long numTasks, long firstLine) {
-    StudyJournal j;
-    std::map<long, long> lineOf;  // task -> the line that gave it
-    std::size_t begin = 0;
-    for (long number = firstLine; begin < text.size(); ++number) {
-        const std::size_t end = text.find('\n', begin);
-        const bool hasEnd = end != std::string::npos;
-        const std::string raw = text.substr(begin, (hasEnd ? end : text.size()) - begin);
-        begin = hasEnd ? end + 1 : text.size();
+long peekStudyJournalTask(const std::string& line) {
+    long task = -1;
+    if (line.size() > 17 && line[16] == ' ') {
+        const std::size_t comma = line.find(',', 17);
+        if (!parseLong(line.substr(17, comma == std::string::npos ? std::string::npos : comma - 17), task)) task = -1;
+    }
+    return task;
+}
+
+namespace {
+
+// Calls f(raw line without '\n', whether it had one) for every line of `in`.
+template <class F>
+void forEachLine(std::istream& in, F f) {
+    std::string raw;
+    while (std::getline(in, raw)) f(raw, !in.eof());
+}
+
+}  // namespace
+
+std::vector<StudyJournalDrop> scanStudyJournal(const std::function<std::unique_ptr<std::istream>()>& open, long numTasks,
+                                               long firstLine,
+                                               const std::function<void(const std::string&, StudyResult&&)>& keep) {
+    std::vector<StudyJournalDrop> dropped;
+    std::vector<bool> seen(std::size_t(std::max(0L, numTasks)), false);
+    std::map<long, std::vector<std::size_t>> duplicates;  // task -> its entries in `dropped`
+    long number = firstLine;
+    std::unique_ptr<std::istream> in = open();
+    forEachLine(*in, [&](const std::string& raw, bool hasEnd) {
         std::string line = raw;
         while (!line.empty() && (line.back() == '\r' || line.back() == ' ' || line.back() == '\t' || line.back() == '\0'))
             line.pop_back();  // CRLF (an editor, a Windows copy), trailing blanks, a NUL-filled tail
         StudyJournalDrop drop;
-        drop.line = number;
+        drop.line = number++;
         if (line.empty()) {
             drop.kind = "blank";
             drop.detail = raw.find('\0') != std::string::npos ? "only NUL bytes (a write the file system never finished)"
                                                               : "a blank line";
-            j.dropped.push_back(drop);
-            continue;
+            dropped.push_back(drop);
+            return;
         }
-        long task = -1;  // what the line says, trusted only when its checksum holds
-        if (line.size() > 17 && line[16] == ' ') {
-            const std::size_t comma = line.find(',', 17);
-            if (!parseLong(line.substr(17, comma == std::string::npos ? std::string::npos : comma - 17), task)) task = -1;
-        }
-        drop.task = task;
+        drop.task = peekStudyJournalTask(line);  // what the line says, trusted only when its checksum holds
         StudyResult r;
         if (parseStudyJournalLine(line, r)) {
             drop.task = r.task;
             if (r.task < 0 || r.task >= numTasks) {
                 drop.kind = "out of range";
                 drop.detail = "task " + std::to_string(r.task) + " is outside the study's 0.." + std::to_string(numTasks - 1);
-            } else if (lineOf.count(r.task)) {
+            } else if (seen[std::size_t(r.task)]) {
                 drop.kind = "duplicate";
-                drop.detail = "task " + std::to_string(r.task) + " is also line " + std::to_string(lineOf[r.task]) +
-                              " (that one is kept)";
+                duplicates[r.task].push_back(dropped.size());
             } else {
-                lineOf[r.task] = number;
-                j.results.emplace(r.task, std::move(r));
-                j.lines.push_back(line);
-                continue;
+                seen[std::size_t(r.task)] = true;
+                keep(line, std::move(r));
+                return;
             }
         } else if (!hasEnd) {
             drop.kind = "torn";
@@ -450,13 +465,50 @@ StudyJournal parseStudyJournal(const std::string& text, long numTasks, long firs
             drop.kind = "unreadable";
             drop.detail = "not a journal line (expected a 16-hex-digit checksum, a space and a result)";
         }
-        j.dropped.push_back(drop);
-    }
+        dropped.push_back(drop);
+    });
+    if (duplicates.empty()) return dropped;
+    // A second pass names the line each duplicate's cell was kept from (no line numbers held per task).
+    std::map<long, long> keptLine;
+    number = firstLine;
+    in = open();
+    forEachLine(*in, [&](const std::string& raw, bool) {
+        const long line = number++;
+        const long task = peekStudyJournalTask(raw);
+        if (!duplicates.count(task) || keptLine.count(task)) return;
+        std::string trimmed = raw;
+        while (!trimmed.empty() && (trimmed.back() == '\r' || trimmed.back() == ' ' || trimmed.back() == '\t' || trimmed.back() == '\0'))
+            trimmed.pop_back();
+        StudyResult r;
+        if (parseStudyJournalLine(trimmed, r) && r.task == task) keptLine[task] = line;
+    });
+    for (const auto& [task, entries] : duplicates)
+        for (std::size_t e : entries)
+            dropped[e].detail = "task " + std::to_string(task) + " is also line " +
+                                (keptLine.count(task) ? std::to_string(keptLine[task]) : std::string("?")) + " (that one is kept)";
+    return dropped;
+}
+
+StudyJournal parseStudyJournal(const std::string& text, long numTasks, long firstLine) {
+    StudyJournal j;
+    j.dropped = scanStudyJournal([&text] { return std::make_unique<std::istringstream>(text); }, numTasks, firstLine,
+                                 [&j](const std::string& line, StudyResult&& r) {
+                                     const long task = r.task;
+                                     j.results.emplace(task, std::move(r));
+                                     j.lines.push_back(line);
+                                 });
     return j;
 }
 
 std::string summarizeStudyJournalDrops(const std::vector<StudyJournalDrop>& dropped, const StudyJournal* journal,
                                        const std::string& file) {
+    return summarizeStudyJournalDrops(dropped, journal ? std::function<bool(long)>([journal](long task) {
+        return journal->results.count(task) > 0;
+    }) : std::function<bool(long)>(), file);
+}
+
+std::string summarizeStudyJournalDrops(const std::vector<StudyJournalDrop>& dropped,
+                                       const std::function<bool(long)>& hasResult, const std::string& file) {
     if (dropped.empty()) return "";
     std::map<std::string, int> byKind;
     std::vector<long> cells;
@@ -466,7 +518,7 @@ std::string summarizeStudyJournalDrops(const std::vector<StudyJournalDrop>& drop
         if (d.kind == "duplicate" || d.kind == "out of range" || d.kind == "blank" || d.kind == "header") continue;
         if (d.task < 0) {
             ++unnamed;
-        } else if (!(journal && journal->results.count(d.task)) &&
+        } else if (!(hasResult && hasResult(d.task)) &&
                    std::find(cells.begin(), cells.end(), d.task) == cells.end()) {
             cells.push_back(d.task);
         }
@@ -496,24 +548,38 @@ std::string formatStudyJournalDrops(const std::vector<StudyJournalDrop>& dropped
 }
 
 std::vector<StudySummaryRow> summarizeStudy(const Study& study, const std::vector<StudyResult>& results) {
+    StudySummaryAccumulator sum(study);
+    for (const StudyResult& r : results) sum.add(r);
+    return sum.getRows();
+}
+
+StudySummaryAccumulator::StudySummaryAccumulator(const Study& study) : protocols_(study.protocols.size()) {
+    for (std::size_t p = 0; p < study.protocols.size(); ++p) protocols_[p].name = study.protocols[p].protocol.name;
+}
+
+void StudySummaryAccumulator::add(const StudyResult& r) {
+    for (Protocol& p : protocols_) {
+        if (r.protocol != p.name) continue;
+        Counts& c = p.counts[{r.row.method, r.row.noise}];
+        c.notConverged += r.status == "not-converged";
+        c.failed += r.status == "failed";
+        if (r.status == "skipped") return;
+        if (r.status != "failed") return p.stats.add(r.row);
+        ElbowValidationRow row = r.row;
+        row.massError = row.tendonError = 0.0 / 0.0;
+        return p.stats.add(row);
+    }
+}
+
+std::vector<StudySummaryRow> StudySummaryAccumulator::getRows() const {
     std::vector<StudySummaryRow> out;
-    for (const StudyProtocol& p : study.protocols) {
-        std::vector<ElbowValidationRow> rows;
-        for (const StudyResult& r : results) {
-            if (r.protocol != p.protocol.name || r.status == "skipped") continue;
-            rows.push_back(r.row);
-            if (r.status == "failed") rows.back().massError = rows.back().tendonError = 0.0 / 0.0;
-        }
-        for (const ElbowValidationSummary& x : summarizeElbowValidation(rows)) {
-            StudySummaryRow row{p.protocol.name, x};
-            for (const StudyResult& r : results)
-                if (r.protocol == p.protocol.name && r.row.method == x.method && r.row.noise == x.noise) {
-                    row.notConverged += r.status == "not-converged";
-                    row.failed += r.status == "failed";
-                }
+    for (const Protocol& p : protocols_)
+        for (const ElbowValidationSummary& x : p.stats.getSummaries()) {
+            StudySummaryRow row{p.name, x};
+            const auto it = p.counts.find({x.method, x.noise});
+            if (it != p.counts.end()) row.notConverged = it->second.notConverged, row.failed = it->second.failed;
             out.push_back(row);
         }
-    }
     return out;
 }
 

@@ -5,7 +5,11 @@
 // (subject, protocol, noise, method) cell is one task: the subject's data are synthesized, read at the
 // noise level and identified; the estimate, the truth, the 95 % intervals, the residual, the iterations
 // and a status are recorded. The cells of one (subject, protocol) share one synthesis, so they are
-// scheduled together as a group; each cell is still recorded (and resumed) on its own.
+// scheduled together as a group while there are enough groups for the threads asking for work; past
+// that (the end of a run, a study of few subjects) a group's cells are split over the idle threads, each
+// piece synthesizing the subject again. Each cell is recorded (and resumed) on its own. Rank 0 keeps one status byte per cell
+// and streams results to the journal; the final files are written from it in task order, a bounded
+// range of tasks per pass, so its memory does not grow with the results.
 //
 // Results are a function of the study alone: a cell depends only on (seed, subject, protocol, noise,
 // method), numbers are written in shortest round-trip form and the table is sorted by task, so the
@@ -27,8 +31,11 @@
 
 #include <cstdint>
 #include <functional>
+#include <istream>
 #include <map>
+#include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace armsim {
@@ -105,6 +112,9 @@ std::string formatStudyResult(const StudyResult& result);
 /// and returns false for a torn or altered line.
 std::string formatStudyJournalLine(const StudyResult& result);
 bool parseStudyJournalLine(const std::string& line, StudyResult& result);
+/// The task a journal line names (its first field after the checksum), without checking the checksum;
+/// -1 when it names none.
+long peekStudyJournalTask(const std::string& line);
 
 /// A journal line a run could not use; its cell, if it names one, is computed again.
 struct StudyJournalDrop {
@@ -126,9 +136,20 @@ struct StudyJournal {
 /// 0 .. numTasks-1 is listed in `dropped`: torn, damaged (checksum), unreadable, blank, out of range,
 /// or a duplicate of an earlier line (the earlier is kept).
 StudyJournal parseStudyJournal(const std::string& text, long numTasks, long firstLine = 2);
-/// One line: the number of lines dropped, by kind, and the cells computed again; "" when none.
+/// The same reading, one line at a time, in memory independent of the journal's length: `open()` gives
+/// the journal's text after its header (called a second time only when lines repeat a task, to name the
+/// line kept); every valid result goes to keep(line as kept, result) in journal order; returns the lines
+/// dropped.
+std::vector<StudyJournalDrop> scanStudyJournal(const std::function<std::unique_ptr<std::istream>()>& open, long numTasks,
+                                               long firstLine,
+                                               const std::function<void(const std::string&, StudyResult&&)>& keep);
+/// One line: the number of lines dropped, by kind, and the cells computed again (those without a
+/// result in the journal); "" when none.
 std::string summarizeStudyJournalDrops(const std::vector<StudyJournalDrop>& dropped, const StudyJournal* journal = nullptr,
                                        const std::string& file = "journal.log");
+/// The same with hasResult(task): whether the journal holds a valid result of the task.
+std::string summarizeStudyJournalDrops(const std::vector<StudyJournalDrop>& dropped,
+                                       const std::function<bool(long)>& hasResult, const std::string& file);
 /// Every dropped line, one per text line: "line 5 (task 4): damaged: ...".
 std::string formatStudyJournalDrops(const std::vector<StudyJournalDrop>& dropped);
 
@@ -140,6 +161,25 @@ struct StudySummaryRow {
 };
 /// Per (protocol, method, noise), in the study's order.
 std::vector<StudySummaryRow> summarizeStudy(const Study& study, const std::vector<StudyResult>& results);
+/// summarizeStudy one result at a time (add them in task order: the sums then match summarizeStudy's to
+/// the bit), in memory independent of the number of results.
+class StudySummaryAccumulator {
+public:
+    explicit StudySummaryAccumulator(const Study& study);
+    void add(const StudyResult& result);
+    std::vector<StudySummaryRow> getRows() const;
+
+private:
+    struct Counts {
+        int notConverged = 0, failed = 0;
+    };
+    struct Protocol {
+        std::string name;
+        ElbowValidationAccumulator stats;
+        std::map<std::pair<std::string, double>, Counts> counts;  // by (method, noise)
+    };
+    std::vector<Protocol> protocols_;
+};
 /// summary.csv: counts by status, bias, RMSE, coverage and interval width.
 std::string formatStudySummaryCsv(const std::vector<StudySummaryRow>& rows);
 
@@ -167,6 +207,9 @@ struct StudyRunOptions {
     /// journal-shard-I-of-N.log (no final files). shards 0: the whole study, merging any shard journals.
     int shard = 0, shards = 0;
     bool merge = false;          ///< assemble the journals into the final files; refuse when cells are missing
+    /// Memory bound of writing the final files [bytes of journal text per pass]: results.csv is written
+    /// in task order from the journal, one range of tasks per pass (one pass for studies below it).
+    long resultsPassBytes = 64L << 20;
 };
 
 /// What a finished run did and wrote.
@@ -183,6 +226,10 @@ struct StudyOutcome {
     int shardJournals = 0;             ///< shard journals merged (and removed)
     int shard = 0, shards = 0;         ///< a shard's run: total, resumed and computed count its cells only
     std::string journalSummary;        ///< summarizeStudyJournalDrops of them; "" when none
+    /// Work units handed out in this run, each one synthesis of its subject: whole (subject, protocol)
+    /// groups while at least as many are left as threads asking, then pieces of a group over the idle
+    /// threads (each piece synthesizes the subject again).
+    long units = 0;
 };
 
 /// Byte transport from the coordinator to worker ranks (MPI in study_mpi.cpp).

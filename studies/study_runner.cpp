@@ -16,6 +16,8 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <cstdint>
+#include <functional>
 #include <deque>
 #include <exception>
 #include <filesystem>
@@ -171,15 +173,32 @@ private:
     std::vector<std::thread> threads_;
 };
 
+// One status byte per cell: what rank 0 keeps of a result (the result itself is in the journal).
+enum CellStatus : std::uint8_t { kMissing = 0, kOk, kNotConverged, kFailed, kSkipped };
+
+std::uint8_t getCellStatus(const std::string& status) {
+    return status == "ok" ? kOk : status == "not-converged" ? kNotConverged : status == "failed" ? kFailed : kSkipped;
+}
+
+// A journal file after its header line (the header skipped when skipHeader).
+std::unique_ptr<std::istream> openJournal(const std::string& path, bool skipHeader) {
+    auto in = std::make_unique<std::ifstream>(path, std::ios::binary);
+    if (!*in) throw InputError(path + ": cannot read");
+    std::string header;
+    if (skipHeader) std::getline(*in, header);
+    return in;
+}
+
 // The output folder: an exclusive lock for this run (released by the kernel when the process dies) and
 // the journal of finished cells. A shard (--shard I/N) has its own lock and journal
 // (journal-shard-I-of-N.log), so the shards of a job array run side by side; a plain run merges every
-// shard journal of the study into journal.log and removes them.
+// shard journal of the study into journal.log and removes them. Journals are read and compacted one
+// line at a time; of each cell only its status byte stays in memory.
 class StudyFolder {
 public:
     StudyFolder(const std::string& dir, const std::string& fingerprint, const Study& study, bool restart,
                 int shard = 0, int shards = 0)
-        : dir_(dir) {
+        : dir_(dir), status_(std::size_t(study.getNumTasks()), kMissing) {
         std::error_code ec;
         fs::create_directories(dir_, ec);
         if (ec || !fs::is_directory(dir_, ec))
@@ -192,19 +211,16 @@ public:
         journalName_ = shards > 0 ? "journal" + suffix + ".log" : "journal.log";
         journalPath_ = dir_ + "/" + journalName_;
         const std::string header = "# armsim study journal; fingerprint " + fingerprint + "; study " + study.name;
-        std::string kept = header + '\n';
+        AtomicFileWriter kept(journalPath_);  // compacted: valid lines only, so appends start on a clean line
+        kept.write(header + '\n');
         if (doesPathExist(journalPath_) && !restart) {
-            StudyJournal journal = readJournal(readFileText(journalPath_), fingerprint, study);
-            for (const std::string& line : journal.lines) kept += line + '\n';
-            summary_ = summarizeStudyJournalDrops(journal.dropped, &journal, journalName_);
+            readJournal(fingerprint, study, kept);
             if (!headerNote_.empty()) summary_ = (summary_.empty() ? journalName_ + ": " : summary_ + "; ") + headerNote_;
-            done_ = std::move(journal.results);
-            dropped_ = std::move(journal.dropped);
         } else if (restart) {
             std::remove((dir_ + "/journal_repairs.log").c_str());  // the repairs of a discarded journal
         }
         const std::vector<std::string> merged = shards > 0 ? std::vector<std::string>() : mergeShards(fingerprint, study, restart, kept);
-        writeFileAtomically(journalPath_, kept);  // compacted: valid lines only, so appends start on a clean line
+        kept.commit();
         for (const std::string& name : merged) {  // now in journal.log
             std::remove((dir_ + "/" + name).c_str());
             std::remove((dir_ + "/.lock" + name.substr(7, name.size() - 11)).c_str());
@@ -213,12 +229,14 @@ public:
         journal_.reset(std::fopen(journalPath_.c_str(), "ab"));
         if (!journal_) throw InputError("study output '" + dir_ + "': cannot append to " + journalName_);
     }
-    const std::map<long, StudyResult>& getDone() const { return done_; }
+    bool isDone(long task) const { return status_[std::size_t(task)] != kMissing; }
+    std::uint8_t getStatus(long task) const { return status_[std::size_t(task)]; }
     const std::vector<StudyJournalDrop>& getDropped() const { return dropped_; }
     const std::string& getDroppedSummary() const { return summary_; }
     long getNumMerged() const { return merged_; }
     int getNumShardJournals() const { return shardJournals_; }
     const std::string& getJournalName() const { return journalName_; }
+    const std::string& getJournalPath() const { return journalPath_; }
     // Appends what the journal dropped to journal_repairs.log (one write), so the repair stays on record
     // after the compacted journal no longer shows it.
     void recordRepairs() const {
@@ -235,11 +253,12 @@ public:
         std::string text;
         for (const StudyResult& r : results) {
             text += formatStudyJournalLine(r) + '\n';
-            done_.emplace(r.task, r);
+            status_[std::size_t(r.task)] = getCellStatus(r.status);
         }
         if (std::fwrite(text.data(), 1, text.size(), journal_.get()) != text.size() || std::fflush(journal_.get()) != 0)
             throw InputError("study output '" + dir_ + "': cannot append to " + journalName_);
     }
+    void closeJournal() { journal_.reset(); }
 
 private:
     struct Lock {  // closing the descriptor releases the lock, also when the constructor throws
@@ -263,10 +282,11 @@ private:
                          "output folder on another file system");
     }
 
-    // The header: "intact" (with its fingerprint in `theirs`) or damaged.
-    static bool readHeader(const std::string& text, std::size_t& end, std::string& theirs) {
-        end = std::min(text.find('\n'), text.size());
-        std::string first = text.substr(0, end);
+    // A journal's first line: true when it is an intact header (its fingerprint in `theirs`).
+    static bool readHeader(const std::string& path, std::string& theirs) {
+        std::ifstream in(path, std::ios::binary);
+        std::string first;
+        std::getline(in, first);
         while (!first.empty() && (first.back() == '\r' || first.back() == ' ')) first.pop_back();
         const std::string prefix = "# armsim study journal; fingerprint ";
         const bool intact = first.rfind(prefix, 0) == 0 && first.size() >= prefix.size() + 16 &&
@@ -276,48 +296,56 @@ private:
         return intact;
     }
 
-    // The journal's results. An intact header of another fingerprint is refused; a damaged header (an
-    // editor, a disk error) is recovered when the journal's first result, computed again now, is the
-    // same: the journal is then this study's, whatever its header says.
-    StudyJournal readJournal(const std::string& text, const std::string& fingerprint, const Study& study) {
-        std::size_t end = 0;
+    // Reads journal.log's results into the status bytes and `kept`. An intact header of another
+    // fingerprint is refused; a damaged header (an editor, a disk error) is recovered when the journal's
+    // first result, computed again now, is the same: the journal is then this study's, whatever its
+    // header says.
+    void readJournal(const std::string& fingerprint, const Study& study, AtomicFileWriter& kept) {
         std::string theirs;
-        if (readHeader(text, end, theirs)) {
-            if (theirs != fingerprint)
-                throw InputError("study output '" + dir_ + "': " + journalName_ + " holds results of another study or " +
-                                 "of a changed study file, protocol or population (fingerprint " + theirs +
-                                 ", this study's " + fingerprint + "); use another output folder or --restart to "
-                                 "discard them");
-            return parseStudyJournal(text.substr(std::min(end + 1, text.size())), study.getNumTasks());
+        const bool intact = readHeader(journalPath_, theirs);
+        if (intact && theirs != fingerprint)
+            throw InputError("study output '" + dir_ + "': " + journalName_ + " holds results of another study or " +
+                             "of a changed study file, protocol or population (fingerprint " + theirs +
+                             ", this study's " + fingerprint + "); use another output folder or --restart to "
+                             "discard them");
+        std::string firstResult;
+        long results = 0;
+        dropped_ = scanStudyJournal([this, intact] { return openJournal(journalPath_, intact); }, study.getNumTasks(),
+                                    intact ? 2 : 1, [&](const std::string& line, StudyResult&& r) {
+                                        if (firstResult.empty()) firstResult = line;
+                                        status_[std::size_t(r.task)] = getCellStatus(r.status);
+                                        kept.write(line + '\n');
+                                        ++results;
+                                    });
+        if (!intact) {
+            if (!dropped_.empty() && dropped_.front().line == 1) {
+                dropped_.front().kind = "header";
+                dropped_.front().detail =
+                    "the header line is damaged (expected '# armsim study journal; fingerprint <16 hex digits>; study <name>')";
+            }
+            if (results == 0) {
+                headerNote_ = "the header is damaged and no line is a result: nothing to resume, every cell is computed";
+            } else {
+                StudyResult mine;
+                parseStudyJournalLine(firstResult, mine);
+                const StudyTask t = getStudyTask(study, mine.task);
+                const std::vector<StudyResult> ours = runStudyGroup(study, t.getGroup(study), {t.index});
+                if (ours.size() != 1 || formatStudyResult(ours.front()) != formatStudyResult(mine))
+                    throw InputError("study output '" + dir_ + "': " + journalName_ + "'s header is damaged and its results " +
+                                     "are not this study's (task " + std::to_string(t.index) + " computed now differs from " +
+                                     "its journal line); use another output folder or --restart to discard them");
+                headerNote_ = "the header was damaged: recovered (task " + std::to_string(t.index) +
+                              ", computed again, equals its journal line)";
+            }
         }
-        StudyJournal journal = parseStudyJournal(text, study.getNumTasks(), 1);  // line 1 may be a result
-        if (!journal.dropped.empty() && journal.dropped.front().line == 1) {
-            journal.dropped.front().kind = "header";
-            journal.dropped.front().detail =
-                "the header line is damaged (expected '# armsim study journal; fingerprint <16 hex digits>; study <name>')";
-        }
-        if (journal.lines.empty()) {
-            headerNote_ = "the header is damaged and no line is a result: nothing to resume, every cell is computed";
-            return journal;
-        }
-        StudyResult mine;
-        parseStudyJournalLine(journal.lines.front(), mine);
-        const StudyTask t = getStudyTask(study, mine.task);
-        const std::vector<StudyResult> ours = runStudyGroup(study, t.getGroup(study), {t.index});
-        if (ours.size() != 1 || formatStudyResult(ours.front()) != formatStudyResult(mine))
-            throw InputError("study output '" + dir_ + "': " + journalName_ + "'s header is damaged and its results " +
-                             "are not this study's (task " + std::to_string(t.index) + " computed now differs from " +
-                             "its journal line); use another output folder or --restart to discard them");
-        headerNote_ = "the header was damaged: recovered (task " + std::to_string(t.index) +
-                      ", computed again, equals its journal line)";
-        return journal;
+        summary_ = summarizeStudyJournalDrops(dropped_, [this](long task) { return isDone(task); }, journalName_);
     }
 
-    // Adds the cells of every shard journal (journal-shard-I-of-N.log) to done_ and `kept`; returns their
-    // names (removed once journal.log holds them). A shard still running, or a shard journal of another
-    // study or with a damaged header, is refused. restart: shard journals are discarded.
+    // Adds the cells of every shard journal (journal-shard-I-of-N.log) to the status bytes and `kept`;
+    // returns their names (removed once journal.log holds them). A shard still running, or a shard
+    // journal of another study or with a damaged header, is refused. restart: shard journals are discarded.
     std::vector<std::string> mergeShards(const std::string& fingerprint, const Study& study, bool restart,
-                                         std::string& kept) {
+                                         AtomicFileWriter& kept) {
         std::vector<std::string> names;
         for (const fs::directory_entry& e : fs::directory_iterator(dir_)) {
             const std::string name = e.path().filename().string();
@@ -332,28 +360,26 @@ private:
                 throw InputError("study output '" + dir_ + "': shard " + shard + " is still running in this folder (" +
                                  name + " is in use): wait for the job array to end");
             if (restart) continue;
-            const std::string text = readFileText(dir_ + "/" + name);
-            std::size_t end = 0;
+            const std::string path = dir_ + "/" + name;
             std::string theirs;
-            if (!readHeader(text, end, theirs) || theirs != fingerprint)
+            if (!readHeader(path, theirs) || theirs != fingerprint)
                 throw InputError("study output '" + dir_ + "': " + name + (theirs.empty() ? " has a damaged header" :
                                  " holds results of another study (fingerprint " + theirs + ", this study's " + fingerprint + ")") +
                                  ": remove it (its cells are computed again) or use --restart to discard every journal");
-            StudyJournal journal = parseStudyJournal(text.substr(std::min(end + 1, text.size())), study.getNumTasks());
+            std::vector<StudyJournalDrop> dropped = scanStudyJournal(
+                [&path] { return openJournal(path, true); }, study.getNumTasks(), 2,
+                [&](const std::string& line, StudyResult&& r) {
+                    if (isDone(r.task)) return;  // also in journal.log or an earlier shard: the same cell
+                    status_[std::size_t(r.task)] = getCellStatus(r.status);
+                    kept.write(line + '\n');
+                    ++merged_;
+                });
             ++shardJournals_;
-            for (const std::string& line : journal.lines) {
-                StudyResult r;
-                parseStudyJournalLine(line, r);
-                if (done_.count(r.task)) continue;  // also in journal.log or an earlier shard: the same cell
-                done_.emplace(r.task, std::move(r));
-                kept += line + '\n';
-                ++merged_;
-            }
-            if (!journal.dropped.empty()) {
-                const std::string s = summarizeStudyJournalDrops(journal.dropped, &journal, name);
+            if (!dropped.empty()) {
+                const std::string s = summarizeStudyJournalDrops(dropped, [this](long task) { return isDone(task); }, name);
                 summary_ += (summary_.empty() ? "" : "; ") + s;
-                for (StudyJournalDrop& d : journal.dropped) d.file = name;
-                dropped_.insert(dropped_.end(), journal.dropped.begin(), journal.dropped.end());
+                for (StudyJournalDrop& d : dropped) d.file = name;
+                dropped_.insert(dropped_.end(), dropped.begin(), dropped.end());
             }
         }
         return names;
@@ -363,11 +389,73 @@ private:
     Lock lock_;
     std::vector<Lock> shardLocks_;  // held while their journals are merged
     std::unique_ptr<std::FILE, int (*)(std::FILE*)> journal_{nullptr, std::fclose};
-    std::map<long, StudyResult> done_;
+    std::vector<std::uint8_t> status_;  // per task
     std::vector<StudyJournalDrop> dropped_;
     std::string summary_, headerNote_;
     long merged_ = 0;
     int shardJournals_ = 0;
+};
+
+// The cells still to compute, handed out as units of work: whole groups (one synthesis for all their
+// cells) while at least as many groups are left as threads asking for work, then a group's cells split
+// over the idle threads that ask together (each piece synthesizes the subject again, in parallel: it
+// pays in wall time, never queueing a piece behind a busy thread). Groups are found from the status
+// bytes as they are handed out: nothing is held per group.
+class WorkQueue {
+public:
+    WorkQueue(const Study& study, const StudyFolder& folder, long first, long step)
+        : folder_(folder), next_(first), step_(step), cells_(study.getCellsPerGroup()) {
+        for (long g = first; g < study.getNumGroups(); g += step) {
+            long missing = 0;
+            for (long t = g * cells_; t < (g + 1) * cells_; ++t) {
+                ++total_;
+                if (folder.isDone(t)) continue;
+                ++missing;
+                if (firstMissing_ < 0) firstMissing_ = t;
+            }
+            missing_ += missing;
+            groupsLeft_ += missing > 0;
+        }
+    }
+    long getNumCells() const { return total_; }        // of this run's share
+    long getNumMissing() const { return missing_; }    // at the start
+    long getFirstMissing() const { return firstMissing_; }
+    bool isEmpty() const { return pieces_.empty() && groupsLeft_ == 0; }
+    // The next unit for one of `idle` threads asking now (the caller hands out `idle` units in a row).
+    GroupWork take(int idle) {
+        if (!pieces_.empty()) {
+            GroupWork w = std::move(pieces_.front());
+            pieces_.pop_front();
+            return w;
+        }
+        GroupWork w;
+        for (;; next_ += step_) {
+            w.group = next_;
+            for (long t = next_ * cells_; t < (next_ + 1) * cells_; ++t)
+                if (!folder_.isDone(t)) w.tasks.push_back(t);
+            if (!w.tasks.empty()) break;
+        }
+        next_ += step_;
+        const long groups = groupsLeft_--;  // this one included
+        if (groups >= idle || w.tasks.size() < 2) return w;
+        const long pieces = std::min<long>(long(w.tasks.size()), (idle + groups - 1) / groups);
+        const std::vector<long> tasks = std::move(w.tasks);
+        for (long i = 0; i < pieces; ++i) {
+            GroupWork piece{w.group, {}};
+            piece.tasks.assign(tasks.begin() + long(tasks.size()) * i / pieces,
+                               tasks.begin() + long(tasks.size()) * (i + 1) / pieces);
+            pieces_.push_back(std::move(piece));
+        }
+        GroupWork first = std::move(pieces_.front());
+        pieces_.pop_front();
+        return first;
+    }
+
+private:
+    const StudyFolder& folder_;
+    long next_, step_, cells_;
+    long total_ = 0, missing_ = 0, firstMissing_ = -1, groupsLeft_ = 0;
+    std::deque<GroupWork> pieces_;
 };
 
 // Per (protocol, method): a statistic of the summary against the noise level.
@@ -395,20 +483,82 @@ void writeNoisePlot(const std::string& path, const std::string& title, const std
     writePlotPng(path, spec);
 }
 
-std::vector<std::string> writeStudyFiles(const Study& study, const std::string& dir,
-                                         const std::map<long, StudyResult>& done) {
-    std::vector<StudyResult> results;
-    results.reserve(done.size());
-    std::string table = getStudyResultsHeader() + '\n', timing = "task,rank,synthesis_s,identification_s\n";
-    for (const auto& [task, r] : done) {
-        table += formatStudyResult(r) + '\n';
-        timing += std::to_string(task) + ',' + std::to_string(r.rank) + ',' + formatNumber(r.synthesisTime) + ',' +
-                  formatNumber(r.identificationTime) + '\n';
-        results.push_back(r);
+// The journal's results in task order, a range of tasks at a time: f(result) for each. A journal that
+// fits in `passBytes` is read once; a larger one is first split by task range into bucket files (one
+// read and one write of it), then each bucket is read, ordered and handed on: memory stays near
+// passBytes whatever the number of results.
+void forEachResultInTaskOrder(const std::string& journalPath, const std::string& scratchDir, long numTasks, long passBytes,
+                              const std::function<void(const StudyResult&)>& f) {
+    std::error_code ec;
+    const std::uintmax_t size = fs::file_size(journalPath, ec);
+    if (ec) throw InputError(journalPath + ": cannot read: " + ec.message());
+    const long wanted = std::clamp<long>(long(size / std::uintmax_t(std::max(1L, passBytes))) + 1, 1, 512);
+    const long perBucket = (numTasks + wanted - 1) / wanted;
+    const long buckets = (numTasks + perBucket - 1) / perBucket;
+    auto emitRange = [&](const std::string& path, bool skipHeader, long lo, long hi) {
+        std::vector<std::string> lines(std::size_t(hi - lo));
+        std::unique_ptr<std::istream> in = openJournal(path, skipHeader);
+        for (std::string line; std::getline(*in, line);) {
+            const long task = peekStudyJournalTask(line);
+            if (task >= lo && task < hi && lines[std::size_t(task - lo)].empty()) lines[std::size_t(task - lo)] = std::move(line);
+        }
+        for (const std::string& line : lines) {
+            if (line.empty()) continue;
+            StudyResult r;
+            if (!parseStudyJournalLine(line, r))
+                throw InputError(journalPath + ": a line changed while the study ran (task " + std::to_string(peekStudyJournalTask(line)) +
+                                 " fails its checksum); run the study again to recompute it");
+            f(r);
+        }
+    };
+    if (buckets == 1) return emitRange(journalPath, true, 0, numTasks);
+    struct Scratch {  // removed however the writing ends
+        std::string dir;
+        ~Scratch() {
+            std::error_code e;
+            fs::remove_all(dir, e);
+        }
+    } scratch{scratchDir};
+    fs::create_directories(scratch.dir, ec);
+    if (ec) throw InputError(scratch.dir + ": cannot create the sorting folder: " + ec.message());
+    {
+        std::vector<std::unique_ptr<std::FILE, int (*)(std::FILE*)>> files;
+        for (long b = 0; b < buckets; ++b) {
+            files.emplace_back(std::fopen((scratch.dir + "/" + std::to_string(b)).c_str(), "wb"), std::fclose);
+            if (!files.back()) throw InputError(scratch.dir + ": cannot write the sorting files");
+        }
+        std::unique_ptr<std::istream> in = openJournal(journalPath, true);
+        for (std::string line; std::getline(*in, line);) {
+            const long task = peekStudyJournalTask(line);
+            if (task < 0 || task >= numTasks) continue;
+            line += '\n';
+            std::FILE* out = files[std::size_t(task / perBucket)].get();
+            if (std::fwrite(line.data(), 1, line.size(), out) != line.size())
+                throw InputError(scratch.dir + ": write failed (disk full?)");
+        }
+        for (auto& file : files)
+            if (std::fflush(file.get()) != 0) throw InputError(scratch.dir + ": write failed (disk full?)");
     }
-    const std::vector<StudySummaryRow> summary = summarizeStudy(study, results);
-    writeFileAtomically(dir + "/results.csv", table);
-    writeFileAtomically(dir + "/timing.csv", timing);
+    for (long b = 0; b < buckets; ++b)
+        emitRange(scratch.dir + "/" + std::to_string(b), false, b * perBucket, std::min(numTasks, (b + 1) * perBucket));
+}
+
+std::vector<std::string> writeStudyFiles(const Study& study, const std::string& dir, const std::string& journalPath,
+                                         long passBytes) {
+    AtomicFileWriter table(dir + "/results.csv"), timing(dir + "/timing.csv");
+    table.write(getStudyResultsHeader() + '\n');
+    timing.write("task,rank,synthesis_s,identification_s\n");
+    StudySummaryAccumulator sum(study);
+    forEachResultInTaskOrder(journalPath, dir + "/.sort." + std::to_string(::getpid()), study.getNumTasks(), passBytes,
+                             [&](const StudyResult& r) {
+                                 table.write(formatStudyResult(r) + '\n');
+                                 timing.write(std::to_string(r.task) + ',' + std::to_string(r.rank) + ',' +
+                                              formatNumber(r.synthesisTime) + ',' + formatNumber(r.identificationTime) + '\n');
+                                 sum.add(r);
+                             });
+    const std::vector<StudySummaryRow> summary = sum.getRows();
+    table.commit();
+    timing.commit();
     writeFileAtomically(dir + "/summary.csv", formatStudySummaryCsv(summary));
     std::vector<std::string> files = {"results.csv", "summary.csv", "timing.csv"};
     if (!study.file.empty()) {
@@ -466,32 +616,24 @@ StudyOutcome runStudy(const Study& study, const StudyRunOptions& options, StudyC
             options.notice(outcome.journalSummary + " (every line in " + outcome.output + "/journal_repairs.log)");
     }
 
-    // Missing cells, grouped, in task order (a shard's: its groups only).
-    std::deque<GroupWork> pending;
-    const int cells = study.getCellsPerGroup();
-    for (long g = sharded ? options.shard : 0; g < study.getNumGroups(); g += sharded ? options.shards : 1) {
-        GroupWork w{g, {}};
-        for (long t = g * cells; t < (g + 1) * cells; ++t) {
-            if (!folder.getDone().count(t)) w.tasks.push_back(t);
-            else ++outcome.resumed;
-            ++outcome.total;
-        }
-        if (!w.tasks.empty()) pending.push_back(std::move(w));
-    }
-    if (options.merge && !pending.empty()) {
-        long missing = 0;
-        for (const GroupWork& w : pending) missing += long(w.tasks.size());
-        throw InputError("study output '" + outcome.output + "': --merge: " + std::to_string(missing) + " of " +
-                         std::to_string(outcome.total) + " cells are in no journal (a shard failed or has not run; " +
-                         "first missing: task " + std::to_string(pending.front().tasks.front()) + "); run the " +
+    // Missing cells, in task order (a shard's: its groups only).
+    WorkQueue pending(study, folder, sharded ? options.shard : 0, sharded ? options.shards : 1);
+    outcome.total = pending.getNumCells();
+    outcome.resumed = outcome.total - pending.getNumMissing();
+    if (options.merge && pending.getNumMissing() > 0)
+        throw InputError("study output '" + outcome.output + "': --merge: " + std::to_string(pending.getNumMissing()) +
+                         " of " + std::to_string(outcome.total) + " cells are in no journal (a shard failed or has not " +
+                         "run; first missing: task " + std::to_string(pending.getFirstMissing()) + "); run the " +
                          "study without --merge to compute them");
-    }
+    auto isOurs = [&](long task) {
+        return !sharded || getStudyTask(study, task).getGroup(study) % options.shards == options.shard;
+    };
 
     StudyProgress progress;
     progress.total = outcome.total;
     progress.resumed = progress.done = outcome.resumed;
-    for (const auto& [task, r] : folder.getDone())
-        progress.failed += r.status == "failed" && (!sharded || getStudyTask(study, task).getGroup(study) % options.shards == options.shard);
+    for (long task = 0; task < study.getNumTasks(); ++task)
+        progress.failed += folder.getStatus(task) == kFailed && isOurs(task);
     auto record = [&](const std::vector<StudyResult>& results) {
         if (results.empty()) return;
         folder.append(results);
@@ -516,16 +658,16 @@ StudyOutcome runStudy(const Study& study, const StudyRunOptions& options, StudyC
     outcome.threads = threads;
     outcome.ranks = 1 + (link ? link->getNumWorkers() : 0);
     {
-        LocalWorkers local(study, pending.empty() ? 0 : threads, 0);
+        LocalWorkers local(study, pending.isEmpty() ? 0 : threads, 0);
         int localInFlight = 0, stopped = 0;
         const int workers = link ? link->getNumWorkers() : 0;
         std::vector<bool> told(workers + 1, false);
         auto lastReport = Clock::now();
         report();
         while (progress.done < progress.total || stopped < workers) {
-            while (localInFlight < local.getNumThreads() && !pending.empty()) {
-                local.add(std::move(pending.front()));
-                pending.pop_front();
+            while (localInFlight < local.getNumThreads() && !pending.isEmpty()) {
+                local.add(pending.take(local.getNumThreads() - localInFlight));
+                ++outcome.units;
                 ++localInFlight;
             }
             int worker = 0;
@@ -540,12 +682,12 @@ StudyOutcome runStudy(const Study& study, const StudyRunOptions& options, StudyC
                                      "be the same on every node");
                 record(results);
                 std::vector<GroupWork> give;
-                while (int(give.size()) < want && !pending.empty()) {
-                    give.push_back(std::move(pending.front()));
-                    pending.pop_front();
+                while (int(give.size()) < want && !pending.isEmpty()) {
+                    give.push_back(pending.take(want - int(give.size())));
+                    ++outcome.units;
                 }
-                link->send(worker, formatWork(give, pending.empty()));
-                if (pending.empty() && !told[worker]) told[worker] = true, ++stopped;
+                link->send(worker, formatWork(give, pending.isEmpty()));
+                if (pending.isEmpty() && !told[worker]) told[worker] = true, ++stopped;
             }
             int groups = 0;
             record(local.take(std::chrono::milliseconds(link ? 1 : 200), groups));
@@ -561,13 +703,14 @@ StudyOutcome runStudy(const Study& study, const StudyRunOptions& options, StudyC
     if (sharded) {  // the plain run (or --merge) after the job array writes the files
         outcome.files = {folder.getJournalName()};
     } else {
-        outcome.files = writeStudyFiles(study, outcome.output, folder.getDone());
+        folder.closeJournal();
+        outcome.files = writeStudyFiles(study, outcome.output, folder.getJournalPath(), options.resultsPassBytes);
     }
     if (doesPathExist(outcome.output + "/journal_repairs.log")) outcome.files.push_back("journal_repairs.log");
-    for (const auto& [task, r] : folder.getDone()) {
-        if (sharded && getStudyTask(study, task).getGroup(study) % options.shards != options.shard) continue;
-        outcome.failed += r.status == "failed";
-        outcome.notConverged += r.status == "not-converged";
+    for (long task = 0; task < study.getNumTasks(); ++task) {
+        if (!isOurs(task)) continue;
+        outcome.failed += folder.getStatus(task) == kFailed;
+        outcome.notConverged += folder.getStatus(task) == kNotConverged;
     }
     outcome.wallTime = std::chrono::duration<double>(Clock::now() - start).count();
     return outcome;

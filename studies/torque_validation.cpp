@@ -132,71 +132,79 @@ std::vector<ElbowValidationRow> runElbowValidation(const Population& population,
 }
 
 std::vector<ElbowValidationSummary> summarizeElbowValidation(const std::vector<ElbowValidationRow>& rows) {
-    std::vector<ElbowValidationSummary> out;
-    for (const ElbowValidationRow& r : rows) {
-        auto it = std::find_if(out.begin(), out.end(),
-                               [&](const ElbowValidationSummary& s) { return s.method == r.method && s.noise == r.noise; });
-        if (it == out.end()) {
-            out.push_back({});
-            it = out.end() - 1;
-            it->method = r.method;
-            it->noise = r.noise;
-        }
-        ++it->subjects;
+    ElbowValidationAccumulator sum;
+    for (const ElbowValidationRow& r : rows) sum.add(r);
+    return sum.getSummaries();
+}
+
+void ElbowValidationAccumulator::Running::add(double x) {
+    ++n;
+    const double d = x - mean;
+    mean += d / double(n);
+    m2 += d * (x - mean);
+}
+
+void ElbowValidationAccumulator::add(const ElbowValidationRow& r) {
+    auto it = std::find_if(cells_.begin(), cells_.end(), [&](const Cell& c) { return c.method == r.method && c.noise == r.noise; });
+    if (it == cells_.end()) {
+        cells_.push_back({});
+        it = cells_.end() - 1;
+        it->method = r.method;
+        it->noise = r.noise;
     }
-    for (ElbowValidationSummary& s : out) {
-        double mb = 0, mm = 0, tb = 0, tm = 0, mw = 0, tw = 0;
-        int mc = 0, mn = 0, tc = 0, tn = 0, n = 0;
-        for (const ElbowValidationRow& r : rows) {
-            if (r.method != s.method || r.noise != s.noise) continue;
-            if (r.estimate.converged) ++s.converged;
-            if (!std::isfinite(r.massError) || !std::isfinite(r.tendonError)) continue;
-            ++n;
-            mb += r.massError, mm += r.massError * r.massError;
-            tb += r.tendonError, tm += r.tendonError * r.tendonError;
-            if (r.massCovered >= 0) {
-                ++mn, mc += r.massCovered;
-                mw += (r.estimate.massUpper - r.estimate.massLower) / r.estimate.mass;
-            }
-            if (r.tendonCovered >= 0) {
-                ++tn, tc += r.tendonCovered;
-                tw += r.estimate.tendonUpper - r.estimate.tendonLower;
-            }
-        }
+    Cell& c = *it;
+    ++c.subjects;
+    if (r.estimate.converged) ++c.converged;
+    if (std::isfinite(r.maxForceError)) {
+        ++c.fn, c.fb += r.maxForceError, c.fm += r.maxForceError * r.maxForceError;
+        if (r.maxForceCovered >= 0) ++c.fcn, c.fc += r.maxForceCovered;
+    }
+    if (!std::isfinite(r.massError) || !std::isfinite(r.tendonError)) return;
+    ++c.n;
+    c.mb += r.massError, c.mm += r.massError * r.massError;
+    c.tb += r.tendonError, c.tm += r.tendonError * r.tendonError;
+    c.massError.add(r.massError), c.massSquare.add(r.massError * r.massError);
+    c.tendonError.add(r.tendonError), c.tendonSquare.add(r.tendonError * r.tendonError);
+    if (r.massCovered >= 0) {
+        ++c.mn, c.mc += r.massCovered;
+        c.mw += (r.estimate.massUpper - r.estimate.massLower) / r.estimate.mass;
+    }
+    if (r.tendonCovered >= 0) {
+        ++c.tn, c.tc += r.tendonCovered;
+        c.tw += r.estimate.tendonUpper - r.estimate.tendonLower;
+    }
+}
+
+std::vector<ElbowValidationSummary> ElbowValidationAccumulator::getSummaries() const {
+    std::vector<ElbowValidationSummary> out;
+    for (const Cell& c : cells_) {
+        ElbowValidationSummary s;
+        s.method = c.method;
+        s.noise = c.noise;
+        s.subjects = c.subjects;
+        s.converged = c.converged;
         s.massBias = s.massRmse = s.tendonBias = s.tendonRmse = 0.0 / 0.0;  // no estimate
-        if (n > 0) {
-            s.massBias = mb / n, s.massRmse = std::sqrt(mm / n);
-            s.tendonBias = tb / n, s.tendonRmse = std::sqrt(tm / n);
+        if (c.n > 0) {
+            s.massBias = c.mb / c.n, s.massRmse = std::sqrt(c.mm / c.n);
+            s.tendonBias = c.tb / c.n, s.tendonRmse = std::sqrt(c.tm / c.n);
         }
-        if (mn > 0) s.massCoverage = double(mc) / mn, s.massIntervalWidth = mw / mn;
-        double fb = 0, fm = 0;
-        int fn = 0, fc = 0, fcn = 0;
-        for (const ElbowValidationRow& r : rows) {
-            if (r.method != s.method || r.noise != s.noise || !std::isfinite(r.maxForceError)) continue;
-            ++fn, fb += r.maxForceError, fm += r.maxForceError * r.maxForceError;
-            if (r.maxForceCovered >= 0) ++fcn, fc += r.maxForceCovered;
-        }
-        if (fn > 0) s.maxForceBias = fb / fn, s.maxForceRmse = std::sqrt(fm / fn);
-        if (fcn > 0) s.maxForceCoverage = double(fc) / fcn;
-        if (tn > 0) s.tendonCoverage = double(tc) / tn, s.tendonIntervalWidth = tw / tn;
+        if (c.mn > 0) s.massCoverage = double(c.mc) / c.mn, s.massIntervalWidth = c.mw / c.mn;
+        if (c.fn > 0) s.maxForceBias = c.fb / c.fn, s.maxForceRmse = std::sqrt(c.fm / c.fn);
+        if (c.fcn > 0) s.maxForceCoverage = double(c.fc) / c.fcn;
+        if (c.tn > 0) s.tendonCoverage = double(c.tc) / c.tn, s.tendonIntervalWidth = c.tw / c.tn;
         // Standard errors over subjects: the mean's, the RMSE's by the delta method (sd of the squared
         // error / (2 RMSE sqrt n)), a fraction's binomial sqrt(p (1 - p) / n).
-        std::vector<double> me, te;
-        for (const ElbowValidationRow& r : rows)
-            if (r.method == s.method && r.noise == s.noise && std::isfinite(r.massError) && std::isfinite(r.tendonError))
-                me.push_back(r.massError), te.push_back(r.tendonError);
-        auto errors = [](const std::vector<double>& e, double mean, double rmse, double& biasSe, double& rmseSe) {
-            const double k = double(e.size());
+        auto errors = [](const Running& e, const Running& e2, double rmse, double& biasSe, double& rmseSe) {
+            const double k = double(e.n);
             if (k < 2) return;
-            double v = 0, v2 = 0;
-            for (double x : e) v += (x - mean) * (x - mean), v2 += std::pow(x * x - rmse * rmse, 2);
-            biasSe = std::sqrt(v / (k - 1) / k);
-            rmseSe = rmse > 0 ? std::sqrt(v2 / (k - 1) / k) / (2 * rmse) : 0.0;
+            biasSe = std::sqrt(e.m2 / (k - 1) / k);
+            rmseSe = rmse > 0 ? std::sqrt(e2.m2 / (k - 1) / k) / (2 * rmse) : 0.0;
         };
-        errors(me, s.massBias, s.massRmse, s.massBiasSe, s.massRmseSe);
-        errors(te, s.tendonBias, s.tendonRmse, s.tendonBiasSe, s.tendonRmseSe);
-        if (mn > 0) s.massCoverageSe = std::sqrt(s.massCoverage * (1 - s.massCoverage) / mn);
-        if (tn > 0) s.tendonCoverageSe = std::sqrt(s.tendonCoverage * (1 - s.tendonCoverage) / tn);
+        errors(c.massError, c.massSquare, s.massRmse, s.massBiasSe, s.massRmseSe);
+        errors(c.tendonError, c.tendonSquare, s.tendonRmse, s.tendonBiasSe, s.tendonRmseSe);
+        if (c.mn > 0) s.massCoverageSe = std::sqrt(s.massCoverage * (1 - s.massCoverage) / c.mn);
+        if (c.tn > 0) s.tendonCoverageSe = std::sqrt(s.tendonCoverage * (1 - s.tendonCoverage) / c.tn);
+        out.push_back(s);
     }
     return out;
 }

@@ -89,6 +89,31 @@ ElbowValidationSubject runElbowValidationSubject(const Population& truth, const 
 std::vector<ElbowValidationRow> runElbowValidation(const Population& population, const ElbowValidationSettings& settings,
                                                    const std::function<void(int, int)>& progress = {});
 std::vector<ElbowValidationSummary> summarizeElbowValidation(const std::vector<ElbowValidationRow>& rows);
+
+/// summarizeElbowValidation one row at a time, in memory independent of the number of rows (studies of
+/// millions of subjects): per (method, noise) in the order of first appearance, running sums for bias,
+/// RMSE and coverage and Welford updates for their standard errors.
+class ElbowValidationAccumulator {
+public:
+    void add(const ElbowValidationRow& row);
+    std::vector<ElbowValidationSummary> getSummaries() const;
+
+private:
+    struct Running {  // mean and sum of squared deviations (Welford)
+        long n = 0;
+        double mean = 0, m2 = 0;
+        void add(double x);
+    };
+    struct Cell {
+        std::string method;
+        double noise = 0;
+        int subjects = 0, converged = 0;
+        int n = 0, mn = 0, mc = 0, tn = 0, tc = 0, fn = 0, fcn = 0, fc = 0;
+        double mb = 0, mm = 0, tb = 0, tm = 0, mw = 0, tw = 0, fb = 0, fm = 0;
+        Running massError, massSquare, tendonError, tendonSquare;
+    };
+    std::vector<Cell> cells_;
+};
 /// One CSV line per row: truth, estimate, 95 % interval, coverage, nuisance truths (SI units, errors in %).
 std::string formatElbowValidationCsv(const std::vector<ElbowValidationRow>& rows);
 /// Per method and noise level: bias, RMSE, coverage, then their standard errors (CSV).

@@ -176,6 +176,47 @@ TEST(Study, ResultsDoNotDependOnTheThreadCount) {
     EXPECT_EQ(readText(d / "results.csv") + readText(d / "summary.csv"), referenceResults());
 }
 
+// Cells are the unit of work: one protocol and 2 subjects make 2 groups of 4 cells. On 4 idle threads
+// each group is split in 2 (each piece synthesizing its subject): 4 units; on 1 thread, 2 units; on 2,
+// 2 units. The files are the same.
+TEST(StudyWork, GroupsAreSplitOverIdleThreadsAndTheFilesStayTheSame) {
+    Study two = smallStudy();
+    two.subjects = 2;
+    two.protocols.resize(1);
+    std::string files[3];
+    const int threads[3] = {1, 2, 4};
+    const long units[3] = {2, 2, 4};
+    for (int i = 0; i < 3; ++i) {
+        const fs::path d = freshDir("split_" + std::to_string(threads[i]));
+        StudyRunOptions o;
+        o.output = d.string();
+        o.threads = threads[i];
+        const StudyOutcome r = runStudy(two, o);
+        EXPECT_EQ(r.computed, 8);
+        EXPECT_EQ(r.units, units[i]) << threads[i] << " threads";
+        files[i] = readText(d / "results.csv") + readText(d / "summary.csv");
+    }
+    EXPECT_EQ(files[0], files[1]);
+    EXPECT_EQ(files[0], files[2]);
+}
+
+// The final files are written from the journal in task order, a bounded range of tasks per pass
+// (memory independent of the number of results): with a pass of 1 byte (one task per bucket file) or
+// 2000 bytes (a few tasks each), the files equal the one-pass run's, and no sorting folder is left.
+TEST(StudyWork, FinalFilesWrittenInManyPassesEqualTheOnePassFiles) {
+    for (long bytes : {1L, 2000L}) {
+        const fs::path d = freshDir("passes_" + std::to_string(bytes));
+        StudyRunOptions o;
+        o.output = d.string();
+        o.threads = 2;
+        o.resultsPassBytes = bytes;
+        runStudy(smallStudy(), o);
+        EXPECT_EQ(readText(d / "results.csv") + readText(d / "summary.csv"), referenceResults()) << bytes << " bytes";
+        for (const fs::directory_entry& e : fs::directory_iterator(d))
+            EXPECT_EQ(e.path().filename().string().find(".sort"), std::string::npos) << e.path();
+    }
+}
+
 // A run killed after some groups leaves a journal with complete lines and maybe one torn line; the
 // next run computes only what is missing and writes the same files as an uninterrupted run.
 TEST(Study, ResumeFromAPartialJournalWithATornLineGivesTheUninterruptedResults) {
@@ -573,7 +614,10 @@ TEST(StudyShards, ShardsThenAPlainRunWriteTheUninterruptedFiles) {
     EXPECT_EQ(merged.shardJournals, 1);
     EXPECT_EQ(readText(d / "results.csv") + readText(d / "summary.csv"), referenceResults());
     for (int shard : {0, 1, 2}) EXPECT_FALSE(fs::exists(d / ("journal-shard-" + std::to_string(shard) + "-of-3.log")));
-    const StudyOutcome again = runStudy(smallStudy(), StudyRunOptions{o.output, 1});  // all in journal.log now
+    StudyRunOptions plain;
+    plain.output = o.output;
+    plain.threads = 1;
+    const StudyOutcome again = runStudy(smallStudy(), plain);  // all in journal.log now
     EXPECT_EQ(again.resumed, 24);
     EXPECT_EQ(again.merged, 0);
 }

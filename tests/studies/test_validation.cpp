@@ -7,6 +7,8 @@
 #include "tests/identification/test_support.h"
 
 #include <algorithm>
+#include <cmath>
+#include <random>
 
 using namespace armsim;
 using namespace armsim::test;
@@ -124,6 +126,42 @@ TEST(Validation, SummaryStandardErrorsMatchClosedForms) {
     EXPECT_NEAR(s[0].tendonBiasSe, 0.001 * std::sqrt(20.0 / 3 / 4), kExact);
     const std::string csv = formatElbowValidationSummaryCsv(s);
     EXPECT_NE(csv.find("mass_rmse_se_pct"), std::string::npos);
+}
+
+// The summary is accumulated row by row (a study of millions of subjects keeps no rows); its standard
+// errors (Welford updates) equal the two-pass sums over stored errors, on 1000 seeded random rows.
+TEST(Validation, SummaryAccumulatedRowByRowEqualsTheTwoPassFormulas) {
+    constexpr double kTwoPassTol = 1e-10;  // relative: rounding of one pass against two
+    std::mt19937_64 rng(7);
+    std::normal_distribution<double> mass(0.05, 0.1), tendon(0.003, 0.004);
+    std::vector<ElbowValidationRow> rows;
+    std::vector<double> m, t;
+    for (int k = 0; k < 1000; ++k) {
+        ElbowValidationRow r;
+        r.subject = k;
+        r.method = "m";
+        r.massError = mass(rng), r.tendonError = tendon(rng);
+        m.push_back(r.massError), t.push_back(r.tendonError);
+        rows.push_back(r);
+    }
+    const std::vector<ElbowValidationSummary> s = summarizeElbowValidation(rows);
+    ASSERT_EQ(s.size(), 1u);
+    auto twoPass = [](const std::vector<double>& e, double& biasSe, double& rmseSe) {
+        const double n = double(e.size());
+        double mean = 0, ms = 0;
+        for (double x : e) mean += x / n, ms += x * x / n;
+        double v = 0, v2 = 0;
+        for (double x : e) v += (x - mean) * (x - mean), v2 += (x * x - ms) * (x * x - ms);
+        biasSe = std::sqrt(v / (n - 1) / n);
+        rmseSe = std::sqrt(v2 / (n - 1) / n) / (2 * std::sqrt(ms));
+    };
+    double mb = 0, mr = 0, tb = 0, tr = 0;
+    twoPass(m, mb, mr);
+    twoPass(t, tb, tr);
+    EXPECT_NEAR(s[0].massBiasSe, mb, kTwoPassTol * mb);
+    EXPECT_NEAR(s[0].massRmseSe, mr, kTwoPassTol * mr);
+    EXPECT_NEAR(s[0].tendonBiasSe, tb, kTwoPassTol * tb);
+    EXPECT_NEAR(s[0].tendonRmseSe, tr, kTwoPassTol * tr);
 }
 
 // Issue 31: out of family (specific tension 20 % higher than the prior's), the recommended protocol's
