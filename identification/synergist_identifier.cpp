@@ -8,6 +8,8 @@
 #include "model/geometry.h"
 #include "model/trial.h"
 
+#include <Eigen/Dense>
+
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -94,7 +96,7 @@ std::vector<double> calcTaredSteadyTorque(const ArmSetup& setup, const SubjectEf
 
 SynergistModel::SynergistModel(const Population& prior, const SynergistOptions& options,
                                const std::vector<TorqueCondition>& conditions)
-    : base_(&prior.base) {
+    : base_(&prior.base), prior_(&prior) {
     const ArmSetup& base = prior.base;
     biceps_ = options.biceps.empty() ? base.getBicepsHeads() : findMuscles(base, options.biceps, "biceps");
     synergists_ = options.synergists.empty() ? base.synergists : findMuscles(base, options.synergists, "synergists");
@@ -267,6 +269,67 @@ void SynergistModel::freeRotatorMass() {
     priorCovariance_ = coupledCovariance_;
 }
 
+std::vector<std::vector<double>> SynergistModel::calcPrimitiveCovariance() const {
+    const int nm = int(base_->muscles.size()), nv = getNumPrimitives();
+    std::vector<std::vector<double>> v(nv, std::vector<double>(nv, 0.0));
+    const Population& p = *prior_;
+    const double s2 = p.strengthSubjectSd * p.strengthSubjectSd, m2 = p.strengthMuscleSd * p.strengthMuscleSd;
+    for (int i = 0; i < nm; ++i) {
+        v[4 * i][4 * i] = p.tendonLengthSd * p.tendonLengthSd;
+        v[4 * i + 1][4 * i + 1] = p.fascicleLengthSd * p.fascicleLengthSd;
+        v[4 * i + 2][4 * i + 2] = p.slowFractionSd * p.slowFractionSd;
+        for (int j = 0; j < nm; ++j) v[4 * i + 3][4 * j + 3] = s2 + (i == j ? m2 : 0.0);
+    }
+    auto uniformVar = [](const UniformRange& r) { return (r.max - r.min) * (r.max - r.min) / 12.0; };
+    v[4 * nm][4 * nm] = p.specificTensionSd * p.specificTensionSd;
+    v[4 * nm + 1][4 * nm + 1] = p.geometryScaleSd * p.geometryScaleSd;
+    v[4 * nm + 2][4 * nm + 2] = uniformVar(p.voluntaryActivation);
+    v[4 * nm + 3][4 * nm + 3] = uniformVar(p.coContraction);
+    return v;
+}
+
+std::vector<std::vector<std::pair<int, double>>> SynergistModel::getParameterTruths() const {
+    const int nm = int(base_->muscles.size()), primary = base_->primary;
+    std::vector<std::vector<std::pair<int, double>>> t(getNumParameters());
+    t[kTendon] = {{4 * primary, 1.0}};
+    t[kFascicle] = {{4 * primary + 1, 1.0}};
+    t[kBicepsSlow] = {{4 * primary + 2, 1.0}};
+    if (!synergists_.empty()) {
+        t[kSynergistTendon] = {{4 * synergists_[0], 1.0}};
+        t[kSynergistFascicle] = {{4 * synergists_[0] + 1, 1.0}};
+        t[kSynergistSlow] = {{4 * synergists_[0] + 2, 1.0}};
+    }
+    if (!extensors_.empty()) t[kExtensorMass] = {{4 * extensors_[0] + 3, 1.0}};
+    t[kSigma] = {{4 * nm, 1.0}};
+    t[kSize] = {{4 * nm + 1, 1.0}};
+    t[kActivation] = {{4 * nm + 2, 1.0}};
+    t[kCoContraction] = {{4 * nm + 3, 1.0}};
+    for (int i = 0; i < nm; ++i) {
+        const int k = findMassIndex(i);
+        if (k >= 0) t[k] = {{4 * i + 3, 1.0}};
+    }
+    return t;
+}
+
+std::vector<SynergistModel::ConsiderParameter> SynergistModel::getConsiderParameters() const {
+    std::vector<ConsiderParameter> out;
+    auto in = [](const std::vector<int>& group, int i) { return std::find(group.begin(), group.end(), i) != group.end(); };
+    const int nm = int(base_->muscles.size());
+    for (int i = 0; i < nm; ++i) {
+        // The muscle whose scale x gives muscle i (its group's first), or -1: x has none for it.
+        const int anchor = in(biceps_, i) ? base_->primary : in(synergists_, i) ? synergists_[0] : -1;
+        for (int kind = 0; kind < 3; ++kind) {
+            if (anchor == i) continue;  // x's own
+            ConsiderParameter c{i, kind, {{4 * i + kind, 1.0}}};
+            if (anchor >= 0) c.truth.push_back({4 * anchor + kind, -1.0});
+            out.push_back(c);
+        }
+        if (in(extensors_, i) && i != extensors_[0]) out.push_back({i, 3, {{4 * i + 3, 1.0}, {4 * extensors_[0] + 3, -1.0}}});
+        if (findMassIndex(i) < 0 && !in(extensors_, i)) out.push_back({i, 3, {{4 * i + 3, 1.0}}});
+    }
+    return out;
+}
+
 int SynergistModel::findMassIndex(int muscle) const {
     for (std::size_t k = 0; k < biceps_.size(); ++k)
         if (biceps_[k] == muscle) return kFirstMass + int(k);
@@ -285,7 +348,7 @@ std::vector<int> SynergistModel::getFlexorMassIndices() const {
     return out;
 }
 
-std::vector<MuscleSpec> SynergistModel::makeMuscles(const double* x) const {
+std::vector<MuscleSpec> SynergistModel::makeMuscles(const double* x, const std::vector<MuscleDeviation>* deviations) const {
     std::vector<MuscleSpec> m = base_->muscles;
     for (std::size_t k = 0; k < biceps_.size(); ++k) {
         MuscleParameters& q = m[biceps_[k]].params;
@@ -303,6 +366,15 @@ std::vector<MuscleSpec> SynergistModel::makeMuscles(const double* x) const {
     }
     for (int i : extensors_) m[i].params.mass *= std::exp(x[kExtensorMass]);
     for (std::size_t k = 0; k < rotators_.size(); ++k) m[rotators_[k]].params.mass *= std::exp(x[getFirstRotatorIndex() + k]);
+    if (deviations)
+        for (std::size_t i = 0; i < m.size() && i < deviations->size(); ++i) {
+            const MuscleDeviation& d = (*deviations)[i];
+            MuscleParameters& q = m[i].params;
+            q.optimalTendonLength *= std::exp(d.lnTendon);
+            q.optimalFascicleLength *= std::exp(d.lnFascicle);
+            q.mass *= std::exp(d.lnMass);
+            if (d.slowShift != 0) q.slowFraction = std::clamp(q.slowFraction + d.slowShift, 0.05, 0.95);
+        }
     const double sigma = std::exp(x[kSigma]), g = std::exp(x[kSize]);
     for (MuscleSpec& spec : m) {
         MuscleParameters& q = spec.params;
@@ -327,9 +399,15 @@ void SynergistModel::calcPredictions(const double* x, std::vector<double>& torqu
 
 void SynergistModel::calcPredictions(const double* x, std::vector<double>& torques, std::vector<double>& forearmTorques,
                                      std::vector<double>& channels) const {
+    calcPredictions(x, nullptr, torques, forearmTorques, channels);
+}
+
+void SynergistModel::calcPredictions(const double* x, const std::vector<MuscleDeviation>* deviations,
+                                     std::vector<double>& torques, std::vector<double>& forearmTorques,
+                                     std::vector<double>& channels) const {
     // Guard: the bounds keep difference probes inside [0, 1].
     const double va = std::clamp(x[kActivation], 0.0, 1.0), cc = std::clamp(x[kCoContraction], 0.0, 1.0);
-    const std::vector<MuscleSpec> muscles = makeMuscles(x);
+    const std::vector<MuscleSpec> muscles = makeMuscles(x, deviations);
     const double g = std::exp(x[kSize]);
     MvcGeometry scaled;
     if (g != 1) {  // every length scales by g: paths and moment arms too
@@ -371,6 +449,75 @@ void SynergistModel::calcPredictions(const double* x, std::vector<double>& torqu
         channels.push_back(v);
     }
 }
+
+namespace {
+
+// The error covariance of the linearized fit when the truth also varies what the fit holds or shares
+// (SynergistModel, consider parameters): with F the free parameters, Lambda the prior's precision on
+// them, C0 = (J_F' J_F + Lambda)^-1 and w = (x_F, x_held, considered) - their means with the prior
+// population's covariance S, the error is C0 (J_F' n + B w), B = [-Lambda, J_F' J_held, J_F' J_c], so
+// its covariance is C0 (J_F' J_F + B S B') C0 (C0 again when the fit's model is the truth's).
+// J: the whitened data residuals' Jacobian over the n parameters then the consider parameters. Writes
+// C0 and C as n x n (zero rows for held parameters); leaves them when a matrix is not positive definite.
+void calcConsideredCovariance(const SynergistModel& model, const MapProblem& map, const std::vector<std::vector<double>>& J,
+                              std::vector<std::vector<double>>& c0Out, std::vector<std::vector<double>>& cOut) {
+    const int n = int(map.priorMean.size()), R = int(J.size()), nk = R > 0 ? int(J[0].size()) - n : 0;
+    std::vector<int> free, held;
+    for (int j = 0; j < n; ++j) (map.lower[j] >= map.upper[j] ? held : free).push_back(j);
+    const int nf = int(free.size()), nh = int(held.size());
+    if (nf == 0) return;
+    Eigen::MatrixXd P(n, n), Jm(R, n + nk);
+    for (int a = 0; a < n; ++a)
+        for (int b = 0; b < n; ++b) P(a, b) = map.priorCovariance[a][b];
+    for (int k = 0; k < R; ++k)
+        for (int j = 0; j < n + nk; ++j) Jm(k, j) = J[k][j];
+    const Eigen::LLT<Eigen::MatrixXd> pl(P);
+    if (pl.info() != Eigen::Success) return;
+    const Eigen::MatrixXd Pinv = pl.solve(Eigen::MatrixXd::Identity(n, n));
+    Eigen::MatrixXd lambda(nf, nf), JF(R, nf), JO(R, nh + nk);
+    for (int a = 0; a < nf; ++a) {
+        JF.col(a) = Jm.col(free[a]);
+        for (int b = 0; b < nf; ++b) lambda(a, b) = Pinv(free[a], free[b]);
+    }
+    for (int a = 0; a < nh; ++a) JO.col(a) = Jm.col(held[a]);
+    for (int a = 0; a < nk; ++a) JO.col(nh + a) = Jm.col(n + a);
+    const Eigen::MatrixXd H = JF.transpose() * JF;
+    const Eigen::LLT<Eigen::MatrixXd> hl(H + lambda);
+    if (hl.info() != Eigen::Success) return;
+    const Eigen::MatrixXd C0 = hl.solve(Eigen::MatrixXd::Identity(nf, nf));
+    // w = T v: the truths as combinations of the population's independent primitives v; a parameter
+    // that stands for none (a group the model does not have) keeps the fit's own prior variance.
+    const std::vector<std::vector<std::pair<int, double>>> truths = model.getParameterTruths();
+    const std::vector<SynergistModel::ConsiderParameter> considered = model.getConsiderParameters();
+    const std::vector<std::vector<double>> V = model.calcPrimitiveCovariance();
+    const int nv = int(V.size()), nw = nf + nh + nk;
+    Eigen::MatrixXd T = Eigen::MatrixXd::Zero(nw, nv + nw);
+    auto fill = [&](int row, const std::vector<std::pair<int, double>>& terms, int parameter) {
+        for (const auto& [v, coefficient] : terms) T(row, v) += coefficient;
+        if (terms.empty() && parameter >= 0) T(row, nv + row) = std::sqrt(map.priorCovariance[parameter][parameter]);
+    };
+    for (int a = 0; a < nf; ++a) fill(a, truths[free[a]], free[a]);
+    for (int a = 0; a < nh; ++a) fill(nf + a, truths[held[a]], -1);  // held and standing for nothing: known
+    for (int a = 0; a < nk; ++a) fill(nf + nh + a, considered[a].truth, -1);
+    Eigen::MatrixXd Vm = Eigen::MatrixXd::Identity(nv + nw, nv + nw);  // private primitives: unit variance
+    for (int a = 0; a < nv; ++a)
+        for (int b = 0; b < nv; ++b) Vm(a, b) = V[a][b];
+    const Eigen::MatrixXd S = T * Vm * T.transpose();
+    Eigen::MatrixXd B(nf, nw);
+    B.leftCols(nf) = -lambda;
+    B.rightCols(nh + nk) = JF.transpose() * JO;
+    Eigen::MatrixXd C = C0 * (H + B * S * B.transpose()) * C0;
+    C = 0.5 * (C + C.transpose());
+    c0Out.assign(n, std::vector<double>(n, 0.0));
+    cOut.assign(n, std::vector<double>(n, 0.0));
+    for (int a = 0; a < nf; ++a)
+        for (int b = 0; b < nf; ++b) {
+            c0Out[free[a]][free[b]] = C0(a, b);
+            cOut[free[a]][free[b]] = C(a, b);
+        }
+}
+
+}  // namespace
 
 MuscleEstimate identifySynergistAware(const Population& prior, const std::vector<TorqueObservation>& data,
                                       const SynergistOptions& options) {
@@ -446,9 +593,9 @@ MuscleEstimate identifySynergistAware(const Population& prior, const std::vector
     map.upper = model.getUpper();
     map.numResiduals = int(nt + nc) + (measured ? 1 : 0);
     // Residuals: torques, then channels, then the measured activation.
-    auto calcResiduals = [&](const double* x, double* r) {
+    auto calcResiduals = [&](const double* x, double* r, const std::vector<P::MuscleDeviation>* deviations = nullptr) {
         std::vector<double> t, f, c;
-        model.calcPredictions(x, t, f, c);
+        model.calcPredictions(x, deviations, t, f, c);
         for (std::size_t k = 0; k < nt; ++k) {
             const Row& row = rows[k];
             r[k] = ((row.forearm ? f : t)[row.observation] - torque[k]) / sd[k];
@@ -554,8 +701,7 @@ MuscleEstimate identifySynergistAware(const Population& prior, const std::vector
     if (measured) addFit("activation", nt + nc, "twitch interpolation");
     for (ChannelFit& f : est.channelFits) f.p = calcChiSquareSurvival(f.chiSquare, f.n);
     if (!m.covariance.empty()) {
-        const auto& C = m.covariance;
-        const int n = int(C.size());
+        const int n = int(m.covariance.size()), R = map.numResiduals;
         const int it = P::kTendon, ig = P::kSize, is = P::kSigma, jf = P::kFascicle;
         // Reported quantities as linear combinations of x: ln M; ln L0T = ln t_b + ln g;
         // ln F0 = ln sigma + ln M - ln f_b - ln g (+ constants).
@@ -570,45 +716,67 @@ MuscleEstimate identifySynergistAware(const Population& prior, const std::vector
                 for (int j = 0; j < n; ++j) v += a[i] * M[i][j] * b[j];
             return v;
         };
+        // The whitened data residuals' Jacobian at the estimate over every parameter (free and held) and
+        // every consider parameter, by central differences: for the free parameters a tangent (step
+        // 1e-5); for the held and considered ones a secant over +/- half their prior sd, the spread the
+        // truth has (muscle forces step with motor-unit recruitment: a tangent there can be any size).
+        const std::vector<P::ConsiderParameter> considered = model.getConsiderParameters();
+        const int nk = int(considered.size());
+        std::vector<std::vector<double>> J(R, std::vector<double>(n + nk, 0.0));
+        std::vector<double> steps(n + nk, 1e-5);
+        for (int j = 0; j < n; ++j)
+            if (map.lower[j] >= map.upper[j]) steps[j] = 0.5 * std::sqrt(map.priorCovariance[j][j]);
+        for (int k = 0; k < nk; ++k) {
+            const double sd[4] = {prior.tendonLengthSd, prior.fascicleLengthSd, prior.slowFractionSd, prior.strengthMuscleSd};
+            steps[n + k] = 0.5 * sd[considered[k].kind];
+        }
+        bool haveJacobian = true;
+        {
+            std::vector<double> xp = x, rp(R), rm(R);
+            std::vector<P::MuscleDeviation> deviations(base.muscles.size());
+            auto shift = [&](int j, double by) {
+                if (j < n) return void(xp[j] = x[j] + by);
+                const P::ConsiderParameter& c = considered[j - n];
+                P::MuscleDeviation& d = deviations[c.muscle];
+                (c.kind == 0 ? d.lnTendon : c.kind == 1 ? d.lnFascicle : c.kind == 2 ? d.slowShift : d.lnMass) = by;
+            };
+            try {
+                for (int j = 0; j < n + nk; ++j) {
+                    if (!(steps[j] > 0)) continue;  // the prior does not vary it
+                    shift(j, steps[j]);
+                    calcResiduals(xp.data(), rp.data(), &deviations);
+                    shift(j, -steps[j]);
+                    calcResiduals(xp.data(), rm.data(), &deviations);
+                    shift(j, 0);
+                    for (int k = 0; k < R; ++k) J[k][j] = (rp[k] - rm[k]) / (2 * steps[j]);
+                }
+            } catch (const std::exception&) {
+                haveJacobian = false;  // keep the Laplace covariance and the conservative quantile of nu
+            }
+        }
+        // C0: the Laplace covariance; C: the estimate's error covariance with the consider parameters.
+        std::vector<std::vector<double>> C0 = m.covariance, C = m.covariance;
+        if (haveJacobian) calcConsideredCovariance(model, map, J, C0, C);
         // Degrees of freedom of each interval. The torque rows' sd is the noise level estimated with nu
-        // dof; a quantity whose posterior variance owes the fraction f = g'C Ht C g / g'C g to the torque
+        // dof; a quantity whose error variance owes the fraction f = g'C0 Ht C0 g / g'C g to the torque
         // rows (Ht = Jt'Jt, their whitened Jacobian) has that variance estimated with about nu / f^2 dof
         // (Satterthwaite); the channels' and the prior's sds are known. Torque alone: f near 1, the
         // Student-t of nu; a volume measured: f small, near the normal quantile.
         std::vector<double> fraction(3, 1.0);
         const int nu = est.noiseDegreesOfFreedom;
-        if (nu > 0) {
-            constexpr double kStep = 1e-5;
-            std::vector<std::vector<double>> jt(nt, std::vector<double>(n, 0.0));
-            std::vector<double> xp = x, rp(map.numResiduals), rm(map.numResiduals);
-            bool ok = true;
-            for (int j = 0; j < n && ok; ++j) {
-                if (map.lower[j] == map.upper[j]) continue;  // held fixed
-                try {
-                    xp[j] = x[j] + kStep;
-                    calcResiduals(xp.data(), rp.data());
-                    xp[j] = x[j] - kStep;
-                    calcResiduals(xp.data(), rm.data());
-                } catch (const std::exception&) {
-                    ok = false;  // keep the conservative quantile of nu
-                }
-                xp[j] = x[j];
-                for (std::size_t k = 0; k < nt && ok; ++k) jt[k][j] = (rp[k] - rm[k]) / (2 * kStep);
-            }
-            if (ok) {
-                std::vector<std::vector<double>> ht(n, std::vector<double>(n, 0.0));
-                for (std::size_t k = 0; k < nt; ++k)
-                    for (int a = 0; a < n; ++a)
-                        if (jt[k][a] != 0)
-                            for (int b = 0; b < n; ++b) ht[a][b] += jt[k][a] * jt[k][b];
-                int q = 0;
-                for (const std::vector<double>* g : {&gm, &gt, &gf}) {
-                    std::vector<double> cg(n, 0.0);  // C g
-                    for (int a = 0; a < n; ++a)
-                        for (int b = 0; b < n; ++b) cg[a] += C[a][b] * (*g)[b];
-                    const double v = quadratic(*g, C, *g);
-                    fraction[q++] = v > 0 ? std::clamp(quadratic(cg, ht, cg) / v, 0.0, 1.0) : 1.0;
-                }
+        if (nu > 0 && haveJacobian) {
+            std::vector<std::vector<double>> ht(n, std::vector<double>(n, 0.0));
+            for (std::size_t k = 0; k < nt; ++k)
+                for (int a = 0; a < n; ++a)
+                    if (J[k][a] != 0)
+                        for (int b = 0; b < n; ++b) ht[a][b] += J[k][a] * J[k][b];
+            int q = 0;
+            for (const std::vector<double>* g : {&gm, &gt, &gf}) {
+                std::vector<double> cg(n, 0.0);  // C0 g
+                for (int a = 0; a < n; ++a)
+                    for (int b = 0; b < n; ++b) cg[a] += C0[a][b] * (*g)[b];
+                const double v = quadratic(*g, C, *g);
+                fraction[q++] = v > 0 ? std::clamp(quadratic(cg, ht, cg) / v, 0.0, 1.0) : 1.0;
             }
         }
         auto quantileOf = [&](double f) {

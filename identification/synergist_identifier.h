@@ -22,6 +22,7 @@
 #include "model/mvc_curve.h"
 
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace armsim {
@@ -67,6 +68,12 @@ struct SynergistOptions {
 /// prior's mean when the prior population does not vary it. Prior: every mass scale shares the
 /// person-level variance (the extensors' one scale averages their muscle terms); lengths, sigma, g and
 /// effort independent, effort uniform ranges as their mean and sd.
+///
+/// The population draws every muscle's lengths, slow fraction and mass on its own, while x shares or
+/// holds them: the 95 % intervals add what that costs (consider parameters, getConsiderParameters: the
+/// estimate's error covariance C (J'J + B S B') C of the linearized fit, C its Laplace covariance, S the
+/// prior population's covariance of the truths x stands for, of the held parameters and of the
+/// considered ones, B their effect on the fit), so intervals keep their coverage in family.
 class SynergistModel {
 public:
     /// Throws InputError for muscle names not in the population's model or a primary muscle that is
@@ -99,8 +106,37 @@ public:
     /// The same and every condition's tared torque about the forearm axis (+ = supination) [N m].
     void calcPredictions(const double* x, std::vector<double>& torques, std::vector<double>& forearmTorques,
                          std::vector<double>& channels) const;
-    /// The population's model with x's muscles.
-    std::vector<MuscleSpec> makeMuscles(const double* x) const;
+    /// A muscle's own departure from what x gives it (the fit's group scales, or the prior's mean where
+    /// x has no scale for it): ln tendon and ln fascicle scale, slow-fraction shift, ln mass scale.
+    struct MuscleDeviation {
+        double lnTendon = 0, lnFascicle = 0, slowShift = 0, lnMass = 0;
+    };
+    /// The same predictions with muscle i departing by (*deviations)[i] (nullptr: none).
+    void calcPredictions(const double* x, const std::vector<MuscleDeviation>* deviations, std::vector<double>& torques,
+                         std::vector<double>& forearmTorques, std::vector<double>& channels) const;
+    /// The population's model with x's muscles (and each muscle's deviation, when given).
+    std::vector<MuscleSpec> makeMuscles(const double* x, const std::vector<MuscleDeviation>* deviations = nullptr) const;
+
+    /// What the prior population varies per person, as independent centred "primitives": for muscle i,
+    /// index 4 i + 0..3 its ln tendon scale, ln fascicle scale, slow-fraction shift and ln mass scale;
+    /// then ln sigma, ln size, voluntary activation and co-contraction (getNumPrimitives() in all).
+    int getNumPrimitives() const { return 4 * int(base_->muscles.size()) + 4; }
+    /// Their covariance: the population's sds (uniform ranges as their variance); the masses share the
+    /// person-level strength.
+    std::vector<std::vector<double>> calcPrimitiveCovariance() const;
+    /// The truth each parameter stands for, as (primitive, coefficient) terms: a group's shared scale
+    /// stands for its first muscle's (the primary's for the biceps heads).
+    std::vector<std::vector<std::pair<int, double>>> getParameterTruths() const;
+    /// What the fit's model simplifies away and the prior varies (the consider parameters of the
+    /// intervals): each muscle's own tendon, fascicle and slow fraction where its group shares one scale
+    /// (the departure from the group's first muscle) or where x has none, and the extensor heads' and
+    /// ungrouped muscles' own masses.
+    struct ConsiderParameter {
+        int muscle = 0;
+        int kind = 0;                                  ///< 0 tendon, 1 fascicle, 2 slow fraction, 3 mass
+        std::vector<std::pair<int, double>> truth;     ///< (primitive, coefficient)
+    };
+    std::vector<ConsiderParameter> getConsiderParameters() const;
 
 private:
     static constexpr int kTendon = 0, kActivation = 1, kCoContraction = 2, kFascicle = 3, kSynergistTendon = 4,
@@ -111,6 +147,7 @@ private:
         double level;
     };
     const ArmSetup* base_;
+    const Population* prior_;
     std::vector<int> biceps_, synergists_, extensors_, rotators_, leftOut_;
     MvcGeometry geometry_;                    // one row per pose (flexion angle, forearm posture)
     std::vector<EffortKind> kinds_;

@@ -410,6 +410,13 @@ long peekStudyJournalTask(const std::string& line) {
 
 namespace {
 
+// Without CRLF's CR (an editor, a Windows copy), trailing blanks and a NUL-filled tail.
+std::string trimJournalLine(std::string line) {
+    while (!line.empty() && (line.back() == '\r' || line.back() == ' ' || line.back() == '\t' || line.back() == '\0'))
+        line.pop_back();
+    return line;
+}
+
 // Calls f(raw line without '\n', whether it had one) for every line of `in`.
 template <class F>
 void forEachLine(std::istream& in, F f) {
@@ -428,9 +435,7 @@ std::vector<StudyJournalDrop> scanStudyJournal(const std::function<std::unique_p
     long number = firstLine;
     std::unique_ptr<std::istream> in = open();
     forEachLine(*in, [&](const std::string& raw, bool hasEnd) {
-        std::string line = raw;
-        while (!line.empty() && (line.back() == '\r' || line.back() == ' ' || line.back() == '\t' || line.back() == '\0'))
-            line.pop_back();  // CRLF (an editor, a Windows copy), trailing blanks, a NUL-filled tail
+        const std::string line = trimJournalLine(raw);
         StudyJournalDrop drop;
         drop.line = number++;
         if (line.empty()) {
@@ -476,11 +481,8 @@ std::vector<StudyJournalDrop> scanStudyJournal(const std::function<std::unique_p
         const long line = number++;
         const long task = peekStudyJournalTask(raw);
         if (!duplicates.count(task) || keptLine.count(task)) return;
-        std::string trimmed = raw;
-        while (!trimmed.empty() && (trimmed.back() == '\r' || trimmed.back() == ' ' || trimmed.back() == '\t' || trimmed.back() == '\0'))
-            trimmed.pop_back();
         StudyResult r;
-        if (parseStudyJournalLine(trimmed, r) && r.task == task) keptLine[task] = line;
+        if (parseStudyJournalLine(trimJournalLine(raw), r) && r.task == task) keptLine[task] = line;
     });
     for (const auto& [task, entries] : duplicates)
         for (std::size_t e : entries)
