@@ -1,9 +1,10 @@
 // libFuzzer target for armsim's file loaders (issue 15). One binary, the loader chosen by the
 // ARMSIM_FUZZ_LOADER environment variable (muscle, arm, model, protocol, torque_protocol, population,
-// study, force_csv, torque_csv, channel_csv, sto, trace). Each input is written to a scratch file and loaded; a loader
+// study, force_csv, torque_csv, channel_csv, sto, trace, study_journal). Each input is written to a scratch file and loaded; a loader
 // may reject it only with InputError (bad input) or SimulationError (a model it cannot solve). Any
 // other exception, a crash, a hang or a sanitizer report is a finding.
 #include "basics/errors.h"
+#include "basics/files.h"
 #include "experiments/data_files.h"
 #include "experiments/population.h"
 #include "experiments/protocol.h"
@@ -45,6 +46,11 @@ const std::map<std::string, std::pair<std::string, Loader>>& getLoaders() {
         {"channel_csv", {".csv", [](const std::string& p) { readChannelData(p); }}},
         {"sto", {".sto", [](const std::string& p) { readStorage(p); }}},
         {"trace", {".csv", [](const std::string& p) { loadActivationTrace(p); }}},
+        {"study_journal", {".log", [](const std::string& p) {  // a study's journal.log, header line included
+             const StudyJournal j = parseStudyJournal(readFileText(p), 1000, 1);
+             summarizeStudyJournalDrops(j.dropped, &j);
+             formatStudyJournalDrops(j.dropped);
+         }}},
     };
     return loaders;
 }
