@@ -210,6 +210,7 @@ public:
                              " is running in this folder");
         journalName_ = shards > 0 ? "journal" + suffix + ".log" : "journal.log";
         journalPath_ = dir_ + "/" + journalName_;
+        removeStaleScratch();
         const std::string header = "# armsim study journal; fingerprint " + fingerprint + "; study " + study.name;
         AtomicFileWriter kept(journalPath_);  // compacted: valid lines only, so appends start on a clean line
         kept.write(header + '\n');
@@ -270,6 +271,18 @@ private:
             if (fd >= 0) ::close(fd);
         }
     };
+
+    // What a run killed while compacting its journal or sorting its results left (ours to remove: we
+    // hold the lock): this journal's temporaries and, for a plain run, the sorting folders.
+    void removeStaleScratch() const {
+        std::error_code ec;
+        for (const fs::directory_entry& e : fs::directory_iterator(dir_, ec)) {
+            const std::string name = e.path().filename().string();
+            const bool journalTemp = name.rfind(journalName_ + ".tmp.", 0) == 0;
+            const bool sorting = journalName_ == "journal.log" && name.rfind(".sort.", 0) == 0;
+            if (journalTemp || sorting) fs::remove_all(e.path(), ec);
+        }
+    }
 
     // Takes the lock file `name` in the folder: false when another process holds it.
     bool lockFile(const std::string& name, Lock& lock) const {

@@ -204,8 +204,9 @@ TEST(StudyWork, GroupsAreSplitOverIdleThreadsAndTheFilesStayTheSame) {
 // (memory independent of the number of results): with a pass of 1 byte (one task per bucket file) or
 // 2000 bytes (a few tasks each), the files equal the one-pass run's, and no sorting folder is left.
 TEST(StudyWork, FinalFilesWrittenInManyPassesEqualTheOnePassFiles) {
+    fs::path done;  // a finished study's folder
     for (long bytes : {1L, 2000L}) {
-        const fs::path d = freshDir("passes_" + std::to_string(bytes));
+        const fs::path d = done = freshDir("passes_" + std::to_string(bytes));
         StudyRunOptions o;
         o.output = d.string();
         o.threads = 2;
@@ -215,6 +216,17 @@ TEST(StudyWork, FinalFilesWrittenInManyPassesEqualTheOnePassFiles) {
         for (const fs::directory_entry& e : fs::directory_iterator(d))
             EXPECT_EQ(e.path().filename().string().find(".sort"), std::string::npos) << e.path();
     }
+    // What a killed run left (a sorting folder, a journal temporary) is removed by the next run.
+    const fs::path& d = done;
+    fs::create_directories(d / ".sort.99999");
+    std::ofstream(d / ".sort.99999" / "0") << "x\n";
+    std::ofstream(d / "journal.log.tmp.99999") << "x\n";
+    StudyRunOptions o;
+    o.output = d.string();
+    o.threads = 1;
+    EXPECT_EQ(runStudy(smallStudy(), o).computed, 0);
+    EXPECT_FALSE(fs::exists(d / ".sort.99999"));
+    EXPECT_FALSE(fs::exists(d / "journal.log.tmp.99999"));
 }
 
 // A run killed after some groups leaves a journal with complete lines and maybe one torn line; the
