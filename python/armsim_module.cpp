@@ -46,7 +46,7 @@ py::dict toDict(const MuscleParameters& p) {
 }
 
 // Applies keyword overrides with the YAML names (mass, optimal_tendon_length, ...) to muscle i.
-void applyOverrides(ArmSetup& s, int i, const py::kwargs& kw) {
+void applyOverrides(ArmSetup& s, int i, const py::dict& kw) {
     MuscleParameters& p = s.muscles[i].params;
     for (auto item : kw) {
         const std::string k = item.first.cast<std::string>();
@@ -76,6 +76,25 @@ void applyOverrides(ArmSetup& s, int i, const py::kwargs& kw) {
     }
 }
 
+constexpr int kModelPickleFormat = 1;
+
+// A model loaded from a name or file, remembering which (a path made absolute) for pickling.
+Model loadPythonModel(const std::string& nameOrFile) {
+    Model m{loadModelChecked(nameOrFile), nameOrFile, {}};
+    if (isRegularFile(nameOrFile)) m.source = std::filesystem::absolute(nameOrFile).lexically_normal().string();
+    return m;
+}
+
+// with_muscle's change, validated (ValueError / TypeError naming the field) and recorded.
+void applyChange(Model& m, const py::object& muscle, const py::dict& kw) {
+    const int i = findMuscleIndex(m.setup, muscle);
+    applyOverrides(m.setup, i, kw);
+    m.setup.calcMuscleParameters(i);  // validates: ValueError naming the field
+    std::vector<std::pair<std::string, double>> values;
+    for (const auto& item : kw) values.push_back({item.first.cast<std::string>(), item.second.cast<double>()});
+    m.changes.push_back({m.setup.muscles[i].params.name, values});
+}
+
 VirtualMuscle buildMuscle(const Model& m, const py::object& muscle) {
     return VirtualMuscle(m.setup.calcMuscleParameters(findMuscleIndex(m.setup, muscle)));
 }
@@ -101,7 +120,7 @@ PYBIND11_MODULE(_armsim, mod) {
         .def_static(
             "load",
             [](const py::object& nameOrFile) {   // str or os.PathLike (pathlib.Path)
-                return Model{loadModelChecked(py::module_::import("os").attr("fspath")(nameOrFile).cast<std::string>())};
+                return loadPythonModel(py::module_::import("os").attr("fspath")(nameOrFile).cast<std::string>());
             },
             py::arg("name_or_file"),
             "Loads a model: a name under assets/models/ ('thesis', 'elbow', 'twin') or a model file path (str or\n"
@@ -110,6 +129,29 @@ PYBIND11_MODULE(_armsim, mod) {
         .def_property_readonly("name", [](const Model& m) { return m.setup.name; }, "the model's name")
         .def("__copy__", [](const Model& m) { return m; })
         .def("__deepcopy__", [](const Model& m, const py::dict&) { return m; }, py::arg("memo"))
+        .def(py::pickle(
+            [](const Model& m) {  // what made it: the model read again, the changes applied again
+                py::list changes;
+                for (const auto& [muscle, values] : m.changes) {
+                    py::dict kw;
+                    for (const auto& [key, value] : values)  // unit counts stay whole numbers
+                        kw[py::str(key)] = key == "slow_units" || key == "fast_units" ? py::object(py::int_(long(value)))
+                                                                                       : py::object(py::float_(value));
+                    changes.append(py::make_tuple(muscle, kw));
+                }
+                return py::make_tuple(kModelPickleFormat, m.source, changes);
+            },
+            [](const py::tuple& state) {
+                if (state.size() != 3 || state[0].cast<int>() != kModelPickleFormat)
+                    throw py::value_error("armsim.Model: a pickle of another armsim version (expected format " +
+                                          std::to_string(kModelPickleFormat) + ")");
+                Model m = loadPythonModel(state[1].cast<std::string>());
+                for (const py::handle change : state[2].cast<py::list>()) {
+                    const py::tuple c = change.cast<py::tuple>();
+                    applyChange(m, py::cast<py::object>(c[0]), c[1].cast<py::dict>());
+                }
+                return m;
+            }))
         .def_property_readonly(
             "muscles", [](const Model& m) {
                 std::vector<std::string> names;
@@ -130,9 +172,7 @@ PYBIND11_MODULE(_armsim, mod) {
         .def(
             "with_muscle", [](const Model& m, const py::object& muscle, const py::kwargs& kw) {
                 Model c = m;
-                const int i = findMuscleIndex(c.setup, muscle);
-                applyOverrides(c.setup, i, kw);
-                c.setup.calcMuscleParameters(i);  // validates: ValueError naming the field
+                applyChange(c, muscle, kw);
                 return c;
             },
             py::arg("muscle") = py::none(),

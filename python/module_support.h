@@ -13,13 +13,21 @@
 #include <string>
 #include <vector>
 
+#include <string>
+#include <utility>
+#include <vector>
+
 namespace armsim::python {
 
 namespace py = pybind11;
 
 /// The Python face of an ArmSetup (armsim.Model): immutable; with_muscle returns a changed copy.
+/// Pickled as what made it: the model it was loaded from (a name, or a file's absolute path, read again
+/// when unpickled) and the with_muscle changes, in order.
 struct Model {
     ArmSetup setup;
+    std::string source;  ///< a name under assets/models/ or a file's absolute path
+    std::vector<std::pair<std::string, std::vector<std::pair<std::string, double>>>> changes;  ///< muscle, (key, value)
 };
 
 /// A table's columns as a dict of float64 arrays, in column order. The arrays are views (stride: one

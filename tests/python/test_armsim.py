@@ -134,6 +134,30 @@ def test_arm_trial_takes_a_forearm_posture_and_a_short_hold(elbow):
         armsim.arm_trial(elbow, effort="supination", **kw)
 
 
+def test_model_pickles_as_what_made_it_for_process_pools(elbow):
+    """A Model pickles as its source (a name or an absolute path) and its with_muscle changes; the
+    unpickled model has the same parameters and the same trial, and goes through a process pool."""
+    import concurrent.futures
+    import pickle
+    changed = elbow.with_muscle("BIClong", mass=0.31).with_muscle("BRA", slow_units=40, optimal_tendon_length=0.06)
+    back = pickle.loads(pickle.dumps(changed))
+    for muscle in ("BIClong", "BRA", "TRIlong"):
+        assert back.parameters(muscle) == changed.parameters(muscle)
+    assert back.parameters("BIClong")["mass"] == 0.31 and back.parameters("BRA")["slow_units"] == 40
+    kw = dict(angle_deg=90.0, hold=0.5, rest=0.2, rate=200.0)
+    assert armsim.arm_trial(back, **kw)[1]["mean_muscle_torque"] == armsim.arm_trial(changed, **kw)[1]["mean_muscle_torque"]
+    path = pathlib.Path(__file__).resolve().parents[2] / "assets" / "models" / "thesis.yaml"
+    with concurrent.futures.ProcessPoolExecutor(max_workers=2) as pool:
+        masses = list(pool.map(_primary_mass, [changed, armsim.Model.load(path)]))
+    assert masses == [changed.parameters()["mass"], armsim.Model.load("thesis").parameters()["mass"]]
+    with pytest.raises(ValueError, match="another armsim version"):
+        armsim.Model.__new__(armsim.Model).__setstate__((99, "thesis", []))
+
+
+def _primary_mass(model):
+    return model.parameters()["mass"]
+
+
 def test_model_takes_a_path_copies_and_types_its_overrides(elbow):
     import copy
     twin = armsim.Model.load(pathlib.Path(__file__).resolve().parents[2] / "assets" / "models" / "twin.yaml")
