@@ -1,7 +1,8 @@
 // armsim: musculoskeletal arm simulation with a Virtual Muscle biceps.
 // Exit codes: 0 done, 2 bad input (options, files; the message names the option or file, the value and
-// what was expected), 3 a simulation that cannot go on, 4 an internal error, 128 + signal when stopped
-// by SIGINT or SIGTERM (after removing the partial output of the run in progress).
+// what was expected; also an output that cannot be written, standard output included), 3 a simulation
+// that cannot go on, 4 an internal error, 128 + signal when stopped by SIGINT, SIGTERM or SIGHUP (after
+// removing the partial output of the run in progress).
 #include "basics/errors.h"
 #include "cli/commands.h"
 #include "cli/plugins.h"
@@ -12,6 +13,7 @@
 #include <chrono>
 #include <csignal>
 #include <cstdio>
+#include <cstring>
 #include <ctime>
 #include <filesystem>
 #include <iostream>
@@ -19,14 +21,14 @@
 
 namespace {
 
-/// SIGINT and SIGTERM are taken by a thread of their own (they are blocked in every other thread): the
+/// SIGINT, SIGTERM and SIGHUP (a closed terminal) are taken by a thread of their own (they are blocked in every other thread): the
 /// first asks the run to stop at its next task boundary (checkInterruption), whose writers then remove
 /// their partial output; a second signal, or a run that has not stopped after 10 s, ends the process
 /// at once (a protocol run's leftover temporary folder is removed by the next run).
 void startSignalThread() {
     sigset_t set;
     sigemptyset(&set);
-    for (int sig : {SIGINT, SIGTERM}) {
+    for (int sig : {SIGINT, SIGTERM, SIGHUP}) {
         struct sigaction old {};
         sigaction(sig, nullptr, &old);
         if (old.sa_handler != SIG_IGN) sigaddset(&set, sig);  // ignored (a script's background job): keep it so
@@ -109,6 +111,16 @@ int main(int argc, char** argv) {
     } catch (const std::exception& e) {
         std::cerr << "armsim: internal error: " << e.what() << "\n";
         return 4;
+    }
+    // What went to standard output must have arrived (a full disk, /dev/full, a closed pipe).
+    errno = 0;
+    std::cout.flush();
+    const bool flushed = std::fflush(stdout) == 0 && !std::ferror(stdout) && std::cout.good();
+    if (!flushed) {
+        const int error = errno;
+        std::cerr << "armsim: error: cannot write to standard output" << (error ? std::string(": ") + std::strerror(error) : "")
+                  << " (the results printed there are incomplete)\n";
+        return 2;
     }
     return 0;
 }

@@ -16,6 +16,7 @@
 #include <memory>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace fs = std::filesystem;
@@ -349,6 +350,16 @@ TEST(Cli, TheCommandDoesNotLoadTheRendererOrMpiUntilAskedTo) {
     EXPECT_NE(bad.output.find("field 'codec' = 'vp9'"), std::string::npos) << bad.output;
 }
 
+// Issue 34: results printed to a standard output that cannot take them (a full disk: /dev/full) are
+// not a success: exit 2 with the reason, not 0.
+TEST(Cli, AStandardOutputThatCannotBeWrittenIsAnError) {
+    const armsim::testing::CommandResult ok = armsim::testing::runCommand("( " + std::string(ARMSIM_EXE) + " model list >/dev/null )");
+    ASSERT_EQ(ok.exitCode, 0) << ok.output;
+    const armsim::testing::CommandResult full = armsim::testing::runCommand("( " + std::string(ARMSIM_EXE) + " model list >/dev/full )");
+    EXPECT_EQ(full.exitCode, 2) << full.output;
+    EXPECT_NE(full.output.find("cannot write to standard output: No space left on device"), std::string::npos) << full.output;
+}
+
 // Issue 15: Ctrl-C (SIGINT) stops a protocol run at its next trial, removes its temporary folder and
 // exits 130; a temporary folder left by a process that died without its cleanup (SIGKILL) is removed
 // by the next run in that place, and an earlier run that process had moved aside is not lost.
@@ -361,16 +372,18 @@ TEST(Cli, AnInterruptedProtocolLeavesNothingAndTheNextRunCleansUpAfterAKilledOne
                                       "conditions:\n  elbow_angles_deg: [45, 60, 90, 120, 150]\n";
     const std::string run = std::string(ARMSIM_EXE) + " protocol " + (d / "long.yaml").string() + " --out " +
                             (d / "run").string() + " --jobs 2";
-    // SIGTERM (a script's background job ignores SIGINT, and armsim keeps it so), once the run's
-    // temporary folder exists.
-    const armsim::testing::CommandResult r = armsim::testing::runCommand(
-        "sh -c '" + run + " & pid=$!; for i in $(seq 200); do ls -a " + d.string() +
-        " | grep -q partial && break; sleep 0.05; done; sleep 0.3; kill -TERM $pid; wait $pid; echo rc=$?'");
-    EXPECT_NE(r.output.find("rc=143"), std::string::npos) << r.output;  // 128 + SIGTERM: stopped, not finished
-    EXPECT_NE(r.output.find("interrupted by signal 15"), std::string::npos) << r.output;
-    std::vector<std::string> left;
-    for (const auto& e : fs::directory_iterator(d)) left.push_back(e.path().filename().string());
-    EXPECT_EQ(left, std::vector<std::string>{"long.yaml"}) << "left behind: " << left.size() << " entries";
+    // SIGTERM (a script's background job ignores SIGINT, and armsim keeps it so) and SIGHUP (a closed
+    // terminal), once the run's temporary folder exists: stopped, not finished (128 + signal).
+    for (const auto& [name, number] : {std::pair<std::string, int>{"TERM", 15}, {"HUP", 1}}) {
+        const armsim::testing::CommandResult r = armsim::testing::runCommand(
+            "sh -c '" + run + " & pid=$!; for i in $(seq 200); do ls -a " + d.string() +
+            " | grep -q partial && break; sleep 0.05; done; sleep 0.3; kill -" + name + " $pid; wait $pid; echo rc=$?'");
+        EXPECT_NE(r.output.find("rc=" + std::to_string(128 + number)), std::string::npos) << name << "\n" << r.output;
+        EXPECT_NE(r.output.find("interrupted by signal " + std::to_string(number)), std::string::npos) << r.output;
+        std::vector<std::string> left;
+        for (const auto& e : fs::directory_iterator(d)) left.push_back(e.path().filename().string());
+        EXPECT_EQ(left, std::vector<std::string>{"long.yaml"}) << name << ": left behind: " << left.size() << " entries";
+    }
 
     // Leftovers of a process that no longer exists (a pid that has just exited).
     const pid_t dead = fork();
