@@ -459,7 +459,9 @@ namespace {
 // its covariance is C0 (J_F' J_F + B S B') C0 (C0 again when the fit's model is the truth's).
 // J: the whitened data residuals' Jacobian over the n parameters then the consider parameters. Writes
 // C0 and C as n x n (zero rows for held parameters); leaves them when a matrix is not positive definite.
-void calcConsideredCovariance(const SynergistModel& model, const MapProblem& map, const std::vector<std::vector<double>>& J,
+void calcConsideredCovariance(const SynergistModel& model, const MapProblem& map,
+                              const std::vector<SynergistModel::ConsiderParameter>& considered,
+                              const std::vector<std::vector<double>>& J,
                               std::vector<std::vector<double>>& c0Out, std::vector<std::vector<double>>& cOut) {
     const int n = int(map.priorMean.size()), R = int(J.size()), nk = R > 0 ? int(J[0].size()) - n : 0;
     std::vector<int> free, held;
@@ -488,7 +490,6 @@ void calcConsideredCovariance(const SynergistModel& model, const MapProblem& map
     // w = T v: the truths as combinations of the population's independent primitives v; a parameter
     // that stands for none (a group the model does not have) keeps the fit's own prior variance.
     const std::vector<std::vector<std::pair<int, double>>> truths = model.getParameterTruths();
-    const std::vector<SynergistModel::ConsiderParameter> considered = model.getConsiderParameters();
     const std::vector<std::vector<double>> V = model.calcPrimitiveCovariance();
     const int nv = int(V.size()), nw = nf + nh + nk;
     Eigen::MatrixXd T = Eigen::MatrixXd::Zero(nw, nv + nw);
@@ -756,7 +757,7 @@ MuscleEstimate identifySynergistAware(const Population& prior, const std::vector
         }
         // C0: the Laplace covariance; C: the estimate's error covariance with the consider parameters.
         std::vector<std::vector<double>> C0 = m.covariance, C = m.covariance;
-        if (haveJacobian) calcConsideredCovariance(model, map, J, C0, C);
+        if (haveJacobian) calcConsideredCovariance(model, map, considered, J, C0, C);
         // Degrees of freedom of each interval. The torque rows' sd is the noise level estimated with nu
         // dof; a quantity whose error variance owes the fraction f = g'C0 Ht C0 g / g'C g to the torque
         // rows (Ht = Jt'Jt, their whitened Jacobian) has that variance estimated with about nu / f^2 dof

@@ -638,15 +638,18 @@ StudyOutcome runStudy(const Study& study, const StudyRunOptions& options, StudyC
                          " of " + std::to_string(outcome.total) + " cells are in no journal (a shard failed or has not " +
                          "run; first missing: task " + std::to_string(pending.getFirstMissing()) + "); run the " +
                          "study without --merge to compute them");
-    auto isOurs = [&](long task) {
-        return !sharded || getStudyTask(study, task).getGroup(study) % options.shards == options.shard;
+    auto countOurs = [&](std::uint8_t status) {  // cells of this run's share with that status
+        long n = 0;
+        for (long task = 0; task < study.getNumTasks(); ++task)
+            n += folder.getStatus(task) == status &&
+                 (!sharded || getStudyTask(study, task).getGroup(study) % options.shards == options.shard);
+        return n;
     };
 
     StudyProgress progress;
     progress.total = outcome.total;
     progress.resumed = progress.done = outcome.resumed;
-    for (long task = 0; task < study.getNumTasks(); ++task)
-        progress.failed += folder.getStatus(task) == kFailed && isOurs(task);
+    progress.failed = countOurs(kFailed);
     auto record = [&](const std::vector<StudyResult>& results) {
         if (results.empty()) return;
         folder.append(results);
@@ -720,11 +723,8 @@ StudyOutcome runStudy(const Study& study, const StudyRunOptions& options, StudyC
         outcome.files = writeStudyFiles(study, outcome.output, folder.getJournalPath(), options.resultsPassBytes);
     }
     if (doesPathExist(outcome.output + "/journal_repairs.log")) outcome.files.push_back("journal_repairs.log");
-    for (long task = 0; task < study.getNumTasks(); ++task) {
-        if (!isOurs(task)) continue;
-        outcome.failed += folder.getStatus(task) == kFailed;
-        outcome.notConverged += folder.getStatus(task) == kNotConverged;
-    }
+    outcome.failed = countOurs(kFailed);
+    outcome.notConverged = countOurs(kNotConverged);
     outcome.wallTime = std::chrono::duration<double>(Clock::now() - start).count();
     return outcome;
 }
