@@ -404,7 +404,7 @@ void SynergistModel::calcPredictions(const double* x, std::vector<double>& torqu
 
 void SynergistModel::calcPredictions(const double* x, const std::vector<MuscleDeviation>* deviations,
                                      std::vector<double>& torques, std::vector<double>& forearmTorques,
-                                     std::vector<double>& channels) const {
+                                     std::vector<double>& channels, PredictionCache* cache) const {
     // Guard: the bounds keep difference probes inside [0, 1].
     const double va = std::clamp(x[kActivation], 0.0, 1.0), cc = std::clamp(x[kCoContraction], 0.0, 1.0);
     const std::vector<MuscleSpec> muscles = makeMuscles(x, deviations);
@@ -417,11 +417,14 @@ void SynergistModel::calcPredictions(const double* x, const std::vector<MuscleDe
                 for (double& v : row) v *= g;
     }
     const MvcGeometry& geometry = g != 1 ? scaled : geometry_;
-    const SteadyMvcCurve relaxed = calcRelaxedCurve(muscles, geometry);
+    if (cache) cache->active.resize(kinds_.size());
+    const std::vector<std::vector<bool>> relaxedAgonists(geometry.flexionDeg.size(), std::vector<bool>(muscles.size(), true));
+    const SteadyMvcCurve relaxed = calcSteadyMvcCurve(muscles, geometry, Effort::Flexion, relaxedAgonists, SubjectEffort{0, 0},
+                                                      cache ? &cache->relaxed : nullptr);
     std::vector<SteadyMvcCurve> active;
     for (std::size_t j = 0; j < kinds_.size(); ++j)
         active.push_back(calcSteadyMvcCurve(muscles, geometry, kinds_[j].effort, agonists_[j],
-                                            makeEffort(kinds_[j].level, va, cc)));
+                                            makeEffort(kinds_[j].level, va, cc), cache ? &cache->active[j] : nullptr));
     torques.clear();
     forearmTorques.clear();
     for (std::size_t c = 0; c < angleOf_.size(); ++c) {
@@ -594,9 +597,10 @@ MuscleEstimate identifySynergistAware(const Population& prior, const std::vector
     map.upper = model.getUpper();
     map.numResiduals = int(nt + nc) + (measured ? 1 : 0);
     // Residuals: torques, then channels, then the measured activation.
+    P::PredictionCache cache;   // the fit, its covariance and the consider Jacobian run on this thread
     auto calcResiduals = [&](const double* x, double* r, const std::vector<P::MuscleDeviation>* deviations = nullptr) {
         std::vector<double> t, f, c;
-        model.calcPredictions(x, deviations, t, f, c);
+        model.calcPredictions(x, deviations, t, f, c, &cache);
         for (std::size_t k = 0; k < nt; ++k) {
             const Row& row = rows[k];
             r[k] = ((row.forearm ? f : t)[row.observation] - torque[k]) / sd[k];

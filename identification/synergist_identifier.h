@@ -111,9 +111,18 @@ public:
     struct MuscleDeviation {
         double lnTendon = 0, lnFascicle = 0, slowShift = 0, lnMass = 0;
     };
-    /// The same predictions with muscle i departing by (*deviations)[i] (nullptr: none).
+    /// Scratch of calcPredictions for the many calls of a fit or a Jacobian, one per thread: the steady
+    /// states of the last call, reused where a muscle's inputs are unchanged (SteadyCurveCache; the
+    /// predictions are bit-identical to calls without it).
+    struct PredictionCache {
+        SteadyCurveCache relaxed;
+        std::vector<SteadyCurveCache> active;   ///< per effort kind
+    };
+    /// The same predictions with muscle i departing by (*deviations)[i] (nullptr: none), with an
+    /// optional cache.
     void calcPredictions(const double* x, const std::vector<MuscleDeviation>* deviations, std::vector<double>& torques,
-                         std::vector<double>& forearmTorques, std::vector<double>& channels) const;
+                         std::vector<double>& forearmTorques, std::vector<double>& channels,
+                         PredictionCache* cache = nullptr) const;
     /// The population's model with x's muscles (and each muscle's deviation, when given).
     std::vector<MuscleSpec> makeMuscles(const double* x, const std::vector<MuscleDeviation>* deviations = nullptr) const;
 

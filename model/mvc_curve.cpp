@@ -5,6 +5,7 @@
 #include "model/muscle_arm.h"
 
 #include <cmath>
+#include <optional>
 #include <stdexcept>
 
 namespace armsim {
@@ -49,43 +50,79 @@ MvcGeometry calcMvcGeometry(const ArmSetup& setup, const std::vector<double>& fl
     return g;
 }
 
+struct SteadyCurveCacheAccess {
+    using Muscle = SteadyCurveCache::Muscle;
+    static std::vector<Muscle>& getMuscles(SteadyCurveCache& c) { return c.muscles_; }
+    static void count(SteadyCurveCache& c, bool reused) { ++(reused ? c.reused_ : c.solved_); }
+};
+
 namespace {
 
-// Every muscle at its steady state at each angle, at the activation agonist(a, i) ? VA : CC.
+// Every muscle at its steady state at each angle, at the activation agonist(a, i) ? VA : CC; states
+// from the cache where their inputs are unchanged.
 template <class IsAgonist>
 SteadyMvcCurve calcSteadyCurve(const std::vector<MuscleSpec>& muscles, const MvcGeometry& geometry,
-                               const SubjectEffort& subject, IsAgonist isAgonist) {
+                               const SubjectEffort& subject, IsAgonist isAgonist, SteadyCurveCache* cache) {
     checkField("voluntary activation", subject.voluntaryActivation, Bound::closed(0, 1));
     checkField("co-contraction", subject.coContraction, Bound::closed(0, 1));
+    const std::size_t nm = muscles.size(), na = geometry.flexionDeg.size();
     SteadyMvcCurve curve;
     curve.flexionDeg = geometry.flexionDeg;
-    std::vector<VirtualMuscle> vm;
-    for (const MuscleSpec& m : muscles) {
-        vm.emplace_back(m.params);
-        curve.muscles.push_back(m.params.name);
+    for (const MuscleSpec& m : muscles) curve.muscles.push_back(m.params.name);
+    curve.points.assign(na, std::vector<SteadyMusclePoint>(nm));
+    std::vector<SteadyCurveCacheAccess::Muscle> local;
+    std::vector<SteadyCurveCacheAccess::Muscle>& memory = cache ? SteadyCurveCacheAccess::getMuscles(*cache) : local;
+    memory.resize(nm);
+    // Every muscle is validated before any is solved (a muscle built afresh, or a cached one whose F0
+    // inputs changed); a cached muscle is built only when one of its states must be solved.
+    std::vector<std::optional<VirtualMuscle>> vm(nm);
+    std::vector<double> F0(nm);
+    for (std::size_t i = 0; i < nm; ++i) {
+        const MuscleParameters& params = muscles[i].params;
+        auto& mem = memory[i];
+        if (!cache || !mem.valid || mem.points.size() != na || !haveSameNormalizedStates(mem.params, params)) {
+            mem.valid = false;
+            mem.points.assign(na, {});
+            vm[i].emplace(params);
+        } else if (params.mass != mem.params.mass || params.coefficients.sigma != mem.params.coefficients.sigma ||
+                   params.coefficients.density != mem.params.coefficients.density) {
+            params.validate();
+        }
+        F0[i] = calcMaxIsometricForce(params);
     }
-    for (std::size_t a = 0; a < geometry.flexionDeg.size(); ++a) {
-        std::vector<SteadyMusclePoint> row;
-        double total = 0, forearm = 0;
-        for (std::size_t i = 0; i < muscles.size(); ++i) {
-            SteadyMusclePoint p;
+    for (std::size_t a = 0; a < na; ++a)
+        for (std::size_t i = 0; i < nm; ++i) {
+            SteadyMusclePoint& p = curve.points[a][i];
             p.pathLength = geometry.pathLength[a][i];
             p.momentArm = geometry.momentArm[a][i];
             p.forearmMomentArm = geometry.forearmMomentArm.empty() ? 0.0 : geometry.forearmMomentArm[a][i];
             p.activation = isAgonist(a, i) ? subject.voluntaryActivation : subject.coContraction;
-            const SteadyState st = vm[i].calcSteadyState(p.pathLength, p.activation);
-            if (!st.converged)
-                throw SimulationError("muscle '" + curve.muscles[i] + "' at " + formatNumber(geometry.flexionDeg[a]) +
-                                      " deg flexion: " + st.message);
-            p.fibreLength = st.L;
-            p.force = st.force;
+            auto& q = memory[i].points[a];
+            const bool reuse = q.valid && q.pathLength == p.pathLength && q.activation == p.activation;
+            if (!reuse) {
+                if (!vm[i]) vm[i].emplace(muscles[i].params);
+                const SteadyState st = vm[i]->calcSteadyState(p.pathLength, p.activation);
+                if (!st.converged)
+                    throw SimulationError("muscle '" + curve.muscles[i] + "' at " + formatNumber(geometry.flexionDeg[a]) +
+                                          " deg flexion: " + st.message);
+                q = {true, p.pathLength, p.activation, st.L, st.normalizedForce};
+            }
+            if (cache) SteadyCurveCacheAccess::count(*cache, reuse);
+            p.fibreLength = q.L;
+            p.force = F0[i] * q.normalizedForce;
             p.torque = p.momentArm * p.force;
             p.forearmTorque = p.forearmMomentArm * p.force;
-            total += p.torque;
-            forearm += p.forearmTorque;
-            row.push_back(p);
         }
-        curve.points.push_back(std::move(row));
+    for (std::size_t i = 0; i < nm; ++i) {
+        memory[i].params = muscles[i].params;
+        memory[i].valid = true;
+    }
+    for (std::size_t a = 0; a < na; ++a) {
+        double total = 0, forearm = 0;
+        for (std::size_t i = 0; i < nm; ++i) {
+            total += curve.points[a][i].torque;
+            forearm += curve.points[a][i].forearmTorque;
+        }
         curve.totalTorque.push_back(total);
         curve.totalForearmTorque.push_back(forearm);
     }
@@ -112,11 +149,12 @@ std::vector<std::vector<bool>> findAgonists(const std::vector<MuscleSpec>& muscl
 }
 
 SteadyMvcCurve calcSteadyMvcCurve(const std::vector<MuscleSpec>& muscles, const MvcGeometry& geometry, Effort effort,
-                                  const std::vector<std::vector<bool>>& agonists, const SubjectEffort& subject) {
+                                  const std::vector<std::vector<bool>>& agonists, const SubjectEffort& subject,
+                                  SteadyCurveCache* cache) {
     if (agonists.size() != geometry.flexionDeg.size())
         throw std::logic_error("calcSteadyMvcCurve: one agonist row per angle expected");
     SteadyMvcCurve c = calcSteadyCurve(muscles, geometry, subject,
-                                       [&](std::size_t a, std::size_t i) { return bool(agonists[a].at(i)); });
+                                       [&](std::size_t a, std::size_t i) { return bool(agonists[a].at(i)); }, cache);
     c.effort = effort;
     return c;
 }

@@ -49,6 +49,33 @@ struct MvcGeometry {
 MvcGeometry calcMvcGeometry(const ArmSetup& setup, const std::vector<double>& flexionDeg,
                             double rotationDeg = 0.0 / 0.0);
 
+/// Scratch (data, not model) of the curve functions below for fits that call them many times: the
+/// last steady state of every (angle, muscle) with what it was solved for. A call reuses a state when the
+/// path length, the activation and the muscle's parameters other than F0's inputs are equal
+/// (haveSameNormalizedStates), scaling it by the new F0: a fit's probe of one muscle's size or one
+/// group's parameter solves only the muscles it moves. Results are bit-identical to a call without it.
+/// One per curve (effort and activation pattern) and per thread.
+class SteadyCurveCache {
+public:
+    /// Solves done and states reused since construction.
+    long getNumSolved() const { return solved_; }
+    long getNumReused() const { return reused_; }
+
+private:
+    friend struct SteadyCurveCacheAccess;
+    struct Point {
+        bool valid = false;
+        double pathLength = 0, activation = 0, L = 0, normalizedForce = 0;
+    };
+    struct Muscle {
+        bool valid = false;
+        MuscleParameters params;     ///< what the points were solved with
+        std::vector<Point> points;   ///< [angle]
+    };
+    std::vector<Muscle> muscles_;
+    long solved_ = 0, reused_ = 0;
+};
+
 /// The curve of `muscles` (setup.muscles, or the same muscles with other parameters) on a geometry
 /// computed for them; as calcSteadyMvcCurve below. A rotation effort's agonists are found per angle by
 /// their forearm moment arm (isAgonistOf); without a forearm rotation it has none.
@@ -59,8 +86,10 @@ std::vector<std::vector<bool>> findAgonists(const std::vector<MuscleSpec>& muscl
                                             Effort effort);
 /// The curve with the agonists given per angle (findAgonists, perhaps of another geometry: a fit that
 /// scales the moment arms keeps its agonists).
+/// `cache` (optional) holds this curve's earlier states (SteadyCurveCache).
 SteadyMvcCurve calcSteadyMvcCurve(const std::vector<MuscleSpec>& muscles, const MvcGeometry& geometry, Effort effort,
-                                  const std::vector<std::vector<bool>>& agonists, const SubjectEffort& subject);
+                                  const std::vector<std::vector<bool>>& agonists, const SubjectEffort& subject,
+                                  SteadyCurveCache* cache = nullptr);
 /// The same with the agonists of a muscle group: Flexor a flexion effort, Extensor an extension effort.
 SteadyMvcCurve calcSteadyMvcCurve(const std::vector<MuscleSpec>& muscles, const MvcGeometry& geometry,
                                   MuscleGroup effort, const SubjectEffort& subject);

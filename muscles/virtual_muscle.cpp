@@ -178,13 +178,50 @@ std::pair<double, double> calcInitialLengthConstants(const MuscleCoefficients& c
     return {c.LrT + c.kT * std::log(c.c1 * c.k1 / (c.cT * c.kT)) - c.kT * c.Lr1 / c.k1, c.kT / c.k1};
 }
 
+// ---- Comparisons -----
+
+// A field added to one of these structs must be added to its comparison below.
+static_assert(sizeof(FibreType) == sizeof(std::string) + 24 * sizeof(double), "FibreType changed: update operator==");
+static_assert(sizeof(MuscleCoefficients) == 15 * sizeof(double), "MuscleCoefficients changed: update operator==");
+static_assert(sizeof(MuscleParameters) == sizeof(std::string) + 5 * sizeof(double) + 4 * sizeof(int) +
+                                              2 * sizeof(FibreType) + sizeof(MuscleCoefficients),
+              "MuscleParameters changed: update haveSameNormalizedStates");
+
+bool operator==(const FibreType& a, const FibreType& b) {
+    return a.name == b.name && a.beta == b.beta && a.omega == b.omega && a.rho == b.rho && a.Vmax == b.Vmax &&
+           a.cV0 == b.cV0 && a.cV1 == b.cV1 && a.bV == b.bV && a.aV0 == b.aV0 && a.aV1 == b.aV1 && a.aV2 == b.aV2 &&
+           a.af == b.af && a.nf0 == b.nf0 && a.nf1 == b.nf1 && a.Tf1 == b.Tf1 && a.Tf2 == b.Tf2 && a.Tf3 == b.Tf3 &&
+           a.Tf4 == b.Tf4 && a.aS1 == b.aS1 && a.aS2 == b.aS2 && a.TS == b.TS && a.cY == b.cY && a.VY == b.VY &&
+           a.TY == b.TY && a.f05 == b.f05;
+}
+
+bool operator==(const MuscleCoefficients& a, const MuscleCoefficients& b) {
+    return a.c1 == b.c1 && a.k1 == b.k1 && a.Lr1 == b.Lr1 && a.eta == b.eta && a.c2 == b.c2 && a.k2 == b.k2 &&
+           a.Lr2 == b.Lr2 && a.cT == b.cT && a.kT == b.kT && a.LrT == b.LrT && a.Ur == b.Ur && a.fmin == b.fmin &&
+           a.fmax == b.fmax && a.sigma == b.sigma && a.density == b.density;
+}
+
+double calcMaxIsometricForce(const MuscleParameters& p) {
+    return p.coefficients.sigma * p.mass / (p.coefficients.density * p.optimalFascicleLength);
+}
+
+bool haveSameNormalizedStates(const MuscleParameters& a, const MuscleParameters& b) {
+    MuscleCoefficients ca = a.coefficients;
+    ca.sigma = b.coefficients.sigma;
+    ca.density = b.coefficients.density;
+    return a.optimalFascicleLength == b.optimalFascicleLength && a.optimalTendonLength == b.optimalTendonLength &&
+           a.maxPathLength == b.maxPathLength && a.slowFraction == b.slowFraction &&
+           a.numSlowUnits == b.numSlowUnits && a.numFastUnits == b.numFastUnits && a.apportioning == b.apportioning &&
+           a.slow == b.slow && a.fast == b.fast && ca == b.coefficients;
+}
+
 // ---- VirtualMuscle ------------------------------------------------------------------------------
 
 VirtualMuscle::VirtualMuscle(MuscleParameters params) : params_(std::move(params)) {
     params_.validate();
     const auto& c = params_.coefficients;
     const double L0 = params_.optimalFascicleLength;
-    F0_ = c.sigma * params_.mass / (c.density * L0);
+    F0_ = calcMaxIsometricForce(params_);
     Lmax_ = (params_.maxPathLength - calcTendonLengthAtLimit(c) * params_.optimalTendonLength) / L0;
     units_ = calcRecruitment(params_.numSlowUnits, params_.numFastUnits, params_.slowFraction, c.Ur,
                              params_.apportioning);
@@ -423,7 +460,8 @@ SteadyState VirtualMuscle::calcSteadyState(double P, double U) const {
     result.L = b;
     result.fascicleLength = b * L0;
     const double LT = (P - L0 * b) / params_.optimalTendonLength;
-    result.force = F0_ * calcSeriesElastic(params_.coefficients, LT);
+    result.normalizedForce = calcSeriesElastic(params_.coefficients, LT);
+    result.force = F0_ * result.normalizedForce;
 
     std::vector<double>& y = result.states;
     y.assign(numStates_, 0.0);

@@ -76,6 +76,9 @@ struct FibreType {
     /// Throws FieldError ("<prefix>.<field>") for a value outside its documented bound.
     void validate(const std::string& prefix) const;
 };
+/// Every field equal (name included).
+bool operator==(const FibreType& a, const FibreType& b);
+inline bool operator!=(const FibreType& a, const FibreType& b) { return !(a == b); }
 
 /// Whole-muscle coefficients (spec section 2).
 struct MuscleCoefficients {
@@ -97,6 +100,9 @@ struct MuscleCoefficients {
 
     void validate(const std::string& prefix) const;
 };
+/// Every field equal.
+bool operator==(const MuscleCoefficients& a, const MuscleCoefficients& b);
+inline bool operator!=(const MuscleCoefficients& a, const MuscleCoefficients& b) { return !(a == b); }
 
 /// How a fibre type's PCSA fraction is split among its units.
 enum class Apportioning {
@@ -122,6 +128,11 @@ struct MuscleParameters {
     /// Throws FieldError naming the field, its value and the violated bound.
     void validate() const;
 };
+/// F0 = sigma M / (rho L0) [N] (spec section 2): the only way mass, sigma and density enter the model.
+double calcMaxIsometricForce(const MuscleParameters& p);
+/// Whether a and b have the same steady isometric states up to the scale F0: every field equal except
+/// name, mass, coefficients.sigma and coefficients.density (calcMaxIsometricForce's inputs).
+bool haveSameNormalizedStates(const MuscleParameters& a, const MuscleParameters& b);
 
 // ---- Elements (spec section 4), plain functions -------------------------------------------------
 
@@ -173,6 +184,7 @@ struct SteadyState {
     bool converged = false;      ///< false: no equilibrium; message says why
     std::string message;         ///< why it failed (empty on success)
     double force = 0;            ///< Fse = Fce [N]
+    double normalizedForce = 0;  ///< Fse / F0 [1] (force is F0 times it)
     double L = 0;                ///< fascicle length / L0 [1]
     double fascicleLength = 0;   ///< L * L0 [m]
     int evaluations = 0;         ///< residual evaluations the root finder used

@@ -148,9 +148,9 @@ Sensitivities calcSensitivities(const Population& prior, const std::vector<Torqu
     const std::vector<std::vector<double>> xs = drawFromPrior(model, settings.seed, settings.draws);
     const int nt = int(conditions.size()), nch = int(channels.size());
     const int rows = nt + nch + (forearm ? nt : 0);
-    auto predict = [&](const double* x) {
+    auto predict = [&](const double* x, SynergistModel::PredictionCache* cache) {
         std::vector<double> t, f, c;
-        model.calcPredictions(x, t, f, c);
+        model.calcPredictions(x, nullptr, t, f, c, cache);
         t.insert(t.end(), c.begin(), c.end());
         if (forearm) t.insert(t.end(), f.begin(), f.end());
         return t;
@@ -159,8 +159,9 @@ Sensitivities calcSensitivities(const Population& prior, const std::vector<Torqu
     runParallel(int(xs.size()), settings.jobs, [&](int d) {
         DrawSensitivity& out = s.draws[d];
         try {
+            SynergistModel::PredictionCache cache;   // this draw's probes, on this thread
             std::vector<double> x = xs[d];
-            out.prediction = predict(x.data());
+            out.prediction = predict(x.data(), &cache);
             out.jacobian.resize(rows, n);
             for (int j = 0; j < n; ++j) {
                 const double x0 = x[j];
@@ -169,9 +170,9 @@ Sensitivities calcSensitivities(const Population& prior, const std::vector<Torqu
                     continue;
                 }
                 x[j] = x0 + kStep;
-                const std::vector<double> up = predict(x.data());
+                const std::vector<double> up = predict(x.data(), &cache);
                 x[j] = x0 - kStep;
-                const std::vector<double> down = predict(x.data());
+                const std::vector<double> down = predict(x.data(), &cache);
                 x[j] = x0;
                 for (int r = 0; r < rows; ++r) out.jacobian(r, j) = (up[r] - down[r]) / (2 * kStep);
             }

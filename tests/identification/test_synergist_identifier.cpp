@@ -12,6 +12,7 @@
 
 #include <Eigen/Dense>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
@@ -318,6 +319,71 @@ TEST(ElbowIdentification, TwoAxisConditionsPredictBothAxesOfTheTrial) {
         EXPECT_NEAR(trial.meanMuscleTorque, torque[k], kTrialRelTol * scale) << getEffortName(conditions[k].effort);
         EXPECT_NEAR(trial.meanForearmTorque, forearm[k], kTrialRelTol * scale) << getEffortName(conditions[k].effort);
     }
+}
+
+// The prediction cache (SteadyCurveCache) is exact: along a fit-like sequence of points (central
+// probes of every parameter, a repeated point, a step of all of them, muscle deviations), predictions
+// with one cache equal the predictions without it bit for bit, in three postures and both axes; and it
+// does its work: a mass probe solves nothing, a biceps tendon probe only the biceps heads.
+TEST(ElbowIdentification, CachedPredictionsEqualUncachedOnesBitForBit) {
+    constexpr double kStep = 1e-6;   // a numeric Jacobian's relative probe
+    const Population& prior = population();
+    std::vector<TorqueCondition> conditions = {{30, Effort::Flexion, 1.0, 1}, {90, Effort::Flexion, 1.0, 1},
+                                               {90, Effort::Extension, 1.0, 1}, {90, Effort::Supination, 1.0, 1},
+                                               {120, Effort::Flexion, 0.5, 1}};
+    conditions[3].rotationDeg = -60;
+    conditions[4].rotationDeg = 45;
+    const SynergistModel model(prior, SynergistOptions{}, conditions);
+    const int n = model.getNumParameters();
+    std::vector<std::vector<double>> points{model.getPriorMean()};
+    for (int j = 0; j < n; ++j)
+        for (double sign : {1.0, -1.0}) {
+            std::vector<double> x = model.getPriorMean();
+            x[j] += sign * kStep;
+            points.push_back(x);
+        }
+    points.push_back(model.getPriorMean());
+    std::vector<double> step = model.getPriorMean();
+    for (int j = 0; j < n; ++j) step[j] = std::clamp(step[j] + 0.01 * (j % 3 - 1), model.getLower()[j], model.getUpper()[j]);
+    points.push_back(step);
+    SynergistModel::PredictionCache cache;
+    auto expectSame = [&](const std::vector<double>& x, const std::vector<SynergistModel::MuscleDeviation>* d) {
+        std::vector<double> t0, f0, c0, t1, f1, c1;
+        model.calcPredictions(x.data(), d, t0, f0, c0);
+        model.calcPredictions(x.data(), d, t1, f1, c1, &cache);
+        ASSERT_EQ(t0.size(), t1.size());
+        for (std::size_t k = 0; k < t0.size(); ++k) {
+            EXPECT_EQ(t0[k], t1[k]) << "condition " << k;   // bit for bit
+            EXPECT_EQ(f0[k], f1[k]) << "condition " << k;
+        }
+    };
+    for (const auto& x : points) expectSame(x, nullptr);
+    std::vector<SynergistModel::MuscleDeviation> deviations(prior.base.muscles.size());
+    deviations[prior.base.primary].lnTendon = 0.02;
+    deviations.back().lnMass = -0.1;
+    expectSame(step, &deviations);
+    expectSame(step, nullptr);
+    EXPECT_GT(cache.relaxed.getNumReused(), 0);
+
+    // What one probe solves: the states of the curves at the points, counted.
+    auto solvedBy = [&](int j) {
+        SynergistModel::PredictionCache c;
+        std::vector<double> t, f, ch, x = model.getPriorMean();
+        model.calcPredictions(x.data(), nullptr, t, f, ch, &c);
+        auto count = [&] {
+            long s = c.relaxed.getNumSolved();
+            for (const SteadyCurveCache& a : c.active) s += a.getNumSolved();
+            return s;
+        };
+        const long before = count();
+        x[j] += kStep;
+        model.calcPredictions(x.data(), nullptr, t, f, ch, &c);
+        return count() - before;
+    };
+    const long poses = 4, curves = 5;   // (30, 90, 120 deg; rotations 0, -60, 45): 4 poses; relaxed + 4 kinds
+    EXPECT_EQ(solvedBy(model.getMassIndex()), 0);
+    EXPECT_EQ(solvedBy(SynergistModel::getTendonIndex()), long(prior.base.getBicepsHeads().size()) * poses * curves);
+    EXPECT_EQ(solvedBy(SynergistModel::getSizeIndex()), long(prior.base.muscles.size()) * poses * curves);
 }
 
 // The forearm axis identifies: torque data of both axes made by the identifier's own model at a known x
