@@ -1,6 +1,7 @@
 // armsim design: the torque protocol that minimises the synergist-aware identifier's expected posterior
 // uncertainty of the biceps mass and tendon length over a population (studies/experiment_design.h),
 // compared with the thesis's five-angle protocol, predicted and (with --validate-subjects) obtained.
+#include "basics/quick_run.h"
 #include "basics/csv.h"
 #include "basics/format.h"
 #include "basics/output_folder.h"
@@ -148,7 +149,7 @@ void runDesign(const DesignOptions& o) {
                  "tendon_interval_width_mm", "predicted_mass_sd_pct", "predicted_tendon_sd_mm"});
     for (const auto& [protocol, predicted] : {std::pair{thesis, reference}, std::pair{d.protocol, d.predicted}}) {
         ElbowValidationSettings v;
-        v.subjects = o.validateSubjects;
+        v.subjects = capForQuickRun(o.validateSubjects, kQuickSubjects, "validation subjects");
         v.seed = o.seed;
         v.jobs = o.jobs;
         v.activationSd = o.activationSd;

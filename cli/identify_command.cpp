@@ -1,6 +1,7 @@
 // armsim identify: muscle mass and optimal tendon length (or other parameters) from measured MVC forces,
 // with the steady or the faithful forward model; armsim validate: the identifiers against ground truth
 // on synthetic MVC data; and the main-job step that identifies the thesis's and our own MVC data.
+#include "basics/quick_run.h"
 #include "basics/errors.h"
 #include "basics/files.h"
 #include "basics/format.h"
@@ -280,7 +281,7 @@ void runElbowValidate(const ValidateOptions& o) {
     const Population prior = o.prior.empty() ? family : loadPopulation(o.prior);
     const bool inFamily = o.truthPopulation.empty() && o.prior.empty();
     ElbowValidationSettings s;
-    s.subjects = o.subjects;
+    s.subjects = capForQuickRun(o.subjects, kQuickSubjects, "validation subjects");
     s.seed = o.seed;
     s.jobs = o.jobs;
     s.activationSd = o.activationSd;

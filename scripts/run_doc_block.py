@@ -68,6 +68,8 @@ def run_block(doc, line, source, build, keep):
     os.symlink(os.path.abspath(build), os.path.join(work, "build"))
     os.mkdir(os.path.join(work, ".bin"))
     os.symlink(os.path.join(os.path.abspath(build), "armsim"), os.path.join(work, ".bin", "armsim"))
+    # `python3` is the interpreter the tests were configured with (the one with numpy and matplotlib).
+    os.symlink(sys.executable, os.path.join(work, ".bin", "python3"))
     env = dict(os.environ)
     env["PATH"] = os.path.join(work, ".bin") + os.pathsep + env.get("PATH", "")
     env["PYTHONPATH"] = os.path.join(os.path.abspath(build), "python") + os.pathsep + env.get("PYTHONPATH", "")

@@ -19,6 +19,9 @@ mpi_tests="Mpi|TwoRanks|slurm[.]"  # the Slurm tests run MPI ranks under srun
 # Coverage statistics over many virtual subjects run in the plain build only (2.3 min here under the
 # sanitizers); every line they run is also run, under the sanitizers, by the single-fit tests.
 statistical_tests="ChannelIntervalsCoverWhatThePopulationVariesAndTheFitShares"
+# The README's blocks (label docs) need the Python module, which this build leaves out; the commands
+# they run are run here by the CLI tests.
+doc_tests="docs[.]README[.]"
 LSAN_OPTIONS=suppressions=$PWD/tests/sanitizers/lsan.supp \
-  ctest --test-dir build-sanitize --output-on-failure -j2 --timeout 900 -E "$mpi_tests|$statistical_tests"
+  ctest --test-dir build-sanitize --output-on-failure -j2 --timeout 900 -E "$mpi_tests|$statistical_tests|$doc_tests"
 ASAN_OPTIONS=detect_leaks=0 ctest --test-dir build-sanitize --output-on-failure -j2 --timeout 900 -R "$mpi_tests"

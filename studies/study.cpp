@@ -4,6 +4,7 @@
 #include "basics/csv.h"
 #include "basics/files.h"
 #include "basics/param_node.h"
+#include "basics/quick_run.h"
 
 #include <fmt/format.h>
 
@@ -167,7 +168,7 @@ Study readStudy(const std::string& path) {
     s.population = loadStudyPopulation(truthKey, s.populationReference);
     s.priorReference = n.getString("prior", "");
     s.prior = s.priorReference.empty() ? s.population : loadStudyPopulation("prior", s.priorReference);
-    s.subjects = n.getInt("subjects", 1, 10000000);
+    s.subjects = capForQuickRun(n.getInt("subjects", 1, 10000000), kQuickSubjects, "study subjects");
     s.seed = unsigned(n.getInt("seed", 0, 2147483647, 1));
     const std::vector<std::string> protocols = n.getStrings("protocols");
     for (std::size_t i = 0; i < protocols.size(); ++i) {

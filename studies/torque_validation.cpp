@@ -3,6 +3,7 @@
 #include "basics/bound.h"
 #include "basics/csv.h"
 #include "basics/parallel.h"
+#include "basics/quick_run.h"
 
 #include <algorithm>
 #include <cmath>
@@ -122,8 +123,9 @@ std::vector<ElbowValidationRow> runElbowValidation(const Population& population,
                                                    const ElbowValidationSettings& settings,
                                                    const std::function<void(int, int)>& progress) {
     const ValidationPlan plan = planElbowValidation(population, prior, settings);
-    std::vector<std::vector<ElbowValidationRow>> perSubject(settings.subjects);
-    runParallel(settings.subjects, settings.jobs, [&](int s) {
+    const int subjects = capForQuickRun(settings.subjects, kQuickSubjects, "validation subjects");
+    std::vector<std::vector<ElbowValidationRow>> perSubject(subjects);
+    runParallel(subjects, settings.jobs, [&](int s) {
         perSubject[s] = runPlannedSubject(population, prior, settings, plan, s).rows;
     }, progress);
     std::vector<ElbowValidationRow> rows;

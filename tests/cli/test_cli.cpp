@@ -25,6 +25,7 @@ namespace {
 
 using armsim::testing::CommandResult;
 using armsim::testing::runArmsim;
+using armsim::testing::runCommand;
 
 fs::path freshDir(const std::string& name) {
     const fs::path d = fs::temp_directory_path() / ("armsim_cli_" + name + "_" + std::to_string(::getpid()));
@@ -252,6 +253,23 @@ TEST(Cli, ValidationWithoutMvcsSaysWhySynergistVaDidNotFit) {
     EXPECT_NE(r.output.find("no fit converged"), std::string::npos) << r.output;
     EXPECT_NE(r.output.find("twitch interpolation needs maximal efforts"), std::string::npos) << r.output;
     EXPECT_EQ(r.output.find("nan"), std::string::npos) << r.output;
+}
+
+// ARMSIM_QUICK=1 (how the README's blocks run in ctest) caps a validation's subjects and says so; any
+// value other than 1 or 0 is refused, naming the variable.
+TEST(Cli, QuickRunCapsTheSubjectsAndSaysSo) {
+    const fs::path d = freshDir("quick");
+    const CommandResult r = runCommand("ARMSIM_QUICK=1 " + std::string(ARMSIM_EXE) + " validate --truth elbow --subjects 50" +
+                                       " --jobs 2 --out " + (d / "v").string());
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    EXPECT_NE(r.output.find("ARMSIM_QUICK=1: validation subjects 50 capped at 3"), std::string::npos) << r.output;
+    const std::string summary = armsim::testing::readFileText(d / "v" / "elbow_validation_summary.csv");
+    EXPECT_NE(summary.find("\nthesis,0.02,3,"), std::string::npos) << summary;   // method, noise, subjects
+    const CommandResult bad = runCommand("ARMSIM_QUICK=yes " + std::string(ARMSIM_EXE) + " validate --truth elbow --subjects 5" +
+                                         " --out " + (d / "w").string());
+    EXPECT_EQ(bad.exitCode, 2) << bad.output;
+    EXPECT_NE(bad.output.find("ARMSIM_QUICK=yes: expected 1"), std::string::npos) << bad.output;
+    EXPECT_FALSE(fs::exists(d / "w"));
 }
 
 // armsim run on built-in defaults: the thesis arm where it reproduces the thesis, the anatomical
