@@ -41,6 +41,9 @@ void printPrediction(const ProtocolPrediction& p) {
                 "criterion %.2f  (prior: %.1f %%, %.1f mm, %.1f %%; %d draws)\n",
                 p.name.c_str(), p.trials, 100 * p.massSd, 1000 * p.tendonSd, 100 * p.flexorStrengthSd, p.criterion,
                 100 * p.priorMassSd, 1000 * p.priorTendonSd, 100 * p.priorFlexorStrengthSd, p.drawsUsed);
+    if (std::isfinite(p.massSdConsidered))
+        std::printf("             with what the fit shares or holds and people vary (the intervals' widening): "
+                    "sd(ln M) %.1f %%, sd(L0T) %.1f mm\n", 100 * p.massSdConsidered, 1000 * p.tendonSdConsidered);
     std::printf("             posterior correlation of ln M with:");
     for (std::size_t j = 0; j < p.parameterNames.size(); ++j)
         if (std::abs(p.massCorrelation[j]) >= 0.3 && p.massCorrelation[j] < 0.999)

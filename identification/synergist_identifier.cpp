@@ -453,31 +453,29 @@ void SynergistModel::calcPredictions(const double* x, const std::vector<MuscleDe
     }
 }
 
-namespace {
-
 // The error covariance of the linearized fit when the truth also varies what the fit holds or shares
 // (SynergistModel, consider parameters): with F the free parameters, Lambda the prior's precision on
 // them, C0 = (J_F' J_F + Lambda)^-1 and w = (x_F, x_held, considered) - their means with the prior
 // population's covariance S, the error is C0 (J_F' n + B w), B = [-Lambda, J_F' J_held, J_F' J_c], so
 // its covariance is C0 (J_F' J_F + B S B') C0 (C0 again when the fit's model is the truth's).
-// J: the whitened data residuals' Jacobian over the n parameters then the consider parameters. Writes
-// C0 and C as n x n (zero rows for held parameters); leaves them when a matrix is not positive definite.
-void calcConsideredCovariance(const SynergistModel& model, const MapProblem& map,
-                              const std::vector<SynergistModel::ConsiderParameter>& considered,
-                              const std::vector<std::vector<double>>& J,
-                              std::vector<std::vector<double>>& c0Out, std::vector<std::vector<double>>& cOut) {
-    const int n = int(map.priorMean.size()), R = int(J.size()), nk = R > 0 ? int(J[0].size()) - n : 0;
+bool SynergistModel::calcConsideredCovariance(const std::vector<std::vector<double>>& J,
+                                              std::vector<std::vector<double>>& c0Out,
+                                              std::vector<std::vector<double>>& cOut) const {
+    const std::vector<ConsiderParameter> considered = getConsiderParameters();
+    const int n = getNumParameters(), R = int(J.size()), nk = int(considered.size());
+    if (R > 0 && int(J[0].size()) != n + nk)
+        throw std::logic_error("calcConsideredCovariance: expected " + std::to_string(n + nk) + " Jacobian columns");
     std::vector<int> free, held;
-    for (int j = 0; j < n; ++j) (map.lower[j] >= map.upper[j] ? held : free).push_back(j);
+    for (int j = 0; j < n; ++j) (lower_[j] >= upper_[j] ? held : free).push_back(j);
     const int nf = int(free.size()), nh = int(held.size());
-    if (nf == 0) return;
+    if (nf == 0) return false;
     Eigen::MatrixXd P(n, n), Jm(R, n + nk);
     for (int a = 0; a < n; ++a)
-        for (int b = 0; b < n; ++b) P(a, b) = map.priorCovariance[a][b];
+        for (int b = 0; b < n; ++b) P(a, b) = priorCovariance_[a][b];
     for (int k = 0; k < R; ++k)
         for (int j = 0; j < n + nk; ++j) Jm(k, j) = J[k][j];
     const Eigen::LLT<Eigen::MatrixXd> pl(P);
-    if (pl.info() != Eigen::Success) return;
+    if (pl.info() != Eigen::Success) return false;
     const Eigen::MatrixXd Pinv = pl.solve(Eigen::MatrixXd::Identity(n, n));
     Eigen::MatrixXd lambda(nf, nf), JF(R, nf), JO(R, nh + nk);
     for (int a = 0; a < nf; ++a) {
@@ -488,17 +486,17 @@ void calcConsideredCovariance(const SynergistModel& model, const MapProblem& map
     for (int a = 0; a < nk; ++a) JO.col(nh + a) = Jm.col(n + a);
     const Eigen::MatrixXd H = JF.transpose() * JF;
     const Eigen::LLT<Eigen::MatrixXd> hl(H + lambda);
-    if (hl.info() != Eigen::Success) return;
+    if (hl.info() != Eigen::Success) return false;
     const Eigen::MatrixXd C0 = hl.solve(Eigen::MatrixXd::Identity(nf, nf));
     // w = T v: the truths as combinations of the population's independent primitives v; a parameter
     // that stands for none (a group the model does not have) keeps the fit's own prior variance.
-    const std::vector<std::vector<std::pair<int, double>>> truths = model.getParameterTruths();
-    const std::vector<std::vector<double>> V = model.calcPrimitiveCovariance();
+    const std::vector<std::vector<std::pair<int, double>>> truths = getParameterTruths();
+    const std::vector<std::vector<double>> V = calcPrimitiveCovariance();
     const int nv = int(V.size()), nw = nf + nh + nk;
     Eigen::MatrixXd T = Eigen::MatrixXd::Zero(nw, nv + nw);
     auto fill = [&](int row, const std::vector<std::pair<int, double>>& terms, int parameter) {
         for (const auto& [v, coefficient] : terms) T(row, v) += coefficient;
-        if (terms.empty() && parameter >= 0) T(row, nv + row) = std::sqrt(map.priorCovariance[parameter][parameter]);
+        if (terms.empty() && parameter >= 0) T(row, nv + row) = std::sqrt(priorCovariance_[parameter][parameter]);
     };
     for (int a = 0; a < nf; ++a) fill(a, truths[free[a]], free[a]);
     for (int a = 0; a < nh; ++a) fill(nf + a, truths[held[a]], -1);  // held and standing for nothing: known
@@ -519,9 +517,24 @@ void calcConsideredCovariance(const SynergistModel& model, const MapProblem& map
             c0Out[free[a]][free[b]] = C0(a, b);
             cOut[free[a]][free[b]] = C(a, b);
         }
+    return true;
 }
 
-}  // namespace
+void SynergistModel::setDeviation(std::vector<MuscleDeviation>& deviations, const ConsiderParameter& c, double by) {
+    MuscleDeviation& d = deviations.at(std::size_t(c.muscle));
+    (c.kind == 0 ? d.lnTendon : c.kind == 1 ? d.lnFascicle : c.kind == 2 ? d.slowShift : d.lnMass) = by;
+}
+
+std::vector<double> SynergistModel::getSecantSteps() const {
+    const std::vector<ConsiderParameter> considered = getConsiderParameters();
+    const int n = getNumParameters();
+    std::vector<double> steps(std::size_t(n) + considered.size(), 0.0);
+    for (int j = 0; j < n; ++j)
+        if (lower_[j] >= upper_[j]) steps[j] = 0.5 * std::sqrt(priorCovariance_[j][j]);
+    const double sd[4] = {prior_->tendonLengthSd, prior_->fascicleLengthSd, prior_->slowFractionSd, prior_->strengthMuscleSd};
+    for (std::size_t k = 0; k < considered.size(); ++k) steps[n + k] = 0.5 * sd[considered[k].kind];
+    return steps;
+}
 
 MuscleEstimate identifySynergistAware(const Population& prior, const std::vector<TorqueObservation>& data,
                                       const SynergistOptions& options) {
@@ -728,22 +741,16 @@ MuscleEstimate identifySynergistAware(const Population& prior, const std::vector
         const std::vector<P::ConsiderParameter> considered = model.getConsiderParameters();
         const int nk = int(considered.size());
         std::vector<std::vector<double>> J(R, std::vector<double>(n + nk, 0.0));
-        std::vector<double> steps(n + nk, 1e-5);
+        std::vector<double> steps = model.getSecantSteps();
         for (int j = 0; j < n; ++j)
-            if (map.lower[j] >= map.upper[j]) steps[j] = 0.5 * std::sqrt(map.priorCovariance[j][j]);
-        for (int k = 0; k < nk; ++k) {
-            const double sd[4] = {prior.tendonLengthSd, prior.fascicleLengthSd, prior.slowFractionSd, prior.strengthMuscleSd};
-            steps[n + k] = 0.5 * sd[considered[k].kind];
-        }
+            if (!(map.lower[j] >= map.upper[j])) steps[j] = 1e-5;
         bool haveJacobian = true;
         {
             std::vector<double> xp = x, rp(R), rm(R);
             std::vector<P::MuscleDeviation> deviations(base.muscles.size());
             auto shift = [&](int j, double by) {
                 if (j < n) return void(xp[j] = x[j] + by);
-                const P::ConsiderParameter& c = considered[j - n];
-                P::MuscleDeviation& d = deviations[c.muscle];
-                (c.kind == 0 ? d.lnTendon : c.kind == 1 ? d.lnFascicle : c.kind == 2 ? d.slowShift : d.lnMass) = by;
+                P::setDeviation(deviations, considered[j - n], by);
             };
             try {
                 for (int j = 0; j < n + nk; ++j) {
@@ -761,7 +768,7 @@ MuscleEstimate identifySynergistAware(const Population& prior, const std::vector
         }
         // C0: the Laplace covariance; C: the estimate's error covariance with the consider parameters.
         std::vector<std::vector<double>> C0 = m.covariance, C = m.covariance;
-        if (haveJacobian) calcConsideredCovariance(model, map, considered, J, C0, C);
+        if (haveJacobian) model.calcConsideredCovariance(J, C0, C);
         // Degrees of freedom of each interval. The torque rows' sd is the noise level estimated with nu
         // dof; a quantity whose error variance owes the fraction f = g'C0 Ht C0 g / g'C g to the torque
         // rows (Ht = Jt'Jt, their whitened Jacobian) has that variance estimated with about nu / f^2 dof

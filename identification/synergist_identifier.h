@@ -146,6 +146,19 @@ public:
         std::vector<std::pair<int, double>> truth;     ///< (primitive, coefficient)
     };
     std::vector<ConsiderParameter> getConsiderParameters() const;
+    /// Sets c's entry of deviations (sized one per muscle) to `by`.
+    static void setDeviation(std::vector<MuscleDeviation>& deviations, const ConsiderParameter& c, double by);
+    /// The Jacobian steps of the intervals' secants, over the n parameters then getConsiderParameters():
+    /// half the prior's sd for a held parameter and half the population's sd for a consider parameter
+    /// (muscle forces step with motor-unit recruitment: a tangent there can be any size); 0 for a free
+    /// parameter (its column is a tangent) and for what the prior does not vary.
+    std::vector<double> getSecantSteps() const;
+    /// The estimate's error covariance with the consider parameters (the class comment): J the whitened
+    /// residuals' Jacobian, rows over the n parameters then getConsiderParameters(). Writes C0 (the
+    /// Laplace covariance of the free parameters) and C, both n x n with zero rows for held parameters;
+    /// false, leaving them, when a matrix is not positive definite.
+    bool calcConsideredCovariance(const std::vector<std::vector<double>>& J, std::vector<std::vector<double>>& C0,
+                                  std::vector<std::vector<double>>& C) const;
 
 private:
     static constexpr int kTendon = 0, kActivation = 1, kCoContraction = 2, kFascicle = 3, kSynergistTendon = 4,

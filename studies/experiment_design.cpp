@@ -12,6 +12,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 
 namespace armsim {
 
@@ -35,6 +36,9 @@ struct DrawSensitivity {
     bool ok = false;
     std::vector<double> prediction;  // [row]
     Eigen::MatrixXd jacobian;        // [row][parameter], each row divided by the row's sd (whitened)
+    // [row][parameter, then consider parameter]: the free columns jacobian's, the held and consider
+    // parameters' secants (SynergistModel::getSecantSteps), whitened alike
+    Eigen::MatrixXd considerJacobian;
 };
 
 struct Sensitivities {
@@ -50,6 +54,7 @@ struct Sensitivities {
     double relativeSd = 0;         // sigma: relative sd of one trial's torque
     double activationSd = 0;
     std::vector<DrawSensitivity> draws;
+    std::shared_ptr<const SynergistModel> model;  // for the consider parameters' widening
 };
 
 }  // namespace
@@ -120,9 +125,10 @@ Sensitivities calcSensitivities(const Population& prior, const std::vector<Torqu
     options.freeSlowFraction = settings.freeSlowFraction;
     options.channels = channels;
     options.emgCrosstalk = noise.emgCrosstalk;
-    const SynergistModel model(prior, options, conditions);
-    const int n = model.getNumParameters();
     Sensitivities s;
+    s.model = std::make_shared<const SynergistModel>(prior, options, conditions);
+    const SynergistModel& model = *s.model;
+    const int n = model.getNumParameters();
     s.names = model.getParameterNames();
     s.massIndex = model.getMassIndex();
     s.tendonIndex = SynergistModel::getTendonIndex();
@@ -148,9 +154,13 @@ Sensitivities calcSensitivities(const Population& prior, const std::vector<Torqu
     const std::vector<std::vector<double>> xs = drawFromPrior(model, settings.seed, settings.draws);
     const int nt = int(conditions.size()), nch = int(channels.size());
     const int rows = nt + nch + (forearm ? nt : 0);
-    auto predict = [&](const double* x, SynergistModel::PredictionCache* cache) {
+    const std::vector<SynergistModel::ConsiderParameter> considered = model.getConsiderParameters();
+    const std::vector<double> secant = model.getSecantSteps();
+    const int nk = int(considered.size());
+    auto predict = [&](const double* x, SynergistModel::PredictionCache* cache,
+                       const std::vector<SynergistModel::MuscleDeviation>* deviations = nullptr) {
         std::vector<double> t, f, c;
-        model.calcPredictions(x, nullptr, t, f, c, cache);
+        model.calcPredictions(x, deviations, t, f, c, cache);
         t.insert(t.end(), c.begin(), c.end());
         if (forearm) t.insert(t.end(), f.begin(), f.end());
         return t;
@@ -176,6 +186,29 @@ Sensitivities calcSensitivities(const Population& prior, const std::vector<Torqu
                 x[j] = x0;
                 for (int r = 0; r < rows; ++r) out.jacobian(r, j) = (up[r] - down[r]) / (2 * kStep);
             }
+            // The held and consider parameters' secants: what the truth varies and the fit does not.
+            out.considerJacobian = Eigen::MatrixXd::Zero(rows, n + nk);
+            out.considerJacobian.leftCols(n) = out.jacobian;
+            std::vector<SynergistModel::MuscleDeviation> deviations(prior.base.muscles.size());
+            for (int j = 0; j < n + nk; ++j) {
+                if (!(secant[j] > 0)) continue;
+                std::vector<double> up, down;
+                if (j < n) {
+                    const double x0 = x[j];
+                    x[j] = x0 + secant[j];
+                    up = predict(x.data(), &cache);
+                    x[j] = x0 - secant[j];
+                    down = predict(x.data(), &cache);
+                    x[j] = x0;
+                } else {
+                    SynergistModel::setDeviation(deviations, considered[j - n], secant[j]);
+                    up = predict(x.data(), &cache, &deviations);
+                    SynergistModel::setDeviation(deviations, considered[j - n], -secant[j]);
+                    down = predict(x.data(), &cache, &deviations);
+                    SynergistModel::setDeviation(deviations, considered[j - n], 0);
+                }
+                for (int r = 0; r < rows; ++r) out.considerJacobian(r, j) = (up[r] - down[r]) / (2 * secant[j]);
+            }
             // Transducer rows as the identifier weights them: sd relative to the trial's load (both axes
             // when the forearm axis is read); a rotation effort's flexion axis is not fitted.
             for (int r = 0; r < rows; ++r) {
@@ -183,8 +216,13 @@ Sensitivities calcSensitivities(const Population& prior, const std::vector<Torqu
                 const int c = r < nt ? r : r - nt - nch;
                 double v = out.prediction[r];
                 if (axis && forearm) v = std::hypot(out.prediction[c], out.prediction[nt + nch + c]);
-                out.jacobian.row(r) /= calcRowSd(s, r, v);
-                if (r < nt && isForearmEffort(conditions[c].effort)) out.jacobian.row(r).setZero();
+                const double sd = calcRowSd(s, r, v);
+                out.jacobian.row(r) /= sd;
+                out.considerJacobian.row(r) /= sd;
+                if (r < nt && isForearmEffort(conditions[c].effort)) {
+                    out.jacobian.row(r).setZero();
+                    out.considerJacobian.row(r).setZero();
+                }
             }
             out.ok = true;
         } catch (const SimulationError&) {
@@ -207,7 +245,29 @@ Eigen::MatrixXd calcPosterior(const Sensitivities& s, int d, const std::vector<i
     return precision.inverse();
 }
 
-ProtocolPrediction evaluate(const Sensitivities& s, const std::vector<int>& counts, const std::string& name) {
+// The error covariance of draw d's fit with what the fit shares or holds and the truth varies
+// (SynergistModel::calcConsideredCovariance): empty when a matrix is not positive definite.
+std::vector<std::vector<double>> calcConsideredPosterior(const Sensitivities& s, int d, const std::vector<int>& counts) {
+    const DrawSensitivity& ds = s.draws[d];
+    const int cols = int(ds.considerJacobian.cols());
+    std::vector<std::vector<double>> J;
+    for (std::size_t c = 0; c < counts.size(); ++c) {
+        if (counts[c] == 0) continue;
+        std::vector<double> row(cols);
+        for (int j = 0; j < cols; ++j) row[j] = std::sqrt(double(counts[c])) * ds.considerJacobian(int(c), j);
+        J.push_back(std::move(row));
+    }
+    if (s.activationSd > 0) {
+        J.emplace_back(cols, 0.0);
+        J.back()[s.activationIndex] = 1 / s.activationSd;
+    }
+    std::vector<std::vector<double>> C0, C;
+    if (!s.model->calcConsideredCovariance(J, C0, C)) return {};
+    return C;
+}
+
+ProtocolPrediction evaluate(const Sensitivities& s, const std::vector<int>& counts, const std::string& name,
+                            bool considered = false) {
     ProtocolPrediction p;
     p.name = name;
     for (int c = 0; c < s.numTorqueRows && c < int(counts.size()); ++c) p.trials += counts[c];
@@ -218,8 +278,8 @@ ProtocolPrediction evaluate(const Sensitivities& s, const std::vector<int>& coun
     p.massCorrelation.assign(n, 0.0);
     p.posteriorSd.assign(n, 0.0);
     const double gT = kTendonGoal / s.baseTendonLength;
-    double crit = 0, vm = 0, vt = 0, vf = 0;
-    int used = 0;
+    double crit = 0, vm = 0, vt = 0, vf = 0, wm = 0, wt = 0;
+    int used = 0, widened = 0;
     for (std::size_t d = 0; d < s.draws.size(); ++d) {
         if (!s.draws[d].ok) continue;
         const Eigen::MatrixXd C = calcPosterior(s, int(d), counts);
@@ -233,7 +293,19 @@ ProtocolPrediction evaluate(const Sensitivities& s, const std::vector<int>& coun
             p.massCorrelation[j] += C(s.massIndex, j) / std::sqrt(cm * C(j, j));
             p.posteriorSd[j] += std::sqrt(C(j, j));
         }
+        if (considered) {
+            const std::vector<std::vector<double>> W = calcConsideredPosterior(s, int(d), counts);
+            if (!W.empty()) {
+                wm += W[s.massIndex][s.massIndex];
+                wt += W[s.tendonIndex][s.tendonIndex] + W[s.sizeIndex][s.sizeIndex] + 2 * W[s.tendonIndex][s.sizeIndex];
+                ++widened;
+            }
+        }
         ++used;
+    }
+    if (widened > 0) {
+        p.massSdConsidered = std::sqrt(wm / widened);
+        p.tendonSdConsidered = s.baseTendonLength * std::sqrt(wt / widened);
     }
     if (used == 0) throw SimulationError("experiment design: no prior draw has a steady state at every condition");
     p.drawsUsed = used;
@@ -349,7 +421,7 @@ ProtocolPrediction predictProtocol(const Population& prior, const TorqueProtocol
     if (forearm)
         for (const TorqueCondition& c : protocol.conditions) counts.push_back(c.repetitions);
     const Sensitivities s = calcSensitivities(prior, protocol.conditions, settings, {}, rows, protocol.channelNoise, forearm);
-    return evaluate(s, counts, protocol.name);
+    return evaluate(s, counts, protocol.name, true);
 }
 
 double LabCosts::calcMinutes(const TorqueProtocol& p) const {
@@ -404,7 +476,7 @@ DesignResult designChannelProtocol(const Population& prior, const DesignSettings
         if (progress) progress(settings.draws + done, total);
     });
     for (std::size_t d = 0; d < s.draws.size(); ++d) s.draws[d].ok = r.draws[d].ok = s.draws[d].ok && r.draws[d].ok;
-    result.reference = evaluate(r, countTrials(reference.conditions), reference.name);
+    result.reference = evaluate(r, countTrials(reference.conditions), reference.name, true);
 
     // Items: a block of MVCs at a candidate (repeatable), ultrasound at a picked candidate, EMG (once,
     // every picked block), a volume scan per muscle, anthropometry. Greedy by criterion drop per minute.
@@ -500,7 +572,7 @@ DesignResult designChannelProtocol(const Population& prior, const DesignSettings
         if (chosen.volume[v]) p.volumeScan.push_back(volumeRows[v].first);
     p.anthropometry = chosen.arm;
     p.channelNoise = noise;
-    result.predicted = evaluate(s, toCounts(chosen), p.name);
+    result.predicted = evaluate(s, toCounts(chosen), p.name, true);
     p.description = fmt::format(
         "designed by armsim design --budget {}: {:.0f} lab minutes ({} trials), {} prior draws (seed {}); predicted "
         "posterior sd of ln M {:.1f} %, of L0T {:.1f} mm",
@@ -525,7 +597,7 @@ DesignResult designProtocol(const Population& prior, const DesignSettings& setti
         if (progress) progress(settings.draws + done, total);
     });
     for (std::size_t d = 0; d < s.draws.size(); ++d) s.draws[d].ok = r.draws[d].ok = s.draws[d].ok && r.draws[d].ok;
-    result.reference = evaluate(r, countTrials(reference.conditions), reference.name);
+    result.reference = evaluate(r, countTrials(reference.conditions), reference.name, true);
 
     std::vector<int> counts(result.candidates.size(), 0);
     for (int k = 0; k < picks; ++k) {
@@ -553,7 +625,7 @@ DesignResult designProtocol(const Population& prior, const DesignSettings& setti
             tc.repetitions = counts[c];
             p.conditions.push_back(tc);
         }
-    result.predicted = evaluate(s, counts, p.name);
+    result.predicted = evaluate(s, counts, p.name, true);
     p.description = fmt::format(
         "designed by armsim design: {} trials, {} prior draws (seed {}); predicted posterior sd of ln M {:.1f} %, of "
         "L0T {:.1f} mm",
@@ -579,7 +651,8 @@ std::string formatPredictionsCsv(const std::vector<ProtocolPrediction>& predicti
     if (predictions.empty()) return "";
     std::vector<std::string> header = {"protocol", "trials", "draws_used", "criterion", "mass_sd_pct", "tendon_sd_mm",
                                        "flexor_strength_sd_pct", "prior_mass_sd_pct", "prior_tendon_sd_mm",
-                                       "prior_flexor_strength_sd_pct"};
+                                       "prior_flexor_strength_sd_pct", "mass_sd_considered_pct",
+                                       "tendon_sd_considered_mm"};
     for (const std::string& n : predictions.front().parameterNames) header.push_back("corr_lnM_" + n);
     for (const std::string& n : predictions.front().parameterNames) header.push_back("sd_" + n);
     CsvText csv(header);
@@ -588,6 +661,7 @@ std::string formatPredictionsCsv(const std::vector<ProtocolPrediction>& predicti
         row.addText(p.name).addInteger(p.trials).addInteger(p.drawsUsed).addNumber(p.criterion);
         row.addNumber(100 * p.massSd).addNumber(1000 * p.tendonSd).addNumber(100 * p.flexorStrengthSd);
         row.addNumber(100 * p.priorMassSd).addNumber(1000 * p.priorTendonSd).addNumber(100 * p.priorFlexorStrengthSd);
+        row.addNumber(100 * p.massSdConsidered).addNumber(1000 * p.tendonSdConsidered);
         for (double v : p.massCorrelation) row.addNumber(v);
         for (double v : p.posteriorSd) row.addNumber(v);
         csv.addRow(row);

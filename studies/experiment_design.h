@@ -73,6 +73,11 @@ struct ProtocolPrediction {
     double priorFlexorStrengthSd = 0.0 / 0.0;  ///< its prior sd [1]
     double priorMassSd = 0.0 / 0.0;      ///< the prior's sd of ln M [1]
     double priorTendonSd = 0.0 / 0.0;    ///< the prior's sd of L0T [m]
+    /// massSd and tendonSd with what the fit shares or holds and the truth varies (the identifier's
+    /// consider parameters, SynergistModel::calcConsideredCovariance): the widths its intervals report
+    /// [1], [m]. NaN where not computed (the greedy search's trial designs).
+    double massSdConsidered = 0.0 / 0.0;
+    double tendonSdConsidered = 0.0 / 0.0;
     std::vector<std::string> parameterNames;
     /// Mean over draws of the posterior correlation of ln M with each parameter.
     std::vector<double> massCorrelation;
@@ -123,8 +128,8 @@ DesignResult designProtocol(const Population& prior, const DesignSettings& setti
 DesignResult designChannelProtocol(const Population& prior, const DesignSettings& settings,
                                    const TorqueProtocol& reference, const std::function<void(int, int)>& progress = {});
 
-/// CSV: one row per protocol: name, trials, criterion, mass_sd_pct, tendon_sd_mm, prior sds, and the
-/// mean posterior correlation of ln M with every parameter.
+/// CSV: one row per protocol: name, trials, criterion, mass_sd_pct, tendon_sd_mm, prior sds, the same
+/// widths with the consider parameters, and the mean posterior correlation of ln M with every parameter.
 std::string formatPredictionsCsv(const std::vector<ProtocolPrediction>& predictions);
 
 }  // namespace armsim
