@@ -280,6 +280,8 @@ py::dict toDict(const ProtocolPrediction& p) {
     d["prior_mass_sd"] = p.priorMassSd;
     d["prior_tendon_sd"] = p.priorTendonSd;
     d["prior_flexor_strength_sd"] = p.priorFlexorStrengthSd;
+    d["mass_sd_considered"] = p.massSdConsidered;     // with what the fit shares (the intervals' widening)
+    d["tendon_sd_considered"] = p.tendonSdConsidered;
     d["parameter_names"] = p.parameterNames;
     d["mass_correlation"] = toArray(p.massCorrelation);
     d["posterior_sd"] = toArray(p.posteriorSd);
