@@ -13,6 +13,7 @@ FieldError::FieldError(std::string field, const std::string& message)
 
 void requestInterruption(int sig) { interruption.store(sig); }
 int getInterruption() { return interruption.load(); }
+void clearInterruption() { interruption.store(0); }
 void checkInterruption() {
     if (const int sig = interruption.load())
         throw InterruptedError("interrupted by signal " + std::to_string(sig));

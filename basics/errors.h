@@ -45,6 +45,8 @@ private:
 void requestInterruption(int sig);
 /// The signal that asked to stop, 0 if none.
 int getInterruption();
+/// Forgets a request (a library host such as Python that goes on after a stop).
+void clearInterruption();
 /// Throws InterruptedError when an interruption was requested; long loops call it between tasks
 /// (runParallel does before every task).
 void checkInterruption();

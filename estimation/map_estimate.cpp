@@ -1,5 +1,7 @@
 #include "estimation/map_estimate.h"
 
+#include "basics/errors.h"
+
 #include <ceres/ceres.h>
 #include <glog/logging.h>
 #include <Eigen/Cholesky>
@@ -30,6 +32,13 @@ struct MapCost {
 };
 
 constexpr double kSmoothStep = 1e-3;  // on x: ln scales and activations
+
+// Stops the solve at the next iteration after Ctrl-C (requestInterruption); the caller then throws.
+struct InterruptionCallback : ceres::IterationCallback {
+    ceres::CallbackReturnType operator()(const ceres::IterationSummary&) override {
+        return getInterruption() ? ceres::SOLVER_ABORT : ceres::SOLVER_CONTINUE;
+    }
+};
 
 // The Laplace covariance (J^T J)^{-1} of every residual, data and prior, with J by central differences
 // of step kSmoothStep (one-sided at a bound), the fixed coordinates left out (zero rows and columns).
@@ -115,8 +124,11 @@ MapResult calcMapEstimate(const MapProblem& problem) {
     so.max_num_iterations = problem.maxIterations;
     so.function_tolerance = problem.functionTolerance;
     so.parameter_tolerance = 1e-10;
+    InterruptionCallback interruption;
+    so.callbacks.push_back(&interruption);
     ceres::Solver::Summary summary;
     ceres::Solve(so, &pr, &summary);
+    checkInterruption();
     result.converged = summary.termination_type == ceres::CONVERGENCE;
     result.failed = summary.termination_type == ceres::FAILURE;
     result.message = summary.BriefReport();

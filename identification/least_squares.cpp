@@ -1,4 +1,5 @@
 // Bounded Levenberg-Marquardt (Ceres) with covariance-based intervals and seeded multi-start.
+#include "basics/errors.h"
 #include "basics/format.h"
 #include "basics/portable_random.h"
 #include "identification/solver_context.h"
@@ -95,6 +96,7 @@ class HistoryCallback : public ceres::IterationCallback {
 public:
     HistoryCallback(SolverContext& ctx, const std::vector<double>& z) : ctx_(ctx), z_(z) {}
     ceres::CallbackReturnType operator()(const ceres::IterationSummary& s) override {
+        if (getInterruption()) return ceres::SOLVER_ABORT;   // Ctrl-C: runFrom throws after the solve
         if (s.iteration == 0 || s.step_is_successful) {
             std::vector<double> r;
             const std::vector<double> x = ctx_.map.fromScaled(z_);
@@ -159,6 +161,7 @@ Run runFrom(SolverContext& ctx, const std::vector<double>& xStart) {
     so.update_state_every_iteration = true;
     so.callbacks.push_back(&callback);
     ceres::Solve(so, run.problem.get(), &run.summary);
+    checkInterruption();   // Ctrl-C: HistoryCallback aborted the solve
     run.history = ctx.takeHistory();
     std::vector<double> r;
     if (ctx.calcResiduals(ctx.map.fromScaled(run.z), r)) run.cost = calcWeightedCost(r, calcWeights(ctx));

@@ -17,19 +17,23 @@ std::string getAssetDirectory() {
     const char* env = std::getenv("ARMSIM_ASSETS");
     if (env && *env) return env;
     std::error_code ec;
-    if (std::filesystem::is_directory(ARMSIM_ASSET_DIR, ec)) return ARMSIM_ASSET_DIR;  // the source tree
-    // An installed armsim (cmake --install): <prefix>/bin/armsim with <prefix>/share/armsim/assets.
+    // An installed command (cmake --install): <prefix>/bin/armsim reads <prefix>/share/armsim/assets,
+    // even while the source tree it was built from exists. (The installed Python package sets
+    // ARMSIM_ASSETS itself: python/armsim/__init__.py.)
     const std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", ec);
-    const std::filesystem::path installed = exe.parent_path().parent_path() / "share" / "armsim" / "assets";
-    if (!ec && std::filesystem::is_directory(installed, ec)) return installed.string();
-    return ARMSIM_ASSET_DIR;
+    if (!ec && exe.filename() == "armsim") {
+        const std::filesystem::path installed = exe.parent_path().parent_path() / "share" / "armsim" / "assets";
+        if (std::filesystem::is_directory(installed, ec)) return installed.string();
+    }
+    return ARMSIM_ASSET_DIR;   // the source tree
 }
 
 std::string findAsset(const std::string& name) {
     if (doesPathExist(name)) return name;
     const std::string inAssets = getAssetDirectory() + "/" + name;
     if (doesPathExist(inAssets)) return inAssets;
-    throw InputError(name + ": no such file (looked here and in " + getAssetDirectory() + ")");
+    throw InputError(name + ": no such file (looked here and in " + getAssetDirectory() +
+                     "; the environment variable ARMSIM_ASSETS names another assets folder)");
 }
 
 namespace {

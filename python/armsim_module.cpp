@@ -227,10 +227,9 @@ PYBIND11_MODULE(_armsim, mod) {
             else if (onset > 0) s.activation = ActivationProfile::step(onset, 0.0, activation);
             else s.activation = ActivationProfile::constant(activation);
             Table t;
-            {
-                py::gil_scoped_release release;
+            runInterruptible([&] {
                 t = runMuscleIsometric(vm, s);
-            }
+            });
             return toDict(std::move(t));
         },
         py::arg("model"), py::arg("path_length") = 0.375, py::arg("activation") = 1.0, py::arg("onset") = 0.0,
@@ -240,7 +239,7 @@ PYBIND11_MODULE(_armsim, mod) {
         "until onset [s], then a ramp of `rise` [s] (0: a step) to `activation`. Returns a dict of float64\n"
         "arrays: time_s, activation, force_N, fce_N, fascicle_length_m, fascicle_velocity_mps,\n"
         "tendon_length_m, active_fraction, and the states (views of one buffer, strided: np.ascontiguousarray\n"
-        "copies one column out). Releases the GIL.");
+        "copies one column out). Releases the GIL; Ctrl-C raises KeyboardInterrupt.");
 
     mod.def(
         "arm_trial",
@@ -259,10 +258,9 @@ PYBIND11_MODULE(_armsim, mod) {
             s.sampleRate = rate;
             s.averagingWindow = window ? *window : std::min(s.averagingWindow, s.holdDuration);   // as a trial file's default
             IsometricTrialResult r;
-            {
-                py::gil_scoped_release release;
+            runInterruptible([&] {
                 r = runIsometricTrial(m.setup, s);
-            }
+            });
             py::dict summary;
             summary["mean_force"] = r.summary.meanForce;
             summary["mean_muscle_torque"] = r.summary.meanMuscleTorque;
@@ -286,7 +284,7 @@ PYBIND11_MODULE(_armsim, mod) {
         "antagonist_activation. Returns (series, summary): series a dict of float64 arrays (time_s,\n"
         "activation, elbow_angle_deg, muscle_force_N, holding_torque_Nm, muscle_torque_Nm, strap_force_N,\n"
         "per-muscle force_<muscle>_N with several muscles, states); summary the means over the last\n"
-        "averaging_window [s] (None: 1 s, or the whole hold when shorter). Releases the GIL.");
+        "averaging_window [s] (None: 1 s, or the whole hold when shorter). Releases the GIL; Ctrl-C raises KeyboardInterrupt.");
 
     mod.def(
         "run_study",
@@ -299,10 +297,9 @@ PYBIND11_MODULE(_armsim, mod) {
             o.output = out;
             o.restart = restart;
             StudyOutcome r;
-            {
-                py::gil_scoped_release release;
+            runInterruptible([&] {
                 r = runStudy(study, o);
-            }
+            });
             py::dict d;
             d["output"] = r.output;
             d["total"] = r.total;
@@ -322,7 +319,7 @@ PYBIND11_MODULE(_armsim, mod) {
         "folder, total, computed, resumed, failed and not_converged task counts, wall_time [s], files,\n"
         "journal_dropped (journal lines the run could not use; their cells were computed again) and\n"
         "journal_summary (what they were; also in the folder's journal_repairs.log).\n"
-        "Resumes from the folder's journal like the command. Releases the GIL.");
+        "Resumes from the folder's journal like the command. Releases the GIL; Ctrl-C raises KeyboardInterrupt.");
 
     addIdentificationBindings(mod);
 }

@@ -347,10 +347,9 @@ py::dict identifyPy(const Model& m, const py::object& data, const std::string& m
     choice.warmStart = warmStart;
     choice.jobs = jobs;
     IdentificationReport r;
-    {
-        py::gil_scoped_release release;
+    runInterruptible([&] {
         r = identifyAndRecheck(pr, io, m.setup.arm, choice);
-    }
+    });
     py::dict d = toPython(r);
     if (!out.is_none()) {
         const std::string dir = pathOf(out, "out");
@@ -374,10 +373,9 @@ py::list identifyTorquePy(const py::object& data, const py::object& population, 
     if (!channels.is_none()) o.channels = readChannelData(findFile(pathOf(channels, "channels")));
     std::vector<MuscleEstimate> estimates;
     std::string skipped;
-    {
-        py::gil_scoped_release release;
+    runInterruptible([&] {
         estimates = identifyTorqueData(prior, obs, o, &skipped);
-    }
+    });
     if (!skipped.empty() && PyErr_WarnEx(PyExc_UserWarning, skipped.c_str(), 1) != 0) throw py::error_already_set();
     const double noise = findJudgingNoiseLevel(o, estimates);
     py::list l;
@@ -410,10 +408,9 @@ py::dict validatePy(const Model& m, int seeds, unsigned seed, const std::vector<
     s.jobs = jobs;
     s.validate(m.setup.arm);
     std::vector<ValidationRow> rows;
-    {
-        py::gil_scoped_release release;
+    runInterruptible([&] {
         rows = runValidation(m.setup.arm, m.setup.calcBicepsParameters(), s);
-    }
+    });
     Columns c;
     for (const ValidationRow& r : rows) {
         c.add("truth", r.truth);
@@ -463,10 +460,9 @@ py::tuple validateElbowPy(const py::object& population, int subjects, unsigned s
         s.protocol.validate();
     }
     std::vector<ElbowValidationRow> rows;
-    {
-        py::gil_scoped_release release;
+    runInterruptible([&] {
         rows = runElbowValidation(pop, priorPop, s);
-    }
+    });
     Columns c;
     for (const ElbowValidationRow& r : rows) {
         c.add("subject", r.subject);
@@ -531,10 +527,9 @@ py::dict designPy(const py::object& population, const std::vector<double>& angle
     TorqueProtocol thesis;
     thesis.name = "thesis";
     DesignResult r;
-    {
-        py::gil_scoped_release release;
+    runInterruptible([&] {
         r = designProtocol(pop, s, thesis);
-    }
+    });
     py::dict d;
     py::list conditions, steps;
     for (const TorqueCondition& c : r.protocol.conditions) conditions.append(toDict(c));
@@ -561,13 +556,12 @@ py::dict runProtocolPy(const py::object& file, const py::object& outArgument, in
         std::vector<TorqueObservation> data;
         std::vector<ChannelObservation> channels;
         std::vector<std::string> files;
-        {
-            py::gil_scoped_release release;
+        runInterruptible([&] {
             const VirtualSubject subject = loadTorqueProtocolSubject(protocol);
             data = synthesizeTorqueData(subject, protocol, protocol.seed, jobs);
             if (protocol.hasChannels()) channels = synthesizeChannelData(subject, protocol, data, protocol.seed);
             if (!out.empty()) files = writeTorqueProtocolRun(out, protocol, data, channels);
-        }
+        });
         d["name"] = protocol.name;
         d["kind"] = "torque";
         d["data"] = toDict(data);
@@ -578,10 +572,9 @@ py::dict runProtocolPy(const py::object& file, const py::object& outArgument, in
     const Protocol protocol = readProtocol(path);
     const ArmSetup subject = loadProtocolSubject(protocol);
     ProtocolResult r;
-    {
-        py::gil_scoped_release release;
+    runInterruptible([&] {
         r = runProtocol(protocol, subject, {out, jobs, {}});
-    }
+    });
     d["name"] = protocol.name;
     d["kind"] = getProtocolKindName(protocol.kind);
     d["trials"] = toDict(std::move(r.trials));
@@ -631,7 +624,7 @@ forward: steady | faithful (Simbody arm trials in the loop, at hold [s] and rate
 Returns the report as a dict with the keys of the command's JSON report (method, stop_reason,
 converged, message, parameters with intervals, uncertainty with covariance and correlation arrays,
 model_checks: the estimate re-checked by the steady model and the faithful model at 1000 Hz), plus
-estimate {name: value}, observations and history as dicts of float64 arrays. Releases the GIL.)");
+estimate {name: value}, observations and history as dicts of float64 arrays. Releases the GIL; Ctrl-C raises KeyboardInterrupt.)");
 
     mod.def("identify_torque", &identifyTorquePy, "data"_a, "population"_a = py::none(), "noise_level"_a = py::none(),
             "activation"_a = py::none(), "activation_sd"_a = 0.02, "channels"_a = py::none(), "emg_crosstalk"_a = 0.10,
@@ -651,7 +644,7 @@ effort 1/-1, level, repetition; e.g. run_protocol(...)['data']).  population: pr
 [m], 95 % mass_interval and tendon_interval, nuisance estimates, predicted_torque, and
 residual_check (chi-square against the noise level). A method that cannot run on these data (the
 thesis method without flexion MVCs at two angles) is left out with a UserWarning saying why.
-Releases the GIL.)");
+Releases the GIL; Ctrl-C raises KeyboardInterrupt.)");
 
     mod.def(
         "read_torque_data", [](const py::object& path) { return toDict(readTorqueData(findFile(pathOf(path, "path")))); },
@@ -688,7 +681,7 @@ Returns (rows, summary): rows as columns (subject, noise, method, true_mass, tru
 mass, tendon_length, mass_lower, mass_upper, tendon_lower, tendon_upper, converged, mass_error,
 tendon_error, mass_covered, tendon_covered, and the nuisance truths voluntary_activation,
 co_contraction, strength_level, biceps_short_scale, synergist_scale); summary one dict per method
-and noise (bias, RMSE, coverage, interval widths). Releases the GIL.)");
+and noise (bias, RMSE, coverage, interval widths). Releases the GIL; Ctrl-C raises KeyboardInterrupt.)");
 
     mod.def("design_protocol", &designPy, "population"_a = py::none(),
             "angles"_a = std::vector<double>{15, 30, 45, 60, 75, 90, 105, 120, 135}, "levels"_a = py::none(),
@@ -699,7 +692,7 @@ the biceps mass and tendon length over the population (as `armsim design`): gree
 of `repetitions` trials among flexion MVCs at `angles` [deg], extension MVCs (extension=True) and
 submaximal `levels` (fractions of MVC), within `trials`. Returns conditions, protocol_yaml (a torque
 protocol file's text: write it and pass it to run_protocol or validate_elbow), predicted and
-reference (the thesis's five angles) uncertainty, and the greedy steps. Releases the GIL.)");
+reference (the thesis's five angles) uncertainty, and the greedy steps. Releases the GIL; Ctrl-C raises KeyboardInterrupt.)");
 
     mod.def("run_protocol", &runProtocolPy, "file"_a, "out"_a = py::none(), "jobs"_a = 2,
             R"(Runs an experiment protocol file (a path or a name under assets/, e.g.
@@ -709,7 +702,7 @@ protocol.yaml and torque_angle.png written into it); None computes only.
 Arm protocols (mvc, submaximal, force_length, composition) return trials and summary (dicts of
 float64 arrays: per trial and per condition), fits (quadratic force-angle fits), emg_to_activation,
 muscle_sweep, composition, files. Torque protocols (kind: torque) return data: the tared torque per
-trial with the torque data file's columns, ready for identify_torque. Releases the GIL.)");
+trial with the torque data file's columns, ready for identify_torque. Releases the GIL; Ctrl-C raises KeyboardInterrupt.)");
 }
 
 }  // namespace armsim::python

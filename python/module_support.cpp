@@ -3,6 +3,9 @@
 #include "basics/errors.h"
 #include "muscles/muscle_file.h"
 
+#include <csignal>
+#include <mutex>
+
 namespace armsim::python {
 
 py::dict toDict(const Table& t) { return toDict(Table(t)); }
@@ -75,6 +78,50 @@ std::string findFile(const std::string& name) {
         PyErr_SetString(PyExc_FileNotFoundError, e.what());
         throw py::error_already_set();
     }
+}
+
+namespace {
+
+std::mutex sigintMutex;
+int sigintUsers = 0;             // scopes routing SIGINT now (calls from several Python threads)
+struct sigaction pythonSigint;   // Python's handler, put back by the last scope
+
+extern "C" void onSigint(int sig) { requestInterruption(sig); }
+
+bool isPythonMainThread() {
+    const py::module_ threading = py::module_::import("threading");
+    return threading.attr("current_thread")().is(threading.attr("main_thread")());
+}
+
+}  // namespace
+
+InterruptibleScope::InterruptibleScope() {
+    if (isPythonMainThread()) {
+        std::lock_guard<std::mutex> lock(sigintMutex);
+        if (sigintUsers++ == 0) {
+            struct sigaction a {};
+            a.sa_handler = onSigint;
+            sigemptyset(&a.sa_mask);
+            sigaction(SIGINT, &a, &pythonSigint);
+        }
+        routed_ = true;
+    }
+    saved_ = PyEval_SaveThread();
+}
+
+InterruptibleScope::~InterruptibleScope() {
+    if (routed_) {
+        std::lock_guard<std::mutex> lock(sigintMutex);
+        if (--sigintUsers == 0) sigaction(SIGINT, &pythonSigint, nullptr);
+    }
+    PyEval_RestoreThread(saved_);   // the GIL back
+}
+
+void InterruptibleScope::raiseIfInterrupted() {
+    if (!getInterruption()) return;
+    clearInterruption();
+    PyErr_SetNone(PyExc_KeyboardInterrupt);
+    throw py::error_already_set();
 }
 
 }  // namespace armsim::python

@@ -3,6 +3,7 @@
 // FileNotFoundError of the command line's wording.
 #pragma once
 
+#include "basics/errors.h"
 #include "basics/table.h"
 #include "model/model_file.h"
 
@@ -14,6 +15,7 @@
 #include <vector>
 
 #include <string>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -49,6 +51,50 @@ py::array_t<double> toArray(const std::vector<std::vector<double>>& rows);
 /// findAsset(name) (a path, or a name under the asset folder), FileNotFoundError with its message
 /// when neither exists.
 std::string findFile(const std::string& name);
+
+/// For the duration of a long call: the GIL released and, on Python's main thread, Ctrl-C (SIGINT)
+/// routed to armsim's own stop (requestInterruption, as the command line does): the loops stop at their
+/// next step, task or solver iteration and their writers remove partial output. Python's SIGINT handler
+/// is back when the scope ends. Use runInterruptible.
+class InterruptibleScope {
+public:
+    InterruptibleScope();   ///< with the GIL held
+    ~InterruptibleScope();
+    InterruptibleScope(const InterruptibleScope&) = delete;
+    InterruptibleScope& operator=(const InterruptibleScope&) = delete;
+    /// Raises KeyboardInterrupt (and clears the stop) when Ctrl-C arrived; call with the GIL held.
+    static void raiseIfInterrupted();
+
+private:
+    bool routed_ = false;
+    PyThreadState* saved_ = nullptr;   // the GIL, released (PyEval_SaveThread)
+};
+
+/// Runs f() in an InterruptibleScope and returns what it returns; Ctrl-C during it raises
+/// KeyboardInterrupt (within about one trial step, solver iteration or task: tests/python).
+template <class F>
+auto runInterruptible(F&& f) -> decltype(f()) {
+    using R = decltype(f());
+    try {
+        if constexpr (std::is_void_v<R>) {
+            {
+                InterruptibleScope scope;
+                f();
+            }
+            InterruptibleScope::raiseIfInterrupted();
+        } else {
+            R r = [&] {
+                InterruptibleScope scope;
+                return f();
+            }();
+            InterruptibleScope::raiseIfInterrupted();
+            return r;
+        }
+    } catch (const InterruptedError&) {
+        InterruptibleScope::raiseIfInterrupted();
+        throw;
+    }
+}
 
 /// Adds identify, identify_torque, read_torque_data, validate, validate_elbow, design_protocol and
 /// run_protocol (python/identification_bindings.cpp).

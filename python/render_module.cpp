@@ -45,10 +45,9 @@ PYBIND11_MODULE(_render, mod) {
             v.videoPath = path;
             const Table table = toTable(series, "series");
             TrialVideoResult r;
-            {
-                py::gil_scoped_release release;
+            runInterruptible([&] {
                 r = renderTrialVideo(m.setup, table, v);
-            }
+            });
             py::dict d;
             d["path"] = r.videoPath;
             d["frames"] = r.frames;
@@ -61,7 +60,7 @@ columns, so the replay is exact) to a video file: H.264 .mp4 (codec 'h264') or M
 ('mjpg'), at fps frames per second of video and playback_speed trial seconds per video second;
 width and height even, in [16, 4096]. The arm's decorations with the muscles coloured by
 color_by ('activation' or 'force'), the transducer, a force arrow and, with overlay, time, angle,
-forces and live plots. Written whole or not at all. Returns {'path', 'frames'}. Releases the GIL.)");
+forces and live plots. Written whole or not at all. Returns {'path', 'frames'}. Releases the GIL; Ctrl-C raises KeyboardInterrupt.)");
 
     mod.def(
         "render_frame",
@@ -73,11 +72,10 @@ forces and live plots. Written whole or not at all. Returns {'path', 'frames'}. 
                 checkField("time", time, Bound::closed(table.get(0, "time_s"), table.get(table.getNumRows() - 1, "time_s"),
                                                        "s, within the trial"));
             cv::Mat rgb;
-            {
-                py::gil_scoped_release release;
+            runInterruptible([&] {
                 TrialRenderer renderer(m.setup, table, v);
                 cv::cvtColor(renderer.renderRow(renderer.findRow(time)), rgb, cv::COLOR_BGR2RGB);
-            }
+            });
             py::array_t<std::uint8_t> a({rgb.rows, rgb.cols, 3});
             for (int r = 0; r < rgb.rows; ++r)
                 std::memcpy(a.mutable_data(r, 0, 0), rgb.ptr(r), std::size_t(rgb.cols) * 3);

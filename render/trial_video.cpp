@@ -506,6 +506,7 @@ TrialVideoResult renderTrialVideo(const ArmSetup& setup, const Table& table, con
     if (!writer.isOpen()) return result;
     const int n = renderer.getNumFrames();
     for (int k = 0; k < n; ++k) {
+        checkInterruption();   // Ctrl-C: the writer's destructor removes the partial video
         writer.write(renderer.renderRow(renderer.findRow(renderer.getFrameTime(k))));
         if (progress) progress(k + 1, n);
     }

@@ -2,6 +2,7 @@
 
 #include "basics/bound.h"
 #include "basics/csv.h"
+#include "basics/errors.h"
 #include "basics/format.h"
 #include "basics/parallel.h"
 #include "basics/portable_random.h"
@@ -73,6 +74,7 @@ std::vector<std::vector<double>> drawFromPrior(const SynergistModel& model, unsi
     const Eigen::MatrixXd L = Eigen::LLT<Eigen::MatrixXd>(freeSigma).matrixL();
     std::vector<std::vector<double>> out;
     for (int d = 0; d < draws; ++d) {
+        checkInterruption();
         // A draw whose person has no steady state in some condition (a fascicle past the nf limit at the
         // longest path) is drawn again, as population draws are (experiments/population.h).
         for (unsigned attempt = 0;; ++attempt) {
@@ -507,6 +509,7 @@ DesignResult designChannelProtocol(const Population& prior, const DesignSettings
         TorqueCondition bestCondition;
         auto consider = [&](const Choice& ch, double minutes, const std::string& item, const TorqueCondition& c) {
             if (spent + minutes > settings.budgetMinutes + 1e-9) return;
+            checkInterruption();
             const double v = evaluate(s, toCounts(ch), "").criterion;
             const double score = (current - v) / minutes;
             if (score > bestScore) bestScore = score, best = ch, bestMinutes = minutes, bestItem = item, bestCriterion = v,
@@ -604,6 +607,7 @@ DesignResult designProtocol(const Population& prior, const DesignSettings& setti
         int best = -1;
         double bestCriterion = INFINITY;
         for (std::size_t c = 0; c < counts.size(); ++c) {
+            checkInterruption();
             counts[c] += settings.repetitions;
             const double v = evaluate(s, counts, "").criterion;
             counts[c] -= settings.repetitions;

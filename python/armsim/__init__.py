@@ -6,7 +6,8 @@ out. Units are SI; keyword names are those of the YAML files, and for the comman
 names with underscores (--max-iterations: max_iterations; --speed is playback_speed). Errors carry
 the command line's messages: ValueError for bad input, FileNotFoundError for a missing file,
 RuntimeError for a simulation that cannot go on. Long calls release the GIL, so threads can run
-trials in parallel.
+trials in parallel, and Ctrl-C raises KeyboardInterrupt in them. Models and protocols are found in the
+assets folder: ARMSIM_ASSETS if set, else the installed one (cmake --install) or the source tree's.
 
     import armsim
     model = armsim.Model.load("twin")
@@ -14,6 +15,24 @@ trials in parallel.
     report = armsim.identify(armsim.Model.load("thesis"), "measured/thesis_measured.csv")
     armsim.render_video(model, series, "mvc.mp4")
 """
+import os as _os
+
+
+def _use_installed_assets():
+    """An installed package (cmake --install) reads its models from the prefix's assets folder, unless
+    ARMSIM_ASSETS says otherwise; a package in the build tree finds the source tree's."""
+    paths = _os.path.join(_os.path.dirname(__file__), "_install_paths.txt")
+    if _os.environ.get("ARMSIM_ASSETS") or not _os.path.exists(paths):
+        return
+    with open(paths, encoding="utf-8") as f:
+        for line in f:
+            key, _, value = line.strip().partition("=")
+            if key == "assets" and _os.path.isdir(value):
+                _os.environ["ARMSIM_ASSETS"] = value
+
+
+_use_installed_assets()
+
 from ._armsim import (Model, arm_trial, design_protocol, identify, identify_torque, muscle_trial, read_torque_data,
                       run_protocol, run_study, steady_state, validate, validate_elbow, __version__)
 

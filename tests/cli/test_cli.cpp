@@ -516,6 +516,10 @@ TEST(Cli, TheInstalledCommandRunsAndFindsItsPlugins) {
     EXPECT_TRUE(fs::exists(prefix / "share" / "armsim" / "assets" / "models" / "thesis.yaml"));
     const armsim::testing::CommandResult version = armsim::testing::runCommand(exe.string() + " --version");
     EXPECT_EQ(version.output, std::string("armsim ") + ARMSIM_VERSION + "\n");
+    // It reads the installed assets, not the source tree's (a missing file names where it looked).
+    const armsim::testing::CommandResult missing =
+        armsim::testing::runCommand("env -u ARMSIM_ASSETS " + exe.string() + " muscle steady --muscle no_such_muscle.yaml");
+    EXPECT_NE(missing.output.find((prefix / "share" / "armsim" / "assets").string()), std::string::npos) << missing.output;
     if (ARMSIM_RENDER_BUILT) {
         EXPECT_TRUE(fs::exists(prefix / "lib" / "armsim" / "libarmsim_render_plugin.so"));
         const armsim::testing::CommandResult trial = armsim::testing::runCommand(
@@ -527,5 +531,30 @@ TEST(Cli, TheInstalledCommandRunsAndFindsItsPlugins) {
         EXPECT_EQ(still.exitCode, 0) << still.output;
         EXPECT_TRUE(fs::exists(d / "s.png"));
     }
+#ifdef ARMSIM_PYTHON_EXE
+    // Issue 32: an install to any prefix, unprivileged, puts the Python package under it
+    // (P/lib/python3.X/dist-packages/armsim) and nothing outside it; the installed package reads the
+    // assets installed under P (not the source tree's) and loads a model from there.
+    const fs::path p = d / "prefix";
+    const armsim::testing::CommandResult own = armsim::testing::runCommand(std::string(ARMSIM_CMAKE) + " --install " +
+                                                                           ARMSIM_BUILD_DIR + " --prefix " + p.string());
+    ASSERT_EQ(own.exitCode, 0) << own.output;
+    std::istringstream lines(own.output);
+    for (std::string line; std::getline(lines, line);) {
+        const auto at = line.find(": /");
+        if (line.rfind("-- ", 0) == 0 && at != std::string::npos) {
+            EXPECT_EQ(line.substr(at + 2, p.string().size()), p.string()) << "installed outside the prefix: " << line;
+        }
+    }
+    const armsim::testing::CommandResult py = armsim::testing::runCommand(
+        "cd " + d.string() + " && env -u ARMSIM_ASSETS PYTHONPATH=$(ls -d " + p.string() +
+        "/lib/python3*/dist-packages) " + ARMSIM_PYTHON_EXE +
+        " -c 'import os, armsim; print(armsim.__file__); print(os.environ[\"ARMSIM_ASSETS\"]); "
+        "print(armsim.Model.load(\"twin\"))'");
+    ASSERT_EQ(py.exitCode, 0) << py.output;
+    EXPECT_NE(py.output.find(p.string() + "/lib/python3"), std::string::npos) << py.output;   // the installed package
+    EXPECT_NE(py.output.find(p.string() + "/share/armsim/assets\n"), std::string::npos) << py.output;
+    EXPECT_NE(py.output.find("<armsim.Model 'twin', 10 muscles>"), std::string::npos) << py.output;
+#endif
     fs::remove_all(d);
 }
