@@ -23,6 +23,8 @@ struct DesignOptions {
     std::string population;
     std::vector<double> angles = {15, 30, 45, 60, 75, 90, 105, 120, 135};
     std::vector<double> levels;
+    std::vector<double> postures;
+    std::string criterion = "considered";
     bool noExtension = false;
     int trials = 15;
     int repetitions = 3;
@@ -57,6 +59,8 @@ void runDesign(const DesignOptions& o) {
     DesignSettings s;
     s.flexionDeg = o.angles;
     s.levels = o.levels;
+    s.postures = o.postures;
+    s.ownModelCriterion = o.criterion == "own";
     s.extension = !o.noExtension;
     s.trials = o.trials;
     s.repetitions = o.repetitions;
@@ -97,7 +101,10 @@ void runDesign(const DesignOptions& o) {
                                      ? std::string(step.item == "ultrasound" ? "ultrasound at " : "") +
                                            getEffortName(step.condition.effort) + " " +
                                            (step.condition.level == 1 ? "MVC" : formatNumber(100 * step.condition.level) + " %") +
-                                           " at " + formatNumber(step.condition.flexionDeg) + " deg"
+                                           " at " + formatNumber(step.condition.flexionDeg) + " deg" +
+                                           (std::isnan(step.condition.rotationDeg)
+                                                ? std::string()
+                                                : ", forearm " + formatNumber(step.condition.rotationDeg) + " deg")
                                      : step.item;
         minutes += std::isfinite(step.minutes) ? step.minutes : 0;
         std::printf("  %2zu. %-38s criterion %.3f%s\n", k + 1, what.c_str(), step.criterion,
@@ -202,6 +209,14 @@ void addDesignCommand(CLI::App& app) {
     addNumberListOption(*c, "--levels", o->levels,
                   "allowed submaximal levels (EMG feedback, fractions of MVC in (0, 1)), comma-separated; default none");
     c->add_flag("--no-extension", o->noExtension, "no extension MVCs");
+    c->add_option("--criterion", o->criterion,
+                  "widths minimised: considered (with what the identifier's fit shares or holds and people vary: what "
+                  "its intervals report) or own (the Laplace widths of the fit's own model)")
+        ->capture_default_str()
+        ->check(CLI::IsMember({"considered", "own"}));
+    addNumberListOption(*c, "--postures", o->postures,
+                        "forearm postures allowed besides the model's [deg, + = supination, -90..90], comma-separated: "
+                        "flexion, extension, supination and pronation MVCs in them, both transducer axes read; default none");
     c->add_option("--budget", o->budget,
                   "lab minutes: design across channels (MVC blocks, ultrasound, EMG, volume scans, anthropometry; "
                   "costs in docs/channels.md) instead of a trial budget")

@@ -510,11 +510,16 @@ py::tuple validateElbowPy(const py::object& population, int subjects, unsigned s
 py::dict designPy(const py::object& population, const std::vector<double>& angles,
                   const std::optional<std::vector<double>>& levels,
                   bool extension, int trials, int repetitions, int draws, unsigned seed, double activationSd,
-                  bool freeSlowFraction, int jobs) {
+                  bool freeSlowFraction, int jobs, const std::optional<std::vector<double>>& postures,
+                  const std::string& criterion) {
     const Population pop = toPopulation(population);
     DesignSettings s;
     s.flexionDeg = angles;
     s.levels = levels.value_or(std::vector<double>{});
+    s.postures = postures.value_or(std::vector<double>{});
+    if (criterion != "considered" && criterion != "own")
+        throw InputError("criterion '" + criterion + "': expected 'considered' or 'own'");
+    s.ownModelCriterion = criterion == "own";
     s.extension = extension;
     s.trials = trials;
     s.repetitions = repetitions;
@@ -686,11 +691,15 @@ and noise (bias, RMSE, coverage, interval widths). Releases the GIL; Ctrl-C rais
     mod.def("design_protocol", &designPy, "population"_a = py::none(),
             "angles"_a = std::vector<double>{15, 30, 45, 60, 75, 90, 105, 120, 135}, "levels"_a = py::none(),
             "extension"_a = true, "trials"_a = 15, "repetitions"_a = 3, "draws"_a = 32, "seed"_a = 1u,
-            "activation_sd"_a = 0.02, "free_slow_fraction"_a = false, "jobs"_a = 2,
+            "activation_sd"_a = 0.02, "free_slow_fraction"_a = false, "jobs"_a = 2, "postures"_a = py::none(),
+            "criterion"_a = "considered",
             R"(The torque protocol that minimises the synergist-aware identifier's expected uncertainty of
 the biceps mass and tendon length over the population (as `armsim design`): greedy picks of blocks
 of `repetitions` trials among flexion MVCs at `angles` [deg], extension MVCs (extension=True) and
-submaximal `levels` (fractions of MVC), within `trials`. Returns conditions, protocol_yaml (a torque
+submaximal `levels` (fractions of MVC), within `trials`; with `postures` [deg, + = supination] also
+flexion, extension, supination and pronation MVCs in those forearm postures (both transducer axes
+read). criterion: 'considered' (the widths the identifier's intervals report, with what its fit
+shares) or 'own' (the fit's own Laplace widths). Returns conditions, protocol_yaml (a torque
 protocol file's text: write it and pass it to run_protocol or validate_elbow), predicted and
 reference (the thesis's five angles) uncertainty, and the greedy steps. Releases the GIL; Ctrl-C raises KeyboardInterrupt.)");
 

@@ -56,6 +56,7 @@ struct Sensitivities {
     double activationSd = 0;
     std::vector<DrawSensitivity> draws;
     std::shared_ptr<const SynergistModel> model;  // for the consider parameters' widening
+    bool consideredCriterion = true;               // !DesignSettings::ownModelCriterion
 };
 
 }  // namespace
@@ -152,6 +153,7 @@ Sensitivities calcSensitivities(const Population& prior, const std::vector<Torqu
                                                      2 * sigma(s.tendonIndex, s.sizeIndex));
     s.relativeSd = std::hypot(prior.transducerNoise, prior.trialCv);
     s.activationSd = settings.activationSd;
+    s.consideredCriterion = !settings.ownModelCriterion;
 
     const std::vector<std::vector<double>> xs = drawFromPrior(model, settings.seed, settings.draws);
     const int nt = int(conditions.size()), nch = int(channels.size());
@@ -287,7 +289,12 @@ ProtocolPrediction evaluate(const Sensitivities& s, const std::vector<int>& coun
         const Eigen::MatrixXd C = calcPosterior(s, int(d), counts);
         const double cm = C(s.massIndex, s.massIndex);
         const double ct = C(s.tendonIndex, s.tendonIndex) + C(s.sizeIndex, s.sizeIndex) + 2 * C(s.tendonIndex, s.sizeIndex);
-        crit += cm / (kMassGoal * kMassGoal) + ct / (gT * gT);
+        std::vector<std::vector<double>> W;   // with the consider parameters (empty: not computed, or not definite)
+        if (considered || s.consideredCriterion) W = calcConsideredPosterior(s, int(d), counts);
+        const double wmm = W.empty() ? cm : W[s.massIndex][s.massIndex];
+        const double wtt = W.empty() ? ct : W[s.tendonIndex][s.tendonIndex] + W[s.sizeIndex][s.sizeIndex] + 2 * W[s.tendonIndex][s.sizeIndex];
+        crit += s.consideredCriterion ? wmm / (kMassGoal * kMassGoal) + wtt / (gT * gT)
+                                      : cm / (kMassGoal * kMassGoal) + ct / (gT * gT);
         vm += cm;
         vt += ct;
         vf += s.flexorMean.dot(C * s.flexorMean);
@@ -295,13 +302,10 @@ ProtocolPrediction evaluate(const Sensitivities& s, const std::vector<int>& coun
             p.massCorrelation[j] += C(s.massIndex, j) / std::sqrt(cm * C(j, j));
             p.posteriorSd[j] += std::sqrt(C(j, j));
         }
-        if (considered) {
-            const std::vector<std::vector<double>> W = calcConsideredPosterior(s, int(d), counts);
-            if (!W.empty()) {
-                wm += W[s.massIndex][s.massIndex];
-                wt += W[s.tendonIndex][s.tendonIndex] + W[s.sizeIndex][s.sizeIndex] + 2 * W[s.tendonIndex][s.sizeIndex];
-                ++widened;
-            }
+        if (considered && !W.empty()) {
+            wm += wmm;
+            wt += wtt;
+            ++widened;
         }
         ++used;
     }
@@ -329,7 +333,8 @@ std::vector<int> countTrials(const std::vector<TorqueCondition>& conditions) {
     return counts;
 }
 
-// Every condition the settings allow: flexion (and extension) efforts at each angle and level.
+// Every condition the settings allow: flexion (and extension) efforts at each angle and level, then in
+// each other posture the maximal ones, then supination and pronation MVCs at each angle in every posture.
 std::vector<TorqueCondition> makeCandidates(const DesignSettings& settings) {
     std::vector<TorqueCondition> out;
     std::vector<double> levels = {1.0};
@@ -338,9 +343,29 @@ std::vector<TorqueCondition> makeCandidates(const DesignSettings& settings) {
         if (effort == Effort::Extension && !settings.extension) continue;
         for (double level : levels)
             for (double q : settings.flexionDeg) out.push_back({q, effort, level, 1});
+        for (double r : settings.postures)
+            for (double q : settings.flexionDeg) {
+                TorqueCondition c{q, effort, 1.0, 1};
+                c.rotationDeg = r;
+                out.push_back(c);
+            }
+    }
+    if (!settings.postures.empty()) {
+        std::vector<double> postures = {0.0 / 0.0};
+        postures.insert(postures.end(), settings.postures.begin(), settings.postures.end());
+        for (Effort effort : {Effort::Supination, Effort::Pronation})
+            for (double r : postures)
+                for (double q : settings.flexionDeg) {
+                    TorqueCondition c{q, effort, 1.0, 1};
+                    c.rotationDeg = r;
+                    out.push_back(c);
+                }
     }
     return out;
 }
+
+// Whether a condition can carry ultrasound and EMG: flexion or extension in the model's posture.
+bool takesChannels(const TorqueCondition& c) { return std::isnan(c.rotationDeg) && !isForearmEffort(c.effort); }
 
 ChannelObservation makeRow(const char* channel, const std::string& muscle, double flexionDeg, Effort effort,
                            double level) {
@@ -378,6 +403,7 @@ void DesignSettings::validate() const {
     if (flexionDeg.empty()) throw FieldError("angles", "no angles: expected at least one");
     for (double q : flexionDeg) checkField("angles", q, Bound::closed(0, 180, "deg, 0 = extended"));
     for (double l : levels) checkField("levels", l, Bound::open(0, 1, "fraction of maximal, in (0, 1)"));
+    for (double r : postures) checkField("postures", r, Bound::closed(-90, 90, "deg, + = supination"));
     checkField("repetitions", repetitions, Bound::closed(1, 100));
     checkField("trials", trials, Bound{double(repetitions), 10000, false, false, "at least one block of repetitions"});
     checkField("draws", draws, Bound::closed(1, 100000));
@@ -451,7 +477,12 @@ DesignResult designChannelProtocol(const Population& prior, const DesignSettings
     const int nc = int(result.candidates.size());
     std::vector<ChannelObservation> rows;
     std::vector<std::vector<int>> ultrasoundRows(nc), emgRows(nc);
+    const bool forearm = !settings.postures.empty();
+    if (forearm && !base.arm.forearmRotation.enabled)
+        throw InputError("design: postures need a model whose forearm rotates; the prior's model '" + base.name +
+                         "' has none");
     for (int c = 0; c < nc; ++c) {
+        if (!takesChannels(result.candidates[c])) continue;
         for (const ChannelObservation& o : makeConditionRows(base, result.candidates[c], true, false)) {
             ultrasoundRows[c].push_back(nc + int(rows.size()));
             rows.push_back(o);
@@ -473,7 +504,7 @@ DesignResult designChannelProtocol(const Population& prior, const DesignSettings
     const int total = 2 * settings.draws + 1;
     Sensitivities s = calcSensitivities(prior, result.candidates, settings, [&](int done, int) {
         if (progress) progress(done, total);
-    }, rows, noise);
+    }, rows, noise, forearm);
     Sensitivities r = calcSensitivities(prior, reference.conditions, settings, [&](int done, int) {
         if (progress) progress(settings.draws + done, total);
     });
@@ -489,9 +520,10 @@ DesignResult designChannelProtocol(const Population& prior, const DesignSettings
         std::vector<bool> volume;
     } chosen{std::vector<int>(nc, 0), std::vector<bool>(nc, false), false, false, std::vector<bool>(volumeRows.size(), false)};
     auto toCounts = [&](const Choice& ch) {
-        std::vector<int> counts(nc + rows.size(), 0);
+        std::vector<int> counts(nc + rows.size() + (forearm ? nc : 0), 0);
         for (int c = 0; c < nc; ++c) {
             counts[c] = ch.torque[c];
+            if (forearm) counts[nc + rows.size() + c] = ch.torque[c];   // the forearm axis of the same trials
             if (ch.ultrasound[c]) for (int k : ultrasoundRows[c]) counts[k] = ch.torque[c];
             if (ch.emg) for (int k : emgRows[c]) counts[k] = ch.torque[c];
         }
@@ -519,14 +551,16 @@ DesignResult designChannelProtocol(const Population& prior, const DesignSettings
             Choice ch = chosen;
             ch.torque[c] += reps;
             consider(ch, block, "torque", result.candidates[c]);
-            if (chosen.torque[c] > 0 && !chosen.ultrasound[c]) {
+            if (chosen.torque[c] > 0 && !chosen.ultrasound[c] && takesChannels(result.candidates[c])) {
                 ch = chosen;
                 ch.ultrasound[c] = true;
                 consider(ch, cost.ultrasoundAngle, "ultrasound", result.candidates[c]);
             }
         }
         const TorqueCondition none{0.0 / 0.0, Effort::Flexion, 0, 0};
-        if (!chosen.emg && std::any_of(chosen.torque.begin(), chosen.torque.end(), [](int n) { return n > 0; })) {
+        bool emgPossible = false;
+        for (int c = 0; c < nc; ++c) emgPossible = emgPossible || (chosen.torque[c] > 0 && takesChannels(result.candidates[c]));
+        if (!chosen.emg && emgPossible) {
             Choice ch = chosen;
             ch.emg = true;
             consider(ch, cost.emgSetup, "emg", none);
@@ -568,9 +602,10 @@ DesignResult designChannelProtocol(const Population& prior, const DesignSettings
             TorqueCondition tc = result.candidates[c];
             tc.repetitions = chosen.torque[c];
             tc.ultrasound = chosen.ultrasound[c];
-            tc.emg = chosen.emg;
+            tc.emg = chosen.emg && takesChannels(tc);
             p.conditions.push_back(tc);
         }
+    p.forearmTorque = forearm;
     for (std::size_t v = 0; v < volumeRows.size(); ++v)
         if (chosen.volume[v]) p.volumeScan.push_back(volumeRows[v].first);
     p.anthropometry = chosen.arm;
@@ -578,9 +613,10 @@ DesignResult designChannelProtocol(const Population& prior, const DesignSettings
     result.predicted = evaluate(s, toCounts(chosen), p.name, true);
     p.description = fmt::format(
         "designed by armsim design --budget {}: {:.0f} lab minutes ({} trials), {} prior draws (seed {}); predicted "
-        "posterior sd of ln M {:.1f} %, of L0T {:.1f} mm",
+        "sd of ln M {:.1f} %, of L0T {:.1f} mm with what the fit shares ({:.1f} %, {:.1f} mm for its own model)",
         formatNumber(settings.budgetMinutes), cost.calcMinutes(p), result.predicted.trials, settings.draws,
-        settings.seed, 100 * result.predicted.massSd, 1000 * result.predicted.tendonSd);
+        settings.seed, 100 * result.predicted.massSdConsidered, 1000 * result.predicted.tendonSdConsidered,
+        100 * result.predicted.massSd, 1000 * result.predicted.tendonSd);
     return result;
 }
 
@@ -593,9 +629,18 @@ DesignResult designProtocol(const Population& prior, const DesignSettings& setti
     result.candidates = makeCandidates(settings);
     const int picks = settings.trials / settings.repetitions;
     const int total = 2 * settings.draws + picks;
+    const bool forearm = !settings.postures.empty();
+    if (forearm && !prior.base.arm.forearmRotation.enabled)
+        throw InputError("design: postures need a model whose forearm rotates; the prior's model '" + prior.base.name +
+                         "' has none");
     Sensitivities s = calcSensitivities(prior, result.candidates, settings, [&](int done, int) {
         if (progress) progress(done, total);
-    });
+    }, {}, {}, forearm);
+    // Rows: every candidate's torque, then (both axes read) its forearm torque.
+    auto withForearm = [&](std::vector<int> counts) {
+        if (forearm) counts.insert(counts.end(), counts.begin(), counts.end());
+        return counts;
+    };
     Sensitivities r = calcSensitivities(prior, reference.conditions, settings, [&](int done, int) {
         if (progress) progress(settings.draws + done, total);
     });
@@ -603,16 +648,21 @@ DesignResult designProtocol(const Population& prior, const DesignSettings& setti
     result.reference = evaluate(r, countTrials(reference.conditions), reference.name, true);
 
     std::vector<int> counts(result.candidates.size(), 0);
+    double current = INFINITY;
     for (int k = 0; k < picks; ++k) {
         int best = -1;
         double bestCriterion = INFINITY;
         for (std::size_t c = 0; c < counts.size(); ++c) {
             checkInterruption();
             counts[c] += settings.repetitions;
-            const double v = evaluate(s, counts, "").criterion;
+            const double v = evaluate(s, withForearm(counts), "").criterion;
             counts[c] -= settings.repetitions;
             if (v < bestCriterion) bestCriterion = v, best = int(c);
         }
+        // With the widened widths more trials can widen them (the fit then pins what it shares on the
+        // data): the design stops below the budget when no block narrows them.
+        if (k > 0 && !(bestCriterion < current)) break;
+        current = bestCriterion;
         counts[best] += settings.repetitions;
         TorqueCondition picked = result.candidates[best];
         picked.repetitions = settings.repetitions;
@@ -629,23 +679,25 @@ DesignResult designProtocol(const Population& prior, const DesignSettings& setti
             tc.repetitions = counts[c];
             p.conditions.push_back(tc);
         }
-    result.predicted = evaluate(s, counts, p.name, true);
+    p.forearmTorque = forearm;
+    result.predicted = evaluate(s, withForearm(counts), p.name, true);
     p.description = fmt::format(
-        "designed by armsim design: {} trials, {} prior draws (seed {}); predicted posterior sd of ln M {:.1f} %, of "
-        "L0T {:.1f} mm",
-        result.predicted.trials, settings.draws, settings.seed, 100 * result.predicted.massSd,
-        1000 * result.predicted.tendonSd);
+        "designed by armsim design: {} trials, {} prior draws (seed {}); predicted sd of ln M {:.1f} %, of L0T {:.1f} mm "
+        "with what the fit shares ({:.1f} %, {:.1f} mm for its own model)",
+        result.predicted.trials, settings.draws, settings.seed, 100 * result.predicted.massSdConsidered,
+        1000 * result.predicted.tendonSdConsidered, 100 * result.predicted.massSd, 1000 * result.predicted.tendonSd);
     return result;
 }
 
 std::string formatDesignStepsCsv(const DesignResult& result) {
-    CsvText csv({"step", "effort", "flexion_deg", "level", "repetitions", "criterion", "item", "minutes"});
+    CsvText csv({"step", "effort", "flexion_deg", "level", "repetitions", "criterion", "item", "minutes", "rotation_deg"});
     for (std::size_t k = 0; k < result.steps.size(); ++k) {
         const DesignStep& s = result.steps[k];
         CsvRow row;
         row.addInteger(long(k) + 1).addText(getEffortName(s.condition.effort)).addNumber(s.condition.flexionDeg);
         row.addNumber(s.condition.level).addInteger(s.condition.repetitions).addNumber(s.criterion);
         row.addText(s.item).addNumber(s.minutes);
+        row.addText(std::isnan(s.condition.rotationDeg) ? std::string() : formatNumber(s.condition.rotationDeg));
         csv.addRow(row);
     }
     return csv.getText();

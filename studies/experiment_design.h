@@ -12,8 +12,11 @@
 //
 // Criterion (minimised): mean over draws of var(ln M) / g_M^2 + var(ln L0T) / g_T^2 with the issue's
 // goals g_M = 10 % (mass RMSE) and g_T = 1 cm / L0T (tendon RMSE): each width counts relative to its goal.
+// The variances are the identifier's error covariance with the consider parameters (what its fit shares
+// or holds and the population varies: SynergistModel::calcConsideredCovariance) unless
+// DesignSettings::ownModelCriterion asks for the Laplace covariance above.
 // Design: greedy, a block of `repetitions` trials of the candidate condition that lowers the criterion
-// most, until the trial budget is spent (information adds over trials, so this is the usual greedy
+// most, until the trial budget is spent or no block lowers it (information adds over trials, so this is the usual greedy
 // approximation to the optimal exact design); a condition picked twice gets twice the repetitions.
 #pragma once
 
@@ -45,6 +48,16 @@ struct DesignSettings {
     /// Submaximal levels allowed (EMG feedback: the agonists' EMG held at that fraction of its MVC
     /// value; needs surface EMG), fractions in (0, 1); empty: maximal efforts only.
     std::vector<double> levels;
+    /// Forearm postures allowed besides the model's [deg], + = supination (a model with a forearm
+    /// rotation): flexion and extension MVCs at every angle in each, and supination and pronation MVCs at
+    /// every angle in each and in the model's posture; every trial then reads both transducer axes
+    /// (the design's protocol says forearm_torque). Empty: the model's posture and flexion axis only.
+    std::vector<double> postures;
+    /// What the greedy design minimises: the widths with the consider parameters (what the identifier's
+    /// intervals report; default), or the Laplace widths of the fit's own model (the design before
+    /// 2026-11-26: it buys information that the population's per-muscle variation takes back, e.g.
+    /// flexion MVCs in other forearm postures).
+    bool ownModelCriterion = false;
     int trials = 15;                     ///< budget: total trials (thesis: 5 angles x 3)
     int repetitions = 3;                 ///< trials per pick (>= 2: the identifier estimates its noise from repeats)
     int draws = 32;                      ///< prior draws the criterion averages over
@@ -101,7 +114,8 @@ struct DesignResult {
     std::vector<TorqueCondition> candidates;  ///< every condition considered
 };
 
-/// design_steps.csv: step, effort, flexion_deg, level, repetitions, criterion after the pick, item, minutes.
+/// design_steps.csv: step, effort, flexion_deg, level, repetitions, criterion after the pick, item, minutes,
+/// rotation_deg (empty: the model's posture).
 std::string formatDesignStepsCsv(const DesignResult& result);
 
 /// `draws` parameter vectors of the identifier's prior (Gaussian, clipped to its bounds), seeded by

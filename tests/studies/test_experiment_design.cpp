@@ -133,13 +133,15 @@ TEST(ExperimentDesign, WidenedWidthMatchesTheSpreadOfEstimatesOfPeopleTheFitSimp
     EXPECT_GT(rms / predicted.tendonSd, kAboveOwnModel);
 }
 
-// Information only adds: the predicted widths shrink (never grow) as repetitions are added, and the
-// greedy design's criterion falls step by step and ends at or below the thesis protocol's (whose
-// conditions are all candidates) with the same budget.
+// Information only adds to the fit's own model: its Laplace widths shrink (never grow) as repetitions
+// are added, and the greedy design on them falls step by step and ends at or below the thesis protocol's
+// (whose conditions are all candidates) with the same budget. With the widened widths (the default
+// criterion) more torque-only trials can widen them; that design stops where no block narrows them.
 TEST(ExperimentDesign, WidthsShrinkWithTrialsAndTheDesignBeatsTheThesisProtocol) {
     const Population prior = makePrior();
     DesignSettings settings;
     settings.draws = 8;
+    settings.ownModelCriterion = true;
     TorqueProtocol thesis;
     thesis.name = "thesis";
     double last = INFINITY;
@@ -157,6 +159,12 @@ TEST(ExperimentDesign, WidthsShrinkWithTrialsAndTheDesignBeatsTheThesisProtocol)
     EXPECT_LE(d.predicted.criterion, d.reference.criterion);
     EXPECT_NEAR(d.predicted.criterion, d.steps.back().criterion, 1e-12);
     EXPECT_EQ(d.reference.trials, 15);
+    settings.ownModelCriterion = false;
+    const DesignResult w = designProtocol(prior, settings, thesis);
+    ASSERT_FALSE(w.steps.empty());
+    for (std::size_t k = 1; k < w.steps.size(); ++k) EXPECT_LT(w.steps[k].criterion, w.steps[k - 1].criterion);
+    EXPECT_LE(w.protocol.getNumTrials(), settings.trials);
+    EXPECT_NEAR(w.predicted.criterion, w.steps.back().criterion, 1e-12);
 }
 
 // Freed slow-fibre fractions are informed by submaximal efforts: with the identifier's own model as
@@ -202,6 +210,42 @@ TEST(ExperimentDesign, FreedSlowFractionsAreInformedBySubmaximalEfforts) {
     const MuscleEstimate fixed = identifySynergistAware(prior, data, options);
     EXPECT_TRUE(std::find(fixed.nuisanceNames.begin(), fixed.nuisanceNames.end(), "biceps_slow_fraction_shift") ==
                 fixed.nuisanceNames.end());
+}
+
+// Forearm postures as candidates (issue 31): with postures allowed the design reads both transducer axes
+// and may pick flexion MVCs in other postures and supination or pronation MVCs. Minimising the fit's own
+// Laplace widths it buys flexion MVCs in other postures whose information the population's per-muscle
+// variation takes back (its widened L0T width is far above its own); minimising the widened widths (the
+// default) it ends narrower in the widths the identifier reports. Its protocol predicts alike when read
+// back (both axes, postures and all), and a model whose forearm does not rotate is refused.
+TEST(ExperimentDesign, PosturesAreCandidatesAndTheWidenedCriterionIsNotFooledByThem) {
+    constexpr double kSame = 1e-9;
+    const Population prior = makePrior();
+    DesignSettings settings;
+    settings.draws = 8;
+    settings.flexionDeg = {30, 90, 135};
+    settings.postures = {-60, 60};
+    settings.budgetMinutes = 100;
+    TorqueProtocol thesis;
+    const DesignResult widened = designChannelProtocol(prior, settings, thesis);
+    settings.ownModelCriterion = true;
+    const DesignResult own = designChannelProtocol(prior, settings, thesis);
+    EXPECT_TRUE(widened.protocol.forearmTorque);
+    EXPECT_TRUE(std::any_of(own.protocol.conditions.begin(), own.protocol.conditions.end(),
+                            [](const TorqueCondition& c) { return !std::isnan(c.rotationDeg); }));
+    std::printf("postures allowed: widened widths of the design by the widened criterion %.2f %% / %.2f mm, by the "
+                "own-model criterion %.2f %% / %.2f mm (its own widths %.2f %% / %.2f mm)\n",
+                100 * widened.predicted.massSdConsidered, 1000 * widened.predicted.tendonSdConsidered,
+                100 * own.predicted.massSdConsidered, 1000 * own.predicted.tendonSdConsidered, 100 * own.predicted.massSd,
+                1000 * own.predicted.tendonSd);
+    EXPECT_GT(own.predicted.tendonSdConsidered, 1.3 * own.predicted.tendonSd);   // the trap
+    EXPECT_LT(widened.predicted.tendonSdConsidered, own.predicted.tendonSdConsidered);
+    settings.ownModelCriterion = false;
+    const ProtocolPrediction again = predictProtocol(prior, widened.protocol, settings);
+    EXPECT_NEAR(again.tendonSdConsidered, widened.predicted.tendonSdConsidered, kSame * widened.predicted.tendonSdConsidered);
+    EXPECT_NEAR(again.massSd, widened.predicted.massSd, kSame * widened.predicted.massSd);
+    EXPECT_THROW(designChannelProtocol(loadPopulation(findAsset("subjects/elbow_population.yaml")), settings, thesis),
+                 InputError);
 }
 
 // Issue 31, design across channels: the picks' minutes add up to the written protocol's lab minutes
