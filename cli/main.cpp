@@ -5,6 +5,7 @@
 // removing the partial output of the run in progress).
 #include "basics/errors.h"
 #include "cli/commands.h"
+#include "cli/report.h"
 #include "cli/plugins.h"
 
 #include <pthread.h>
@@ -85,6 +86,7 @@ int main(int argc, char** argv) {
     try {
         app.parse(argc, argv);
         armsim::checkInterruption();  // a command that finished its work after Ctrl-C still reports the stop
+        armsim::cli::writeCommandReport(app, argc, argv);   // FOLDER/index.html of a command that wrote a folder
     } catch (const CLI::CallForHelp& e) {
         return app.exit(e);
     } catch (const CLI::CallForAllHelp& e) {

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Installs the Debian 12 packages armsim builds and runs with; `--tests` also those only the tests
 # need (clang for scripts/sanitize.sh and scripts/fuzz.sh; Slurm and munge for the local cluster of
-# scripts/slurm-local.sh). Idempotent: packages already present are skipped; a held dpkg lock is waited
+# scripts/slurm-local.sh; Chromium opens the reports, scripts/check_report_in_browser.py). Idempotent: packages already present are skipped; a held dpkg lock is waited
 # for instead of failing; sudo is used when not root.
 set -euo pipefail
 
@@ -24,6 +24,7 @@ packages=(
 test_packages=(
   clang libclang-rt-14-dev
   slurm-wlm munge
+  chromium
 )
 [ $with_tests -eq 1 ] && packages+=("${test_packages[@]}")
 

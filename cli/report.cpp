@@ -1,0 +1,120 @@
+#include "cli/report.h"
+
+#include "basics/html_report.h"
+
+#include <chrono>
+#include <ctime>
+#include <filesystem>
+#include <regex>
+#include <utility>
+#include <vector>
+
+namespace armsim::cli {
+
+namespace {
+
+// (pattern on the file name, sentence): the first match describes the file.
+const std::vector<std::pair<std::regex, std::string>>& getCaptions() {
+    static const std::vector<std::pair<std::regex, std::string>> captions = [] {
+        std::vector<std::pair<std::string, std::string>> t = {
+            {"force_length\\.png", "steady isometric force against path length (or angle) at full, half and no activation, with integrated trials as a second method"},
+            {"step_activation\\.png", "muscle force after a 0 to 1 activation step"},
+            {"mvc_angles\\.png", "isometric MVC at the thesis's five elbow angles: true muscle force, the transducer's reading and the biceps-force estimates"},
+            {"mvc_angles_twin\\.png", "the twin's five-angle MVC: tared torque, every muscle's force and the thesis's biceps estimate beside the heads' true force"},
+            {"moment_arms\\.png", "every muscle's moment arm against elbow flexion, with the published ranges"},
+            {"forearm_moment_arms\\.png", "every muscle's moment arm about the forearm rotation axis (and the elbow) against forearm rotation"},
+            {"mvc_flexion\\.png", "steady flexion MVC torque against angle, per muscle and net, with the published points"},
+            {"mvc_extension\\.png", "steady extension MVC torque against angle, per muscle and net, with the published points"},
+            {"check_moment_arms\\.png", "the model's moment arms with the target file's bands drawn"},
+            {"check_mvc\\.png", "the model's MVC torque-angle curves with the measured bands drawn"},
+            {"force_angle\\.png", "force against elbow angle over the protocol's trials, with the quadratic fit"},
+            {"emg_trial\\.png", "one trial's synthetic surface EMG and its features"},
+            {".*_convergence\\.png", "an identification's convergence: cost and parameters per iteration"},
+            {"design_criterion\\.png", "the design's criterion after each greedy pick"},
+            {"torque_angle\\.png", "measured (synthesized) torque against angle with each method's fitted curve"},
+            {"fascicle_length\\.png", "ultrasound fascicle lengths at rest and at the plateau against angle, truth and fits"},
+            {"emg\\.png", "normalised EMG amplitudes per muscle and condition, measured and predicted"},
+            {"mass_estimates\\.png", "the biceps long head's mass by every method with its 95 % interval, beside the truth"},
+            {"validation_scatter\\.png", "identified against true values over the virtual subjects (failed fits marked)"},
+            {".*\\.(mp4|avi)", "an offscreen rendering of a recorded trial (muscles on their paths, coloured by activation)"},
+            {"still_.*\\.png", "a still of the rendered trial"},
+            {"scorecard\\.csv", "every anatomy target: the model's value, the band, pass or fail"},
+            {"score_summary\\.csv", "targets passed per kind and muscle"},
+            {"muscles\\.csv", "the model's muscle table (SI units)"},
+            {"summary\\.csv", "per condition means and sds of the protocol's trials"},
+            {"fits\\.csv", "quadratic fits of force against angle"},
+            {"trials\\.csv", "every trial's summary"},
+            {"elbow_validation_summary\\.csv", "per method and noise level: bias, RMSE, coverage and interval widths with their standard errors"},
+            {"elbow_validation\\.csv", "every virtual subject's estimates, intervals and truths"},
+            {"estimates\\.csv", "every method's estimate and interval beside the truth"},
+            {"torque_estimates\\.csv", "every method's estimate, interval and fit check"},
+            {"channel_fits\\.csv", "each channel's chi-square check and worst measurement"},
+            {"design_predictions\\.csv", "predicted widths (own model and with what the fit shares) and posterior correlations per protocol"},
+            {"design_steps\\.csv", "the greedy picks in order, with the criterion after each"},
+            {"torque_data\\.csv", "the tared torque of every trial, as identify-torque reads it"},
+            {"channel_data\\.csv", "ultrasound, EMG, volume and anthropometry measurements, as identify-torque reads them"},
+            {"results\\.csv", "every cell of the study: subject, protocol, noise, method, estimates and truths"},
+            {".*_history\\.csv", "an identification's iterations: cost and parameters"},
+            {".*\\.json", "a report (machine-readable)"},
+            {".*\\.yaml", "the settings of the run (readable by armsim again)"},
+            {".*\\.sto", "the trial in OpenSim's storage format"},
+        };
+        std::vector<std::pair<std::regex, std::string>> out;
+        for (auto& [pattern, sentence] : t) out.emplace_back(std::regex(pattern), sentence);
+        return out;
+    }();
+    return captions;
+}
+
+std::string quote(const std::string& a) {
+    if (!a.empty() && a.find_first_of(" \t\"'\\$`*?;&|<>()") == std::string::npos) return a;
+    std::string q = "'";
+    for (char c : a) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+    return q + "'";
+}
+
+}  // namespace
+
+std::string describeOutputFile(const std::string& relativePath) {
+    const std::string name = std::filesystem::path(relativePath).filename().string();
+    for (const auto& [pattern, sentence] : getCaptions())
+        if (std::regex_match(name, pattern)) return sentence;
+    return "";
+}
+
+void writeCommandReport(const CLI::App& app, int argc, char** argv) {
+    const CLI::App* ran = &app;
+    for (;;) {
+        const std::vector<const CLI::App*> subs = ran->get_subcommands([](const CLI::App* s) { return s->parsed(); });
+        if (subs.empty()) break;
+        ran = subs.front();
+    }
+    if (ran == &app) return;
+    const CLI::Option* out = ran->get_option_no_throw("--out");
+    if (!out) return;
+    const std::string dir = out->as<std::string>();
+    std::error_code ec;
+    if (dir.empty() || !std::filesystem::is_directory(dir, ec)) return;
+
+    FolderReport r;
+    std::string name = ran->get_name();
+    for (const CLI::App* p = ran->get_parent(); p && p != &app; p = p->get_parent()) name = p->get_name() + " " + name;
+    r.title = "armsim " + name;
+    std::string line;
+    for (int i = 0; i < argc; ++i) line += (i ? " " : "") + quote(argv[i]);
+    const std::time_t now = std::chrono::system_clock::to_time_t(std::chrono::system_clock::now());
+    char when[32];
+    std::strftime(when, sizeof when, "%Y-%m-%d %H:%M:%S UTC", std::gmtime(&now));
+    r.facts = {{"command", line}, {"armsim", ARMSIM_VERSION}, {"finished", when},
+               {"working directory", std::filesystem::current_path(ec).string()}};
+    for (const CLI::Option* o : ran->get_options()) {
+        if (o->get_name().empty() || o->get_name() == "--help" || o->get_name() == "-h") continue;
+        std::string v = o->count() > 0 ? o->as<std::string>() : o->get_default_str();
+        if (v.empty() && o->get_type_size() == 0) v = o->count() > 0 ? "yes" : "no";   // flags
+        r.facts.emplace_back(o->get_name(), v.empty() ? "-" : v);
+    }
+    r.describe = describeOutputFile;
+    writeFolderReport(dir, r);
+}
+
+}  // namespace armsim::cli

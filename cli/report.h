@@ -1,0 +1,18 @@
+// The index.html every command that writes a folder leaves in it (basics/html_report.h): what ran and a
+// sentence per file, from the file names armsim writes.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+namespace armsim::cli {
+
+/// After a successful command: when the command that ran has an --out that names a folder, writes
+/// FOLDER/index.html (command line, version, time, the command's settings, every plot, video and table
+/// of the folder). Throws std::runtime_error when it cannot write.
+void writeCommandReport(const CLI::App& app, int argc, char** argv);
+
+/// One sentence on what an armsim output file shows, from its path relative to its folder ("" : not
+/// an armsim name).
+std::string describeOutputFile(const std::string& relativePath);
+
+}  // namespace armsim::cli

@@ -1,0 +1,62 @@
+// The folder report (index.html): every file of the folder shown or linked by its relative path, names
+// escaped, small tables shown whole and large ones in part, the facts and sentences as given, and a
+// rewrite that replaces the page atomically. (A real browser opens it: report.MainJobReportOpensInChromium.)
+#include "basics/html_report.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+using namespace armsim;
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string read(const fs::path& p) {
+    std::ifstream in(p);
+    std::stringstream s;
+    s << in.rdbuf();
+    return s.str();
+}
+
+}  // namespace
+
+TEST(HtmlReport, ShowsEveryFileOfTheFolderByItsRelativePath) {
+    const fs::path d = fs::path(::testing::TempDir()) / "armsim_html_report";
+    fs::remove_all(d);
+    fs::create_directories(d / "sub dir");
+    std::ofstream(d / "plot.png") << "png";
+    std::ofstream(d / "sub dir" / "v<1>.mp4") << "mp4";
+    std::ofstream(d / "small.csv") << "# comment\na,b\n1,2.123456789\n";
+    {
+        std::ofstream big(d / "big.csv");
+        big << "x\n";
+        for (int i = 0; i < 100; ++i) big << i << "\n";
+    }
+    std::ofstream(d / "notes.json") << "{}";
+    std::ofstream(d / ".hidden") << "x";
+    FolderReport r;
+    r.title = "armsim test & <check>";
+    r.facts = {{"command", "armsim x --out 'a b'"}};
+    r.describe = [](const std::string& rel) { return rel == "plot.png" ? std::string("a plot of <things>") : std::string(); };
+    writeFolderReport(d.string(), r);
+    const std::string html = read(d / "index.html");
+    EXPECT_NE(html.find("<title>armsim test &amp; &lt;check&gt;</title>"), std::string::npos);
+    EXPECT_NE(html.find("<code>armsim x --out 'a b'</code>"), std::string::npos);   // quotes need no escape in text
+    EXPECT_NE(html.find("<img src=\"plot.png\""), std::string::npos);
+    EXPECT_NE(html.find("a plot of &lt;things&gt;"), std::string::npos);
+    EXPECT_NE(html.find("<video controls muted preload=\"metadata\" src=\"sub%20dir/v%3C1%3E.mp4\""), std::string::npos);
+    EXPECT_NE(html.find("<h2>sub dir/</h2>"), std::string::npos);
+    EXPECT_NE(html.find("<td>2.123</td>"), std::string::npos);          // numbers to 4 digits
+    EXPECT_EQ(html.find("comment"), std::string::npos);                // comment lines are not rows
+    EXPECT_NE(html.find("(first 12 of 100 rows)"), std::string::npos);
+    EXPECT_NE(html.find("href=\"notes.json\""), std::string::npos);
+    EXPECT_EQ(html.find(".hidden"), std::string::npos);
+    EXPECT_EQ(html.find("http"), std::string::npos);                   // nothing from the network
+    // Written again, it replaces itself and does not list itself.
+    writeFolderReport(d.string(), r);
+    EXPECT_EQ(read(d / "index.html").find("index.html"), std::string::npos);
+    fs::remove_all(d);
+}
