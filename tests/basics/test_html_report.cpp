@@ -3,25 +3,16 @@
 // rewrite that replaces the page atomically. (A real browser opens it: report.MainJobReportOpensInChromium.)
 #include "basics/html_report.h"
 
+#include "tests/support/temp_files.h"
+
 #include <gtest/gtest.h>
 
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 
 using namespace armsim;
+using armsim::testing::readFileText;
 namespace fs = std::filesystem;
-
-namespace {
-
-std::string read(const fs::path& p) {
-    std::ifstream in(p);
-    std::stringstream s;
-    s << in.rdbuf();
-    return s.str();
-}
-
-}  // namespace
 
 TEST(HtmlReport, ShowsEveryFileOfTheFolderByItsRelativePath) {
     const fs::path d = fs::path(::testing::TempDir()) / "armsim_html_report";
@@ -42,7 +33,7 @@ TEST(HtmlReport, ShowsEveryFileOfTheFolderByItsRelativePath) {
     r.facts = {{"command", "armsim x --out 'a b'"}};
     r.describe = [](const std::string& rel) { return rel == "plot.png" ? std::string("a plot of <things>") : std::string(); };
     writeFolderReport(d.string(), r);
-    const std::string html = read(d / "index.html");
+    const std::string html = readFileText(d / "index.html");
     EXPECT_NE(html.find("<title>armsim test &amp; &lt;check&gt;</title>"), std::string::npos);
     EXPECT_NE(html.find("<code>armsim x --out 'a b'</code>"), std::string::npos);   // quotes need no escape in text
     EXPECT_NE(html.find("<img src=\"plot.png\""), std::string::npos);
@@ -57,6 +48,6 @@ TEST(HtmlReport, ShowsEveryFileOfTheFolderByItsRelativePath) {
     EXPECT_EQ(html.find("http"), std::string::npos);                   // nothing from the network
     // Written again, it replaces itself and does not list itself.
     writeFolderReport(d.string(), r);
-    EXPECT_EQ(read(d / "index.html").find("index.html"), std::string::npos);
+    EXPECT_EQ(readFileText(d / "index.html").find("index.html"), std::string::npos);
     fs::remove_all(d);
 }
