@@ -511,7 +511,7 @@ py::dict designPy(const py::object& population, const std::vector<double>& angle
                   const std::optional<std::vector<double>>& levels,
                   bool extension, int trials, int repetitions, int draws, unsigned seed, double activationSd,
                   bool freeSlowFraction, int jobs, const std::optional<std::vector<double>>& postures,
-                  const std::string& criterion) {
+                  const std::string& criterion, double budgetMinutes) {
     const Population pop = toPopulation(population);
     DesignSettings s;
     s.flexionDeg = angles;
@@ -520,6 +520,7 @@ py::dict designPy(const py::object& population, const std::vector<double>& angle
     if (criterion != "considered" && criterion != "own")
         throw InputError("criterion '" + criterion + "': expected 'considered' or 'own'");
     s.ownModelCriterion = criterion == "own";
+    s.budgetMinutes = budgetMinutes;
     s.extension = extension;
     s.trials = trials;
     s.repetitions = repetitions;
@@ -533,7 +534,7 @@ py::dict designPy(const py::object& population, const std::vector<double>& angle
     thesis.name = "thesis";
     DesignResult r;
     runInterruptible([&] {
-        r = designProtocol(pop, s, thesis);
+        r = s.budgetMinutes > 0 ? designChannelProtocol(pop, s, thesis) : designProtocol(pop, s, thesis);
     });
     py::dict d;
     py::list conditions, steps;
@@ -692,14 +693,15 @@ and noise (bias, RMSE, coverage, interval widths). Releases the GIL; Ctrl-C rais
             "angles"_a = std::vector<double>{15, 30, 45, 60, 75, 90, 105, 120, 135}, "levels"_a = py::none(),
             "extension"_a = true, "trials"_a = 15, "repetitions"_a = 3, "draws"_a = 32, "seed"_a = 1u,
             "activation_sd"_a = 0.02, "free_slow_fraction"_a = false, "jobs"_a = 2, "postures"_a = py::none(),
-            "criterion"_a = "considered",
+            "criterion"_a = "considered", "budget_minutes"_a = 0.0,
             R"(The torque protocol that minimises the synergist-aware identifier's expected uncertainty of
 the biceps mass and tendon length over the population (as `armsim design`): greedy picks of blocks
 of `repetitions` trials among flexion MVCs at `angles` [deg], extension MVCs (extension=True) and
 submaximal `levels` (fractions of MVC), within `trials`; with `postures` [deg, + = supination] also
 flexion, extension, supination and pronation MVCs in those forearm postures (both transducer axes
 read). criterion: 'considered' (the widths the identifier's intervals report, with what its fit
-shares) or 'own' (the fit's own Laplace widths). Returns conditions, protocol_yaml (a torque
+shares) or 'own' (the fit's own Laplace widths). budget_minutes > 0: design across channels within
+that many lab minutes (as `armsim design --budget`; trials ignored). Returns conditions, protocol_yaml (a torque
 protocol file's text: write it and pass it to run_protocol or validate_elbow), predicted and
 reference (the thesis's five angles) uncertainty, and the greedy steps. Releases the GIL; Ctrl-C raises KeyboardInterrupt.)");
 

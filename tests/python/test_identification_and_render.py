@@ -98,6 +98,16 @@ def test_design_protocol_equals_the_cpp_api_and_writes_a_readable_protocol(refer
     assert run["kind"] == "torque" and len(run["data"]["torque_Nm"]) == 6
 
 
+def test_design_across_channels_with_postures_reads_both_axes():
+    d = armsim.design_protocol(draws=4, angles=[30, 90, 135], postures=[-60], budget_minutes=60)
+    assert "forearm_torque: true" in d["protocol_yaml"]
+    assert "volume_scan" in d["protocol_yaml"] or "anthropometry: true" in d["protocol_yaml"]
+    p = d["predicted"]
+    assert np.isfinite(p["tendon_sd_considered"]) and np.isfinite(p["mass_sd_considered"])
+    with pytest.raises(ValueError, match="criterion"):
+        armsim.design_protocol(draws=4, criterion="best")
+
+
 def test_run_protocol_torque_equals_the_cpp_api_and_feeds_identify_torque(reference, tmp_path):
     run = armsim.run_protocol("protocols/designed_emg_torque.yaml", out=str(tmp_path / "run"))
     np.testing.assert_allclose(run["data"]["torque_Nm"], reference["torque_protocol_torque"], rtol=REL_TOL)
