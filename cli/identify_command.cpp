@@ -253,21 +253,29 @@ void addElbowValidationPlots(const std::vector<ElbowValidationRow>& rows, Output
         const std::string m = method;
         const int color = m == "thesis" ? 1 : m == "synergist" ? 0 : m == "synergist-va" ? 2 : 3;
         if (std::none_of(rows.begin(), rows.end(), [&](const ElbowValidationRow& r) { return r.method == m; })) continue;
+        // Fits that did not converge are drawn as a series of their own (grey), never as results.
         PlotSeries a{method, {}, {}, true, color}, b = a, c = a;
+        PlotSeries fa{std::string(method) + ": not converged", {}, {}, true, 5}, fb = fa, fc = fa;
         for (const ElbowValidationRow& r : rows) {
             if (r.method != method || !std::isfinite(r.estimate.mass)) continue;
-            a.x.push_back(1000 * r.trueMass);
-            a.y.push_back(1000 * r.estimate.mass);
-            b.x.push_back(r.voluntaryActivation);
-            b.y.push_back(100 * r.massError);
-            c.x.push_back(r.synergistScale);
-            c.y.push_back(100 * r.massError);
+            const bool ok = r.estimate.converged;
+            (ok ? a : fa).x.push_back(1000 * r.trueMass);
+            (ok ? a : fa).y.push_back(1000 * r.estimate.mass);
+            (ok ? b : fb).x.push_back(r.voluntaryActivation);
+            (ok ? b : fb).y.push_back(100 * r.massError);
+            (ok ? c : fc).x.push_back(r.synergistScale);
+            (ok ? c : fc).y.push_back(100 * r.massError);
             lo = std::min(lo, 1000 * r.trueMass);
             hi = std::max(hi, 1000 * r.trueMass);
         }
         vsTruth.series.push_back(a);
         vsActivation.series.push_back(b);
         vsSynergists.series.push_back(c);
+        if (!fa.x.empty()) {
+            vsTruth.series.push_back(fa);
+            vsActivation.series.push_back(fb);
+            vsSynergists.series.push_back(fc);
+        }
     }
     vsTruth.series.push_back({"identity", {lo, hi}, {lo, hi}, false, 7});
     out.writeWith("mass_identified_vs_true.png", [&](const std::string& p) { writePlotPng(p, vsTruth); });
