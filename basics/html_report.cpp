@@ -14,6 +14,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
+// Marks a page as armsim's: a later run replaces it, while an index.html of someone else is left alone.
+constexpr const char* kGenerator = "<meta name=\"generator\" content=\"armsim folder report\">";
+
 std::string escape(const std::string& s) {
     std::string out;
     for (char c : s) {
@@ -128,18 +131,37 @@ window.addEventListener('load', function () {
 
 }  // namespace
 
+bool isFolderReport(const std::string& path) {
+    std::ifstream in(path);
+    std::string head(512, '\0');
+    in.read(head.data(), std::streamsize(head.size()));
+    head.resize(std::size_t(in.gcount()));
+    return head.find(kGenerator) != std::string::npos;
+}
+
 void writeFolderReport(const std::string& dir, const FolderReport& report) {
     const fs::path root(dir);
+    std::error_code ec;
+    if (fs::exists(root / "index.html", ec) && !isFolderReport((root / "index.html").string()))
+        throw std::runtime_error((root / "index.html").string() + ": not written by armsim: left as it is");
     std::map<std::string, std::vector<std::string>> byFolder;   // folder ("" = top) -> files
-    for (const fs::directory_entry& e : fs::recursive_directory_iterator(root)) {
-        if (!e.is_regular_file()) continue;
+    long seen = 0;
+    for (fs::recursive_directory_iterator it(root, fs::directory_options::skip_permission_denied, ec), end;
+         !ec && it != end; it.increment(ec)) {
+        const fs::directory_entry& e = *it;
+        if (++seen > kMaxReportFiles)
+            throw std::runtime_error(dir + ": more than " + std::to_string(kMaxReportFiles) + " files: no report written");
+        std::error_code fe;
+        if (!e.is_regular_file(fe)) continue;
         const std::string rel = fs::relative(e.path(), root).generic_string();
-        if (rel == "index.html" || rel.find("/.") != std::string::npos || rel[0] == '.') continue;
+        if (rel == "index.html" || rel.find("/.") != std::string::npos || rel[0] == '.' ||
+            rel.find(".tmp") != std::string::npos)
+            continue;
         const std::string folder = fs::path(rel).parent_path().generic_string();
         byFolder[folder].push_back(rel);
     }
     std::ostringstream h;
-    h << "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\n<title>" << escape(report.title)
+    h << "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">" << kGenerator << "\n<title>" << escape(report.title)
       << "</title>\n<style>" << kStyle << "</style></head>\n<body data-resources=\"pending\">\n<h1>"
       << escape(report.title) << "</h1>\n<table class=\"facts\">";
     for (const auto& [label, value] : report.facts)

@@ -22,9 +22,14 @@ struct FolderReport {
 /// videos embedded with their sentence; .csv tables of at most kPreviewRows rows and 12 columns shown
 /// (larger ones: their first rows), every file linked. The page checks on load that each image and
 /// video loaded and records the result in its body's data-resources attribute ("ok" or the missing
-/// files: what the tests read in a real browser). Throws std::runtime_error when it cannot write.
+/// files: what the tests read in a real browser). An index.html that armsim did not write is left
+/// alone, and a folder of more than kMaxReportFiles files gets none: both throw std::runtime_error, as
+/// does a failed write.
 void writeFolderReport(const std::string& dir, const FolderReport& report);
+/// Whether the file at path is a page writeFolderReport wrote.
+bool isFolderReport(const std::string& path);
 
 constexpr int kPreviewRows = 12;
+constexpr long kMaxReportFiles = 5000;
 
 }  // namespace armsim

@@ -86,7 +86,11 @@ int main(int argc, char** argv) {
     try {
         app.parse(argc, argv);
         armsim::checkInterruption();  // a command that finished its work after Ctrl-C still reports the stop
-        armsim::cli::writeCommandReport(app, argc, argv);   // FOLDER/index.html of a command that wrote a folder
+        try {   // FOLDER/index.html of a command that wrote a folder; the command's own files stand either way
+            armsim::cli::writeCommandReport(app, argc, argv);
+        } catch (const std::exception& e) {
+            std::cerr << "armsim: warning: no index.html: " << e.what() << "\n";
+        }
     } catch (const CLI::CallForHelp& e) {
         return app.exit(e);
     } catch (const CLI::CallForAllHelp& e) {

@@ -3,6 +3,7 @@
 #include "basics/html_report.h"
 
 #include <chrono>
+#include <cstdlib>
 #include <ctime>
 #include <filesystem>
 #include <regex>
@@ -93,6 +94,9 @@ std::string describeOutputFile(const std::string& relativePath) {
 }
 
 void writeCommandReport(const CLI::App& app, int argc, char** argv) {
+    // Under mpirun only rank 0 writes it (every rank runs this).
+    for (const char* rank : {"OMPI_COMM_WORLD_RANK", "PMI_RANK", "SLURM_PROCID"})
+        if (const char* v = std::getenv(rank); v && std::string(v) != "0") return;
     const CLI::App* ran = &app;
     for (;;) {
         const std::vector<const CLI::App*> subs = ran->get_subcommands([](const CLI::App* s) { return s->parsed(); });
@@ -117,9 +121,15 @@ void writeCommandReport(const CLI::App& app, int argc, char** argv) {
     std::strftime(when, sizeof when, "%Y-%m-%d %H:%M:%S UTC", std::gmtime(&now));
     r.facts = {{"command", line}, {"armsim", ARMSIM_VERSION}, {"finished", when},
                {"working directory", std::filesystem::current_path(ec).string()}};
+    if (const char* quick = std::getenv("ARMSIM_QUICK"); quick && std::string(quick) == "1")
+        r.facts.emplace_back("ARMSIM_QUICK", "1: population sizes capped (a quick try, not a result)");
     for (const CLI::Option* o : ran->get_options()) {
         if (o->get_name().empty() || o->get_name() == "--help" || o->get_name() == "-h") continue;
-        std::string v = o->count() > 0 ? o->as<std::string>() : o->get_default_str();
+        std::string v;
+        if (o->count() > 0)
+            for (const std::string& x : o->results()) v += (v.empty() ? "" : " ") + x;
+        else
+            v = o->get_default_str();
         if (v.empty() && o->get_type_size() == 0) v = o->count() > 0 ? "yes" : "no";   // flags
         r.facts.emplace_back(o->get_name(), v.empty() ? "-" : v);
     }

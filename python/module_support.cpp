@@ -88,15 +88,18 @@ struct sigaction pythonSigint;   // Python's handler, put back by the last scope
 
 extern "C" void onSigint(int sig) { requestInterruption(sig); }
 
-bool isPythonMainThread() {
+// Python's main thread with Python's own SIGINT handler in place (not SIG_IGN, not a user handler).
+bool shouldRoute() {
     const py::module_ threading = py::module_::import("threading");
-    return threading.attr("current_thread")().is(threading.attr("main_thread")());
+    if (!threading.attr("current_thread")().is(threading.attr("main_thread")())) return false;
+    const py::module_ signal = py::module_::import("signal");
+    return signal.attr("getsignal")(signal.attr("SIGINT")).is(signal.attr("default_int_handler"));
 }
 
 }  // namespace
 
 InterruptibleScope::InterruptibleScope() {
-    if (isPythonMainThread()) {
+    if (shouldRoute()) {
         std::lock_guard<std::mutex> lock(sigintMutex);
         if (sigintUsers++ == 0) {
             struct sigaction a {};
@@ -117,9 +120,8 @@ InterruptibleScope::~InterruptibleScope() {
     PyEval_RestoreThread(saved_);   // the GIL back
 }
 
-void InterruptibleScope::raiseIfInterrupted() {
-    if (!getInterruption()) return;
-    clearInterruption();
+void InterruptibleScope::raiseKeyboardInterrupt(bool clear) {
+    if (clear) clearInterruption();
     PyErr_SetNone(PyExc_KeyboardInterrupt);
     throw py::error_already_set();
 }

@@ -52,46 +52,57 @@ py::array_t<double> toArray(const std::vector<std::vector<double>>& rows);
 /// when neither exists.
 std::string findFile(const std::string& name);
 
-/// For the duration of a long call: the GIL released and, on Python's main thread, Ctrl-C (SIGINT)
-/// routed to armsim's own stop (requestInterruption, as the command line does): the loops stop at their
-/// next step, task or solver iteration and their writers remove partial output. Python's SIGINT handler
-/// is back when the scope ends. Use runInterruptible.
+/// For the duration of a long call: the GIL released and, when called on Python's main thread with
+/// Python's own SIGINT handler in place (not ignored, not the user's), Ctrl-C routed to armsim's stop
+/// (requestInterruption, as the command line does): the loops stop at their next step, task or solver
+/// iteration and their writers remove partial output. Python's handler is back when the scope ends.
+/// Use runInterruptible.
 class InterruptibleScope {
 public:
     InterruptibleScope();   ///< with the GIL held
     ~InterruptibleScope();
     InterruptibleScope(const InterruptibleScope&) = delete;
     InterruptibleScope& operator=(const InterruptibleScope&) = delete;
-    /// Raises KeyboardInterrupt (and clears the stop) when Ctrl-C arrived; call with the GIL held.
-    static void raiseIfInterrupted();
+    bool isRouted() const { return routed_; }
+    /// Raises KeyboardInterrupt; `clear`: forget the stop (the routed call does, once it has stopped).
+    [[noreturn]] static void raiseKeyboardInterrupt(bool clear);
 
 private:
     bool routed_ = false;
     PyThreadState* saved_ = nullptr;   // the GIL, released (PyEval_SaveThread)
 };
 
-/// Runs f() in an InterruptibleScope and returns what it returns; Ctrl-C during it raises
-/// KeyboardInterrupt (within about one trial step, solver iteration or task: tests/python).
+/// Runs f() in an InterruptibleScope and returns what it returns. Ctrl-C during it raises
+/// KeyboardInterrupt (within about one trial step, solver iteration or task: tests/python); a call on
+/// another thread that the stop reaches raises it too.
 template <class F>
 auto runInterruptible(F&& f) -> decltype(f()) {
     using R = decltype(f());
+    bool routed = false;
     try {
         if constexpr (std::is_void_v<R>) {
             {
                 InterruptibleScope scope;
+                routed = scope.isRouted();
                 f();
             }
-            InterruptibleScope::raiseIfInterrupted();
+            if (routed && getInterruption()) InterruptibleScope::raiseKeyboardInterrupt(true);
         } else {
             R r = [&] {
                 InterruptibleScope scope;
+                routed = scope.isRouted();
                 return f();
             }();
-            InterruptibleScope::raiseIfInterrupted();
+            if (routed && getInterruption()) InterruptibleScope::raiseKeyboardInterrupt(true);
             return r;
         }
+    } catch (const py::error_already_set&) {
+        throw;
     } catch (const InterruptedError&) {
-        InterruptibleScope::raiseIfInterrupted();
+        InterruptibleScope::raiseKeyboardInterrupt(routed);
+    } catch (...) {
+        // Another error on the way out of a stopped call: the stop is what the user asked for.
+        if (routed && getInterruption()) InterruptibleScope::raiseKeyboardInterrupt(true);
         throw;
     }
 }

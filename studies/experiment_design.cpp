@@ -190,10 +190,12 @@ Sensitivities calcSensitivities(const Population& prior, const std::vector<Torqu
                 x[j] = x0;
                 for (int r = 0; r < rows; ++r) out.jacobian(r, j) = (up[r] - down[r]) / (2 * kStep);
             }
-            // The held and consider parameters' secants: what the truth varies and the fit does not.
+            // The held and consider parameters' secants: what the truth varies and the fit does not. A
+            // secant without a steady state leaves the draw without them (its own widths still count).
             out.considerJacobian = Eigen::MatrixXd::Zero(rows, n + nk);
             out.considerJacobian.leftCols(n) = out.jacobian;
             std::vector<SynergistModel::MuscleDeviation> deviations(prior.base.muscles.size());
+            try {
             for (int j = 0; j < n + nk; ++j) {
                 if (!(secant[j] > 0)) continue;
                 std::vector<double> up, down;
@@ -212,6 +214,9 @@ Sensitivities calcSensitivities(const Population& prior, const std::vector<Torqu
                     SynergistModel::setDeviation(deviations, considered[j - n], 0);
                 }
                 for (int r = 0; r < rows; ++r) out.considerJacobian(r, j) = (up[r] - down[r]) / (2 * secant[j]);
+            }
+            } catch (const SimulationError&) {
+                out.considerJacobian.resize(0, 0);
             }
             // Transducer rows as the identifier weights them: sd relative to the trial's load (both axes
             // when the forearm axis is read); a rotation effort's flexion axis is not fitted.
@@ -254,6 +259,7 @@ Eigen::MatrixXd calcPosterior(const Sensitivities& s, int d, const std::vector<i
 std::vector<std::vector<double>> calcConsideredPosterior(const Sensitivities& s, int d, const std::vector<int>& counts) {
     const DrawSensitivity& ds = s.draws[d];
     const int cols = int(ds.considerJacobian.cols());
+    if (cols == 0) return {};   // its secants had no steady state
     std::vector<std::vector<double>> J;
     for (std::size_t c = 0; c < counts.size(); ++c) {
         if (counts[c] == 0) continue;
@@ -659,6 +665,7 @@ DesignResult designProtocol(const Population& prior, const DesignSettings& setti
             counts[c] -= settings.repetitions;
             if (v < bestCriterion) bestCriterion = v, best = int(c);
         }
+        if (best < 0) throw SimulationError("experiment design: no candidate has a finite criterion");
         // With the widened widths more trials can widen them (the fit then pins what it shares on the
         // data): the design stops below the budget when no block narrows them.
         if (k > 0 && !(bestCriterion < current)) break;

@@ -49,5 +49,10 @@ TEST(HtmlReport, ShowsEveryFileOfTheFolderByItsRelativePath) {
     // Written again, it replaces itself and does not list itself.
     writeFolderReport(d.string(), r);
     EXPECT_EQ(readFileText(d / "index.html").find("index.html"), std::string::npos);
+    EXPECT_TRUE(isFolderReport((d / "index.html").string()));
+    // Someone else's index.html is left as it is.
+    std::ofstream(d / "index.html") << "<html>mine</html>";
+    EXPECT_THROW(writeFolderReport(d.string(), r), std::runtime_error);
+    EXPECT_EQ(readFileText(d / "index.html"), "<html>mine</html>");
     fs::remove_all(d);
 }

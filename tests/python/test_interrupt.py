@@ -90,3 +90,21 @@ def test_ctrl_c_raises_keyboard_interrupt_promptly(name, tmp_path):
     if name == "run_study":
         # The journal stays (a later run resumes); the final files are not written.
         assert not (tmp_path / "study_out" / "results.csv").exists()
+
+
+def test_an_ignored_sigint_stays_ignored():
+    """A program that ignores SIGINT (signal.SIG_IGN, as a background job does) is not stopped by it."""
+    script = textwrap.dedent(f"""
+        import signal, sys, armsim
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+        print({STARTED!r}, flush=True)
+        d = armsim.design_protocol(draws=64)
+        print("finished", d["predicted"]["draws_used"], flush=True)
+    """)
+    child = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    assert child.stdout.readline().strip() == STARTED
+    time.sleep(0.3)
+    child.send_signal(signal.SIGINT)
+    out, err = child.communicate(timeout=120)
+    assert child.returncode == 0 and "finished 64" in out, out + err
+
