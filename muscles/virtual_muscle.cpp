@@ -180,7 +180,9 @@ std::pair<double, double> calcInitialLengthConstants(const MuscleCoefficients& c
 
 // ---- Comparisons -----
 
-// A field added to one of these structs must be added to its comparison below.
+// A field added to one of these structs must be added to its comparison below. The size checks catch
+// most additions, not one int-sized field in MuscleParameters' 4 bytes of tail padding after
+// `apportioning`: add such a field to haveSameNormalizedStates by hand.
 static_assert(sizeof(FibreType) == sizeof(std::string) + 24 * sizeof(double), "FibreType changed: update operator==");
 static_assert(sizeof(MuscleCoefficients) == 15 * sizeof(double), "MuscleCoefficients changed: update operator==");
 static_assert(sizeof(MuscleParameters) == sizeof(std::string) + 5 * sizeof(double) + 4 * sizeof(int) +
