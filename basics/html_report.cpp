@@ -1,5 +1,6 @@
 #include "basics/html_report.h"
 
+#include "basics/csv.h"
 #include "basics/files.h"
 
 #include <algorithm>
@@ -59,16 +60,7 @@ std::string previewCsv(const fs::path& file, int& rowsShown, long& rowsTotal) {
         if (line.empty() || line[0] == '#') continue;
         ++rowsTotal;
         if (int(rows.size()) > kPreviewRows) continue;
-        std::vector<std::string> cells;
-        std::string cell;
-        bool quoted = false;
-        for (char c : line) {
-            if (c == '"') quoted = !quoted;
-            else if (c == ',' && !quoted) cells.push_back(cell), cell.clear();
-            else cell += c;
-        }
-        cells.push_back(cell);
-        rows.push_back(std::move(cells));
+        rows.push_back(splitCsvRecord(line));
     }
     if (rows.empty()) return "";
     html += "<div class=\"table\"><table>";

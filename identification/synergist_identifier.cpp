@@ -30,8 +30,11 @@ double sumTaredTorque(const SteadyMvcCurve& active, const SteadyMvcCurve& relaxe
     return t;
 }
 
-SteadyMvcCurve calcRelaxedCurve(const std::vector<MuscleSpec>& muscles, const MvcGeometry& g) {
-    return calcSteadyMvcCurve(muscles, g, MuscleGroup::Flexor, SubjectEffort{0, 0});
+// Every muscle at rest (U = 0), with an optional cache (SteadyCurveCache).
+SteadyMvcCurve calcRelaxedCurve(const std::vector<MuscleSpec>& muscles, const MvcGeometry& g,
+                                SteadyCurveCache* cache = nullptr) {
+    const std::vector<std::vector<bool>> any(g.flexionDeg.size(), std::vector<bool>(muscles.size(), true));
+    return calcSteadyMvcCurve(muscles, g, Effort::Flexion, any, SubjectEffort{0, 0}, cache);
 }
 
 // The effort of a condition at level l: agonists l VA, antagonists l CC.
@@ -232,6 +235,7 @@ SynergistModel::SynergistModel(const Population& prior, const SynergistOptions& 
     if (options.readsForearmTorque ||
         std::any_of(conditions.begin(), conditions.end(), [](const TorqueCondition& c) { return isForearmEffort(c.effort); }))
         freeRotatorMass();
+    prepareConsidered();
 }
 
 std::vector<std::string> SynergistModel::getParameterNames() const {
@@ -418,9 +422,7 @@ void SynergistModel::calcPredictions(const double* x, const std::vector<MuscleDe
     }
     const MvcGeometry& geometry = g != 1 ? scaled : geometry_;
     if (cache) cache->active.resize(kinds_.size());
-    const std::vector<std::vector<bool>> relaxedAgonists(geometry.flexionDeg.size(), std::vector<bool>(muscles.size(), true));
-    const SteadyMvcCurve relaxed = calcSteadyMvcCurve(muscles, geometry, Effort::Flexion, relaxedAgonists, SubjectEffort{0, 0},
-                                                      cache ? &cache->relaxed : nullptr);
+    const SteadyMvcCurve relaxed = calcRelaxedCurve(muscles, geometry, cache ? &cache->relaxed : nullptr);
     std::vector<SteadyMvcCurve> active;
     for (std::size_t j = 0; j < kinds_.size(); ++j)
         active.push_back(calcSteadyMvcCurve(muscles, geometry, kinds_[j].effort, agonists_[j],
@@ -458,36 +460,20 @@ void SynergistModel::calcPredictions(const double* x, const std::vector<MuscleDe
 // them, C0 = (J_F' J_F + Lambda)^-1 and w = (x_F, x_held, considered) - their means with the prior
 // population's covariance S, the error is C0 (J_F' n + B w), B = [-Lambda, J_F' J_held, J_F' J_c], so
 // its covariance is C0 (J_F' J_F + B S B') C0 (C0 again when the fit's model is the truth's).
-bool SynergistModel::calcConsideredCovariance(const std::vector<std::vector<double>>& J,
-                                              std::vector<std::vector<double>>& c0Out,
-                                              std::vector<std::vector<double>>& cOut) const {
+void SynergistModel::prepareConsidered() {
     const std::vector<ConsiderParameter> considered = getConsiderParameters();
-    const int n = getNumParameters(), R = int(J.size()), nk = int(considered.size());
-    if (R > 0 && int(J[0].size()) != n + nk)
-        throw std::logic_error("calcConsideredCovariance: expected " + std::to_string(n + nk) + " Jacobian columns");
-    std::vector<int> free, held;
-    for (int j = 0; j < n; ++j) (lower_[j] >= upper_[j] ? held : free).push_back(j);
-    const int nf = int(free.size()), nh = int(held.size());
-    if (nf == 0) return false;
-    Eigen::MatrixXd P(n, n), Jm(R, n + nk);
+    const int n = getNumParameters(), nk = int(considered.size());
+    for (int j = 0; j < n; ++j) (lower_[j] >= upper_[j] ? held_ : free_).push_back(j);
+    const int nf = int(free_.size()), nh = int(held_.size());
+    Eigen::MatrixXd P(n, n);
     for (int a = 0; a < n; ++a)
         for (int b = 0; b < n; ++b) P(a, b) = priorCovariance_[a][b];
-    for (int k = 0; k < R; ++k)
-        for (int j = 0; j < n + nk; ++j) Jm(k, j) = J[k][j];
     const Eigen::LLT<Eigen::MatrixXd> pl(P);
-    if (pl.info() != Eigen::Success) return false;
+    if (nf == 0 || pl.info() != Eigen::Success) return;
     const Eigen::MatrixXd Pinv = pl.solve(Eigen::MatrixXd::Identity(n, n));
-    Eigen::MatrixXd lambda(nf, nf), JF(R, nf), JO(R, nh + nk);
-    for (int a = 0; a < nf; ++a) {
-        JF.col(a) = Jm.col(free[a]);
-        for (int b = 0; b < nf; ++b) lambda(a, b) = Pinv(free[a], free[b]);
-    }
-    for (int a = 0; a < nh; ++a) JO.col(a) = Jm.col(held[a]);
-    for (int a = 0; a < nk; ++a) JO.col(nh + a) = Jm.col(n + a);
-    const Eigen::MatrixXd H = JF.transpose() * JF;
-    const Eigen::LLT<Eigen::MatrixXd> hl(H + lambda);
-    if (hl.info() != Eigen::Success) return false;
-    const Eigen::MatrixXd C0 = hl.solve(Eigen::MatrixXd::Identity(nf, nf));
+    freePrecision_.assign(nf, std::vector<double>(nf));
+    for (int a = 0; a < nf; ++a)
+        for (int b = 0; b < nf; ++b) freePrecision_[a][b] = Pinv(free_[a], free_[b]);
     // w = T v: the truths as combinations of the population's independent primitives v; a parameter
     // that stands for none (a group the model does not have) keeps the fit's own prior variance.
     const std::vector<std::vector<std::pair<int, double>>> truths = getParameterTruths();
@@ -498,13 +484,41 @@ bool SynergistModel::calcConsideredCovariance(const std::vector<std::vector<doub
         for (const auto& [v, coefficient] : terms) T(row, v) += coefficient;
         if (terms.empty() && parameter >= 0) T(row, nv + row) = std::sqrt(priorCovariance_[parameter][parameter]);
     };
-    for (int a = 0; a < nf; ++a) fill(a, truths[free[a]], free[a]);
-    for (int a = 0; a < nh; ++a) fill(nf + a, truths[held[a]], -1);  // held and standing for nothing: known
+    for (int a = 0; a < nf; ++a) fill(a, truths[free_[a]], free_[a]);
+    for (int a = 0; a < nh; ++a) fill(nf + a, truths[held_[a]], -1);  // held and standing for nothing: known
     for (int a = 0; a < nk; ++a) fill(nf + nh + a, considered[a].truth, -1);
     Eigen::MatrixXd Vm = Eigen::MatrixXd::Identity(nv + nw, nv + nw);  // private primitives: unit variance
     for (int a = 0; a < nv; ++a)
         for (int b = 0; b < nv; ++b) Vm(a, b) = V[a][b];
     const Eigen::MatrixXd S = T * Vm * T.transpose();
+    truthCovariance_.assign(nw, std::vector<double>(nw));
+    for (int a = 0; a < nw; ++a)
+        for (int b = 0; b < nw; ++b) truthCovariance_[a][b] = S(a, b);
+}
+
+bool SynergistModel::calcConsideredCovariance(const std::vector<std::vector<double>>& J,
+                                              std::vector<std::vector<double>>& c0Out,
+                                              std::vector<std::vector<double>>& cOut) const {
+    const int n = getNumParameters(), R = int(J.size());
+    const int nf = int(free_.size()), nh = int(held_.size()), nw = int(truthCovariance_.size()), nk = nw - nf - nh;
+    if (truthCovariance_.empty()) return false;
+    if (R > 0 && int(J[0].size()) != n + nk)
+        throw std::logic_error("calcConsideredCovariance: expected " + std::to_string(n + nk) + " Jacobian columns");
+    Eigen::MatrixXd Jm(R, n + nk), lambda(nf, nf), S(nw, nw);
+    for (int k = 0; k < R; ++k)
+        for (int j = 0; j < n + nk; ++j) Jm(k, j) = J[k][j];
+    for (int a = 0; a < nf; ++a)
+        for (int b = 0; b < nf; ++b) lambda(a, b) = freePrecision_[a][b];
+    for (int a = 0; a < nw; ++a)
+        for (int b = 0; b < nw; ++b) S(a, b) = truthCovariance_[a][b];
+    Eigen::MatrixXd JF(R, nf), JO(R, nh + nk);
+    for (int a = 0; a < nf; ++a) JF.col(a) = Jm.col(free_[a]);
+    for (int a = 0; a < nh; ++a) JO.col(a) = Jm.col(held_[a]);
+    for (int a = 0; a < nk; ++a) JO.col(nh + a) = Jm.col(n + a);
+    const Eigen::MatrixXd H = JF.transpose() * JF;
+    const Eigen::LLT<Eigen::MatrixXd> hl(H + lambda);
+    if (hl.info() != Eigen::Success) return false;
+    const Eigen::MatrixXd C0 = hl.solve(Eigen::MatrixXd::Identity(nf, nf));
     Eigen::MatrixXd B(nf, nw);
     B.leftCols(nf) = -lambda;
     B.rightCols(nh + nk) = JF.transpose() * JO;
@@ -514,8 +528,8 @@ bool SynergistModel::calcConsideredCovariance(const std::vector<std::vector<doub
     cOut.assign(n, std::vector<double>(n, 0.0));
     for (int a = 0; a < nf; ++a)
         for (int b = 0; b < nf; ++b) {
-            c0Out[free[a]][free[b]] = C0(a, b);
-            cOut[free[a]][free[b]] = C(a, b);
+            c0Out[free_[a]][free_[b]] = C0(a, b);
+            cOut[free_[a]][free_[b]] = C(a, b);
         }
     return true;
 }

@@ -185,6 +185,13 @@ private:
     int findPose(double flexionDeg, std::vector<std::pair<double, double>>& poses, double rotationDeg = 0.0 / 0.0);
     std::vector<double> priorMean_, lower_, upper_;
     std::vector<std::vector<double>> priorCovariance_;
+    // What calcConsideredCovariance needs of the model alone, computed once at construction
+    // (prepareConsidered): the free and held parameters, the prior's precision on the free ones and the
+    // covariance S of the truths (free, held, considered). Both empty when the prior covariance is not
+    // positive definite.
+    std::vector<int> free_, held_;
+    std::vector<std::vector<double>> freePrecision_, truthCovariance_;
+    void prepareConsidered();
     std::vector<std::vector<double>> coupledCovariance_;  // with the rotators coupled (freeRotatorMass)
     friend MuscleEstimate identifySynergistAware(const Population&, const std::vector<TorqueObservation>&,
                                                  const SynergistOptions&);
