@@ -136,7 +136,7 @@ PathElementSpec readViaElement(const ParamNode& n, int index) {
     return e;
 }
 
-MuscleSpec readMuscle(const ParamNode& n, double specificTension) {
+MuscleSpec readMuscle(const ParamNode& n, const MuscleDefaults& defaults) {
     MuscleSpec m;
     const std::string name = n.getString("name");
     if (!std::regex_match(name, std::regex("[A-Za-z][A-Za-z0-9_]*")))
@@ -161,7 +161,7 @@ MuscleSpec readMuscle(const ParamNode& n, double specificTension) {
         require("fibre_fractions", nullptr);
         require("fibre_types", nullptr);
     }
-    readMuscleFields(n, m.params, false, specificTension);
+    readMuscleFields(n, m.params, false, defaults);
     m.maxPathFromRange = !n.has("max_path_length");
     m.params.name = name;
     m.sourceParams = m.params;
@@ -344,7 +344,9 @@ ArmSetup loadModelFile(const std::string& file) {
 
     if (root.has("specific_tension"))
         s.specificTension = root.getNumber("specific_tension", getSpecificTensionBound());
-    for (const ParamNode& m : root.children("muscles")) s.muscles.push_back(readMuscle(m, s.specificTension));
+    if (root.has("max_firing_rate")) s.maxFiringRate = root.getNumber("max_firing_rate", getMaxFiringRateBound());
+    for (const ParamNode& m : root.children("muscles"))
+        s.muscles.push_back(readMuscle(m, MuscleDefaults{s.specificTension, s.maxFiringRate}));
     if (s.muscles.empty()) throw InputError(root.where("muscles") + ": field 'muscles' is empty: expected at least one muscle");
     if (root.has("primary")) {
         const std::string primary = root.getString("primary");

@@ -13,6 +13,8 @@
 //                                        (defaults of the virtual subject's effort, see SubjectEffort)
 //   specific_tension: SIGMA              [N/m^2] every muscle's sigma unless the muscle gives its own
 //                                        (default: the fibre-type file's, Virtual Muscle's 31.8 N/cm^2)
+//   max_firing_rate: FMAX                [f0.5] every motor unit's firing rate at full drive unless the
+//                                        muscle gives its own (default: the fibre-type file's fmax, 2)
 //   roles: {biceps: [NAMES], synergists: [NAMES], surface_emg: [NAMES]}
 //                                        the heads of the thesis's "biceps" (the primary among them) and
 //                                        the flexors the synergist-aware identifier estimates one by one
@@ -23,7 +25,8 @@
 //                                        parameters (a `parameters:` muscle file and/or the fields of a
 //                                        muscle file; `max_isometric_force` [N] or `volume` [m^3] may
 //                                        stand for `mass` and `tendon_slack_length` [m] for
-//                                        `optimal_tendon_length`; `specific_tension` [N/m^2]), and a
+//                                        `optimal_tendon_length`; `specific_tension` [N/m^2],
+//                                        `max_firing_rate` [f0.5]), and a
 //                                        path: origin, via (points, cylinders, spheres), insertion.
 //                                        A `parameters:` file's mass stays as that file gives it.
 //
@@ -148,6 +151,9 @@ struct ArmSetup {
     ArmParameters arm;                    ///< segments, elbow range, transducer (and the thesis's A, B)
     /// The model file's specific_tension [N/m^2]; 0: none given (each muscle's fibre-type file's sigma).
     double specificTension = 0;
+    /// The model file's max_firing_rate, every motor unit's firing rate at full drive [f0.5]; 0: none
+    /// given (each muscle's fibre-type file's fmax).
+    double maxFiringRate = 0;
     SubjectEffort effort;                 ///< defaults of the subject's effort
     std::vector<MuscleSpec> muscles;
     int primary = 0;                      ///< index of the thesis's "biceps"

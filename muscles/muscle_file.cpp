@@ -102,7 +102,9 @@ void loadFibreTypes(const std::string& path, FibreType& slow, FibreType& fast, M
 
 Bound getSpecificTensionBound() { return Bound::closed(1e4, 2e6, "N/m^2 (1-200 N/cm^2)"); }
 
-void readMuscleFields(const ParamNode& root, MuscleParameters& p, bool required, double specificTension) {
+Bound getMaxFiringRateBound() { return Bound{0.5, 8, false, true, "f0.5, above fmin 0.5"}; }
+
+void readMuscleFields(const ParamNode& root, MuscleParameters& p, bool required, const MuscleDefaults& defaults) {
     const Bound any = Bound::any();
     auto number = [&](const std::string& key, double& field) {
         if (required || root.has(key)) field = root.getNumber(key, any);
@@ -146,10 +148,12 @@ void readMuscleFields(const ParamNode& root, MuscleParameters& p, bool required,
         const std::string typesFile = root.findFile("fibre_types", "fibre-type file");
         loadFibreTypes(typesFile, p.slow, p.fast, p.coefficients);
     }
-    // The model's specific tension, then the muscle's own, replace the fibre-type file's.
-    if (specificTension > 0) p.coefficients.sigma = specificTension;
+    // The model's defaults, then the muscle's own values, replace the fibre-type file's.
+    if (defaults.specificTension > 0) p.coefficients.sigma = defaults.specificTension;
     if (root.has("specific_tension"))
         p.coefficients.sigma = root.getNumber("specific_tension", getSpecificTensionBound());
+    if (defaults.maxFiringRate > 0) p.coefficients.fmax = defaults.maxFiringRate;
+    if (root.has("max_firing_rate")) p.coefficients.fmax = root.getNumber("max_firing_rate", getMaxFiringRateBound());
     // Conversions need the coefficients (sigma, rho, LrT), so they come last.
     if (root.has("volume"))
         p.mass = root.getNumber("volume", Bound{0, 0.01, true, false, "m^3"}) * p.coefficients.density;
@@ -169,7 +173,7 @@ MuscleParameters loadMuscleParameters(const std::string& path) {
     MuscleParameters p;
     p.name = root.getString("name");
     root.getString("source", "");
-    readMuscleFields(root, p, true, 0);
+    readMuscleFields(root, p, true, MuscleDefaults{});
     root.finish();
     root.rethrowWithLocation([&] { p.validate(); });
     return p;

@@ -26,12 +26,19 @@ class ParamNode;
 /// [kg], max_isometric_force [N] (mass = F0 L0 rho / sigma) and volume [m^3] (mass = rho V, so
 /// F0 = sigma V / L0), optimal_fascicle_length, optimal_tendon_length or tendon_slack_length [m]
 /// (L0T = slack / LrT, see model/model_file.h), max_path_length, pennation_angle (informative),
-/// fibre_fractions, motor_units, fibre_types, specific_tension [N/m^2]. sigma is, in order of
-/// precedence: the muscle's specific_tension, specificTension when > 0 (a model's), the fibre-type
-/// file's. Does not validate.
-void readMuscleFields(const ParamNode& root, MuscleParameters& p, bool required, double specificTension);
+/// fibre_fractions, motor_units, fibre_types, specific_tension [N/m^2], max_firing_rate [f0.5]. Each of
+/// sigma and fmax is, in order of precedence: the muscle's own key, the model's default when > 0, the
+/// fibre-type file's. Does not validate.
+struct MuscleDefaults {
+    double specificTension = 0;  ///< sigma [N/m^2]; 0: the fibre-type file's
+    double maxFiringRate = 0;    ///< fmax, every unit's firing rate at full drive [f0.5]; 0: the fibre-type file's
+};
+void readMuscleFields(const ParamNode& root, MuscleParameters& p, bool required, const MuscleDefaults& defaults);
 /// Plausible specific tension [N/m^2]: 1-200 N/cm^2 (in vivo 25-30, Virtual Muscle 31.8; model files
 /// fitted to strong subjects imply up to ~140).
 Bound getSpecificTensionBound();
+/// Plausible fmax [f0.5]: above Virtual Muscle's fmin (0.5) and at most 8 (human motor units at MVC
+/// fire up to about 4x the mean rate, Bellemare et al. 1983).
+Bound getMaxFiringRateBound();
 
 }  // namespace armsim

@@ -347,6 +347,45 @@ TEST(ModelFile, BadFilesNameTheFileLineAndKey) {
     EXPECT_NE(msg.find("elbow"), std::string::npos) << msg;  // lists the shipped models
 }
 
+// Drive apart from the fibre-type file (issue 28): max_firing_rate from the model file or the muscle
+// replaces the file's fmax, and a unit at full drive fires at it (the envelope at U = 1).
+TEST(ModelFile, MaxFiringRateReplacesTheFibreTypeFilesFmax) {
+    const std::string types = std::string(ARMSIM_ASSET_DIR) + "/muscles/human_fibre_types.yaml";
+    auto muscle = [&](const std::string& name, const std::string& fields) {
+        return "  - name: " + name + "\n" + fields +
+               "    volume: 80.0e-6\n    optimal_fascicle_length: 0.12\n    tendon_slack_length: 0.2\n"
+               "    fibre_types: " + types + "\n    fibre_fractions: {slow: 0.5, fast: 0.5}\n"
+               "    path:\n      origin: {body: upper_arm, location: [0, 0.3, 0]}\n"
+               "      insertion: {body: forearm, location: [0, -0.05, 0]}\n";
+    };
+    const std::string text = "name: drive\narm: arm/default_male.yaml\nmax_firing_rate: 3.5\nmuscles:\n" +
+                             muscle("modelRate", "") + muscle("ownRate", "    max_firing_rate: 2.5\n");
+    const ArmSetup s = loadModel(writeTemp("drive.yaml", text));
+    EXPECT_EQ(s.maxFiringRate, 3.5);
+    const MuscleParameters a = s.calcMuscleParameters(0), b = s.calcMuscleParameters(1);
+    EXPECT_EQ(a.coefficients.fmax, 3.5);
+    EXPECT_EQ(b.coefficients.fmax, 2.5);
+    EXPECT_DOUBLE_EQ(calcEnvelopeFrequency(a.coefficients, 0.3, 1.0), 3.5);
+    // Without it: the fibre-type file's (Virtual Muscle's 2), as the thesis model keeps.
+    const ArmSetup thesis = loadModel("thesis");
+    EXPECT_EQ(thesis.maxFiringRate, 0);
+    EXPECT_EQ(thesis.biceps().coefficients.fmax, 2.0);
+    // The twin's rate fuses both fibre types down to 0.7 L0 (assets/models/twin.yaml; Bellemare 1983):
+    // Af >= 0.93 there, where Virtual Muscle's fmax 2 gives 0.38 (slow).
+    const ArmSetup twin = loadModel("twin");
+    const MuscleParameters& p = twin.muscles[0].params;
+    const double L = 0.7;
+    EXPECT_GE(calcActivationFrequency(p.slow, p.coefficients.fmax, calcNf(p.slow, L)), 0.93);
+    EXPECT_GE(calcActivationFrequency(p.fast, p.coefficients.fmax * p.fast.aS2, calcNf(p.fast, L)), 0.93);
+    EXPECT_LT(calcActivationFrequency(p.slow, 2.0, calcNf(p.slow, L)), 0.5);
+
+    const std::string msg = messageOf(writeTemp("drive_bad.yaml", "name: drive\narm: arm/default_male.yaml\n"
+                                                                  "max_firing_rate: 0.4\nmuscles:\n" + muscle("m", "")));
+    EXPECT_NE(msg.find("drive_bad.yaml:3"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("max_firing_rate' = 0.4"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("above fmin"), std::string::npos) << msg;
+}
+
 // Strength apart from size (issue 28): sigma from the model file or the muscle, mass from a volume,
 // F0 = sigma V / L0 following sigma; a muscle given by max_isometric_force keeps F0 whatever sigma.
 TEST(ModelFile, SpecificTensionAndVolumeSetF0AndMass) {
