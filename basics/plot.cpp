@@ -22,6 +22,28 @@ namespace {
 
 std::mutex plplotMutex;  // PLplot keeps global state
 
+// PLplot reports a failed call (a bad argument) by printing to stderr and skipping the call; this
+// handler keeps the first such message of a plot instead (guarded by plplotMutex), so the plot fails
+// with it rather than being written blank beside lines of PLplot's own on stderr.
+std::string plplotAbortMessage;
+void recordPlplotAbort(const char* message) {
+    if (plplotAbortMessage.empty()) plplotAbortMessage = message ? message : "unknown PLplot error";
+}
+
+/// Starts capturing PLplot's aborted calls (call with plplotMutex held).
+void startCapturingAborts() {
+    plplotAbortMessage.clear();
+    plsabort(recordPlplotAbort);
+}
+
+/// Throws, naming the plot, when a PLplot call was aborted since startCapturingAborts; removes tmp.
+void throwOnAbortedCall(const std::string& tmp, const std::string& path, const std::string& title) {
+    if (plplotAbortMessage.empty()) return;
+    std::error_code ec;
+    std::filesystem::remove(tmp, ec);
+    throw std::logic_error(path + ": plot '" + title + "' not written: PLplot refused a call: " + plplotAbortMessage);
+}
+
 // Palette (colour map 0): 0 background, 1 axes/text, then the series colours.
 constexpr int kPalette[][3] = {{255, 255, 255}, {0, 0, 0},     {31, 119, 180}, {214, 39, 40},
                                {44, 160, 44},   {255, 127, 14}, {148, 103, 189}, {127, 127, 127},
@@ -118,10 +140,21 @@ void writePlotPng(const std::string& path, const PlotSpec& spec) {
     x1 = limit(spec.xMax, x1, false);
     y0 = limit(spec.yMin, y0, spec.logY);
     y1 = limit(spec.yMax, y1, spec.logY);
+    // A fixed limit on one side of data that lie at or beyond it (all-zero torques under yMin = 0)
+    // would leave an empty range: open it to the fixed side's scale.
+    auto open = [](double& lo, double& hi, double given) {
+        if (hi > lo) return;
+        const double span = std::max(1.0, std::abs(lo)) * 0.1;
+        if (std::isnan(given)) lo = hi - span;
+        else hi = lo + span;
+    };
+    open(x0, x1, spec.xMin);
+    open(y0, y1, spec.logY || std::isnan(spec.yMin) ? NAN : spec.yMin);
 
     const std::string tmp = beginPng(path);
     {
         std::lock_guard<std::mutex> lock(plplotMutex);
+        startCapturingAborts();
         startStream(tmp, spec.width, spec.height);
         plinit();
         plcol0(1);
@@ -172,6 +205,7 @@ void writePlotPng(const std::string& path, const PlotSpec& spec) {
                      markerCounts.data(), symbols.data());
         }
         plend1();
+        throwOnAbortedCall(tmp, path, spec.title);
     }
     finishPng(tmp, path);
 }
@@ -217,6 +251,7 @@ void writeHeatMapPng(const std::string& path, const HeatMapSpec& spec) {
         startStream(tmp, spec.width, spec.height);
         // Colour map 1: dark blue -> teal -> yellow (viridis-like), linear in RGB.
         PLFLT pos[] = {0.0, 0.5, 1.0}, r[] = {0.27, 0.13, 0.99}, g[] = {0.00, 0.57, 0.91}, b[] = {0.33, 0.55, 0.14};
+        startCapturingAborts();
         plscmap1n(256);
         plscmap1l(1, 3, pos, r, g, b, nullptr);
         plinit();
@@ -257,6 +292,7 @@ void writeHeatMapPng(const std::string& path, const HeatMapSpec& spec) {
                    PL_POSITION_RIGHT | PL_POSITION_OUTSIDE | PL_POSITION_VIEWPORT, 0.02, 0.0, 0.04, 1.0, 0, 1, 1,
                    0.0, 0.0, 0, 0.0, 1, labelOpts, labels, 1, axisOpts, ticks, subTicks, nValues, valueRows);
         plend1();
+        throwOnAbortedCall(tmp, path, spec.title);
     }
     finishPng(tmp, path);
 }

@@ -80,14 +80,16 @@ ElbowReference loadDefaultElbowReference() {
 
 Table calcMuscleTable(const ArmSetup& setup) {
     Table t({"F0_N", "L0_m", "L0T_m", "mass_kg", "max_path_m", "slow_fraction", "flexor", "force_scale",
-             "fascicle_length_scale", "tendon_length_scale", "specific_tension_N_per_m2", "volume_m3"});
+             "fascicle_length_scale", "tendon_length_scale", "specific_tension_N_per_m2", "volume_m3",
+             "max_firing_rate_f05"});
     for (int i = 0; i < setup.getNumMuscles(); ++i) {
         const MuscleParameters p = setup.calcMuscleParameters(i);
         const VirtualMuscle m(p);
         const MuscleCalibration& c = setup.muscles[i].calibration;
         t.appendRow({m.getF0(), p.optimalFascicleLength, p.optimalTendonLength, p.mass, p.maxPathLength,
                      p.slowFraction, setup.muscles[i].group == MuscleGroup::Flexor ? 1.0 : 0.0, c.forceScale,
-                     c.fascicleLengthScale, c.tendonLengthScale, p.coefficients.sigma, p.mass / p.coefficients.density});
+                     c.fascicleLengthScale, c.tendonLengthScale, p.coefficients.sigma, p.mass / p.coefficients.density,
+                     p.coefficients.fmax});
     }
     return t;
 }

@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <csignal>
 #include <filesystem>
 #include <fstream>
@@ -98,4 +99,25 @@ TEST(Plot, AWriteCutOffByAFullDiskLeavesNoFileAndNamesThePlot) {
     EXPECT_FALSE(fs::exists(p));
     for (const auto& e : fs::directory_iterator(fs::temp_directory_path()))  // nor its temporary
         EXPECT_EQ(e.path().filename().string().find(p.filename().string() + ".tmp"), std::string::npos) << e.path();
+}
+
+// Fixed axis limits that leave an empty range (yMin = yMax = 0 from a caller scaling to an all-zero
+// torque: the thesis model's extension MVC; data below yMin = 0) made PLplot refuse the plot with lines
+// on stderr and a blank PNG: the range opens to the fixed side, the plot is whole and PLplot prints nothing.
+TEST(Plot, FixedLimitsThatLeaveAnEmptyRangeGiveAWholePlotAndNoPlplotLines) {
+    const fs::path p = fs::temp_directory_path() / ("armsim_plot_flat_" + std::to_string(::getpid()) + ".png");
+    for (int c = 0; c < 2; ++c) {
+        PlotSpec spec;
+        spec.title = "flat";
+        spec.yMin = 0;
+        spec.yMax = c == 0 ? 0.0 : NAN;
+        const double y = c == 0 ? 0.0 : -1e-3;
+        spec.series.push_back({"flat", {0, 1, 2}, {y, y, y}});
+        testing::internal::CaptureStderr();
+        EXPECT_NO_THROW(writePlotPng(p.string(), spec));
+        const std::string err = testing::internal::GetCapturedStderr();
+        EXPECT_EQ(err, "") << "case " << c;
+        EXPECT_TRUE(isWholePng(p.string()));
+        fs::remove(p);
+    }
 }

@@ -9,6 +9,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <cstdio>
 #include <filesystem>
@@ -234,6 +235,23 @@ TEST(Cli, ModelShowWritesTablesAndPlots) {
     }
     const armsim::Table arms = armsim::Table::readCsv((d / "moment_arms.csv").string());
     EXPECT_NEAR(t.get(9, "torque_BRA_Nm"), arms.get(9, "moment_arm_BRA_m") * t.get(9, "force_BRA_N"), 1e-6);
+    // Each muscle's drive at full activation: the elbow keeps Virtual Muscle's fmax 2, the twin fuses (3).
+    auto firingRates = [](const fs::path& file) {
+        std::ifstream in(file);
+        std::string line;
+        std::getline(in, line);
+        const std::vector<std::string> header = armsim::splitCsvRecord(line);
+        const auto column = std::find(header.begin(), header.end(), "max_firing_rate_f05") - header.begin();
+        std::vector<double> rates;
+        while (std::getline(in, line))
+            if (!line.empty()) rates.push_back(std::stod(armsim::splitCsvRecord(line).at(std::size_t(column))));
+        return rates;
+    };
+    const std::vector<double> elbowRates = firingRates(d / "muscles.csv");
+    EXPECT_EQ(elbowRates, std::vector<double>(7, 2.0));
+    const fs::path twin = freshDir("model_show_twin");
+    ASSERT_EQ(runArmsim("model show --model twin --step 10 --out " + twin.string()).exitCode, 0);
+    EXPECT_EQ(firingRates(twin / "muscles.csv"), std::vector<double>(10, 3.0));
 
     const CommandResult bad = runArmsim("model show --model elbow --step 0 --out " + d.string());
     EXPECT_NE(bad.exitCode, 0);

@@ -20,6 +20,17 @@ using SimTK::Vec2;
 
 namespace {
 
+/// One muscle of a model file's `muscles:` list (L0 0.12 m, slack 0.2 m, human fibre types, a straight
+/// path) with `fields` (each an indented line) for its size and the rest.
+std::string makeMuscleEntry(const std::string& name, const std::string& fields) {
+    const std::string types = std::string(ARMSIM_ASSET_DIR) + "/muscles/human_fibre_types.yaml";
+    return "  - name: " + name + "\n" + fields +
+           "    optimal_fascicle_length: 0.12\n    tendon_slack_length: 0.2\n"
+           "    fibre_types: " + types + "\n    fibre_fractions: {slow: 0.5, fast: 0.5}\n"
+           "    path:\n      origin: {body: upper_arm, location: [0, 0.3, 0]}\n"
+           "      insertion: {body: forearm, location: [0, -0.05, 0]}\n";
+}
+
 constexpr double kExactTol = 1e-12;        // m: closed forms
 constexpr double kMomentArmRelTol = 1e-6;  // two ways to a moment arm (issue 10)
 constexpr double kDerivativeStep = 1e-6;   // rad, central difference of the path length
@@ -350,13 +361,8 @@ TEST(ModelFile, BadFilesNameTheFileLineAndKey) {
 // Drive apart from the fibre-type file (issue 28): max_firing_rate from the model file or the muscle
 // replaces the file's fmax, and a unit at full drive fires at it (the envelope at U = 1).
 TEST(ModelFile, MaxFiringRateReplacesTheFibreTypeFilesFmax) {
-    const std::string types = std::string(ARMSIM_ASSET_DIR) + "/muscles/human_fibre_types.yaml";
-    auto muscle = [&](const std::string& name, const std::string& fields) {
-        return "  - name: " + name + "\n" + fields +
-               "    volume: 80.0e-6\n    optimal_fascicle_length: 0.12\n    tendon_slack_length: 0.2\n"
-               "    fibre_types: " + types + "\n    fibre_fractions: {slow: 0.5, fast: 0.5}\n"
-               "    path:\n      origin: {body: upper_arm, location: [0, 0.3, 0]}\n"
-               "      insertion: {body: forearm, location: [0, -0.05, 0]}\n";
+    auto muscle = [](const std::string& name, const std::string& fields) {
+        return makeMuscleEntry(name, fields + "    volume: 80.0e-6\n");
     };
     const std::string text = "name: drive\narm: arm/default_male.yaml\nmax_firing_rate: 3.5\nmuscles:\n" +
                              muscle("modelRate", "") + muscle("ownRate", "    max_firing_rate: 2.5\n");
@@ -389,14 +395,7 @@ TEST(ModelFile, MaxFiringRateReplacesTheFibreTypeFilesFmax) {
 // Strength apart from size (issue 28): sigma from the model file or the muscle, mass from a volume,
 // F0 = sigma V / L0 following sigma; a muscle given by max_isometric_force keeps F0 whatever sigma.
 TEST(ModelFile, SpecificTensionAndVolumeSetF0AndMass) {
-    const std::string types = std::string(ARMSIM_ASSET_DIR) + "/muscles/human_fibre_types.yaml";
-    auto muscle = [&](const std::string& name, const std::string& fields) {
-        return "  - name: " + name + "\n" + fields +
-               "    optimal_fascicle_length: 0.12\n    tendon_slack_length: 0.2\n"
-               "    fibre_types: " + types + "\n    fibre_fractions: {slow: 0.5, fast: 0.5}\n"
-               "    path:\n      origin: {body: upper_arm, location: [0, 0.3, 0]}\n"
-               "      insertion: {body: forearm, location: [0, -0.05, 0]}\n";
-    };
+    const auto muscle = makeMuscleEntry;
     const double sigma = 250000, own = 400000, V = 80e-6, F0 = 600, L0 = 0.12;
     const std::string text = "name: sigma\narm: arm/default_male.yaml\nspecific_tension: 250000\nmuscles:\n" +
                              muscle("byVolume", "    volume: 80.0e-6\n") +
