@@ -22,28 +22,6 @@ namespace {
 
 std::mutex plplotMutex;  // PLplot keeps global state
 
-// PLplot reports a failed call (a bad argument) by printing to stderr and skipping the call; this
-// handler keeps the first such message of a plot instead (guarded by plplotMutex), so the plot fails
-// with it rather than being written blank beside lines of PLplot's own on stderr.
-std::string plplotAbortMessage;
-void recordPlplotAbort(const char* message) {
-    if (plplotAbortMessage.empty()) plplotAbortMessage = message ? message : "unknown PLplot error";
-}
-
-/// Starts capturing PLplot's aborted calls (call with plplotMutex held).
-void startCapturingAborts() {
-    plplotAbortMessage.clear();
-    plsabort(recordPlplotAbort);
-}
-
-/// Throws, naming the plot, when a PLplot call was aborted since startCapturingAborts; removes tmp.
-void throwOnAbortedCall(const std::string& tmp, const std::string& path, const std::string& title) {
-    if (plplotAbortMessage.empty()) return;
-    std::error_code ec;
-    std::filesystem::remove(tmp, ec);
-    throw std::logic_error(path + ": plot '" + title + "' not written: PLplot refused a call: " + plplotAbortMessage);
-}
-
 // Palette (colour map 0): 0 background, 1 axes/text, then the series colours.
 constexpr int kPalette[][3] = {{255, 255, 255}, {0, 0, 0},     {31, 119, 180}, {214, 39, 40},
                                {44, 160, 44},   {255, 127, 14}, {148, 103, 189}, {127, 127, 127},
@@ -89,10 +67,30 @@ void finishPng(const std::string& tmp, const std::string& path) {
     }
 }
 
-/// Starts a PLplot stream on the pngcairo device writing tmp, with the series palette.
-void startStream(const std::string& tmp, int width, int height) {
+/// A PLplot stream's report of a refused call. PLplot reports a bad argument by skipping the call and
+/// printing to stderr; with this buffer set on the stream (plsError) it keeps the message instead, and
+/// the plot fails with it rather than being written blank beside lines of PLplot's own.
+struct PlplotErrors {
+    PLINT code = 0;
+    char message[2048] = {};
+    /// Throws, naming the plot, when a call was refused; removes tmp.
+    void throwIfAny(const std::string& tmp, const std::string& path, const std::string& title) const {
+        if (code == 0) return;
+        std::error_code ec;
+        std::filesystem::remove(tmp, ec);
+        std::string text(message);
+        text.erase(0, text.find_first_not_of("\n *"));
+        std::replace(text.begin(), text.end(), '\n', ' ');
+        throw std::logic_error(path + ": plot '" + title + "' not written: PLplot refused a call: " + text);
+    }
+};
+
+/// Starts a PLplot stream on the pngcairo device writing tmp, with the series palette; refused calls
+/// are kept in errors.
+void startStream(const std::string& tmp, int width, int height, PlplotErrors& errors) {
     PLINT stream = 0;
     plmkstrm(&stream);
+    plsError(&errors.code, errors.message);
     plsdev("pngcairo");
     plsfnam(tmp.c_str());
     plspage(0, 0, width, height, 0, 0);
@@ -133,6 +131,7 @@ void writePlotPng(const std::string& path, const PlotSpec& spec) {
     };
     pad(x0, x1);
     pad(y0, y1);
+    const double dataX0 = x0, dataX1 = x1, dataY0 = y0, dataY1 = y1;
     auto limit = [](double given, double fallback, bool log) {
         return std::isnan(given) ? fallback : (log ? std::log10(given) : given);
     };
@@ -140,22 +139,16 @@ void writePlotPng(const std::string& path, const PlotSpec& spec) {
     x1 = limit(spec.xMax, x1, false);
     y0 = limit(spec.yMin, y0, spec.logY);
     y1 = limit(spec.yMax, y1, spec.logY);
-    // A fixed limit on one side of data that lie at or beyond it (all-zero torques under yMin = 0)
-    // would leave an empty range: open it to the fixed side's scale.
-    auto open = [](double& lo, double& hi, double given) {
-        if (hi > lo) return;
-        const double span = std::max(1.0, std::abs(lo)) * 0.1;
-        if (std::isnan(given)) lo = hi - span;
-        else hi = lo + span;
-    };
-    open(x0, x1, spec.xMin);
-    open(y0, y1, spec.logY || std::isnan(spec.yMin) ? NAN : spec.yMin);
+    // Fixed limits that leave an empty or inverted range (yMin = yMax = 0 from a caller scaling to an
+    // all-zero curve; data wholly beyond a fixed limit) give way to the data's own range.
+    if (!(x1 > x0)) x0 = dataX0, x1 = dataX1;
+    if (!(y1 > y0)) y0 = dataY0, y1 = dataY1;
 
     const std::string tmp = beginPng(path);
     {
         std::lock_guard<std::mutex> lock(plplotMutex);
-        startCapturingAborts();
-        startStream(tmp, spec.width, spec.height);
+        PlplotErrors errors;
+        startStream(tmp, spec.width, spec.height, errors);
         plinit();
         plcol0(1);
         plschr(0, 1.1);
@@ -205,7 +198,7 @@ void writePlotPng(const std::string& path, const PlotSpec& spec) {
                      markerCounts.data(), symbols.data());
         }
         plend1();
-        throwOnAbortedCall(tmp, path, spec.title);
+        errors.throwIfAny(tmp, path, spec.title);
     }
     finishPng(tmp, path);
 }
@@ -248,10 +241,10 @@ void writeHeatMapPng(const std::string& path, const HeatMapSpec& spec) {
     const std::string tmp = beginPng(path);
     {
         std::lock_guard<std::mutex> lock(plplotMutex);
-        startStream(tmp, spec.width, spec.height);
+        PlplotErrors errors;
+        startStream(tmp, spec.width, spec.height, errors);
         // Colour map 1: dark blue -> teal -> yellow (viridis-like), linear in RGB.
         PLFLT pos[] = {0.0, 0.5, 1.0}, r[] = {0.27, 0.13, 0.99}, g[] = {0.00, 0.57, 0.91}, b[] = {0.33, 0.55, 0.14};
-        startCapturingAborts();
         plscmap1n(256);
         plscmap1l(1, 3, pos, r, g, b, nullptr);
         plinit();
@@ -292,7 +285,7 @@ void writeHeatMapPng(const std::string& path, const HeatMapSpec& spec) {
                    PL_POSITION_RIGHT | PL_POSITION_OUTSIDE | PL_POSITION_VIEWPORT, 0.02, 0.0, 0.04, 1.0, 0, 1, 1,
                    0.0, 0.0, 0, 0.0, 1, labelOpts, labels, 1, axisOpts, ticks, subTicks, nValues, valueRows);
         plend1();
-        throwOnAbortedCall(tmp, path, spec.title);
+        errors.throwIfAny(tmp, path, spec.title);
     }
     finishPng(tmp, path);
 }

@@ -316,7 +316,7 @@ ModelReportFiles writeModelReport(const ArmSetup& setup, const std::string& outD
         for (const PlotSeries& ps : plot.series)
             for (double v : ps.y) top = std::max(top, v);
         plot.yMin = 0;
-        plot.yMax = 1.7 * top;  // room for the legend above the curves
+        if (top > 0) plot.yMax = 1.7 * top;  // room for the legend above the curves (none: a model without the group)
         writePlotPng(path("mvc_" + name + ".png"), plot);
         out.files.push_back(path("mvc_" + name + ".png"));
     }

@@ -147,7 +147,7 @@ MuscleSpec readMuscle(const ParamNode& n, const MuscleDefaults& defaults) {
     m.group = group == "flexor" ? MuscleGroup::Flexor : group == "extensor" ? MuscleGroup::Extensor : MuscleGroup::Forearm;
     const bool fromFile = n.has("parameters");
     if (fromFile) {
-        m.params = loadMuscleParameters(n.findFile("parameters", "muscle file"));
+        m.params = loadMuscleParameters(n.findFile("parameters", "muscle file"), defaults);
     } else {
         auto require = [&](const char* key, const char* alternative) {
             if (n.has(key) || (alternative && n.has(alternative))) return;

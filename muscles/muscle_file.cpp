@@ -14,9 +14,17 @@
 namespace armsim {
 
 std::string getAssetDirectory() {
-    const char* env = std::getenv("ARMSIM_ASSETS");
-    if (env && *env) return env;
     std::error_code ec;
+    const char* env = std::getenv("ARMSIM_ASSETS");
+    if (env && *env) {
+        // A folder without models/ is not an assets folder: say so once, by the variable's name, instead
+        // of a missing-file error about whichever asset is read first.
+        if (!std::filesystem::is_directory(std::filesystem::path(env) / "models", ec))
+            throw InputError(std::string("ARMSIM_ASSETS = '") + env +
+                             "': not an armsim assets folder (expected its models/, muscles/, subjects/ ...); "
+                             "unset it to use the assets armsim was built or installed with");
+        return env;
+    }
     // An installed command (cmake --install): <prefix>/bin/armsim reads <prefix>/share/armsim/assets,
     // even while the source tree it was built from exists. (The installed Python package sets
     // ARMSIM_ASSETS itself: python/armsim/__init__.py.)
@@ -102,7 +110,7 @@ void loadFibreTypes(const std::string& path, FibreType& slow, FibreType& fast, M
 
 Bound getSpecificTensionBound() { return Bound::closed(1e4, 2e6, "N/m^2 (1-200 N/cm^2)"); }
 
-Bound getMaxFiringRateBound() { return Bound{0.5, 8, false, true, "f0.5, above fmin 0.5"}; }
+Bound getMaxFiringRateBound() { return Bound{0.5, 8, true, false, "f0.5, above fmin 0.5"}; }
 
 void readMuscleFields(const ParamNode& root, MuscleParameters& p, bool required, const MuscleDefaults& defaults) {
     const Bound any = Bound::any();
@@ -144,15 +152,17 @@ void readMuscleFields(const ParamNode& root, MuscleParameters& p, bool required,
                              ? Apportioning::Equal : Apportioning::Thesis;
         mu.finish();
     }
-    if (required || root.has("fibre_types")) {
+    const bool readsTypes = required || root.has("fibre_types");
+    if (readsTypes) {
         const std::string typesFile = root.findFile("fibre_types", "fibre-type file");
         loadFibreTypes(typesFile, p.slow, p.fast, p.coefficients);
     }
-    // The model's defaults, then the muscle's own values, replace the fibre-type file's.
-    if (defaults.specificTension > 0) p.coefficients.sigma = defaults.specificTension;
+    // The model's defaults replace the fibre-type file's values just read (not values read earlier,
+    // e.g. from a `parameters:` file), then the muscle's own keys replace both.
+    if (readsTypes && defaults.specificTension > 0) p.coefficients.sigma = defaults.specificTension;
     if (root.has("specific_tension"))
         p.coefficients.sigma = root.getNumber("specific_tension", getSpecificTensionBound());
-    if (defaults.maxFiringRate > 0) p.coefficients.fmax = defaults.maxFiringRate;
+    if (readsTypes && defaults.maxFiringRate > 0) p.coefficients.fmax = defaults.maxFiringRate;
     if (root.has("max_firing_rate")) p.coefficients.fmax = root.getNumber("max_firing_rate", getMaxFiringRateBound());
     // Conversions need the coefficients (sigma, rho, LrT), so they come last.
     if (root.has("volume"))
@@ -168,12 +178,12 @@ void readMuscleFields(const ParamNode& root, MuscleParameters& p, bool required,
     }
 }
 
-MuscleParameters loadMuscleParameters(const std::string& path) {
+MuscleParameters loadMuscleParameters(const std::string& path, const MuscleDefaults& defaults) {
     const ParamNode root = ParamNode::loadFile(path);
     MuscleParameters p;
     p.name = root.getString("name");
     root.getString("source", "");
-    readMuscleFields(root, p, true, MuscleDefaults{});
+    readMuscleFields(root, p, true, defaults);
     root.finish();
     root.rethrowWithLocation([&] { p.validate(); });
     return p;

@@ -273,6 +273,18 @@ TEST(Cli, ValidationWithoutMvcsSaysWhySynergistVaDidNotFit) {
     EXPECT_EQ(r.output.find("nan"), std::string::npos) << r.output;
 }
 
+// ARMSIM_ASSETS pointing at a folder that is not an assets folder is named, with the value, instead of
+// a missing-file error about whichever asset is read first; nothing is written.
+TEST(Cli, AnAssetsVariableThatPointsNowhereIsNamed) {
+    const fs::path d = freshDir("assets_nowhere");
+    const CommandResult r = armsim::testing::runCommand("ARMSIM_ASSETS=" + (d / "nowhere").string() + " " +
+                                                        std::string(ARMSIM_EXE) + " model show --out " + (d / "out").string());
+    EXPECT_EQ(r.exitCode, 2) << r.output;
+    EXPECT_NE(r.output.find("ARMSIM_ASSETS = '" + (d / "nowhere").string() + "': not an armsim assets folder"),
+              std::string::npos) << r.output;
+    EXPECT_FALSE(fs::exists(d / "out"));
+}
+
 // ARMSIM_QUICK=1 (how the README's blocks run in ctest) caps a validation's subjects and says so; any
 // value other than 1 or 0 is refused, naming the variable.
 TEST(Cli, QuickRunCapsTheSubjectsAndSaysSo) {

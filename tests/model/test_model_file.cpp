@@ -385,11 +385,34 @@ TEST(ModelFile, MaxFiringRateReplacesTheFibreTypeFilesFmax) {
     EXPECT_GE(calcActivationFrequency(p.fast, p.coefficients.fmax * p.fast.aS2, calcNf(p.fast, L)), 0.93);
     EXPECT_LT(calcActivationFrequency(p.slow, 2.0, calcNf(p.slow, L)), 0.5);
 
+    // A `parameters:` muscle file keeps its own rate; one without gets the model's.
+    const std::string types = std::string(ARMSIM_ASSET_DIR) + "/muscles/human_fibre_types.yaml";
+    auto muscleFile = [&](const std::string& name, const std::string& own) {
+        return writeTemp(name + ".yaml", "name: " + name + "\nmass: 0.3\noptimal_fascicle_length: 0.12\n"
+                                         "optimal_tendon_length: 0.2\nmax_path_length: 0.4\n"
+                                         "fibre_fractions: {slow: 0.5, fast: 0.5}\nmotor_units: {slow: 3, fast: 3}\n"
+                                         "fibre_types: " + types + "\n" + own);
+    };
+    const std::string path = "    path:\n      origin: {body: upper_arm, location: [0, 0.3, 0]}\n"
+                             "      insertion: {body: forearm, location: [0, -0.05, 0]}\n";
+    const ArmSetup f = loadModel(writeTemp("drive_files.yaml",
+        "name: drive\narm: arm/default_male.yaml\nmax_firing_rate: 3.5\nmuscles:\n"
+        "  - name: ownFile\n    parameters: " + muscleFile("own_rate", "max_firing_rate: 2.5\n") + "\n" + path +
+        "  - name: plainFile\n    parameters: " + muscleFile("plain_rate", "") + "\n" + path));
+    EXPECT_EQ(f.calcMuscleParameters(0).coefficients.fmax, 2.5);
+    EXPECT_EQ(f.calcMuscleParameters(1).coefficients.fmax, 3.5);
+
+    // Bounds: above fmin (0.5 is refused, named with the file and line), at most 8.
     const std::string msg = messageOf(writeTemp("drive_bad.yaml", "name: drive\narm: arm/default_male.yaml\n"
-                                                                  "max_firing_rate: 0.4\nmuscles:\n" + muscle("m", "")));
+                                                                  "max_firing_rate: 0.5\nmuscles:\n" + muscle("m", "")));
     EXPECT_NE(msg.find("drive_bad.yaml:3"), std::string::npos) << msg;
-    EXPECT_NE(msg.find("max_firing_rate' = 0.4"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("max_firing_rate' = 0.5"), std::string::npos) << msg;
     EXPECT_NE(msg.find("above fmin"), std::string::npos) << msg;
+    EXPECT_EQ(loadModel(writeTemp("drive_top.yaml", "name: drive\narm: arm/default_male.yaml\nmax_firing_rate: 8\n"
+                                                    "muscles:\n" + muscle("m", ""))).maxFiringRate, 8.0);
+    EXPECT_NE(messageOf(writeTemp("drive_over.yaml", "name: drive\narm: arm/default_male.yaml\nmax_firing_rate: 8.5\n"
+                                                     "muscles:\n" + muscle("m", ""))).find("max_firing_rate' = 8.5"),
+              std::string::npos);
 }
 
 // Strength apart from size (issue 28): sigma from the model file or the muscle, mass from a volume,

@@ -89,19 +89,19 @@ TEST(ExperimentDesign, PredictedWidthMatchesTheSpreadOfMapEstimatesOnTheModelsOw
 
 // The widened prediction against a second method: persons drawn from the population itself (each muscle
 // its own tendon, fascicle, slow fraction and mass, which the identifier's fit shares or holds) through
-// the recommended protocol (every channel), fitted with the population as prior: the RMS error of L0T over
+// the recommended protocol (every channel), fitted with the population as prior. The RMS error of L0T over
 // 100 persons must not exceed the design's width with the consider parameters (tendonSdConsidered, what
-// the identifier's intervals report) and must lie well above the narrower width of the fit's own model.
-// The widened width is linear in what the fit holds; on the twin with a fused MVC drive most of it is the
-// pronator teres' tendon and fascicle (held; 60 % and 12 % of the widened L0T variance for the
-// recommended protocol's own subject), and the fits respond to them less than the linear width
-// assumes (about 0.7 of it, from the widths measured and predicted): measured 13.2 mm against 17.1 mm
-// predicted (0.77; 11.6 against 12.7 mm on the twin at fmax 2) and 7.8 mm own.
-// RMS over 100 persons: sampling sd about 7 %.
-TEST(ExperimentDesign, WidenedWidthMatchesTheSpreadOfEstimatesOfPeopleTheFitSimplifies) {
+// the identifier's intervals report): intervals at least as wide as the errors; and it must lie well
+// above the narrower width of the fit's own model. A known conservative bias, bounded here, not hidden:
+// with transducer noise only, the twin at fmax 3 gives 13.2 mm against 17.1 mm predicted (ratio 0.77;
+// 11.6 against 12.7 mm, 0.91, at fmax 2) and 7.8 mm own. The widened variance is linear in what the fit
+// holds, 72 % of it the pronator teres' own tendon and fascicle (one person of the recommended protocol).
+// With the population's 5 % trial variability the prediction and validation agree (README: 10.7 mm
+// predicted, 10.2 mm obtained in family). RMS over 100 persons: sampling sd about 7 %.
+TEST(ExperimentDesign, WidenedWidthBoundsTheSpreadOfEstimatesOfPeopleTheFitSimplifies) {
     constexpr int kPeople = 100;
     constexpr double kMaxRatio = 1.15;          // not narrower than the spread: 2 sampling sds
-    constexpr double kMinRatio = 0.65;          // conservative by at most 1.5x
+    constexpr double kMinRatio = 0.65;          // the known conservative bias (0.77) plus 2 sampling sds
     constexpr double kAboveOwnModel = 1.2;      // measured 1.69: the own model's prediction is too narrow
     const Population prior = makePrior();
     const TorqueProtocol protocol = readTorqueProtocol(findAsset("protocols/recommended.yaml"));
