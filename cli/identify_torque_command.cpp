@@ -11,6 +11,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <memory>
 
 namespace armsim::cli {
@@ -129,7 +130,14 @@ void addIdentifyTorqueCommand(CLI::App& app) {
                   "relative sd of one trial's torque (default: estimated from repeated trials)")
         ->check(CLI::Range(1e-4, 0.5));
     c->add_option("--activation", o->activation, "measured voluntary activation (twitch interpolation): adds synergist-va")
-        ->check(CLI::Range(0.0, 1.0));
+        ->check(CLI::Validator(
+            [](std::string& text) {
+                // 0 is no voluntary drive at all: not a measurement of a maximal effort.
+                const double v = std::strtod(text.c_str(), nullptr);
+                return v > 0 && v <= 1 ? std::string()
+                                       : "voluntary activation " + text + ": expected in (0, 1] (a fraction of full drive)";
+            },
+            "(0, 1]"));
     c->add_option("--activation-sd", o->activationSd, "sd of that measurement")->capture_default_str()->check(CLI::Range(1e-4, 0.5));
     c->add_option("--channels", o->channels,
                   "channel CSV (docs/channels.md: ultrasound fascicle length and volume, EMG, upper-arm length): adds "

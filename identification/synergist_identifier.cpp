@@ -555,7 +555,7 @@ MuscleEstimate identifySynergistAware(const Population& prior, const std::vector
     if (data.empty()) throw InputError("synergist-aware identifier: no observations");
     const bool measured = std::isfinite(options.measuredActivation);
     if (measured) {
-        checkField("measured voluntary activation", options.measuredActivation, Bound::closed(0, 1));
+        checkField("measured voluntary activation", options.measuredActivation, Bound{0, 1, true, false, "fraction of full drive"});
         checkField("activation sd", options.activationSd, Bound::positive());
     }
     // One condition per observation: the model computes each distinct angle and effort kind once.

@@ -124,6 +124,8 @@ std::vector<BadInput> makeCatalogue() {
         {"TorqueDataMissing", {}, "identify-torque IN/none.csv --out OUT/it", {"none.csv"}},
         {"TorqueDataWrongSign", {{"t.csv", "flexion_deg,torque_Nm\n90,-40\n"}}, "identify-torque IN/t.csv --out OUT/it",
          {"t.csv:2", "torque_Nm", "-40"}},
+        {"TorqueActivationZero", {}, "identify-torque measured/thesis_mvc_torque.csv --activation 0 --out OUT/it",
+         {"--activation", "voluntary activation 0: expected in (0, 1]"}},
         {"TorqueNoiseLevelOutOfRange", {}, "identify-torque measured/thesis_mvc_torque.csv --noise-level 2 --out OUT/it",
          {"--noise-level", "2"}},
         {"ValidateNoiseNotANumber", {}, "validate --noise abc --out OUT/v", {"--noise", "abc"}},

@@ -195,6 +195,8 @@ def test_render_video_writes_an_mp4_of_the_trials_frames(elbow, reference, tmp_p
     (lambda m: armsim.identify_torque("measured/thesis_mvc_torque.csv", noise_level=2.0), ValueError,
      "field 'noise_level' = 2"),
     (lambda m: armsim.identify_torque({"flexion_deg": [90.0]}), ValueError, "missing column 'torque_Nm'"),
+    (lambda m: armsim.identify_torque("measured/thesis_mvc_torque.csv", activation=0.0), ValueError,
+     "field 'activation' = 0: expected in (0, 1]"),
     (lambda m: armsim.validate_elbow(subjects=0), ValueError, "field 'subjects' = 0"),
     (lambda m: armsim.validate_elbow(population="/no/such/population.yaml"), FileNotFoundError, "population.yaml"),
     (lambda m: armsim.design_protocol(trials=0), ValueError, "trials"),
