@@ -26,6 +26,12 @@ mkdir -p "$work"
 cd "$work"  # the jobs' working directory: their logs land here
 
 cluster=$src/scripts/slurm-local.sh
+# A cluster of this build's own (state folder and ports from the build folder), so two test suites on
+# one machine (a fresh clone beside a sanitizer build) do not start and stop each other's cluster. The
+# folder stays short: munge's socket path must fit a Unix socket name.
+key=$(printf '%s' "$(dirname "$work")" | cksum | cut -d' ' -f1)
+export ARMSIM_SLURM_DIR=${ARMSIM_SLURM_DIR:-/tmp/armsim-slurm-$(id -u)-$((key % 100000))}
+export ARMSIM_SLURM_PORT=${ARMSIM_SLURM_PORT:-$((16817 + 2 * (key % 2000)))}
 started=0
 jobs=()
 cleanup() {
