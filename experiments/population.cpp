@@ -89,6 +89,7 @@ Population loadPopulation(const std::string& path) {
     } catch (const InputError& e) {
         throw InputError(root.where("model") + ": field 'model' = '" + model + "': " + e.what());
     }
+    if (root.has("muscle_model")) readMuscleModelKey(root, p.base);
     if (root.has("strength")) {
         const ParamNode s = root.child("strength");
         p.strengthMeanScale = s.getNumber("mean_scale", Bound::any(), p.strengthMeanScale);

@@ -9,7 +9,7 @@
 // muscle's L0 and L0T; moment arms scale with it) are person-level ln-normal scales; they come from a
 // stream of their own ({seed, index, 1}), so populations without them draw exactly as before. Lengths: scale ~ N(1, sd^2) per muscle, truncated at 3 sd.
 // Slow fraction: F_slow + N(0, sd^2), clipped to [0.05, 0.95]. A muscle's lengths are redrawn while its
-// relaxed fascicle at the longest path (P_max) would pass 95 % of the model's nf limit (such a person
+// relaxed (Virtual Muscle) fascicle at the longest path (P_max) would pass 95 % of the model's nf limit (such a person
 // could not extend the elbow within the model's validity), so length draws are slightly narrower than
 // stated for muscles near that limit. Effort: voluntary activation and co-contraction uniform in
 // their ranges; trial CV as given. Every draw comes from one PortableRandom seeded with {seed, index}
@@ -55,7 +55,10 @@ struct Population {
 };
 
 /// Reads a population file (strict: unknown keys are errors; every error names file, line, key,
-/// value and the expected range). `model:` is a model name or file (loadModel).
+/// value and the expected range). `model:` is a model name or file (loadModel); `muscle_model:` (as in
+/// a model file: a name or {model: NAME, COEFFICIENT: VALUE}) gives every muscle of the base that
+/// muscle model, so a population of the same people (the same draws of mass, lengths, composition)
+/// can have Hill-type muscles, a truth structurally unlike the identifiers' Virtual Muscle.
 Population loadPopulation(const std::string& path);
 /// assets/subjects/default_population.yaml.
 Population loadDefaultPopulation();

@@ -59,6 +59,18 @@ MuscleParameters ArmSetup::calcMuscleParameters(int i) const {
     return p;
 }
 
+std::shared_ptr<const MuscleModel> ArmSetup::buildMuscleModel(int i) const {
+    const MuscleSpec& m = muscles.at(i);
+    const MuscleModelType& type = findMuscleModelType(m.muscleModel);
+    return type.build(MuscleModelInput{calcMuscleParameters(i), m.muscleModelCoefficients});
+}
+
+bool ArmSetup::hasOnlyVirtualMuscles() const {
+    for (const MuscleSpec& m : muscles)
+        if (m.muscleModel != kDefaultMuscleModel) return false;
+    return true;
+}
+
 void ArmSetup::validate() const {
     arm.validate();
     effort.validate();
@@ -76,6 +88,91 @@ void ArmSetup::validate() const {
 ArmSetup ArmSetup::loadDefault() { return loadModel("thesis"); }
 
 namespace {
+struct MuscleModelChoice {
+    std::string name;
+    std::map<std::string, double> coefficients;
+};
+MuscleModelChoice readMuscleModelChoice(const ParamNode& n, const std::string& inherited);
+}  // namespace
+
+void readMuscleModelKey(const ParamNode& node, ArmSetup& setup) {
+    const MuscleModelChoice c = readMuscleModelChoice(node, kDefaultMuscleModel);
+    node.rethrowWithLocation([&] {
+        try {
+            setMuscleModel(setup, c.name, c.coefficients);
+        } catch (const FieldError&) {
+            throw;
+        } catch (const InputError& e) {
+            throw InputError(node.where("muscle_model") + ": " + e.what());
+        }
+    });
+}
+
+namespace {
+std::map<std::string, double> loadMuscleModelCoefficients(const MuscleModelType& type);
+}  // namespace
+
+void setMuscleModel(ArmSetup& setup, const std::string& name, const std::map<std::string, double>& coefficients) {
+    const MuscleModelType& type = findMuscleModelType(name);
+    std::map<std::string, double> c = loadMuscleModelCoefficients(type);
+    for (const auto& [k, v] : coefficients) {
+        if (std::find(type.coefficientKeys.begin(), type.coefficientKeys.end(), k) == type.coefficientKeys.end())
+            throw InputError("muscle model " + name + " has no coefficient '" + k + "'");
+        c[k] = v;
+    }
+    for (MuscleSpec& m : setup.muscles) {
+        m.muscleModel = name;
+        m.muscleModelCoefficients = c;
+    }
+    for (int i = 0; i < setup.getNumMuscles(); ++i) setup.buildMuscleModel(i);  // validates
+}
+
+namespace {
+
+// A model file's `muscle_model:` (at the top or in a muscle): a registry name, or a mapping with an
+// optional `model:` and coefficients of that model (or of `inherited` when it names none).
+MuscleModelChoice readMuscleModelChoice(const ParamNode& n, const std::string& inherited) {
+    MuscleModelChoice c{inherited, {}};
+    auto findType = [&](const ParamNode& node, const std::string& key, const std::string& name) -> const MuscleModelType& {
+        try {
+            return findMuscleModelType(name);
+        } catch (const InputError& e) {
+            throw InputError(node.where(key) + ": field '" + node.path(key) + "' = '" + name + "': " +
+                             std::string(e.what()).substr(std::string(e.what()).find("expected")));
+        }
+    };
+    if (!n.isMapping("muscle_model")) {
+        c.name = n.getString("muscle_model");
+        findType(n, "muscle_model", c.name);
+        return c;
+    }
+    const ParamNode m = n.child("muscle_model");
+    if (m.has("model")) c.name = m.getString("model");
+    const MuscleModelType& type = findType(m, "model", c.name);
+    for (const std::string& key : m.getKeys()) {
+        if (key == "model") continue;
+        if (std::find(type.coefficientKeys.begin(), type.coefficientKeys.end(), key) == type.coefficientKeys.end()) {
+            std::string keys;
+            for (const std::string& k : type.coefficientKeys) keys += (keys.empty() ? "" : ", ") + k;
+            throw InputError(m.where(key) + ": field '" + m.path(key) + "': muscle model " + type.name +
+                             " has no such coefficient (expected " + (keys.empty() ? "none" : "one of " + keys) + ")");
+        }
+        c.coefficients[key] = m.getNumber(key, Bound::any());
+    }
+    m.finish();
+    return c;
+}
+
+// The shipped coefficients of a muscle model (assets/muscles/<file>), as numbers by key.
+std::map<std::string, double> loadMuscleModelCoefficients(const MuscleModelType& type) {
+    std::map<std::string, double> out;
+    if (type.coefficientFile.empty()) return out;
+    const ParamNode f = ParamNode::loadFile(findAsset("muscles/" + type.coefficientFile));
+    f.getString("source", "");
+    for (const std::string& key : type.coefficientKeys) out[key] = f.getNumber(key, Bound::any());
+    f.finish();
+    return out;
+}
 
 std::array<double, 3> readVec3(const ParamNode& n, const std::string& key, const Bound& bound) {
     const std::vector<double> v = n.getNumbers(key, bound);
@@ -136,8 +233,20 @@ PathElementSpec readViaElement(const ParamNode& n, int index) {
     return e;
 }
 
-MuscleSpec readMuscle(const ParamNode& n, const MuscleDefaults& defaults) {
+MuscleSpec readMuscle(const ParamNode& n, const MuscleDefaults& defaults, const MuscleModelChoice& model) {
     MuscleSpec m;
+    m.muscleModel = model.name;
+    m.muscleModelCoefficients = model.coefficients;
+    if (n.has("muscle_model")) {
+        const MuscleModelChoice own = readMuscleModelChoice(n, model.name);
+        if (own.name != model.name) {
+            m.muscleModel = own.name;
+            m.muscleModelCoefficients.clear();
+        }
+        if (m.muscleModelCoefficients.empty() && m.muscleModel != kDefaultMuscleModel)
+            m.muscleModelCoefficients = loadMuscleModelCoefficients(findMuscleModelType(m.muscleModel));
+        for (const auto& [k, v] : own.coefficients) m.muscleModelCoefficients[k] = v;
+    }
     const std::string name = n.getString("name");
     if (!std::regex_match(name, std::regex("[A-Za-z][A-Za-z0-9_]*")))
         throw InputError(n.where("name") + ": field '" + n.path("name") + "' = '" + name +
@@ -345,8 +454,15 @@ ArmSetup loadModelFile(const std::string& file) {
     if (root.has("specific_tension"))
         s.specificTension = root.getNumber("specific_tension", getSpecificTensionBound());
     if (root.has("max_firing_rate")) s.maxFiringRate = root.getNumber("max_firing_rate", getMaxFiringRateBound());
+    MuscleModelChoice model{kDefaultMuscleModel, {}};
+    if (root.has("muscle_model")) {
+        model = readMuscleModelChoice(root, kDefaultMuscleModel);
+        std::map<std::string, double> c = loadMuscleModelCoefficients(findMuscleModelType(model.name));
+        for (const auto& [k, v] : model.coefficients) c[k] = v;
+        model.coefficients = c;
+    }
     for (const ParamNode& m : root.children("muscles"))
-        s.muscles.push_back(readMuscle(m, MuscleDefaults{s.specificTension, s.maxFiringRate}));
+        s.muscles.push_back(readMuscle(m, MuscleDefaults{s.specificTension, s.maxFiringRate}, model));
     if (s.muscles.empty()) throw InputError(root.where("muscles") + ": field 'muscles' is empty: expected at least one muscle");
     if (root.has("primary")) {
         const std::string primary = root.getString("primary");
@@ -389,6 +505,8 @@ ArmSetup loadModelFile(const std::string& file) {
     resolveMaxPathLengths(s);
     try {
         s.validate();
+        for (int i = 0; i < s.getNumMuscles(); ++i)
+            if (s.muscles[i].muscleModel != kDefaultMuscleModel) s.buildMuscleModel(i);  // validates its coefficients
     } catch (const InputError& e) {
         throw InputError(file + ": " + e.what());
     }

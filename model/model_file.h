@@ -1,4 +1,5 @@
-// Model files (assets/models/*.yaml): an arm and its muscles, each a Virtual Muscle on its own path.
+// Model files (assets/models/*.yaml): an arm and its muscles, each a muscle model (Virtual Muscle by
+// default) on its own path.
 // Framework-free data; model/muscle_arm.h builds the Simbody system from it.
 //
 // A model file has
@@ -19,9 +20,14 @@
 //                                        the heads of the thesis's "biceps" (the primary among them) and
 //                                        the flexors the synergist-aware identifier estimates one by one
 //                                        (default: the primary alone; none)
+//   muscle_model: NAME or {model: NAME, COEFFICIENT: VALUE, ...}
+//                                        every muscle's model (muscles/muscle_models.h: virtual_muscle,
+//                                        the default, or thelen2003) and coefficients of that model over
+//                                        its shipped file's (assets/muscles/NAME.yaml); a muscle's own
+//                                        `muscle_model:` replaces the model, or adds coefficients to it
 //   primary: NAME                        the muscle the thesis calls "the biceps": the transducer
 //                                        estimate and the identification address it (default: first)
-//   muscles: [...]                       each: name, group (flexor|extensor|forearm), Virtual Muscle
+//   muscles: [...]                       each: name, group (flexor|extensor|forearm), muscle_model, Virtual Muscle
 //                                        parameters (a `parameters:` muscle file and/or the fields of a
 //                                        muscle file; `max_isometric_force` [N] or `volume` [m^3] may
 //                                        stand for `mass` and `tendon_slack_length` [m] for
@@ -41,9 +47,12 @@
 #pragma once
 
 #include "model/arm_parameters.h"
+#include "muscles/muscle_models.h"
 #include "muscles/virtual_muscle.h"
 
 #include <array>
+#include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -130,6 +139,10 @@ struct MuscleSpec {
     /// false: params.maxPathLength as given.
     bool maxPathFromRange = true;
     std::string source;                   ///< where the numbers come from
+    /// The muscle model it is built with (muscles/muscle_models.h registry name) and that model's own
+    /// coefficients (the model's shipped file, then the model file's, then the muscle's own).
+    std::string muscleModel = kDefaultMuscleModel;
+    std::map<std::string, double> muscleModelCoefficients;
     /// Sets calibration and recomputes params from sourceParams (P_max kept).
     void setCalibration(const MuscleCalibration& c);
 };
@@ -174,6 +187,10 @@ struct ArmSetup {
     MuscleParameters& biceps() { return muscles.at(primary).params; }
     /// Validated parameters of muscle i (P_max as resolved).
     MuscleParameters calcMuscleParameters(int i) const;
+    /// Muscle i built with its muscle model (validated; P_max as resolved).
+    std::shared_ptr<const MuscleModel> buildMuscleModel(int i) const;
+    /// true when every muscle is a Virtual Muscle.
+    bool hasOnlyVirtualMuscles() const;
     /// The primary muscle's, as calcMuscleParameters(primary).
     MuscleParameters calcBicepsParameters() const { return calcMuscleParameters(primary); }
     /// Throws InputError for an inconsistent model (no muscles, duplicate names, bad primary).
@@ -190,6 +207,14 @@ ArmSetup applyCalibration(const ArmSetup& setup, const std::vector<MuscleCalibra
 /// The model virtual subjects default to (the default population's, the main job's, protocols' and
 /// `model show` / `check`'s): the anatomical twin.
 inline const char* const kDefaultSubjectModel = "twin";
+
+/// Every muscle of setup built with model `name` and coefficients (over the model's shipped file's);
+/// InputError naming an unknown model or coefficient.
+void setMuscleModel(ArmSetup& setup, const std::string& name, const std::map<std::string, double>& coefficients = {});
+class ParamNode;
+/// setMuscleModel from node's `muscle_model:` key (a name or {model: NAME, COEFFICIENT: VALUE}), as a
+/// model file writes it; errors name the file and line.
+void readMuscleModelKey(const ParamNode& node, ArmSetup& setup);
 
 /// Loads a model: a name under assets/models/ ("thesis", "elbow", "twin") or a file path. Every error names
 /// the file, line, key and value. P_max of muscles with `max_path_length: range` is resolved

@@ -65,8 +65,7 @@ MuscleArm::MuscleArm(const ArmSetup& setup, std::vector<ActivationProfile> activ
         throw std::logic_error("MuscleArm: " + std::to_string(activations.size()) + " activation profiles for " +
                                std::to_string(setup_.getNumMuscles()) + " muscles");
     for (int i = 0; i < setup_.getNumMuscles(); ++i) {
-        auto muscle = std::make_shared<VirtualMuscle>(setup_.calcMuscleParameters(i));
-        forces_.emplace_back(arm_->updForces(), std::move(muscle), buildMusclePath(*arm_, setup_.muscles[i]),
+        forces_.emplace_back(arm_->updForces(), setup_.buildMuscleModel(i), buildMusclePath(*arm_, setup_.muscles[i]),
                              std::move(activations[i]));
     }
     arm_->finalize();
@@ -87,21 +86,21 @@ double MuscleArm::calcForearmMomentArm(const State& s, int i) const {
 }
 
 void MuscleArm::setSteadyMuscleStates(State& s) const {
-    for (const VirtualMuscleForce& f : forces_) {
+    for (const MuscleForce& f : forces_) {
         try {
             f.setSteadyMuscleStates(s);
         } catch (const SimulationError& e) {
-            throw SimulationError("muscle '" + f.getMuscle().getParameters().name + "': " + e.what());
+            throw SimulationError("muscle '" + f.getMuscle().getName() + "': " + e.what());
         }
     }
 }
 
 void MuscleArm::setInitialMuscleStates(State& s) const {
-    for (const VirtualMuscleForce& f : forces_) f.setInitialMuscleStates(s);
+    for (const MuscleForce& f : forces_) f.setInitialMuscleStates(s);
 }
 
 void MuscleArm::checkMuscleStates(const State& s) const {
-    for (const VirtualMuscleForce& f : forces_) f.checkMuscleStates(s);
+    for (const MuscleForce& f : forces_) f.checkMuscleStates(s);
 }
 
 std::vector<std::string> MuscleArm::getStateColumnNames() const {
@@ -113,7 +112,7 @@ std::vector<std::string> MuscleArm::getStateColumnNames() const {
 }
 
 void MuscleArm::appendMuscleStates(const State& s, std::vector<double>& row) const {
-    for (const VirtualMuscleForce& f : forces_) {
+    for (const MuscleForce& f : forces_) {
         const std::vector<double> y = f.getMuscleStates(s);
         row.insert(row.end(), y.begin(), y.end());
     }
@@ -121,7 +120,7 @@ void MuscleArm::appendMuscleStates(const State& s, std::vector<double>& row) con
 
 void MuscleArm::setMuscleStates(State& s, const std::vector<double>& y) const {
     std::size_t at = 0;
-    for (const VirtualMuscleForce& f : forces_) {
+    for (const MuscleForce& f : forces_) {
         const std::size_t n = std::size_t(f.getMuscle().getNumStates());
         if (at + n > y.size()) throw std::logic_error("MuscleArm::setMuscleStates: too few values");
         f.setMuscleStates(s, std::vector<double>(y.begin() + at, y.begin() + at + n));

@@ -1,5 +1,5 @@
-// The arm built from a model (model/model_file.h): an ArmModel plus one Virtual Muscle force element
-// per muscle, each on its own path (muscles/muscle_path.h: via points, wrapping cylinders and spheres).
+// The arm built from a model (model/model_file.h): an ArmModel plus one muscle force element (its
+// muscle model from the model file) per muscle, each on its own path (muscles/muscle_path.h: via points, wrapping cylinders and spheres).
 #pragma once
 
 #include "model/arm.h"
@@ -34,12 +34,12 @@ public:
     const SimTK::State& getDefaultState() const { return arm_->getDefaultState(); }
 
     int getNumMuscles() const { return int(forces_.size()); }
-    const VirtualMuscleForce& getMuscleForce(int i) const { return forces_.at(i); }
-    const VirtualMuscle& getMuscle(int i) const { return forces_.at(i).getMuscle(); }
+    const MuscleForce& getMuscleForce(int i) const { return forces_.at(i); }
+    const MuscleModel& getMuscle(int i) const { return forces_.at(i).getMuscle(); }
     const std::string& getMuscleName(int i) const { return setup_.muscles.at(i).params.name; }
     /// The primary muscle (the thesis's biceps).
-    const VirtualMuscleForce& getBiceps() const { return forces_.at(setup_.primary); }
-    const VirtualMuscle& getMuscle() const { return getBiceps().getMuscle(); }
+    const MuscleForce& getBiceps() const { return forces_.at(setup_.primary); }
+    const MuscleModel& getMuscle() const { return getBiceps().getMuscle(); }
 
     /// Path length of muscle i [m] (Stage::Position).
     double calcPathLength(const SimTK::State& s, int i) const;
@@ -68,7 +68,7 @@ public:
 private:
     ArmSetup setup_;
     std::unique_ptr<ArmModel> arm_;
-    std::vector<VirtualMuscleForce> forces_;
+    std::vector<MuscleForce> forces_;
 };
 
 /// Path geometry of a model without muscles or states: lengths and moment arms at any elbow angle.

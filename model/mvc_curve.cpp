@@ -5,7 +5,7 @@
 #include "model/muscle_arm.h"
 
 #include <cmath>
-#include <optional>
+#include <memory>
 #include <stdexcept>
 
 namespace armsim {
@@ -75,20 +75,27 @@ SteadyMvcCurve calcSteadyCurve(const std::vector<MuscleSpec>& muscles, const Mvc
     memory.resize(nm);
     // Every muscle is validated before any is solved (a muscle built afresh, or a cached one whose F0
     // inputs changed); a cached muscle is built only when one of its states must be solved.
-    std::vector<std::optional<VirtualMuscle>> vm(nm);
+    // Muscles of another model than Virtual Muscle are built afresh and never reuse cached states.
+    std::vector<std::shared_ptr<const MuscleModel>> model(nm);
+    auto build = [&](std::size_t i) {
+        const MuscleSpec& m = muscles[i];
+        if (m.muscleModel == kDefaultMuscleModel) model[i] = std::make_shared<VirtualMuscle>(m.params);
+        else model[i] = findMuscleModelType(m.muscleModel).build({m.params, m.muscleModelCoefficients});
+    };
     std::vector<double> F0(nm);
     for (std::size_t i = 0; i < nm; ++i) {
         const MuscleParameters& params = muscles[i].params;
         auto& mem = memory[i];
-        if (!cache || !mem.valid || mem.points.size() != na || !haveSameNormalizedStates(mem.params, params)) {
+        const bool virtualMuscle = muscles[i].muscleModel == kDefaultMuscleModel;
+        if (!cache || !virtualMuscle || !mem.valid || mem.points.size() != na || !haveSameNormalizedStates(mem.params, params)) {
             mem.valid = false;
             mem.points.assign(na, {});
-            vm[i].emplace(params);
+            build(i);
         } else if (params.mass != mem.params.mass || params.coefficients.sigma != mem.params.coefficients.sigma ||
                    params.coefficients.density != mem.params.coefficients.density) {
             params.validate();
         }
-        F0[i] = calcMaxIsometricForce(params);
+        F0[i] = virtualMuscle ? calcMaxIsometricForce(params) : model[i]->getF0();
     }
     for (std::size_t a = 0; a < na; ++a)
         for (std::size_t i = 0; i < nm; ++i) {
@@ -100,8 +107,8 @@ SteadyMvcCurve calcSteadyCurve(const std::vector<MuscleSpec>& muscles, const Mvc
             auto& q = memory[i].points[a];
             const bool reuse = q.valid && q.pathLength == p.pathLength && q.activation == p.activation;
             if (!reuse) {
-                if (!vm[i]) vm[i].emplace(muscles[i].params);
-                const SteadyState st = vm[i]->calcSteadyState(p.pathLength, p.activation);
+                if (!model[i]) build(i);
+                const SteadyState st = model[i]->calcSteadyState(p.pathLength, p.activation);
                 if (!st.converged)
                     throw SimulationError("muscle '" + curve.muscles[i] + "' at " + formatNumber(geometry.flexionDeg[a]) +
                                           " deg flexion: " + st.message);
@@ -115,7 +122,7 @@ SteadyMvcCurve calcSteadyCurve(const std::vector<MuscleSpec>& muscles, const Mvc
         }
     for (std::size_t i = 0; i < nm; ++i) {
         memory[i].params = muscles[i].params;
-        memory[i].valid = true;
+        memory[i].valid = muscles[i].muscleModel == kDefaultMuscleModel;
     }
     for (std::size_t a = 0; a < na; ++a) {
         double total = 0, forearm = 0;

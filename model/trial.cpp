@@ -202,8 +202,7 @@ IsometricTrialResult runIsometricTrial(const ArmSetup& setup, const IsometricTri
     result.series = Table(withMuscleColumns(columns, model));
     result.series.reserveRows(int(std::lround(settings.getDuration() * settings.sampleRate)) + 1);
     const double h = sum.momentArm;
-    const double L0 = model.getMuscle(primary).getParameters().optimalFascicleLength;
-    std::vector<const VirtualMuscle*> muscles;
+    std::vector<const MuscleModel*> muscles;
     for (int i = 0; i < n; ++i) muscles.push_back(&model.getMuscle(i));
     const std::vector<const ActivationProfile*> activations = getActivationProfiles(model);
     // Where each muscle's states sit in y = [q u z].
@@ -241,8 +240,9 @@ IsometricTrialResult runIsometricTrial(const ArmSetup& setup, const IsometricTri
             calcTransducerReading(ap, muscleTorque / ap.strapDistance, settings.elbowAngle, h, F);
         sum.saturated = sum.saturated || r.saturated;
         const double* yp = y + firstState[primary];
-        row.assign({t, profile.getValue(t), radToDeg(settings.elbowAngle), 0.0, F, yp[VirtualMuscle::kL] * L0,
-                    yp[VirtualMuscle::kV] * L0, torque, muscleTorque, r.strapForce, r.saturated ? 1.0 : 0.0,
+        const double Pp = sum.pathLengths[primary], Up = activations[primary]->getValue(t);
+        row.assign({t, profile.getValue(t), radToDeg(settings.elbowAngle), 0.0, F,
+                    muscles[primary]->calcFascicleLength(Pp, yp), muscles[primary]->calcFascicleVelocity(Pp, Up, yp), torque, muscleTorque, r.strapForce, r.saturated ? 1.0 : 0.0,
                     r.forceMomentArm, r.forceFixedRatio, r.errorMomentArmPct, r.errorFixedRatioPct});
         if (forearm) row.push_back(forearmTare - forearmTorque);  // tared, + = supination
         appendMuscleForces(row, activations, forces, t);
@@ -342,7 +342,7 @@ Table runFreeMovement(const ArmSetup& setup, const FreeMovementSettings& setting
     const ArmModel& arm = model.getArm();
     const MultibodySystem& system = model.getSystem();
     const int primary = setup.primary, n = model.getNumMuscles();
-    const VirtualMuscleForce& biceps = model.getBiceps();
+    const MuscleForce& biceps = model.getBiceps();
 
     State state = model.getDefaultState();
     arm.setElbowAngle(state, settings.initialAngle);
@@ -354,7 +354,7 @@ Table runFreeMovement(const ArmSetup& setup, const FreeMovementSettings& setting
                                "moment_arm_m", "muscle_force_N", "fascicle_length_m", "fascicle_velocity_mps",
                                "active_fraction"},
                               model));
-    const double L0 = model.getMuscle(primary).getParameters().optimalFascicleLength;
+    const double L0 = model.getMuscle(primary).getOptimalFascicleLength();
     std::vector<double> forces(n);
     const std::vector<const ActivationProfile*> activations = getActivationProfiles(model);
     const IntegrationStats st = simulateSampled(

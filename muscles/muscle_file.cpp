@@ -132,7 +132,8 @@ void readMuscleFields(const ParamNode& root, MuscleParameters& p, bool required,
     number("optimal_fascicle_length", p.optimalFascicleLength);
     numberOrConverted("optimal_tendon_length", "tendon_slack_length", p.optimalTendonLength);
     if (root.has("max_path_length") || required) number("max_path_length", p.maxPathLength);
-    root.getNumber("pennation_angle", Bound{0, 1.5707963267948966, false, true, "rad, informative only"}, 0.0);
+    if (root.has("pennation_angle"))
+        p.pennationAngle = root.getNumber("pennation_angle", Bound{0, 1.5707963267948966, false, true, "rad"});
 
     if (required || root.has("fibre_fractions")) {
         const ParamNode fr = root.child("fibre_fractions");

@@ -33,7 +33,7 @@ class ParamNode;
 /// Reads the fields of a muscle file present in root into p (all of them when required): one of mass
 /// [kg], max_isometric_force [N] (mass = F0 L0 rho / sigma) and volume [m^3] (mass = rho V, so
 /// F0 = sigma V / L0), optimal_fascicle_length, optimal_tendon_length or tendon_slack_length [m]
-/// (L0T = slack / LrT, see model/model_file.h), max_path_length, pennation_angle (informative),
+/// (L0T = slack / LrT, see model/model_file.h), max_path_length, pennation_angle [rad] (Hill-type models),
 /// fibre_fractions, motor_units, fibre_types, specific_tension [N/m^2], max_firing_rate [f0.5]. Each of
 /// sigma and fmax is, in order of precedence: the muscle's own key, the model's default when > 0, the
 /// fibre-type file's; the defaults are applied only where root reads a fibre-type file (or when

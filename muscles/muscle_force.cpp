@@ -9,16 +9,16 @@ using namespace SimTK;
 
 namespace armsim {
 
-class VirtualMuscleForce::Impl : public Force::Custom::Implementation {
+class MuscleForce::Impl : public Force::Custom::Implementation {
 public:
-    Impl(SubsystemIndex forces, std::shared_ptr<const VirtualMuscle> muscle, MusclePath path,
+    Impl(SubsystemIndex forces, std::shared_ptr<const MuscleModel> muscle, MusclePath path,
          ActivationProfile activation)
         : forces_(forces), muscle_(std::move(muscle)), path_(std::move(path)), activation_(std::move(activation)) {}
 
-    const VirtualMuscle& muscle() const { return *muscle_; }
+    const MuscleModel& muscle() const { return *muscle_; }
     const MusclePath& path() const { return path_; }
     const ActivationProfile& activation() const { return activation_; }
-    const std::string& name() const { return muscle_->getParameters().name; }
+    const std::string& name() const { return muscle_->getName(); }
 
     void realizeTopology(State& s) const override {
         const Vector zInit(muscle_->getNumStates(), 0.0);
@@ -53,82 +53,82 @@ public:
     }
 
     SubsystemIndex forces_;
-    std::shared_ptr<const VirtualMuscle> muscle_;
+    std::shared_ptr<const MuscleModel> muscle_;
     MusclePath path_;
     ActivationProfile activation_;
     mutable ZIndex firstZ_;  // topology-stage cache
 };
 
-VirtualMuscleForce::VirtualMuscleForce(GeneralForceSubsystem& forces, std::shared_ptr<const VirtualMuscle> muscle,
+MuscleForce::MuscleForce(GeneralForceSubsystem& forces, std::shared_ptr<const MuscleModel> muscle,
                                        const MobilizedBody& originBody, const Vec3& originStation,
                                        const MobilizedBody& insertionBody, const Vec3& insertionStation,
                                        ActivationProfile activation)
-    : VirtualMuscleForce(forces, std::move(muscle),
+    : MuscleForce(forces, std::move(muscle),
                          MusclePath(originBody, originStation, insertionBody, insertionStation),
                          std::move(activation)) {}
 
-VirtualMuscleForce::VirtualMuscleForce(GeneralForceSubsystem& forces, std::shared_ptr<const VirtualMuscle> muscle,
+MuscleForce::MuscleForce(GeneralForceSubsystem& forces, std::shared_ptr<const MuscleModel> muscle,
                                        MusclePath path, ActivationProfile activation)
     : Force::Custom(forces, new Impl(forces.getMySubsystemIndex(), std::move(muscle), std::move(path),
                                      std::move(activation))) {}
 
-const VirtualMuscleForce::Impl& VirtualMuscleForce::getImpl() const {
+const MuscleForce::Impl& MuscleForce::getImpl() const {
     return dynamic_cast<const Impl&>(getImplementation());
 }
 
-const VirtualMuscle& VirtualMuscleForce::getMuscle() const { return getImpl().muscle(); }
-const MusclePath& VirtualMuscleForce::getPath() const { return getImpl().path(); }
-const ActivationProfile& VirtualMuscleForce::getActivationProfile() const { return getImpl().activation(); }
+const MuscleModel& MuscleForce::getMuscle() const { return getImpl().muscle(); }
+const MusclePath& MuscleForce::getPath() const { return getImpl().path(); }
+const ActivationProfile& MuscleForce::getActivationProfile() const { return getImpl().activation(); }
 
-double VirtualMuscleForce::getPathLength(const State& s) const { return getImpl().pathLength(s); }
+double MuscleForce::getPathLength(const State& s) const { return getImpl().pathLength(s); }
 
-PathGeometry VirtualMuscleForce::calcPathGeometry(const State& s, bool withPolyline) const {
+PathGeometry MuscleForce::calcPathGeometry(const State& s, bool withPolyline) const {
     return getImpl().geometry(s, withPolyline);
 }
 
-double VirtualMuscleForce::getActivation(const State& s) const {
+double MuscleForce::getActivation(const State& s) const {
     return getImpl().activation().getValue(s.getTime());
 }
 
-double VirtualMuscleForce::getForce(const State& s) const {
+double MuscleForce::getForce(const State& s) const {
     return getMuscle().calcForce(getPathLength(s), getImpl().z(s));
 }
 
-double VirtualMuscleForce::getFascicleLength(const State& s) const {
-    return getImpl().z(s)[VirtualMuscle::kL] * getMuscle().getParameters().optimalFascicleLength;
+double MuscleForce::getFascicleLength(const State& s) const {
+    return getMuscle().calcFascicleLength(getPathLength(s), getImpl().z(s));
 }
 
-double VirtualMuscleForce::getFascicleVelocity(const State& s) const {
-    return getImpl().z(s)[VirtualMuscle::kV] * getMuscle().getParameters().optimalFascicleLength;
+double MuscleForce::getFascicleVelocity(const State& s) const {
+    return getMuscle().calcFascicleVelocity(getPathLength(s), getActivation(s), getImpl().z(s));
 }
 
-MuscleOutputs VirtualMuscleForce::calcOutputs(const State& s) const {
+MuscleOutputs MuscleForce::calcOutputs(const State& s) const {
     return getMuscle().calcOutputs(getPathLength(s), getActivation(s), getImpl().z(s));
 }
 
-std::vector<double> VirtualMuscleForce::getMuscleStates(const State& s) const {
+std::vector<double> MuscleForce::getMuscleStates(const State& s) const {
     const double* z = getImpl().z(s);
     return std::vector<double>(z, z + getMuscle().getNumStates());
 }
 
-int VirtualMuscleForce::getFirstStateIndex(const State& s) const {
+int MuscleForce::getFirstStateIndex(const State& s) const {
     return int(s.getZStart(getImpl().forces_)) + int(getImpl().firstZ_);
 }
 
-void VirtualMuscleForce::setMuscleStates(State& s, const std::vector<double>& y) const {
-    SimTK_APIARGCHECK_ALWAYS(int(y.size()) == getMuscle().getNumStates(), "VirtualMuscleForce",
+void MuscleForce::setMuscleStates(State& s, const std::vector<double>& y) const {
+    SimTK_APIARGCHECK_ALWAYS(int(y.size()) == getMuscle().getNumStates(), "MuscleForce",
                              "setMuscleStates", "wrong number of muscle states");
     Vector& z = s.updZ(getImpl().forces_);
     for (int i = 0; i < int(y.size()); ++i) z[getImpl().firstZ_ + i] = y[i];
 }
 
-void VirtualMuscleForce::setInitialMuscleStates(State& s) const {
+void MuscleForce::setInitialMuscleStates(State& s) const {
     const auto& sys = getForceSubsystem().getSystem();
     sys.realize(s, Stage::Position);
     setMuscleStates(s, getMuscle().calcInitialState(getPathLength(s)));
 }
 
-void VirtualMuscleForce::setSteadyMuscleStates(State& s) const {
+void MuscleForce::setSteadyMuscleStates(State& s) const {
     const auto& sys = getForceSubsystem().getSystem();
     sys.realize(s, Stage::Position);
     const SteadyState ss = getMuscle().calcSteadyState(getPathLength(s), getActivation(s));
@@ -136,11 +136,11 @@ void VirtualMuscleForce::setSteadyMuscleStates(State& s) const {
     setMuscleStates(s, ss.states);
 }
 
-void VirtualMuscleForce::checkMuscleStates(const State& s) const {
+void MuscleForce::checkMuscleStates(const State& s) const {
     getMuscle().checkStates(s.getTime(), getImpl().z(s));
 }
 
-Vec3 VirtualMuscleForce::calcActivationColor(double a) {
+Vec3 MuscleForce::calcActivationColor(double a) {
     a = std::min(1.0, std::max(0.0, a));
     return Vec3(0.15 + 0.8 * a, 0.25 * (1 - a) + 0.1, 0.85 * (1 - a) + 0.1);
 }

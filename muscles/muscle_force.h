@@ -1,38 +1,38 @@
-// The Simbody adapter of the Virtual Muscle: a Force::Custom that owns the muscle states as Simbody
-// continuous (z) states and applies Fse along its path (muscles/muscle_path.h): a straight line between
+// The Simbody adapter of a muscle model (muscles/muscle_model.h): a Force::Custom that owns the muscle
+// states as Simbody continuous (z) states and applies the tendon force along its path (muscles/muscle_path.h): a straight line between
 // two stations, or a path through via points and over wrapping surfaces.
 #pragma once
 
 #include "muscles/activation.h"
 #include "muscles/muscle_path.h"
 #include "muscles/simbody.h"
-#include "muscles/virtual_muscle.h"
+#include "muscles/muscle_model.h"
 
 #include <memory>
 #include <vector>
 
 namespace armsim {
 
-/// A Virtual Muscle acting along a MusclePath.
+/// A muscle model acting along a MusclePath.
 ///
-/// The muscle's states (VirtualMuscle::getNumStates(), all of order 1) are allocated as z states in
+/// The muscle's states (MuscleModel::getNumStates(), all of order 1) are allocated as z states in
 /// realizeTopology and their derivatives written in realizeDynamics; the tension Fse acts along the
 /// path (pulling origin and insertion together, pressing on via points and wrapping surfaces).
 /// Activation U(t) comes from an ActivationProfile evaluated at the state's time. Path length P [m]
 /// must stay inside (0, P_max].
 ///
 /// Like every Simbody handle this class has no data members; the implementation holds the model.
-class VirtualMuscleForce : public SimTK::Force::Custom {
+class MuscleForce : public SimTK::Force::Custom {
 public:
-    VirtualMuscleForce() = default;
-    VirtualMuscleForce(SimTK::GeneralForceSubsystem& forces, std::shared_ptr<const VirtualMuscle> muscle,
+    MuscleForce() = default;
+    MuscleForce(SimTK::GeneralForceSubsystem& forces, std::shared_ptr<const MuscleModel> muscle,
                        const SimTK::MobilizedBody& originBody, const SimTK::Vec3& originStation,
                        const SimTK::MobilizedBody& insertionBody, const SimTK::Vec3& insertionStation,
                        ActivationProfile activation);
-    VirtualMuscleForce(SimTK::GeneralForceSubsystem& forces, std::shared_ptr<const VirtualMuscle> muscle,
+    MuscleForce(SimTK::GeneralForceSubsystem& forces, std::shared_ptr<const MuscleModel> muscle,
                        MusclePath path, ActivationProfile activation);
 
-    const VirtualMuscle& getMuscle() const;
+    const MuscleModel& getMuscle() const;
     const MusclePath& getPath() const;
     const ActivationProfile& getActivationProfile() const;
 

@@ -120,7 +120,7 @@ IntegrationStats simulateSampled(const MultibodySystem& system, State& state, do
     return stats;
 }
 
-void MuscleIsometricSettings::validate(const VirtualMuscle& muscle) const {
+void MuscleIsometricSettings::validate(const MuscleModel& muscle) const {
     muscle.checkPathLength(pathLength);
     checkField("duration", duration, Bound::positive("s"));
     checkField("sample_rate", sampleRate, Bound::positive("Hz"));
@@ -128,19 +128,18 @@ void MuscleIsometricSettings::validate(const VirtualMuscle& muscle) const {
     integration.validate();
 }
 
-Table runMuscleIsometric(const VirtualMuscle& muscle, const MuscleIsometricSettings& settings,
+Table runMuscleIsometric(const MuscleModel& muscle, const MuscleIsometricSettings& settings,
                          IntegrationStats* stats) {
     settings.validate(muscle);
     const double P = settings.pathLength;
-    const double L0 = muscle.getParameters().optimalFascicleLength;
-    const double L0T = muscle.getParameters().optimalTendonLength;
+    const double L0 = muscle.getOptimalFascicleLength();
     Table table({"time_s", "activation", "force_N", "fce_N", "fascicle_length_m", "fascicle_velocity_mps",
                  "tendon_length_m", "active_fraction"});
     table.reserveRows(int(std::lround(settings.duration * settings.sampleRate)) + 1);
     const OdeVisitor sample = [&](double t, const double* z) {
         const double U = settings.activation.getValue(t);
         const MuscleOutputs o = muscle.calcOutputs(P, U, z);
-        table.appendRow({t, U, o.Fse, o.Fce, o.L * L0, o.V * L0, o.LT * L0T, o.activeFraction});
+        table.appendRow({t, U, o.Fse, o.Fce, o.L * L0, o.V * L0, o.tendonLength, o.activeFraction});
     };
     std::vector<double> z;
     if (settings.startSteady) {
@@ -162,8 +161,9 @@ Table runMuscleIsometric(const VirtualMuscle& muscle, const MuscleIsometricSetti
         MultibodySystem system;
         SimbodyMatterSubsystem matter(system);
         GeneralForceSubsystem forces(system);
-        const VirtualMuscleForce force(forces, std::make_shared<VirtualMuscle>(muscle), matter.Ground(), Vec3(0),
-                                       matter.Ground(), Vec3(P, 0, 0), settings.activation);
+        // The caller's muscle outlives the system: share it without ownership.
+        const MuscleForce force(forces, std::shared_ptr<const MuscleModel>(&muscle, [](const MuscleModel*) {}),
+                                matter.Ground(), Vec3(0), matter.Ground(), Vec3(P, 0, 0), settings.activation);
         system.realizeTopology();
         State state = system.getDefaultState();
         force.setMuscleStates(state, z);

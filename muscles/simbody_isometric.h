@@ -6,7 +6,7 @@
 #include "muscles/activation.h"
 #include "muscles/simbody.h"
 #include "numerics/stiff_ode.h"
-#include "muscles/virtual_muscle.h"
+#include "muscles/muscle_model.h"
 
 #include <functional>
 #include <vector>
@@ -41,12 +41,12 @@ struct MuscleIsometricSettings {
     bool integrateSimbodySystem = false;
     IntegrationSettings integration;
     /// Throws InputError naming the field for a bad value (path checked against the muscle's P_max).
-    void validate(const VirtualMuscle& muscle) const;
+    void validate(const MuscleModel& muscle) const;
 };
 
 /// Runs the trial and returns its time series: time_s, activation, force_N (Fse), fce_N,
 /// fascicle_length_m, fascicle_velocity_mps, tendon_length_m, active_fraction.
-Table runMuscleIsometric(const VirtualMuscle& muscle, const MuscleIsometricSettings& settings,
+Table runMuscleIsometric(const MuscleModel& muscle, const MuscleIsometricSettings& settings,
                          IntegrationStats* stats = nullptr);
 
 }  // namespace armsim

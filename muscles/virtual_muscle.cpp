@@ -1,5 +1,7 @@
 #include "muscles/virtual_muscle.h"
 
+#include "numerics/brent.h"
+
 #include "basics/bound.h"
 
 #include <algorithm>
@@ -185,7 +187,7 @@ std::pair<double, double> calcInitialLengthConstants(const MuscleCoefficients& c
 // `apportioning`: add such a field to haveSameNormalizedStates by hand.
 static_assert(sizeof(FibreType) == sizeof(std::string) + 24 * sizeof(double), "FibreType changed: update operator==");
 static_assert(sizeof(MuscleCoefficients) == 15 * sizeof(double), "MuscleCoefficients changed: update operator==");
-static_assert(sizeof(MuscleParameters) == sizeof(std::string) + 5 * sizeof(double) + 4 * sizeof(int) +
+static_assert(sizeof(MuscleParameters) == sizeof(std::string) + 6 * sizeof(double) + 4 * sizeof(int) +
                                               2 * sizeof(FibreType) + sizeof(MuscleCoefficients),
               "MuscleParameters changed: update haveSameNormalizedStates");
 
@@ -212,7 +214,7 @@ bool haveSameNormalizedStates(const MuscleParameters& a, const MuscleParameters&
     ca.sigma = b.coefficients.sigma;
     ca.density = b.coefficients.density;
     return a.optimalFascicleLength == b.optimalFascicleLength && a.optimalTendonLength == b.optimalTendonLength &&
-           a.maxPathLength == b.maxPathLength && a.slowFraction == b.slowFraction &&
+           a.maxPathLength == b.maxPathLength && a.pennationAngle == b.pennationAngle && a.slowFraction == b.slowFraction &&
            a.numSlowUnits == b.numSlowUnits && a.numFastUnits == b.numFastUnits && a.apportioning == b.apportioning &&
            a.slow == b.slow && a.fast == b.fast && ca == b.coefficients;
 }
@@ -348,6 +350,7 @@ void VirtualMuscle::calcStateDerivative(double P, double U, const double* y, dou
         out->L = L;
         out->V = V;
         out->LT = LT;
+        out->tendonLength = LT * params_.optimalTendonLength;
         out->activeFraction = slow.sum + fast.sum;
     }
 }
@@ -368,13 +371,6 @@ void VirtualMuscle::checkStates(double t, const double* y) const {
             << ") L0; beyond it the activation-frequency exponent nf is not positive (spec 4)";
         throw SimulationError(msg.str());
     }
-}
-
-MuscleOutputs VirtualMuscle::calcOutputs(double P, double U, const double* y) const {
-    MuscleOutputs out;
-    std::vector<double> ydot(numStates_);
-    calcStateDerivative(P, U, y, ydot.data(), &out);
-    return out;
 }
 
 double VirtualMuscle::calcSteadyImbalance(double P, double U, double L) const {
@@ -402,7 +398,7 @@ SteadyState VirtualMuscle::calcSteadyState(double P, double U) const {
     const double L0 = params_.optimalFascicleLength;
     const bool nfBound = nfLimit_ * (1.0 - 1e-9) < P / L0;
     double a = kSteadyLmin, b = nfBound ? nfLimit_ * (1.0 - 1e-9) : P / L0;
-    double fa = calcSteadyImbalance(P, U, a), fb = calcSteadyImbalance(P, U, b);
+    const double fa = calcSteadyImbalance(P, U, a), fb = calcSteadyImbalance(P, U, b);
     result.evaluations = 2;
     if (!(fa > 0) || !(fb < 0)) {
         std::ostringstream msg;
@@ -415,50 +411,15 @@ SteadyState VirtualMuscle::calcSteadyState(double P, double U) const {
         result.message = msg.str();
         return result;
     }
-    // Brent's method (Brent 1973, "Algorithms for Minimization without Derivatives", ch. 4).
-    double c = a, fc = fa, d = b - a, e = d;
-    for (int iter = 0; iter < 200; ++iter) {
-        if ((fb > 0) == (fc > 0)) { c = a; fc = fa; d = e = b - a; }
-        if (std::abs(fc) < std::abs(fb)) { a = b; b = c; c = a; fa = fb; fb = fc; fc = fa; }
-        const double tol = 2.0 * std::numeric_limits<double>::epsilon() * std::abs(b) + 0.5 * kSteadyTolL;
-        const double m = 0.5 * (c - b);
-        if (std::abs(m) <= tol || fb == 0.0) {
-            result.converged = true;
-            break;
-        }
-        if (std::abs(e) >= tol && std::abs(fa) > std::abs(fb)) {
-            double p, q, r, s = fb / fa;
-            if (a == c) {
-                p = 2.0 * m * s;
-                q = 1.0 - s;
-            } else {
-                q = fa / fc;
-                r = fb / fc;
-                p = s * (2.0 * m * q * (q - r) - (b - a) * (r - 1.0));
-                q = (q - 1.0) * (r - 1.0) * (s - 1.0);
-            }
-            if (p > 0) q = -q; else p = -p;
-            if (2.0 * p < std::min(3.0 * m * q - std::abs(tol * q), std::abs(e * q))) {
-                e = d;
-                d = p / q;
-            } else {
-                d = m;
-                e = m;
-            }
-        } else {
-            d = m;
-            e = m;
-        }
-        a = b;
-        fa = fb;
-        b += std::abs(d) > tol ? d : (m > 0 ? tol : -tol);
-        fb = calcSteadyImbalance(P, U, b);
-        ++result.evaluations;
-    }
+    const BrentResult root = findRootBrent([&](double L) { return calcSteadyImbalance(P, U, L); }, a, b, fa, fb,
+                                           kSteadyTolL, 200);
+    result.evaluations = root.evaluations;
+    result.converged = root.converged;
     if (!result.converged) {
         result.message = "steady solve did not converge in 200 iterations at path " + fmt(P) + " m";
         return result;
     }
+    b = root.x;
     result.L = b;
     result.fascicleLength = b * L0;
     const double LT = (P - L0 * b) / params_.optimalTendonLength;

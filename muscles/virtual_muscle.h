@@ -33,6 +33,8 @@
 // | Fse     | Outputs::Fse            | series-elastic force = the muscle's output force     | N        |
 #pragma once
 
+#include "muscles/muscle_model.h"
+
 #include <string>
 #include <vector>
 
@@ -117,6 +119,9 @@ struct MuscleParameters {
     double optimalFascicleLength = 0;   ///< L0 [m] (thesis Table 4.2)
     double optimalTendonLength = 0;     ///< L0T [m] (thesis Table 4.2)
     double maxPathLength = 0;           ///< P_max, path at the anatomical limit [m]
+    /// Pennation angle at L0 [rad]: not used by Virtual Muscle; Hill-type models built from these
+    /// parameters (muscles/muscle_models.h) use it.
+    double pennationAngle = 0;
     double slowFraction = 0;            ///< F_slow, PCSA fraction of slow fibres [1] (Table 4.3)
     int numSlowUnits = 3;               ///< Ns (thesis default 3)
     int numFastUnits = 3;               ///< Nf (thesis default 3)
@@ -167,51 +172,35 @@ struct MotorUnit {
 std::vector<MotorUnit> calcRecruitment(int numSlow, int numFast, double slowFraction,
                                        double Ur, Apportioning apportioning);
 
-/// Quantities derived from the state, for output and drawing.
-struct MuscleOutputs {
-    double Fse = 0;              ///< series-elastic (output) force [N]
-    double Fce = 0;              ///< contractile-element force [N]
-    double L = 0;                ///< fascicle length / L0 [1]
-    double V = 0;                ///< fascicle velocity [L0/s]
-    double LT = 0;               ///< tendon length / L0T [1]
-    double activeFraction = 0;   ///< sum_u Af_u p_u: PCSA-weighted activation [1]
-    std::vector<double> Af;      ///< per unit activation-frequency Af_u [1]
-    std::vector<double> fenv;    ///< per unit envelope firing frequency [f0.5]
-};
-
-/// The steady isometric state at constant P and U (spec section 6).
-struct SteadyState {
-    bool converged = false;      ///< false: no equilibrium; message says why
-    std::string message;         ///< why it failed (empty on success)
-    double force = 0;            ///< Fse = Fce [N]
-    double normalizedForce = 0;  ///< Fse / F0 [1] (force is F0 times it)
-    double L = 0;                ///< fascicle length / L0 [1]
-    double fascicleLength = 0;   ///< L * L0 [m]
-    int evaluations = 0;         ///< residual evaluations the root finder used
-    std::vector<double> states;  ///< full state vector, ready for a time integration
-};
-
 /// A built Virtual Muscle: validated parameters plus derived constants (F0, Lmax, units, state
 /// layout). Immutable and cheap to copy; safe to share between threads.
 ///
 /// State vector (all entries of order 1, as CPodes needs): [L, V, Y per type with yield,
 /// (fint, feff) per unit, S per unit whose type has sag].
-class VirtualMuscle {
+class VirtualMuscle final : public MuscleModel {
 public:
     explicit VirtualMuscle(MuscleParameters params);
+    const char* getModelName() const override { return "virtual_muscle"; }
+    const std::string& getName() const override { return params_.name; }
+    double getOptimalFascicleLength() const override { return params_.optimalFascicleLength; }
+    double getMaxPathLength() const override { return params_.maxPathLength; }
+    double calcFascicleLength(double, const double* y) const override { return y[kL] * params_.optimalFascicleLength; }
+    double calcFascicleVelocity(double, double, const double* y) const override {
+        return y[kV] * params_.optimalFascicleLength;
+    }
 
     const MuscleParameters& getParameters() const { return params_; }
     const std::vector<MotorUnit>& getUnits() const { return units_; }
     int getNumUnits() const { return int(units_.size()); }
-    int getNumStates() const { return numStates_; }
-    double getF0() const { return F0_; }
+    int getNumStates() const override { return numStates_; }
+    double getF0() const override { return F0_; }
     double getLmax() const { return Lmax_; }
     /// Mass of the muscle mass node, M / 2 [kg].
     double getNodeMass() const { return 0.5 * params_.mass; }
     /// Largest fascicle length (/ L0) at which every present fibre type keeps nf > 0.
     double getNfLimit() const { return nfLimit_; }
     /// Names of the state entries ("L", "V", "Y_slow", "fint_3", ...).
-    std::vector<std::string> getStateNames() const;
+    std::vector<std::string> getStateNames() const override;
 
     // State layout.
     static constexpr int kL = 0;
@@ -222,24 +211,22 @@ public:
     int getSagIndex(int u) const { return sagIndex_[u]; }  ///< -1: none
 
     /// Throws InputError unless 0 < P <= P_max.
-    void checkPathLength(double pathLength) const;
+    void checkPathLength(double pathLength) const override;
     /// L(0) of spec section 5 (approximate passive equilibrium at path P).
     double calcInitialFascicleLength(double pathLength) const;
     /// Initial state of spec section 5 at path P.
-    std::vector<double> calcInitialState(double pathLength) const;
+    std::vector<double> calcInitialState(double pathLength) const override;
     /// Output force Fse [N] at path P for state y.
-    double calcForce(double pathLength, const double* y) const;
+    double calcForce(double pathLength, const double* y) const override;
     /// dy/dt at path P, activation U. Optionally fills outputs.
     void calcStateDerivative(double pathLength, double U, const double* y, double* ydot,
-                             MuscleOutputs* outputs = nullptr) const;
+                             MuscleOutputs* outputs = nullptr) const override;
     /// Throws SimulationError naming the time t, the muscle and the state unless every entry of y is
     /// finite and 0 < L < getNfLimit() (the model's validity range; step boundaries).
-    void checkStates(double t, const double* y) const;
-    /// Outputs at path P, activation U for state y.
-    MuscleOutputs calcOutputs(double pathLength, double U, const double* y) const;
+    void checkStates(double t, const double* y) const override;
     /// Steady isometric state at path P and activation U: solves Fse(L) = Fce(L, V = 0).
     /// Never throws for a missing equilibrium: returns converged = false with the reason.
-    SteadyState calcSteadyState(double pathLength, double U) const;
+    SteadyState calcSteadyState(double pathLength, double U) const override;
 
 private:
     /// (Fse - Fce) / F0 in the steady state at fascicle length L (V = 0, feff = fenv, Y = 1).

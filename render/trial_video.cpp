@@ -39,7 +39,7 @@ constexpr double kArrowThickness = 4;        // (px)
 constexpr double kArrowMaxTip = 0.03;        // arrow head length (m), at most 40 % of the arrow
 constexpr double kMinArrowLength = 1e-3;     // shorter arrows are not drawn (m)
 constexpr double kMuscleThicknessAtZero = 3; // thickness that follows the coloured quantity (px) ...
-constexpr double kMuscleThicknessGain = 5;   // ... 3 + 5 x value, as VirtualMuscleForce draws it
+constexpr double kMuscleThicknessGain = 5;   // ... 3 + 5 x value, as MuscleForce draws it
 constexpr double kFramingMargin = 1.12;      // visible height / content height
 constexpr double kCameraDistance = 2;        // orthographic camera on +Z (m)
 constexpr double kOverlayReferenceHeight = 720;  // overlay sizes are for this frame height (px)
@@ -361,14 +361,14 @@ struct TrialRenderer::Impl {
         // Every muscle on its wrapped path (via points and wrap surfaces drawn with it), on top.
         const TrialSceneSettings& sc = settings.scene;
         for (int m = 0; m < model->getNumMuscles(); ++m) {
-            const VirtualMuscleForce& f = model->getMuscleForce(m);
+            const MuscleForce& f = model->getMuscleForce(m);
             double value = f.calcOutputs(state).activeFraction;
             if (sc.muscleColoring == MuscleColoring::Force && !muscleForce[m].empty())
                 value = std::clamp(muscleForce[m][row] / muscleForceScale[m], 0.0, 1.0);
             const double thickness = sc.thicknessFollows ? kMuscleThicknessAtZero + kMuscleThicknessGain * value
                                                          : sc.muscleThickness;
             appendPathDecorations(f.getPath(), f.calcPathGeometry(state, true),
-                                  VirtualMuscleForce::calcActivationColor(value), thickness, top);
+                                  MuscleForce::calcActivationColor(value), thickness, top);
         }
     }
 

@@ -24,7 +24,7 @@
 
 namespace armsim {
 
-/// What each muscle path's colour (blue at 0, red at 1, VirtualMuscleForce::calcActivationColor)
+/// What each muscle path's colour (blue at 0, red at 1, MuscleForce::calcActivationColor)
 /// and, optionally, thickness follow.
 enum class MuscleColoring {
     Activation,  ///< the muscle's own decoration: PCSA-weighted active fraction of its motor units

@@ -84,6 +84,21 @@ void BM_TwinMvcTrial(benchmark::State& state) {
 }
 BENCHMARK(BM_TwinMvcTrial)->Arg(1000)->Arg(100)->Unit(benchmark::kMillisecond);
 
+// Issue 29: the same trial on the twin with Thelen 2003 muscles (2 states per muscle against Virtual
+// Muscle's 14-20).
+void BM_HillTwinMvcTrial(benchmark::State& state) {
+    static const ArmSetup twin = [] {
+        ArmSetup s = loadShippedModel("twin");
+        setMuscleModel(s, "thelen2003");
+        return s;
+    }();
+    IsometricTrialSettings s;
+    s.activation = twin.effort.voluntaryActivation;
+    s.antagonistActivation = twin.effort.coContraction;
+    measureIsometricTrial(state, twin, s);
+}
+BENCHMARK(BM_HillTwinMvcTrial)->Arg(1000)->Arg(100)->Unit(benchmark::kMillisecond);
+
 // Issue 30: the locked MVC (0.5 s rest + 3 s hold, 1000 Hz) of N copies of the thesis's straight biceps;
 // arg 0 = N, arg 1 = 1 for the banded Newton solve (the default), 0 for the dense one, arg 2 = sample
 // rate [Hz] (at 1000 Hz the table of every muscle's states dominates from 64 muscles on; 100 Hz shows

@@ -4,6 +4,7 @@
 #include "model/muscle_arm.h"
 #include "model/mvc_curve.h"
 #include "model/trial.h"
+#include "muscles/thelen2003_muscle.h"
 
 #include <gtest/gtest.h>
 
@@ -665,4 +666,46 @@ TEST(ModelFile, RolesComeFromTheModelFile) {
                                                      "      insertion: {body: forearm, location: [0, -0.05, 0]}\n" +
                                                      head.substr(head.find("  - name: a")) + "primary: a\nroles: {biceps: [b]}\n"));
     EXPECT_NE(msg.find("primary muscle 'a'"), std::string::npos) << msg;
+}
+
+// Issue 29: `muscle_model:` chooses each muscle's model: at the top for every muscle, in a muscle for
+// that one (a name replaces the model, coefficients add to it); unknown models and coefficients are
+// refused naming the file's line; a population's `muscle_model:` swaps the model and keeps the people.
+TEST(ModelFile, MuscleModelKeyChoosesEachMusclesModel) {
+    const std::string head = "name: hill\narm: " + std::string(ARMSIM_ASSET_DIR) + "/arm/default_male.yaml\n";
+    const std::string file = writeTemp(
+        "armsim_hill_model.yaml",
+        head + "muscle_model: {model: thelen2003, activation_time_constant: 0.01}\nmuscles:\n" +
+            makeMuscleEntry("A", "    mass: 0.1\n") +
+            makeMuscleEntry("B", "    mass: 0.1\n    muscle_model: {deactivation_time_constant: 0.04}\n") +
+            makeMuscleEntry("C", "    mass: 0.1\n    muscle_model: virtual_muscle\n"));
+    const ArmSetup s = loadModel(file);
+    ASSERT_EQ(s.getNumMuscles(), 3);
+    const auto a = s.buildMuscleModel(0), b = s.buildMuscleModel(1), c = s.buildMuscleModel(2);
+    EXPECT_STREQ(a->getModelName(), "thelen2003");
+    EXPECT_STREQ(c->getModelName(), "virtual_muscle");
+    const auto& ta = dynamic_cast<const Thelen2003Muscle&>(*a).getParameters();
+    const auto& tb = dynamic_cast<const Thelen2003Muscle&>(*b).getParameters();
+    EXPECT_EQ(ta.activationTimeConstant, 0.01);
+    EXPECT_EQ(ta.deactivationTimeConstant, 0.05);  // assets/muscles/thelen2003.yaml
+    EXPECT_EQ(tb.activationTimeConstant, 0.01);    // the model's, kept
+    EXPECT_EQ(tb.deactivationTimeConstant, 0.04);  // the muscle's own
+    // The same F0 in both models (F0 = sigma M / (rho L0)).
+    EXPECT_DOUBLE_EQ(a->getF0(), c->getF0());
+    EXPECT_FALSE(s.hasOnlyVirtualMuscles());
+
+    const std::string unknown = writeTemp("armsim_hill_unknown.yaml", head + "muscle_model: hill\nmuscles:\n" +
+                                                                          makeMuscleEntry("A", "    mass: 0.1\n"));
+    EXPECT_NE(messageOf(unknown).find("armsim_hill_unknown.yaml:3"), std::string::npos) << messageOf(unknown);
+    EXPECT_NE(messageOf(unknown).find("expected one of virtual_muscle, thelen2003"), std::string::npos) << messageOf(unknown);
+    const std::string badKey = writeTemp(
+        "armsim_hill_key.yaml", head + "muscles:\n" +
+                                    makeMuscleEntry("A", "    mass: 0.1\n    muscle_model: {model: thelen2003, tau: 1}\n"));
+    EXPECT_NE(messageOf(badKey).find("muscle_model.tau"), std::string::npos) << messageOf(badKey);
+    EXPECT_NE(messageOf(badKey).find(":6"), std::string::npos) << messageOf(badKey);
+    const std::string badValue = writeTemp(
+        "armsim_hill_value.yaml", head + "muscle_model: {model: thelen2003, fmax_tendon_strain: -0.1}\nmuscles:\n" +
+                                      makeMuscleEntry("A", "    mass: 0.1\n"));
+    EXPECT_NE(messageOf(badValue).find("fmax_tendon_strain"), std::string::npos) << messageOf(badValue);
+    EXPECT_NE(messageOf(badValue).find("-0.1"), std::string::npos) << messageOf(badValue);
 }

@@ -2,6 +2,7 @@
 #include "basics/param_node.h"
 #include "model/geometry.h"
 #include "model/model_file.h"
+#include "model/mvc_curve.h"
 #include "model/trial.h"
 
 #include <gtest/gtest.h>
@@ -392,4 +393,31 @@ TEST(IsometricTrial, BandedNewtonAgreesWithTheSimbodySystem) {
                 EXPECT_LE(diff, kRelTol * scale) << setup->name << " " << getEffortName(effort) << ": column " << c;
             }
         }
+}
+
+// Issue 29: the twin with Thelen 2003 muscles (same geometry and morphometry) runs as an arm: the locked
+// ODE agrees with the Simbody System to 1e-6, and the tared torque at the end of a long hold equals the
+// steady MVC curve's (active less passive), the same quantity two ways.
+TEST(IsometricTrial, HillTypeTwinLockedOdeMatchesSimbodyAndTheSteadyCurve) {
+    constexpr double kRelTol = 1e-6;
+    ArmSetup twin = loadModel("twin");
+    setMuscleModel(twin, "thelen2003");
+    for (double deg : {40.0, 110.0}) {
+        IsometricTrialSettings s = mvcAt(180 - deg);  // included angle
+        s.activation = 0.9;
+        s.antagonistActivation = 0.05;
+        s.holdDuration = 1.5;
+        s.averagingWindow = 0.2;
+        s.bandedNewton = false;
+        const IsometricTrialResult fast = runIsometricTrial(twin, s);
+        s.solver = TrialSolver::SimbodySystem;
+        const IsometricTrialResult reference = runIsometricTrial(twin, s);
+        std::string column;
+        EXPECT_LE(calcMaxColumnDifference(fast.series, reference.series, &column), kRelTol) << deg << " " << column;
+        ASSERT_TRUE(fast.series.hasColumn("state_BIClong_activation"));
+        const SteadyMvcCurve active = calcSteadyMvcCurve(twin, MuscleGroup::Flexor, SubjectEffort{0.9, 0.05}, {deg});
+        const SteadyMvcCurve passive = calcSteadyMvcCurve(twin, MuscleGroup::Flexor, SubjectEffort{0, 0}, {deg});
+        const double steady = active.totalTorque[0] - passive.totalTorque[0];
+        EXPECT_NEAR(fast.summary.meanMuscleTorque, steady, 1e-4 * steady) << deg;
+    }
 }

@@ -33,7 +33,7 @@ TEST(SimbodyReleaseBuild, BuildsAndRealizesASystemWithAMuscle) {
     const Body::Rigid body(MassProperties(2.0, Vec3(0), UnitInertia(0.01)));
     MobilizedBody::Slider slider(matter.Ground(), Transform(Rotation(Pi / 2, ZAxis), Vec3(0)), body,
                                  Transform(Rotation(Pi / 2, ZAxis), Vec3(0)));  // slides along Ground Y
-    VirtualMuscleForce muscle(forces, std::make_shared<VirtualMuscle>(bicepsLongHead()), matter.Ground(),
+    MuscleForce muscle(forces, std::make_shared<VirtualMuscle>(bicepsLongHead()), matter.Ground(),
                               Vec3(0, 0.40, 0), slider, Vec3(0), ActivationProfile::constant(0.0));
     system.realizeTopology();
     State s = system.getDefaultState();
@@ -47,13 +47,13 @@ TEST(SimbodyReleaseBuild, BuildsAndRealizesASystemWithAMuscle) {
     EXPECT_NEAR(muscle.getPathLength(s), 0.40, 1e-15);
 }
 
-TEST(VirtualMuscleForce, AppliesFseAlongThePathAndOwnsItsStates) {
+TEST(MuscleForce, AppliesFseAlongThePathAndOwnsItsStates) {
     MultibodySystem system;
     SimbodyMatterSubsystem matter(system);
     GeneralForceSubsystem forces(system);
     const Body::Rigid body(MassProperties(1.0, Vec3(0), UnitInertia(0.01)));
     MobilizedBody::Translation free(matter.Ground(), Vec3(0), body, Vec3(0));
-    VirtualMuscleForce muscle(forces, std::make_shared<VirtualMuscle>(bicepsLongHead()), matter.Ground(), Vec3(0),
+    MuscleForce muscle(forces, std::make_shared<VirtualMuscle>(bicepsLongHead()), matter.Ground(), Vec3(0),
                               free, Vec3(0), ActivationProfile::constant(1.0));
     system.realizeTopology();
     State s = system.getDefaultState();
@@ -77,18 +77,19 @@ TEST(VirtualMuscleForce, AppliesFseAlongThePathAndOwnsItsStates) {
     }
 }
 
-TEST(VirtualMuscleForce, StopsWithANamedErrorOnNonFiniteStatesOrFasciclesBeyondTheNfLimit) {
+TEST(MuscleForce, StopsWithANamedErrorOnNonFiniteStatesOrFasciclesBeyondTheNfLimit) {
     MultibodySystem system;
     SimbodyMatterSubsystem matter(system);
     GeneralForceSubsystem forces(system);
-    VirtualMuscleForce muscle(forces, std::make_shared<VirtualMuscle>(bicepsLongHead()), matter.Ground(), Vec3(0),
-                              matter.Ground(), Vec3(0.4, 0, 0), ActivationProfile::constant(1.0));
+    const auto vm = std::make_shared<VirtualMuscle>(bicepsLongHead());
+    MuscleForce muscle(forces, vm, matter.Ground(), Vec3(0), matter.Ground(), Vec3(0.4, 0, 0),
+                       ActivationProfile::constant(1.0));
     system.realizeTopology();
     State s = system.getDefaultState();
     muscle.setInitialMuscleStates(s);
     EXPECT_NO_THROW(muscle.checkMuscleStates(s));
     std::vector<double> y = muscle.getMuscleStates(s);
-    y[muscle.getMuscle().getFeffIndex(4)] = NaN;
+    y[vm->getFeffIndex(4)] = NaN;
     muscle.setMuscleStates(s, y);
     s.setTime(1.25);
     try {

@@ -186,7 +186,7 @@ TEST_F(TrialVideo, MuscleColourFollowsActivation) {
         const cv::Mat frame = r.renderRow(row);
         const SimTK::State& s = r.setRow(row);
         const double af = r.getModel().getBiceps().calcOutputs(s).activeFraction;
-        const cv::Vec3b expected = test::toBgr8(VirtualMuscleForce::calcActivationColor(af));
+        const cv::Vec3b expected = test::toBgr8(MuscleForce::calcActivationColor(af));
         const std::vector<cv::Vec3b> px = sampleMuscle(r, row, frame);
         const cv::Vec3b mid = px[px.size() / 2];
         for (int c = 0; c < 3; ++c) EXPECT_NEAR(mid[c], expected[c], kLineColourTolerance) << "row " << row;

@@ -1,0 +1,83 @@
+// The muscle-model interface: what a force element, a trial, a steady solve and a report need from a
+// muscle model, as plain functions of (path length, input, state). Virtual Muscle
+// (muscles/virtual_muscle.h) and Thelen 2003 (muscles/thelen2003_muscle.h) implement it; the Simbody
+// adapter (muscles/muscle_force.h) owns the states. No Simbody, GL or OpenCV here.
+//
+// Conventions: SI units at the boundary (path length P [m], forces [N]); the input U in [0, 1] is the
+// model's neural drive (Virtual Muscle: the recruitment activation; a Hill-type model: the
+// excitation its activation dynamics follow); states are of order 1 (as CPodes needs).
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace armsim {
+
+/// Quantities derived from a state, for output and drawing.
+struct MuscleOutputs {
+    double Fse = 0;              ///< tendon (output) force [N]
+    double Fce = 0;              ///< fibre force along the tendon [N]
+    double L = 0;                ///< fascicle length / L0 [1]
+    double V = 0;                ///< fascicle velocity [L0/s], + = lengthening
+    double LT = 0;               ///< tendon length / the model's reference length (VM: L0T; Hill: slack length) [1]
+    double tendonLength = 0;     ///< tendon length [m]
+    double activeFraction = 0;   ///< how active the muscle is (Virtual Muscle: sum_u Af_u p_u; Hill: a) [1]
+    std::vector<double> Af;      ///< per motor unit activation-frequency Af_u (Virtual Muscle only) [1]
+    std::vector<double> fenv;    ///< per motor unit envelope firing frequency (Virtual Muscle only) [f0.5]
+};
+
+/// The steady isometric state at constant P and U.
+struct SteadyState {
+    bool converged = false;      ///< false: no equilibrium; message says why
+    std::string message;         ///< why it failed (empty on success)
+    double force = 0;            ///< tendon force = fibre force along the tendon [N]
+    double normalizedForce = 0;  ///< force / F0 [1]
+    double L = 0;                ///< fascicle length / L0 [1]
+    double fascicleLength = 0;   ///< L * L0 [m]
+    int evaluations = 0;         ///< residual evaluations the root finder used
+    std::vector<double> states;  ///< full state vector, ready for a time integration
+};
+
+/// A built muscle model: immutable, cheap to share between threads.
+class MuscleModel {
+public:
+    virtual ~MuscleModel() = default;
+
+    /// The registry name of the model ("virtual_muscle", "thelen2003").
+    virtual const char* getModelName() const = 0;
+    /// The muscle's name ("BIClong").
+    virtual const std::string& getName() const = 0;
+    virtual int getNumStates() const = 0;
+    /// Names of the state entries, in order.
+    virtual std::vector<std::string> getStateNames() const = 0;
+    /// Maximal isometric force F0 [N].
+    virtual double getF0() const = 0;
+    /// Optimal fascicle length L0 [m].
+    virtual double getOptimalFascicleLength() const = 0;
+    /// Longest path the model accepts (the anatomical limit P_max) [m].
+    virtual double getMaxPathLength() const = 0;
+
+    /// Throws InputError unless 0 < P <= getMaxPathLength().
+    virtual void checkPathLength(double pathLength) const = 0;
+    /// A state to start an integration from at path P with no drive.
+    virtual std::vector<double> calcInitialState(double pathLength) const = 0;
+    /// Tendon (output) force [N] at path P for state y.
+    virtual double calcForce(double pathLength, const double* y) const = 0;
+    /// dy/dt at path P, input U. Optionally fills outputs.
+    virtual void calcStateDerivative(double pathLength, double U, const double* y, double* ydot,
+                                     MuscleOutputs* outputs = nullptr) const = 0;
+    /// Throws SimulationError naming the time t, the muscle and the state unless y is finite and inside
+    /// the model's validity range (call at step boundaries).
+    virtual void checkStates(double t, const double* y) const = 0;
+    /// Outputs at path P, input U for state y.
+    virtual MuscleOutputs calcOutputs(double pathLength, double U, const double* y) const;
+    /// Steady isometric state at path P and input U. Never throws for a missing equilibrium: returns
+    /// converged = false with the reason.
+    virtual SteadyState calcSteadyState(double pathLength, double U) const = 0;
+    /// Fascicle length [m] of state y at path P.
+    virtual double calcFascicleLength(double pathLength, const double* y) const = 0;
+    /// Fascicle velocity [m/s] (+ = lengthening) of state y at path P, input U.
+    virtual double calcFascicleVelocity(double pathLength, double U, const double* y) const = 0;
+};
+
+}  // namespace armsim
