@@ -441,6 +441,14 @@ void fitResults(const Protocol& protocol, ProtocolResult& result) {
 }  // namespace
 
 ProtocolResult runProtocol(const Protocol& protocol, const ArmSetup& subject, const ProtocolRunOptions& options) {
+    // These protocols simulate the primary muscle's motor units (EMG spike trains, the activation for
+    // a submaximal force, the muscle-alone sweep, the unit grid): Virtual Muscle only.
+    const MuscleSpec& primary = subject.muscles.at(subject.primary);
+    if (primary.muscleModel != kDefaultMuscleModel)
+        throw InputError("protocol '" + protocol.name + "' (" + getProtocolKindName(protocol.kind) +
+                         ") simulates the primary muscle's motor units, but muscle '" + primary.params.name +
+                         "' of model '" + subject.name + "' is muscle_model " + primary.muscleModel +
+                         ": expected virtual_muscle (torque protocols, with conditions:, work with every muscle model)");
     OutputFolder dir(options.outDir, OutputFolder::Mode::ReplaceRun, "manifest.json");
     const VirtualMuscle muscle(subject.calcBicepsParameters());
     ProtocolRun run;

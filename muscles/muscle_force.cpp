@@ -33,7 +33,13 @@ public:
 
     void realizeDynamics(const State& s) const override {
         Vector& zdot = s.updZDot(forces_);
-        muscle_->calcStateDerivative(pathLength(s), activation_.getValue(s.getTime()), z(s), &zdot[firstZ_]);
+        if (muscle_->usesPathVelocity()) {
+            const PathGeometry g = geometry(s);
+            muscle_->calcMovingStateDerivative(g.length, path_.calcLengtheningSpeed(s, g), activation_.getValue(s.getTime()),
+                                               z(s), &zdot[firstZ_]);
+        } else {
+            muscle_->calcStateDerivative(pathLength(s), activation_.getValue(s.getTime()), z(s), &zdot[firstZ_]);
+        }
     }
 
     void calcForce(const State& s, Vector_<SpatialVec>& bodyForces, Vector_<Vec3>&, Vector&) const override {

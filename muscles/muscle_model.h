@@ -66,6 +66,16 @@ public:
     /// dy/dt at path P, input U. Optionally fills outputs.
     virtual void calcStateDerivative(double pathLength, double U, const double* y, double* ydot,
                                      MuscleOutputs* outputs = nullptr) const = 0;
+    /// true when the derivatives depend on how fast the path lengthens (a tendon-force state); the
+    /// Simbody adapter then passes it to calcMovingStateDerivative.
+    virtual bool usesPathVelocity() const { return false; }
+    /// dy/dt with the path lengthening at pathVelocity [m/s]; calcStateDerivative is its isometric case.
+    /// The default ignores pathVelocity (models whose states do not need it).
+    virtual void calcMovingStateDerivative(double pathLength, double pathVelocity, double U, const double* y,
+                                           double* ydot, MuscleOutputs* outputs = nullptr) const {
+        (void)pathVelocity;
+        calcStateDerivative(pathLength, U, y, ydot, outputs);
+    }
     /// Throws SimulationError naming the time t, the muscle and the state unless y is finite and inside
     /// the model's validity range (call at step boundaries).
     virtual void checkStates(double t, const double* y) const = 0;

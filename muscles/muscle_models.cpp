@@ -1,7 +1,11 @@
 #include "muscles/muscle_models.h"
 
 #include "basics/errors.h"
+#include "muscles/degroote2016_muscle.h"
 #include "muscles/thelen2003_muscle.h"
+
+#include <cmath>
+#include <sstream>
 
 namespace armsim {
 
@@ -22,8 +26,41 @@ const std::vector<MuscleModelType>& getMuscleModelTypes() {
          &buildVirtualMuscle},
         {"thelen2003", "Thelen 2003 Hill-type muscle as OpenSim 4's Thelen2003Muscle", getThelen2003CoefficientKeys(),
          "thelen2003.yaml", &buildThelen2003Muscle},
+        {"degroote2016", "De Groote-Fregly 2016 Hill-type muscle as OpenSim 4's DeGrooteFregly2016Muscle",
+         getDeGroote2016CoefficientKeys(), "degroote2016.yaml", &buildDeGroote2016Muscle},
     };
     return types;
+}
+
+HillMorphometry calcHillMorphometry(const MuscleParameters& m) {
+    HillMorphometry h;
+    h.name = m.name;
+    h.maxIsometricForce = calcMaxIsometricForce(m);
+    h.optimalFiberLength = m.optimalFascicleLength;
+    h.tendonSlackLength = m.coefficients.LrT * m.optimalTendonLength;
+    h.pennationAngle = m.pennationAngle;
+    h.maxPathLength = m.maxPathLength;
+    return h;
+}
+
+void checkPathWithin(double P, double maxPath, const std::string& muscle) {
+    auto fmt = [](double v) {
+        std::ostringstream s;
+        s.precision(6);
+        s << v;
+        return s.str();
+    };
+    if (!(P > 0) || !std::isfinite(P)) throw InputError("path length = " + fmt(P) + " m: expected > 0");
+    if (P > maxPath)
+        throw InputError("path length = " + fmt(P) + " m exceeds max_path_length = " + fmt(maxPath) + " m of muscle '" +
+                         muscle + "': expected a path no longer than the anatomical limit");
+}
+
+void throwUnknownCoefficient(const std::string& muscle, const std::string& model, const std::string& key,
+                             const std::vector<std::string>& keys) {
+    std::string list;
+    for (const std::string& k : keys) list += (list.empty() ? "" : ", ") + k;
+    throw InputError("muscle '" + muscle + "': " + model + " has no coefficient '" + key + "': expected one of " + list);
 }
 
 const MuscleModelType& findMuscleModelType(const std::string& name) {

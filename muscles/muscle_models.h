@@ -37,4 +37,74 @@ const MuscleModelType& findMuscleModelType(const std::string& name);
 /// The registry name of the default model, "virtual_muscle".
 inline const char* const kDefaultMuscleModel = "virtual_muscle";
 
+// ---- Helpers for Hill-type models built from morphometry -------------------------------------------
+
+/// A Hill-type muscle's morphometry from Virtual Muscle parameters: F0 = sigma M / (rho L0) (the same
+/// person has the same F0 in every model), optimal fibre length L0, tendon slack length LrT L0T (the
+/// inverse of model/model_file.h's L0T = slack / LrT: the Virtual Muscle tendon's linear part
+/// extrapolates to zero force there), pennation, the path limit P_max.
+struct HillMorphometry {
+    std::string name;
+    double maxIsometricForce = 0;    ///< [N]
+    double optimalFiberLength = 0;   ///< [m]
+    double tendonSlackLength = 0;    ///< [m]
+    double pennationAngle = 0;       ///< at the optimal fibre length [rad]
+    double maxPathLength = 0;        ///< [m]; 0: none given
+};
+HillMorphometry calcHillMorphometry(const MuscleParameters& params);
+
+/// InputError "muscle 'M': MODEL has no coefficient 'KEY': expected one of ...".
+/// Throws InputError unless 0 < P <= maxPathLength (the muscle's anatomical limit).
+void checkPathWithin(double pathLength, double maxPathLength, const std::string& muscle);
+
+[[noreturn]] void throwUnknownCoefficient(const std::string& muscle, const std::string& model, const std::string& key,
+                                          const std::vector<std::string>& keys);
+
+/// A model coefficient a model file may set: its key and the parameter field it sets.
+template <class Params>
+struct CoefficientField {
+    const char* key;
+    double Params::*field;
+};
+
+/// The keys of a coefficient table.
+template <class Params, std::size_t N>
+std::vector<std::string> listCoefficientKeys(const CoefficientField<Params> (&fields)[N]) {
+    std::vector<std::string> keys;
+    for (const CoefficientField<Params>& f : fields) keys.push_back(f.key);
+    return keys;
+}
+
+/// Sets p's fields from coefficients through the table; InputError naming the muscle, the model, the
+/// unknown key and the keys expected.
+template <class Params, std::size_t N>
+void applyCoefficients(Params& p, const std::map<std::string, double>& coefficients,
+                       const CoefficientField<Params> (&fields)[N], const std::string& model) {
+    for (const auto& [key, value] : coefficients) {
+        const CoefficientField<Params>* found = nullptr;
+        for (const CoefficientField<Params>& f : fields)
+            if (key == f.key) found = &f;
+        if (!found) throwUnknownCoefficient(p.name, model, key, listCoefficientKeys(fields));
+        p.*(found->field) = value;
+    }
+}
+
+/// A Hill-type model's parameters (fields name, maxIsometricForce, optimalFiberLength,
+/// tendonSlackLength, pennationAngleAtOptimal, maxPathLength) from the input's morphometry
+/// (calcHillMorphometry) and coefficients (applyCoefficients).
+template <class Params, std::size_t N>
+Params makeHillParameters(const MuscleModelInput& in, const CoefficientField<Params> (&fields)[N],
+                          const std::string& model) {
+    const HillMorphometry h = calcHillMorphometry(in.params);
+    Params p;
+    p.name = h.name;
+    p.maxIsometricForce = h.maxIsometricForce;
+    p.optimalFiberLength = h.optimalFiberLength;
+    p.tendonSlackLength = h.tendonSlackLength;
+    p.pennationAngleAtOptimal = h.pennationAngle;
+    if (h.maxPathLength > 0) p.maxPathLength = h.maxPathLength;
+    applyCoefficients(p, in.coefficients, fields, model);
+    return p;
+}
+
 }  // namespace armsim

@@ -266,6 +266,16 @@ double MusclePath::calcLength(const State& s) const {
     return calcGeometry(s).length;
 }
 
+double MusclePath::calcLengtheningSpeed(const State& s, const PathGeometry& g) const {
+    // The power of a unit tension is -dP/dt: sum over its loads of force . (point velocity).
+    double power = 0;
+    for (const PathLoad& l : g.loads) {
+        const SpatialVec V = elements_[l.element].body.getBodyVelocity(s);
+        power += dot(l.force, V[1] + cross(V[0], l.arm));
+    }
+    return -power;
+}
+
 void MusclePath::applyTension(const PathGeometry& g, double tension, Vector_<SpatialVec>& bodyForces) {
     for (const PathLoad& l : g.loads) {
         const Vec3 f = tension * l.force;

@@ -89,6 +89,9 @@ public:
                               bool withPolyline = false) const;
     /// P [m] (Stage::Position).
     double calcLength(const SimTK::State& s) const;
+    /// dP/dt [m/s] of the path whose geometry at s is g (Stage::Velocity): minus the power of a unit
+    /// tension along it (virtual power; wrapping arcs roll with their surfaces).
+    double calcLengtheningSpeed(const SimTK::State& s, const PathGeometry& g) const;
     /// Adds the forces of a tension [N] along the path to bodyForces (Simbody's calcForce layout).
     static void applyTension(const PathGeometry& g, double tension, SimTK::Vector_<SimTK::SpatialVec>& bodyForces);
 

@@ -155,12 +155,7 @@ double Thelen2003Muscle::calcPennationAngle(double lM) const {
     return s < maxSinPennation_ ? std::asin(s) : p_.maximumPennationAngle;
 }
 
-void Thelen2003Muscle::checkPathLength(double P) const {
-    if (!(P > 0) || !std::isfinite(P)) throw InputError("path length = " + fmtNum(P) + " m: expected > 0");
-    if (P > p_.maxPathLength)
-        throw InputError("path length = " + fmtNum(P) + " m exceeds max_path_length = " + fmtNum(p_.maxPathLength) +
-                         " m of muscle '" + p_.name + "': expected a path no longer than the anatomical limit");
-}
+void Thelen2003Muscle::checkPathLength(double P) const { checkPathWithin(P, p_.maxPathLength, p_.name); }
 
 double Thelen2003Muscle::calcForce(double P, const double* y) const {
     const double lM = std::max(y[kFiberLength] * p_.optimalFiberLength, minFiberLength_);
@@ -284,12 +279,7 @@ std::vector<double> Thelen2003Muscle::calcInitialState(double P) const {
 
 namespace {
 
-struct CoefficientField {
-    const char* key;
-    double Thelen2003Parameters::*field;
-};
-
-const CoefficientField kCoefficients[] = {
+const CoefficientField<Thelen2003Parameters> kCoefficients[] = {
     {"max_contraction_velocity", &Thelen2003Parameters::maxContractionVelocity},
     {"fmax_tendon_strain", &Thelen2003Parameters::fmaxTendonStrain},
     {"fmax_muscle_strain", &Thelen2003Parameters::fmaxMuscleStrain},
@@ -306,36 +296,10 @@ const CoefficientField kCoefficients[] = {
 
 }  // namespace
 
-std::vector<std::string> getThelen2003CoefficientKeys() {
-    std::vector<std::string> keys;
-    for (const CoefficientField& c : kCoefficients) keys.push_back(c.key);
-    return keys;
-}
+std::vector<std::string> getThelen2003CoefficientKeys() { return listCoefficientKeys(kCoefficients); }
 
 Thelen2003Parameters calcThelen2003Parameters(const MuscleModelInput& in) {
-    const MuscleParameters& m = in.params;
-    Thelen2003Parameters p;
-    p.name = m.name;
-    p.maxIsometricForce = calcMaxIsometricForce(m);
-    p.optimalFiberLength = m.optimalFascicleLength;
-    p.tendonSlackLength = m.coefficients.LrT * m.optimalTendonLength;
-    p.pennationAngleAtOptimal = m.pennationAngle;
-    if (m.maxPathLength > 0) p.maxPathLength = m.maxPathLength;
-    for (const auto& [key, value] : in.coefficients) {
-        bool found = false;
-        for (const CoefficientField& c : kCoefficients)
-            if (key == c.key) {
-                p.*c.field = value;
-                found = true;
-            }
-        if (!found) {
-            std::string keys;
-            for (const CoefficientField& c : kCoefficients) keys += std::string(keys.empty() ? "" : ", ") + c.key;
-            throw InputError("muscle '" + m.name + "': thelen2003 has no coefficient '" + key + "': expected one of " +
-                             keys);
-        }
-    }
-    return p;
+    return makeHillParameters(in, kCoefficients, "thelen2003");
 }
 
 std::shared_ptr<const MuscleModel> buildThelen2003Muscle(const MuscleModelInput& in) {

@@ -95,8 +95,8 @@ void applyChange(Model& m, const py::object& muscle, const py::dict& kw) {
     m.changes.push_back({m.setup.muscles[i].params.name, values});
 }
 
-VirtualMuscle buildMuscle(const Model& m, const py::object& muscle) {
-    return VirtualMuscle(m.setup.calcMuscleParameters(findMuscleIndex(m.setup, muscle)));
+std::shared_ptr<const MuscleModel> buildMuscle(const Model& m, const py::object& muscle) {
+    return m.setup.buildMuscleModel(findMuscleIndex(m.setup, muscle));
 }
 
 }  // namespace
@@ -196,9 +196,9 @@ PYBIND11_MODULE(_armsim, mod) {
 
     mod.def(
         "steady_state", [](const Model& m, double pathLength, double activation, const py::object& muscle) {
-            const VirtualMuscle vm = buildMuscle(m, muscle);
+            const auto vm = buildMuscle(m, muscle);
             checkField("activation", activation, Bound::closed(0, 1));
-            const SteadyState s = vm.calcSteadyState(pathLength, activation);
+            const SteadyState s = vm->calcSteadyState(pathLength, activation);
             if (!s.converged) throw SimulationError("steady state at path " + formatNumber(pathLength) + " m: " + s.message);
             py::dict d;
             d["force"] = s.force;
@@ -214,7 +214,7 @@ PYBIND11_MODULE(_armsim, mod) {
         "muscle_trial",
         [](const Model& m, double pathLength, double activation, double onset, double rise, double duration,
            double rate, bool steadyStart, const py::object& muscle) {
-            const VirtualMuscle vm = buildMuscle(m, muscle);
+            const auto vm = buildMuscle(m, muscle);
             checkField("activation", activation, Bound::closed(0, 1));
             checkField("onset", onset, Bound::nonNegative("s"));
             checkField("rise", rise, Bound::nonNegative("s"));
@@ -228,7 +228,7 @@ PYBIND11_MODULE(_armsim, mod) {
             else s.activation = ActivationProfile::constant(activation);
             Table t;
             runInterruptible([&] {
-                t = runMuscleIsometric(vm, s);
+                t = runMuscleIsometric(*vm, s);
             });
             return toDict(std::move(t));
         },

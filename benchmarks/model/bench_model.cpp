@@ -84,12 +84,12 @@ void BM_TwinMvcTrial(benchmark::State& state) {
 }
 BENCHMARK(BM_TwinMvcTrial)->Arg(1000)->Arg(100)->Unit(benchmark::kMillisecond);
 
-// Issue 29: the same trial on the twin with Thelen 2003 muscles (2 states per muscle against Virtual
+// Issue 29: the same trial on the twin with Hill-type muscles (2 states per muscle against Virtual
 // Muscle's 14-20).
-void BM_HillTwinMvcTrial(benchmark::State& state) {
-    static const ArmSetup twin = [] {
+void BM_HillTwinMvcTrial(benchmark::State& state, const char* model) {
+    const ArmSetup twin = [&] {
         ArmSetup s = loadShippedModel("twin");
-        setMuscleModel(s, "thelen2003");
+        setMuscleModel(s, model);
         return s;
     }();
     IsometricTrialSettings s;
@@ -97,7 +97,8 @@ void BM_HillTwinMvcTrial(benchmark::State& state) {
     s.antagonistActivation = twin.effort.coContraction;
     measureIsometricTrial(state, twin, s);
 }
-BENCHMARK(BM_HillTwinMvcTrial)->Arg(1000)->Arg(100)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_HillTwinMvcTrial, thelen2003, "thelen2003")->Arg(1000)->Arg(100)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_HillTwinMvcTrial, degroote2016, "degroote2016")->Arg(1000)->Arg(100)->Unit(benchmark::kMillisecond);
 
 // Issue 30: the locked MVC (0.5 s rest + 3 s hold, 1000 Hz) of N copies of the thesis's straight biceps;
 // arg 0 = N, arg 1 = 1 for the banded Newton solve (the default), 0 for the dense one, arg 2 = sample

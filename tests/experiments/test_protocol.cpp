@@ -391,3 +391,22 @@ TEST(ProtocolRun, AFailedRunLeavesNoOutputAndKeepsTheEarlierRun) {
     EXPECT_EQ(readText(foreign / "notes.txt"), "keep me");
     fs::remove_all(d);
 }
+
+// Issue 29: these protocols simulate the primary's motor units; with a Hill-type primary the run is
+// refused before anything is written, naming the muscle and its model.
+TEST(ProtocolRun, RefusesAPrimaryMuscleWithoutMotorUnits) {
+    const fs::path d = freshDir("hill_primary");
+    const Protocol p = readProtocol(writeProtocol(d, "p.yaml", kSmallMvc).string());
+    ArmSetup subject = loadProtocolSubject(p);
+    setMuscleModel(subject, "thelen2003");
+    try {
+        runProtocol(p, subject, {(d / "out").string(), 1, {}});
+        ADD_FAILURE();
+    } catch (const InputError& e) {
+        const std::string m = e.what();
+        EXPECT_NE(m.find("muscle_model thelen2003"), std::string::npos) << m;
+        EXPECT_NE(m.find("expected virtual_muscle"), std::string::npos) << m;
+    }
+    EXPECT_FALSE(fs::exists(d / "out"));
+    fs::remove_all(d);
+}

@@ -709,3 +709,32 @@ TEST(ModelFile, MuscleModelKeyChoosesEachMusclesModel) {
     EXPECT_NE(messageOf(badValue).find("fmax_tendon_strain"), std::string::npos) << messageOf(badValue);
     EXPECT_NE(messageOf(badValue).find("-0.1"), std::string::npos) << messageOf(badValue);
 }
+
+// Issue 29: dP/dt of every twin path (via points, cylinders, spheres) from the virtual power of a unit
+// tension equals the central difference of P along the elbow's motion.
+TEST(MusclePath, LengtheningSpeedEqualsTheDerivativeOfTheLength) {
+    const ArmSetup twin = loadModel("twin");
+    const MuscleArm arm(twin, ActivationProfile::constant(0.0));
+    SimTK::State s = arm.getDefaultState();
+    const double u = 1.3, h = 1e-6;  // rad/s; rad
+    for (double theta : {1.0, 1.8, 2.6}) {
+        auto lengths = [&](double q) {
+            arm.getArm().setElbowAngle(s, q);
+            arm.getSystem().realize(s, SimTK::Stage::Position);
+            std::vector<double> P;
+            for (int i = 0; i < arm.getNumMuscles(); ++i) P.push_back(arm.calcPathLength(s, i));
+            return P;
+        };
+        const std::vector<double> plus = lengths(theta + h), minus = lengths(theta - h);
+        arm.getArm().setElbowAngle(s, theta);
+        arm.getArm().getForearm().setOneU(s, 0, u);
+        arm.getSystem().realize(s, SimTK::Stage::Velocity);
+        const double qdot = arm.getArm().getElbowAngularVelocity(s);  // d(theta)/dt for this u
+        for (int i = 0; i < arm.getNumMuscles(); ++i) {
+            const MuscleForce& f = arm.getMuscleForce(i);
+            const double speed = f.getPath().calcLengtheningSpeed(s, f.calcPathGeometry(s));
+            const double expected = (plus[i] - minus[i]) / (2 * h) * qdot;
+            EXPECT_NEAR(speed, expected, 1e-7) << arm.getMuscleName(i) << " at " << theta;
+        }
+    }
+}

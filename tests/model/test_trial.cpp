@@ -395,14 +395,15 @@ TEST(IsometricTrial, BandedNewtonAgreesWithTheSimbodySystem) {
         }
 }
 
-// Issue 29: the twin with Thelen 2003 muscles (same geometry and morphometry) runs as an arm: the locked
+// Issue 29: the twin with Hill-type muscles (same geometry and morphometry) runs as an arm: the locked
 // ODE agrees with the Simbody System to 1e-6, and the tared torque at the end of a long hold equals the
 // steady MVC curve's (active less passive), the same quantity two ways.
 TEST(IsometricTrial, HillTypeTwinLockedOdeMatchesSimbodyAndTheSteadyCurve) {
     constexpr double kRelTol = 1e-6;
-    ArmSetup twin = loadModel("twin");
-    setMuscleModel(twin, "thelen2003");
+    for (const char* model : {"thelen2003", "degroote2016"})
     for (double deg : {40.0, 110.0}) {
+        ArmSetup twin = loadModel("twin");
+        setMuscleModel(twin, model);
         IsometricTrialSettings s = mvcAt(180 - deg);  // included angle
         s.activation = 0.9;
         s.antagonistActivation = 0.05;
@@ -413,11 +414,11 @@ TEST(IsometricTrial, HillTypeTwinLockedOdeMatchesSimbodyAndTheSteadyCurve) {
         s.solver = TrialSolver::SimbodySystem;
         const IsometricTrialResult reference = runIsometricTrial(twin, s);
         std::string column;
-        EXPECT_LE(calcMaxColumnDifference(fast.series, reference.series, &column), kRelTol) << deg << " " << column;
+        EXPECT_LE(calcMaxColumnDifference(fast.series, reference.series, &column), kRelTol) << model << " " << deg << " " << column;
         ASSERT_TRUE(fast.series.hasColumn("state_BIClong_activation"));
         const SteadyMvcCurve active = calcSteadyMvcCurve(twin, MuscleGroup::Flexor, SubjectEffort{0.9, 0.05}, {deg});
         const SteadyMvcCurve passive = calcSteadyMvcCurve(twin, MuscleGroup::Flexor, SubjectEffort{0, 0}, {deg});
         const double steady = active.totalTorque[0] - passive.totalTorque[0];
-        EXPECT_NEAR(fast.summary.meanMuscleTorque, steady, 1e-4 * steady) << deg;
+        EXPECT_NEAR(fast.summary.meanMuscleTorque, steady, 1e-4 * steady) << model << " " << deg;
     }
 }
