@@ -76,7 +76,7 @@ void applyOverrides(ArmSetup& s, int i, const py::dict& kw) {
     }
 }
 
-constexpr int kModelPickleFormat = 1;
+constexpr int kModelPickleFormat = 2;  // 2: with the muscle model (1: without, still read)
 
 // A model loaded from a name or file, remembering which (a path made absolute) for pickling.
 Model loadPythonModel(const std::string& nameOrFile) {
@@ -139,16 +139,25 @@ PYBIND11_MODULE(_armsim, mod) {
                                                                                        : py::object(py::float_(value));
                     changes.append(py::make_tuple(muscle, kw));
                 }
-                return py::make_tuple(kModelPickleFormat, m.source, changes);
+                py::dict coefficients;
+                for (const auto& [key, value] : m.muscleModelCoefficients) coefficients[py::str(key)] = value;
+                return py::make_tuple(kModelPickleFormat, m.source, changes, m.muscleModel, coefficients);
             },
             [](const py::tuple& state) {
-                if (state.size() != 3 || state[0].cast<int>() != kModelPickleFormat)
-                    throw py::value_error("armsim.Model: a pickle of another armsim version (expected format " +
+                const int format = state.size() >= 1 ? state[0].cast<int>() : 0;
+                if (!((format == 1 && state.size() == 3) || (format == 2 && state.size() == 5)))
+                    throw py::value_error("armsim.Model: a pickle of another armsim version (expected format 1 or " +
                                           std::to_string(kModelPickleFormat) + ")");
                 Model m = loadPythonModel(state[1].cast<std::string>());
                 for (const py::handle change : state[2].cast<py::list>()) {
                     const py::tuple c = change.cast<py::tuple>();
                     applyChange(m, py::cast<py::object>(c[0]), c[1].cast<py::dict>());
+                }
+                if (format == 2 && !state[3].cast<std::string>().empty()) {
+                    m.muscleModel = state[3].cast<std::string>();
+                    for (const auto& item : state[4].cast<py::dict>())
+                        m.muscleModelCoefficients[py::cast<std::string>(item.first)] = py::cast<double>(item.second);
+                    setMuscleModel(m.setup, m.muscleModel, m.muscleModelCoefficients);
                 }
                 return m;
             }))
@@ -178,6 +187,21 @@ PYBIND11_MODULE(_armsim, mod) {
             py::arg("muscle") = py::none(),
             "A copy with a muscle's parameters changed by keyword (the names of parameters()), e.g.\n"
             "model.with_muscle(mass=0.3, optimal_tendon_length=0.24). Raises ValueError for a bad value.")
+        .def(
+            "with_muscle_model", [](const Model& m, const std::string& name, const py::kwargs& kw) {
+                Model c = m;
+                std::map<std::string, double> coefficients;
+                for (const auto& item : kw) coefficients[py::cast<std::string>(item.first)] = py::cast<double>(item.second);
+                setMuscleModel(c.setup, name, coefficients);
+                c.muscleModel = name;
+                c.muscleModelCoefficients = coefficients;
+                return c;
+            },
+            py::arg("name"),
+            "A copy whose every muscle follows muscle model `name` ('virtual_muscle', 'thelen2003',\n"
+            "'degroote2016') with the same geometry and morphometry, e.g.\n"
+            "model.with_muscle_model('thelen2003', activation_time_constant=0.01). Coefficients by keyword\n"
+            "(assets/muscles/<name>.yaml lists them); raises ValueError for an unknown model, key or value.")
         .def(
             "geometry", [](const Model& m, const std::vector<double>& flexionDeg) {
                 const MvcGeometry g = calcMvcGeometry(m.setup, flexionDeg);

@@ -12,6 +12,7 @@
 #include <pybind11/stl.h>
 
 #include <string>
+#include <map>
 #include <vector>
 
 #include <string>
@@ -25,11 +26,13 @@ namespace py = pybind11;
 
 /// The Python face of an ArmSetup (armsim.Model): immutable; with_muscle returns a changed copy.
 /// Pickled as what made it: the model it was loaded from (a name, or a file's absolute path, read again
-/// when unpickled) and the with_muscle changes, in order.
+/// when unpickled), the with_muscle changes, in order, and the with_muscle_model choice.
 struct Model {
     ArmSetup setup;
     std::string source;  ///< a name under assets/models/ or a file's absolute path
     std::vector<std::pair<std::string, std::vector<std::pair<std::string, double>>>> changes;  ///< muscle, (key, value)
+    std::string muscleModel;  ///< with_muscle_model's model for every muscle ("" = the file's)
+    std::map<std::string, double> muscleModelCoefficients;  ///< and its coefficients
 };
 
 /// A table's columns as a dict of float64 arrays, in column order. The arrays are views (stride: one

@@ -168,3 +168,33 @@ def test_model_takes_a_path_copies_and_types_its_overrides(elbow):
         elbow.with_muscle(mass="heavy")
     with pytest.raises(TypeError, match="'slow_units' = 2.5: expected a whole number"):
         elbow.with_muscle(slow_units=2.5)
+
+
+def test_with_muscle_model_swaps_the_equations_and_keeps_f0(thesis):
+    # Issue 29: the same muscle as Thelen 2003 and De Groote-Fregly 2016 (OpenSim's Hill-type models).
+    # The same F0 = sigma M / (rho L0) (31.8 N/cm^2, 1.06 g/cm^3): at the path where the fibre is near
+    # its optimum (P = L0 + L0T) a fully active Hill muscle gives about F0.
+    p = thesis.parameters()
+    F0 = 31.8e4 * p["mass"] / (1060 * p["optimal_fascicle_length"])
+    P = p["optimal_fascicle_length"] + p["optimal_tendon_length"]
+    vm = armsim.steady_state(thesis, P, 1.0)
+    for name in ("thelen2003", "degroote2016"):
+        hill = thesis.with_muscle_model(name)
+        s = armsim.steady_state(hill, P, 1.0)
+        assert s["force"] == pytest.approx(F0, rel=0.02)
+        assert s["normalized_fascicle_length"] == pytest.approx(1.0, abs=0.03)
+        assert abs(s["force"] - vm["force"]) > 1.0  # other equations
+        t = armsim.muscle_trial(hill, path_length=P, activation=1.0, duration=1.0, rate=10)
+        assert t["force_N"][-1] == pytest.approx(s["force"], rel=1e-4)  # integration ends at the steady state
+    slow = thesis.with_muscle_model("thelen2003", activation_time_constant=0.05)
+    fast = thesis.with_muscle_model("thelen2003")
+    rise = lambda m: armsim.muscle_trial(m, path_length=P, activation=1.0, duration=0.02, rate=1000)["force_N"][-1]
+    assert rise(slow) < rise(fast)
+    # Pickles and copies keep the model and its coefficients.
+    import pickle
+    again = pickle.loads(pickle.dumps(slow))
+    assert rise(again) == rise(slow)
+    with pytest.raises(ValueError, match="expected one of virtual_muscle, thelen2003, degroote2016"):
+        thesis.with_muscle_model("hill")
+    with pytest.raises(ValueError, match="no coefficient 'tau'"):
+        thesis.with_muscle_model("thelen2003", tau=0.1)
