@@ -18,6 +18,10 @@ namespace armsim::cli {
 
 /// Model and muscle options shared by every command that simulates. The muscle overrides apply to
 /// the model's primary muscle (the thesis's biceps); an option not given leaves the model's value.
+/// loadModel(name) with every muscle given muscle model `muscleModel` unless it is empty (the
+/// --muscle-model option; errors name the option and value).
+ArmSetup loadModelWithMuscles(const std::string& name, const std::string& muscleModel);
+
 struct MuscleOptions {
     std::string model = "thesis";          ///< model name under assets/models/ or a model file
     std::string file;                      ///< muscle file replacing the primary muscle's parameters
@@ -27,13 +31,16 @@ struct MuscleOptions {
     std::optional<double> mass;            ///< override M [kg]
     std::optional<double> tendonLength;    ///< override L0T [m]
     std::optional<double> maxPathLength;   ///< override P_max [m]
+    std::string muscleModel;               ///< --muscle-model: every muscle's model ("" = the model file's)
     void add(CLI::App& app);
+    /// Adds --muscle-model (only to commands that honour it).
+    void addMuscleModel(CLI::App& app);
     /// The model with the overrides applied, validated (errors name the option and value).
     ArmSetup loadSetup() const;
     /// The primary muscle's parameters from loadSetup().
     MuscleParameters loadParameters() const;
-    /// loadParameters() built into a VirtualMuscle.
-    VirtualMuscle build() const;
+    /// The primary muscle built with its muscle model (Virtual Muscle unless --muscle-model).
+    std::shared_ptr<const MuscleModel> build() const;
 };
 
 /// Adds a sub-command to the armsim app. Registered at static-initialisation time.

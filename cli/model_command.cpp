@@ -75,14 +75,17 @@ void addModelCommands(CLI::App& app) {
         auto reference = std::make_shared<std::string>();
         CLI::App* c = model->add_subcommand(
             "show", "muscle table, moment arms and steady MVC torque-angle curves (CSV + PNG)");
+        auto muscleModel = std::make_shared<std::string>();
         c->add_option("--model", *name, "model name or file")->capture_default_str();
+        c->add_option("--muscle-model", *muscleModel,
+                      "every muscle's model: virtual_muscle, thelen2003 or degroote2016 (default: the model file's)");
         c->add_option("--out", *out, "output directory")->capture_default_str();
         c->add_option("--step", *step, "angle step [deg]")->capture_default_str();
         c->add_option("--reference", *reference,
                       "published reference data (default assets/measured/elbow_reference.yaml)");
         c->callback([=] {
             const ElbowReference ref = reference->empty() ? loadDefaultElbowReference() : loadElbowReference(*reference);
-            showModel(loadModel(*name), *out, *step, ref);
+            showModel(loadModelWithMuscles(*name, *muscleModel), *out, *step, ref);
         });
     }
 
@@ -92,10 +95,13 @@ void addModelCommands(CLI::App& app) {
         auto targets = std::make_shared<std::string>();
         CLI::App* c = model->add_subcommand(
             "check", "score a model against anatomy targets: scorecard.csv, score_summary.csv, plots with the bands");
+        auto muscleModel = std::make_shared<std::string>();
         c->add_option("--model", *name, "model name or file")->capture_default_str();
+        c->add_option("--muscle-model", *muscleModel,
+                      "every muscle's model: virtual_muscle, thelen2003 or degroote2016 (default: the model file's)");
         c->add_option("--targets", *targets, "target file (default assets/reference/elbow_targets.yaml)");
         c->add_option("--out", *out, "output directory")->capture_default_str();
-        c->callback([=] { checkModel(loadModel(*name), targets->empty() ? loadDefaultAnatomyTargets() : loadAnatomyTargets(*targets), *out); });
+        c->callback([=] { checkModel(loadModelWithMuscles(*name, *muscleModel), targets->empty() ? loadDefaultAnatomyTargets() : loadAnatomyTargets(*targets), *out); });
     }
 
     {

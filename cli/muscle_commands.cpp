@@ -27,8 +27,26 @@ void MuscleOptions::add(CLI::App& app) {
                                                 "longest path over the elbow range)");
 }
 
+void MuscleOptions::addMuscleModel(CLI::App& app) {
+    app.add_option("--muscle-model", muscleModel,
+                   "every muscle's model: virtual_muscle, thelen2003 or degroote2016 (default: the model file's)");
+}
+
+ArmSetup loadModelWithMuscles(const std::string& name, const std::string& muscleModel) {
+    ArmSetup s = loadModel(name);
+    if (muscleModel.empty()) return s;
+    try {
+        findMuscleModelType(muscleModel);
+    } catch (const InputError& e) {
+        const std::string m = e.what();
+        throw InputError("option --muscle-model = '" + muscleModel + "': " + m.substr(m.find("expected")));
+    }
+    setMuscleModel(s, muscleModel);
+    return s;
+}
+
 ArmSetup MuscleOptions::loadSetup() const {
-    ArmSetup s = loadModel(model);
+    ArmSetup s = loadModelWithMuscles(model, muscleModel);
     if (!armFile.empty()) {
         const ArmParameters a = loadArmParameters(findAsset(armFile));
         s.arm = a;
@@ -67,7 +85,10 @@ ArmSetup MuscleOptions::loadSetup() const {
 
 MuscleParameters MuscleOptions::loadParameters() const { return loadSetup().calcBicepsParameters(); }
 
-VirtualMuscle MuscleOptions::build() const { return VirtualMuscle(loadParameters()); }
+std::shared_ptr<const MuscleModel> MuscleOptions::build() const {
+    const ArmSetup s = loadSetup();
+    return s.buildMuscleModel(s.primary);
+}
 
 namespace {
 
@@ -88,18 +109,20 @@ void addMuscleCommands(CLI::App& app) {
         auto U = std::make_shared<double>(1.0);
         CLI::App* c = muscle->add_subcommand("steady", "steady isometric force at one path length and activation");
         opts->add(*c);
+        opts->addMuscleModel(*c);
         c->add_option("--path", *path, "path length P [m]")->capture_default_str();
         c->add_option("--activation", *U, "activation U in [0, 1]")->capture_default_str();
         c->callback([=] {
             checkActivation(*U);
-            const VirtualMuscle m = opts->build();
+            const std::shared_ptr<const MuscleModel> built = opts->build();
+            const MuscleModel& m = *built;
             const SteadyState s = m.calcSteadyState(*path, *U);
             if (!s.converged) throw SimulationError(s.message);
-            std::printf("muscle            %s\n", m.getParameters().name.c_str());
+            std::printf("muscle            %s\n", m.getName().c_str());
             std::printf("path length       %.6f m\nactivation        %.4f\n", *path, *U);
             std::printf("force Fse         %.4f N  (F0 = %.3f N)\n", s.force, m.getF0());
             std::printf("fascicle length   %.6f m  (L = %.6f L0)\n", s.fascicleLength, s.L);
-            std::printf("tendon length     %.6f m\n", *path - s.fascicleLength);
+            std::printf("tendon length     %.6f m\n", m.calcOutputs(*path, *U, s.states.data()).tendonLength);
         });
     }
 
@@ -113,6 +136,7 @@ void addMuscleCommands(CLI::App& app) {
         auto plot = std::make_shared<std::string>();
         CLI::App* c = muscle->add_subcommand("sweep", "steady force over a range of path lengths (force-length)");
         opts->add(*c);
+        opts->addMuscleModel(*c);
         c->add_option("--from", *from, "first path length [m]")->capture_default_str();
         c->add_option("--to", *to, "last path length [m] (at most P_max)")->capture_default_str();
         c->add_option("--step", *step, "path length step [m]")->capture_default_str();
@@ -127,7 +151,8 @@ void addMuscleCommands(CLI::App& app) {
                                  formatNumber(*to) + " m gives " + formatNumber(std::floor((*to - *from) / *step) + 1) +
                                  " path lengths: expected at most 1000001");
             if (!(*to >= *from)) throw InputError("--to must not be below --from");
-            const VirtualMuscle m = opts->build();
+            const std::shared_ptr<const MuscleModel> built = opts->build();
+            const MuscleModel& m = *built;
             m.checkPathLength(*from);
             m.checkPathLength(*to);
             Table t({"path_length_m", "activation", "force_N", "fascicle_length_m", "converged"});
@@ -147,7 +172,7 @@ void addMuscleCommands(CLI::App& app) {
             std::printf("wrote %s (%d path lengths)\n", out->c_str(), n);
             if (!plot->empty()) {
                 PlotSpec spec;
-                spec.title = m.getParameters().name + ": steady force vs path length";
+                spec.title = m.getName() + ": steady force vs path length";
                 spec.xLabel = "path length (cm)";
                 spec.yLabel = "force Fse (N)";
                 spec.series.push_back({"U = " + std::to_string(*U).substr(0, 4), x, y});
@@ -169,6 +194,7 @@ void addMuscleCommands(CLI::App& app) {
         auto trace = std::make_shared<std::string>();
         CLI::App* c = muscle->add_subcommand("trial", "isometric time integration (CPodes) at a fixed path length");
         opts->add(*c);
+        opts->addMuscleModel(*c);
         c->add_option("--path", settings->pathLength, "path length P [m]")->capture_default_str();
         c->add_option("--activation", *U, "activation level after onset, in [0, 1]")->capture_default_str();
         c->add_option("--onset", *onset, "activation onset time [s] (0 before it)")->capture_default_str();
@@ -185,7 +211,8 @@ void addMuscleCommands(CLI::App& app) {
             checkActivation(*U);
             checkField("--onset", *onset, Bound::nonNegative("s"));
             checkField("--rise", *rise, Bound::nonNegative("s"));
-            const VirtualMuscle m = opts->build();
+            const std::shared_ptr<const MuscleModel> built = opts->build();
+            const MuscleModel& m = *built;
             MuscleIsometricSettings s = *settings;
             if (!trace->empty()) s.activation = loadActivationTrace(*trace);
             else if (*rise > 0) s.activation = ActivationProfile::ramp(*onset, *onset + *rise, 0.0, *U);
@@ -199,7 +226,7 @@ void addMuscleCommands(CLI::App& app) {
                         t.get(last, "time_s"), stats.steps, stats.restarts, out->c_str());
             if (!plot->empty()) {
                 PlotSpec spec;
-                spec.title = m.getParameters().name + ": isometric trial at P = " + std::to_string(100 * s.pathLength).substr(0, 5) + " cm";
+                spec.title = m.getName() + ": isometric trial at P = " + std::to_string(100 * s.pathLength).substr(0, 5) + " cm";
                 spec.xLabel = "time (s)";
                 spec.yLabel = "force Fse (N)";
                 spec.series.push_back({"force", t.getColumn("time_s"), t.getColumn("force_N")});

@@ -110,9 +110,9 @@ void runStep(const VirtualMuscle& m, const std::string& outDir) {
 }
 
 const MainJobStepRegistrar registerForceLength(10, "Muscle force-length (steady solve vs integration)",
-                                                [](const MainJobContext& c) { runForceLength(c.muscle.build(), c.outDir); });
+                                                [](const MainJobContext& c) { runForceLength(VirtualMuscle(c.muscle.loadParameters()), c.outDir); });
 const MainJobStepRegistrar registerStep(20, "Muscle step activation",
-                                        [](const MainJobContext& c) { runStep(c.muscle.build(), c.outDir); });
+                                        [](const MainJobContext& c) { runStep(VirtualMuscle(c.muscle.loadParameters()), c.outDir); });
 
 }  // namespace
 

@@ -120,6 +120,11 @@ std::vector<BadInput> makeCatalogue() {
          {"--bounds mass lower", "abc"}},
         {"IdentifyOutIsAFile", {{"afile", "x"}}, "identify measured/thesis_measured.csv --out IN/afile/id",
          {"--out", "afile", "not a folder"}},
+        {"MuscleModelUnknown", {}, "muscle steady --model twin --muscle-model hill",
+         {"--muscle-model", "'hill'", "expected one of virtual_muscle, thelen2003, degroote2016"}},
+        {"ModelFileMuscleModelUnknown",
+         {{"m.yaml", "name: m\narm: arm/default_male.yaml\nmuscle_model: hill\nmuscles:\n  - name: A\n    mass: 0.1\n"}},
+         "model show --model IN/m.yaml --out OUT/ms", {"m.yaml:3", "muscle_model", "'hill'", "expected one of"}},
         // ---- torque data, validation, design, studies ------------------------------------------
         {"TorqueDataMissing", {}, "identify-torque IN/none.csv --out OUT/it", {"none.csv"}},
         {"TorqueDataWrongSign", {{"t.csv", "flexion_deg,torque_Nm\n90,-40\n"}}, "identify-torque IN/t.csv --out OUT/it",
