@@ -1,5 +1,5 @@
 // libFuzzer target for armsim's file loaders (issue 15). One binary, the loader chosen by the
-// ARMSIM_FUZZ_LOADER environment variable (muscle, arm, model, protocol, torque_protocol, population,
+// ARMSIM_FUZZ_LOADER environment variable (muscle, arm, model, osim, protocol, torque_protocol, population,
 // study, force_csv, torque_csv, channel_csv, sto, trace, study_journal). Each input is written to a scratch file and loaded; a loader
 // may reject it only with InputError (bad input) or SimulationError (a model it cannot solve). Any
 // other exception, a crash, a hang or a sanitizer report is a finding.
@@ -14,6 +14,7 @@
 #include "studies/study.h"
 #include "model/arm_parameters.h"
 #include "model/model_file.h"
+#include "model/osim_file.h"
 #include "muscles/activation.h"
 #include "muscles/muscle_file.h"
 
@@ -37,6 +38,7 @@ const std::map<std::string, std::pair<std::string, Loader>>& getLoaders() {
         {"muscle", {".yaml", [](const std::string& p) { loadMuscleParameters(p); }}},
         {"arm", {".yaml", [](const std::string& p) { loadArmParameters(p); }}},
         {"model", {".yaml", [](const std::string& p) { loadModel(p); }}},
+        {"osim", {".osim", [](const std::string& p) { readOsimFile(p); }}},
         {"protocol", {".yaml", [](const std::string& p) { loadProtocolSubject(readProtocol(p)); }}},
         {"torque_protocol", {".yaml", [](const std::string& p) { readTorqueProtocol(p); }}},
         {"population", {".yaml", [](const std::string& p) { loadPopulation(p); }}},
