@@ -59,10 +59,13 @@ MuscleParameters ArmSetup::calcMuscleParameters(int i) const {
     return p;
 }
 
+std::shared_ptr<const MuscleModel> buildMuscleModel(const MuscleSpec& m) {
+    return findMuscleModelType(m.muscleModel).build(MuscleModelInput{m.params, m.muscleModelCoefficients});
+}
+
 std::shared_ptr<const MuscleModel> ArmSetup::buildMuscleModel(int i) const {
     const MuscleSpec& m = muscles.at(i);
-    const MuscleModelType& type = findMuscleModelType(m.muscleModel);
-    return type.build(MuscleModelInput{calcMuscleParameters(i), m.muscleModelCoefficients});
+    return findMuscleModelType(m.muscleModel).build(MuscleModelInput{calcMuscleParameters(i), m.muscleModelCoefficients});
 }
 
 bool ArmSetup::hasOnlyVirtualMuscles() const {

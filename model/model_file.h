@@ -147,6 +147,10 @@ struct MuscleSpec {
     void setCalibration(const MuscleCalibration& c);
 };
 
+/// The muscle built with its muscle model from its parameters as they stand (not validated as Virtual
+/// Muscle parameters unless it is one; ArmSetup::buildMuscleModel validates them first).
+std::shared_ptr<const MuscleModel> buildMuscleModel(const MuscleSpec& muscle);
+
 /// The virtual subject's effort in a trial (spec: a realistic MVC).
 struct SubjectEffort {
     double voluntaryActivation = 1.0;  ///< U of the agonists at a maximal effort [1]

@@ -77,11 +77,7 @@ SteadyMvcCurve calcSteadyCurve(const std::vector<MuscleSpec>& muscles, const Mvc
     // inputs changed); a cached muscle is built only when one of its states must be solved.
     // Muscles of another model than Virtual Muscle are built afresh and never reuse cached states.
     std::vector<std::shared_ptr<const MuscleModel>> model(nm);
-    auto build = [&](std::size_t i) {
-        const MuscleSpec& m = muscles[i];
-        if (m.muscleModel == kDefaultMuscleModel) model[i] = std::make_shared<VirtualMuscle>(m.params);
-        else model[i] = findMuscleModelType(m.muscleModel).build({m.params, m.muscleModelCoefficients});
-    };
+    auto build = [&](std::size_t i) { model[i] = buildMuscleModel(muscles[i]); };
     std::vector<double> F0(nm);
     for (std::size_t i = 0; i < nm; ++i) {
         const MuscleParameters& params = muscles[i].params;

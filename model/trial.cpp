@@ -217,6 +217,7 @@ IsometricTrialResult runIsometricTrial(const ArmSetup& setup, const IsometricTri
         throw std::logic_error("runIsometricTrial: the arm has z states that belong to no muscle");
     std::vector<double> forces(n), row;
 
+    const bool primaryVelocityIsState = muscles[primary]->hasFascicleVelocityState();
     // One sample from y = [q u z]; s is the realized-per-sample reference's State (else null).
     auto sample = [&](double t, const double* y, const State* s) {
         double torque, forearmTorque = 0;
@@ -240,10 +241,11 @@ IsometricTrialResult runIsometricTrial(const ArmSetup& setup, const IsometricTri
             calcTransducerReading(ap, muscleTorque / ap.strapDistance, settings.elbowAngle, h, F);
         sum.saturated = sum.saturated || r.saturated;
         const double* yp = y + firstState[primary];
-        const double Pp = sum.pathLengths[primary], Up = activations[primary]->getValue(t);
+        const double Pp = sum.pathLengths[primary];
+        const double Up = primaryVelocityIsState ? 0.0 : activations[primary]->getValue(t);
         row.assign({t, profile.getValue(t), radToDeg(settings.elbowAngle), 0.0, F,
-                    muscles[primary]->calcFascicleLength(Pp, yp), muscles[primary]->calcFascicleVelocity(Pp, Up, yp), torque, muscleTorque, r.strapForce, r.saturated ? 1.0 : 0.0,
-                    r.forceMomentArm, r.forceFixedRatio, r.errorMomentArmPct, r.errorFixedRatioPct});
+                    muscles[primary]->calcFascicleLength(Pp, yp), muscles[primary]->calcFascicleVelocity(Pp, Up, yp),
+                    torque, muscleTorque, r.strapForce, r.saturated ? 1.0 : 0.0, r.forceMomentArm, r.forceFixedRatio, r.errorMomentArmPct, r.errorFixedRatioPct});
         if (forearm) row.push_back(forearmTare - forearmTorque);  // tared, + = supination
         appendMuscleForces(row, activations, forces, t);
         for (int i = 0; i < n; ++i) row.insert(row.end(), y + firstState[i], y + firstState[i] + muscles[i]->getNumStates());

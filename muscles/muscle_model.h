@@ -88,6 +88,9 @@ public:
     virtual double calcFascicleLength(double pathLength, const double* y) const = 0;
     /// Fascicle velocity [m/s] (+ = lengthening) of state y at path P, input U.
     virtual double calcFascicleVelocity(double pathLength, double U, const double* y) const = 0;
+    /// true when the fascicle velocity is a state, so calcFascicleVelocity ignores P and U (callers that
+    /// sample many states may then skip looking the input up).
+    virtual bool hasFascicleVelocityState() const { return false; }
 };
 
 }  // namespace armsim

@@ -188,6 +188,7 @@ public:
     double calcFascicleVelocity(double, double, const double* y) const override {
         return y[kV] * params_.optimalFascicleLength;
     }
+    bool hasFascicleVelocityState() const override { return true; }
 
     const MuscleParameters& getParameters() const { return params_; }
     const std::vector<MotorUnit>& getUnits() const { return units_; }
