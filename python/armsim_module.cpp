@@ -80,7 +80,7 @@ constexpr int kModelPickleFormat = 2;  // 2: with the muscle model (1: without, 
 
 // A model loaded from a name or file, remembering which (a path made absolute) for pickling.
 Model loadPythonModel(const std::string& nameOrFile) {
-    Model m{loadModelChecked(nameOrFile), nameOrFile, {}};
+    Model m{loadModelChecked(nameOrFile), nameOrFile, {}, {}, {}};
     if (isRegularFile(nameOrFile)) m.source = std::filesystem::absolute(nameOrFile).lexically_normal().string();
     return m;
 }
