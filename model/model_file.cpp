@@ -369,9 +369,13 @@ ArmSetup loadModel(const std::string& nameOrFile) {
     std::string file = nameOrFile;
     const bool looksLikeName = nameOrFile.find('/') == std::string::npos &&
                                nameOrFile.find(".yaml") == std::string::npos;
+    const std::string osimNote = "an OpenSim model: armsim reads .osim files as data (model/osim_file.h) but cannot "
+                                 "simulate them yet; expected an armsim model file (.yaml)";
     if (looksLikeName) {
         const std::string asset = getAssetDirectory() + "/models/" + nameOrFile + ".yaml";
         if (!doesPathExist(asset)) {
+            if (doesPathExist(getAssetDirectory() + "/models/" + nameOrFile + ".osim"))
+                throw InputError("--model '" + nameOrFile + "': assets/models/" + nameOrFile + ".osim is " + osimNote);
             std::string known;
             for (const std::string& m : listModels()) known += (known.empty() ? "" : ", ") + m;
             throw InputError("--model '" + nameOrFile + "': no such model (shipped models: " + known +
@@ -381,6 +385,7 @@ ArmSetup loadModel(const std::string& nameOrFile) {
     } else if (!doesPathExist(file)) {
         throw InputError(file + ": no such model file");
     }
+    if (file.size() > 5 && file.compare(file.size() - 5, 5, ".osim") == 0) throw InputError(file + ": " + osimNote);
 
     // Loading resolves paths over the elbow's range (a few ms, 40 ms under sanitizers): a model is
     // reused while the model file and every file it read are byte for byte as they were and every
