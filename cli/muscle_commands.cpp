@@ -83,7 +83,11 @@ ArmSetup MuscleOptions::loadSetup() const {
     }
 }
 
-MuscleParameters MuscleOptions::loadParameters() const { return loadSetup().calcBicepsParameters(); }
+MuscleParameters MuscleOptions::loadParameters() const {
+    const ArmSetup s = loadSetup();
+    s.requireVirtualMuscles("this command's force model and identifiers", s.primary);
+    return s.calcBicepsParameters();
+}
 
 std::shared_ptr<const MuscleModel> MuscleOptions::build() const {
     const ArmSetup s = loadSetup();

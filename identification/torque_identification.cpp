@@ -18,6 +18,7 @@ const std::vector<std::string>& getElbowMethodKinds() {
 MuscleEstimate identifyElbowMethod(const ElbowMethod& method, const Population& population,
                                    const std::vector<TorqueObservation>& data, unsigned seed, int subject,
                                    const std::vector<ChannelObservation>& channels) {
+    population.base.requireVirtualMuscles("the identifiers (prior population '" + population.name + "')");
     MuscleEstimate e;
     if (method.kind == "thesis") {
         e = identifyThesisMethod(population.base, data);

@@ -74,6 +74,15 @@ bool ArmSetup::hasOnlyVirtualMuscles() const {
     return true;
 }
 
+void ArmSetup::requireVirtualMuscles(const std::string& what, int i) const {
+    for (int k = 0; k < getNumMuscles(); ++k) {
+        if ((i >= 0 && k != i) || muscles[k].muscleModel == kDefaultMuscleModel) continue;
+        throw InputError(what + " model muscle '" + muscles[k].params.name + "' as a Virtual Muscle, but model '" + name +
+                         "' gives it muscle_model " + muscles[k].muscleModel +
+                         ": expected virtual_muscle (a truth with Hill-type muscles goes in the truth population)");
+    }
+}
+
 void ArmSetup::validate() const {
     arm.validate();
     effort.validate();

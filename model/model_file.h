@@ -195,6 +195,9 @@ struct ArmSetup {
     std::shared_ptr<const MuscleModel> buildMuscleModel(int i) const;
     /// true when every muscle is a Virtual Muscle.
     bool hasOnlyVirtualMuscles() const;
+    /// Throws InputError unless muscle i (-1: every muscle) is a Virtual Muscle: `what` (e.g. "the
+    /// identifiers") models it as one, and a Hill-type muscle must not be read as one silently.
+    void requireVirtualMuscles(const std::string& what, int i = -1) const;
     /// The primary muscle's, as calcMuscleParameters(primary).
     MuscleParameters calcBicepsParameters() const { return calcMuscleParameters(primary); }
     /// Throws InputError for an inconsistent model (no muscles, duplicate names, bad primary).

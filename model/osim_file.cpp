@@ -254,8 +254,6 @@ private:
             } else if (kind == "WrapEllipsoid") {
                 o.kind = OsimWrapObject::Kind::Ellipsoid;
                 o.dimensions = vec3(w, "dimensions");
-            } else if (kind == "WrapTorus") {
-                o.kind = OsimWrapObject::Kind::Torus;
             } else {
                 fail(w, "wrap object type " + kind + " is not supported: expected WrapCylinder, WrapSphere or WrapEllipsoid");
             }
@@ -470,6 +468,8 @@ private:
                 fail(child(f, "tendon_compliance_dynamics_mode"), "'" + mode + "': expected explicit (implicit is for direct collocation)");
             if (flag(f, "ignore_tendon_compliance", false))
                 fail(child(f, "ignore_tendon_compliance"), "true: a rigid tendon is not supported (expected false)");
+            if (flag(f, "ignore_passive_fiber_force", false))
+                fail(child(f, "ignore_passive_fiber_force"), "true: not supported (expected false)");
             if (flag(f, "ignore_activation_dynamics", false))
                 fail(child(f, "ignore_activation_dynamics"), "true: expected false (activation dynamics are part of the model)");
             readPath(f, mu);

@@ -95,7 +95,7 @@ struct OsimJoint {
 
 /// A wrapping surface fixed on a body.
 struct OsimWrapObject {
-    enum class Kind { Cylinder, Sphere, Ellipsoid, Torus };
+    enum class Kind { Cylinder, Sphere, Ellipsoid };
     std::string name;
     Kind kind = Kind::Cylinder;
     std::string body;

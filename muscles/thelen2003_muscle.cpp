@@ -181,7 +181,7 @@ void Thelen2003Muscle::calcStateDerivative(double P, double U, const double* y, 
     double vN = calcThelenFiberVelocity(p_, a, fal, afalfv);
     double fv = afalfv / (a * fal);
     // The unilateral stop: a fibre at its minimum length does not shorten further.
-    const bool clamped = y[kFiberLength] * l0 <= minFiberLength_ && vN <= 0;
+    const bool clamped = y[kFiberLength] * l0 <= minFiberLength_ * (1 + 1e-12) && vN <= 0;
     if (clamped) {
         vN = 0;
         fv = 1;
@@ -247,7 +247,15 @@ SteadyState Thelen2003Muscle::calcSteadyState(double P, double U) const {
     r.evaluations = 1;
     const double flo = imbalance(lo);
     if (flo >= 0 || along <= lo * std::cos(calcPennationAngle(lo))) {
-        lM = lo;  // the fibre rests at its minimum length (OpenSim: "fibre at its lower bound")
+        // The fibre would shorten past every length. With pennation, OpenSim's stop holds it at the
+        // minimum length ("fibre at its lower bound"), a rest the derivative keeps; without pennation
+        // the minimum is 0, where no fibre can rest.
+        if (minFiberLength_ <= 0) {
+            r.message = "no steady state at path " + fmtNum(P) + " m: the fibre would shorten to zero length "
+                        "(the path is too short for this muscle's tendon)";
+            return r;
+        }
+        lM = lo;
     } else {
         const double hi = std::sqrt(along * along + height_ * height_);
         const double fhi = imbalance(hi);

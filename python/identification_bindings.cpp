@@ -308,6 +308,7 @@ py::dict identifyPy(const Model& m, const py::object& data, const std::string& m
                     const std::optional<double>& forceSd, const std::string& noise, int multistart, unsigned seed,
                     int maxIterations, double tolerance, int subject, const py::object& out) {
     IdentificationProblem pr;
+    m.setup.requireVirtualMuscles("identify's force models", m.setup.primary);
     pr.base = m.setup.calcBicepsParameters();
     pr.data = toObservations(data, m.setup, subject);
     pr.unknowns.clear();
@@ -407,6 +408,7 @@ py::dict validatePy(const Model& m, int seeds, unsigned seed, const std::vector<
     s.estimate = parseForceEstimateName(estimate);
     s.jobs = jobs;
     s.validate(m.setup.arm);
+    m.setup.requireVirtualMuscles("validate's force models", m.setup.primary);
     std::vector<ValidationRow> rows;
     runInterruptible([&] {
         rows = runValidation(m.setup.arm, m.setup.calcBicepsParameters(), s);

@@ -92,6 +92,7 @@ std::string resolveStudyFile(const ParamNode& n, const std::string& field, const
 void Study::validate() const {
     population.validate();
     prior.validate();
+    prior.base.requireVirtualMuscles("the identifiers (prior population '" + prior.name + "')");
     const std::string& truthPrimary = population.base.muscles.at(population.base.primary).params.name;
     const std::string& priorPrimary = prior.base.muscles.at(prior.base.primary).params.name;
     if (truthPrimary != priorPrimary)

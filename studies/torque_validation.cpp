@@ -60,6 +60,7 @@ ValidationPlan planElbowValidation(const Population& population, const Populatio
                                    const ElbowValidationSettings& settings) {
     population.validate();
     prior.validate();
+    prior.base.requireVirtualMuscles("the identifiers (prior population '" + prior.name + "')");
     const std::string& truthPrimary = population.base.muscles[population.base.primary].params.name;
     const std::string& priorPrimary = prior.base.muscles[prior.base.primary].params.name;
     if (truthPrimary != priorPrimary)

@@ -693,6 +693,15 @@ TEST(ModelFile, MuscleModelKeyChoosesEachMusclesModel) {
     // The same F0 in both models (F0 = sigma M / (rho L0)).
     EXPECT_DOUBLE_EQ(a->getF0(), c->getF0());
     EXPECT_FALSE(s.hasOnlyVirtualMuscles());
+    // What models every muscle as a Virtual Muscle refuses a Hill-type one, naming it.
+    EXPECT_NO_THROW(s.requireVirtualMuscles("the identifiers", 2));
+    try {
+        s.requireVirtualMuscles("the identifiers");
+        ADD_FAILURE();
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("muscle 'A'"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("muscle_model thelen2003"), std::string::npos) << e.what();
+    }
 
     const std::string unknown = writeTemp("armsim_hill_unknown.yaml", head + "muscle_model: hill\nmuscles:\n" +
                                                                           makeMuscleEntry("A", "    mass: 0.1\n"));

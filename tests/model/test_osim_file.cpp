@@ -191,6 +191,11 @@ TEST(OsimFile, ProblemsAreNamedWithFileLineAndElement) {
                    "<socket_parent_frame>/bodyset/r_ulna</socket_parent_frame>");
     e = errorOf(bad);
     EXPECT_NE(e.find("body 'r_ulna' does not exist"), std::string::npos) << e;
+    // A property that would change results and is not modelled.
+    bad = replaced(t, "<max_contraction_velocity>10</max_contraction_velocity>",
+                   "<max_contraction_velocity>10</max_contraction_velocity><ignore_passive_fiber_force>true</ignore_passive_fiber_force>");
+    e = errorOf(bad);
+    EXPECT_NE(e.find("<ignore_passive_fiber_force>: true: not supported"), std::string::npos) << e;
     // An unsupported joint.
     bad = replaced(t, "<CustomJoint name=\"r_shoulder\">", "<BallJoint name=\"r_shoulder\">");
     bad = replaced(bad, "</CustomJoint>", "</BallJoint>");

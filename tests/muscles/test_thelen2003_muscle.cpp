@@ -149,6 +149,25 @@ TEST(Thelen2003Muscle, SimbodyAdapterGivesThePlainIntegrationsSamples) {
                 1e-3 * muscle.calcSteadyState(0.27, 1.0).force);
 }
 
+// Review finding: without pennation the fibre's minimum length is 0, where no fibre rests; a path so
+// short that the fibre would shorten past every length has no steady state (it used to report one at
+// 1e-9 l0 whose derivative was not zero). With pennation the stop holds it, and that rest is one.
+TEST(Thelen2003Muscle, APathTooShortForTheTendonHasNoSteadyStateUnlessTheStopHoldsIt) {
+    Thelen2003Parameters p = triLong();
+    p.pennationAngleAtOptimal = 0;
+    const SteadyState none = Thelen2003Muscle(p).calcSteadyState(p.tendonSlackLength * 1.0001, 1.0);
+    EXPECT_FALSE(none.converged);
+    EXPECT_NE(none.message.find("shorten to zero"), std::string::npos) << none.message;
+    const Thelen2003Muscle pennate(triLong());
+    const double P = 0.143 + 0.5 * pennate.getMinimumFiberLength() * std::cos(triLong().maximumPennationAngle);
+    const SteadyState held = pennate.calcSteadyState(P, 1.0);
+    ASSERT_TRUE(held.converged) << held.message;
+    EXPECT_NEAR(held.fascicleLength, pennate.getMinimumFiberLength(), 1e-15);
+    double ydot[2];
+    pennate.calcStateDerivative(P, 1.0, held.states.data(), ydot);
+    EXPECT_EQ(ydot[1], 0.0);  // the stop
+}
+
 TEST(Thelen2003Muscle, RefusesOutOfRangeParametersNamingTheField) {
     Thelen2003Parameters p = triLong();
     p.fmaxTendonStrain = 0;
