@@ -47,6 +47,10 @@ TEST(DeGroote2016Curves, PassThroughTheirDefiningPoints) {
     EXPECT_NEAR(calcDeGrooteTendonForceLength(p, 1.0), 0.0, kCurveTol);
     EXPECT_NEAR(calcDeGrooteTendonForceLength(p, 1.049), 1.0, kCurveTol);
     EXPECT_NEAR(calcDeGrooteTendonLength(p, calcDeGrooteTendonForceLength(p, 1.03)), 1.03, kCurveTol);
+    // Values OpenSim's own tests state (opensim-core testDeGrooteFregly2016Muscle.cpp): the passive
+    // multiplier at the optimal length and the force-velocity multiplier at full lengthening speed.
+    EXPECT_NEAR(calcDeGrootePassiveForceLength(p, 1.0), 0.0182288, 1e-7);
+    EXPECT_NEAR(calcDeGrooteForceVelocity(1.0), 1.794, 1e-3);
     // Wider with active_force_width_scale, same peak.
     DeGroote2016Parameters wide = p;
     wide.activeForceWidthScale = 1.5;
