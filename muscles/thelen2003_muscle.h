@@ -43,12 +43,12 @@ struct Thelen2003Parameters {
     /// Longest path accepted (anatomical limit) [m]; infinity: no limit.
     double maxPathLength = std::numeric_limits<double>::infinity();
     double maxContractionVelocity = 10;     ///< vmax [l0^M/s] (OpenSim Muscle default)
-    double fmaxTendonStrain = 0.04;         ///< tendon strain at F0^M, eps0^T [1] (OpenSim 4; OpenSim 3: 0.033)
+    double fmaxTendonStrain = 0.04;         ///< tendon strain at F0^M, eps0^T [1] (OpenSim 4; OpenSim 2.x and arm26.osim: 0.033)
     double fmaxMuscleStrain = 0.6;          ///< passive fibre strain at F0^M, eps0^M [1] (OpenSim 4)
     double kshapeActive = 0.45;             ///< gamma, width of the Gaussian force-length curve [1] (OpenSim 4)
     double kshapePassive = 5.0;             ///< k^PE, passive exponential shape [1] (OpenSim 4)
     double af = 0.25;                       ///< A_f, force-velocity shape factor [1] (OpenSim 4)
-    double flen = 1.4;                      ///< F^M_len, maximal lengthening force / F0 [1] (OpenSim 4; OpenSim 3: 1.8)
+    double flen = 1.4;                      ///< F^M_len, maximal lengthening force / F0 [1] (OpenSim 4; OpenSim 2.x and arm26.osim: 1.8)
     double fvLinearExtrapThreshold = 0.95;  ///< fraction of F^M_len beyond which fv^-1 is extrapolated [1] (OpenSim)
     double maximumPennationAngle = 1.4706289056333368;  ///< [rad] (OpenSim: acos(0.1))
     double activationTimeConstant = 0.015;  ///< tau_act [s] (OpenSim 4)
