@@ -2,6 +2,7 @@
 
 #include "basics/bound.h"
 #include "basics/errors.h"
+#include "basics/format.h"
 #include "muscles/muscle_models.h"
 #include "numerics/brent.h"
 
@@ -29,12 +30,6 @@ double gaussianLike(double x, double b1, double b2, double b3, double b4) {
     return b1 * std::exp(-0.5 * (x - b2) * (x - b2) / (w * w));
 }
 
-std::string fmtNum(double v) {
-    std::ostringstream s;
-    s.precision(6);
-    s << v;
-    return s.str();
-}
 
 }  // namespace
 
@@ -45,7 +40,7 @@ void DeGroote2016Parameters::validate() const {
     checkField(q + "tendon_slack_length", tendonSlackLength, Bound::positive("m"));
     checkField(q + "pennation_angle", pennationAngleAtOptimal, {0, kPi / 2, false, true, "rad"});
     if (!(maxPathLength > 0))
-        throw FieldError(q + "max_path_length", "max_path_length = " + fmtNum(maxPathLength) + ": expected > 0 (m)");
+        throw FieldError(q + "max_path_length", "max_path_length = " + formatNumber(maxPathLength) + ": expected > 0 (m)");
     checkField(q + "max_contraction_velocity", maxContractionVelocity, Bound::positive("optimal fibre lengths/s"));
     checkField(q + "activation_time_constant", activationTimeConstant, Bound::positive("s"));
     checkField(q + "deactivation_time_constant", deactivationTimeConstant, Bound::positive("s"));
@@ -171,7 +166,7 @@ double DeGroote2016Muscle::calcFascicleVelocity(double P, double U, const double
 
 SteadyState DeGroote2016Muscle::calcSteadyState(double P, double U) const {
     checkPathLength(P);
-    if (!(U >= 0 && U <= 1)) throw InputError("activation U = " + fmtNum(U) + ": expected in [0, 1]");
+    if (!(U >= 0 && U <= 1)) throw InputError("activation U = " + formatNumber(U) + ": expected in [0, 1]");
     SteadyState r;
     const double a = std::clamp(U, p_.minimumActivation, 1.0), l0 = p_.optimalFiberLength;
     // At rest f_V = 1 (the curve passes (0, 1)): (a f_L + f_PE) cos phi = f_T(l~T) with l~T from the path.
@@ -191,20 +186,20 @@ SteadyState DeGroote2016Muscle::calcSteadyState(double P, double U) const {
     const double along = P - p_.tendonSlackLength;
     const double hi = std::sqrt(std::max(0.0, along * along) + width_ * width_);
     if (!(along > 0) || !(hi > lo)) {
-        r.message = "no steady state at path " + fmtNum(P) + " m: the tendon is slack for every fibre longer than " +
-                    fmtNum(kMinNormFiberLength) + " l0; the path is too short for this muscle";
+        r.message = "no steady state at path " + formatNumber(P) + " m: the tendon is slack for every fibre longer than " +
+                    formatNumber(kMinNormFiberLength) + " l0; the path is too short for this muscle";
         return r;
     }
     const double flo = imbalance(lo), fhi = imbalance(hi);
     if (!(flo < 0) || !(fhi > 0)) {
-        r.message = "no steady state at path " + fmtNum(P) + " m: no fibre length in [" + fmtNum(lo) + ", " +
-                    fmtNum(hi) + "] m balances the tendon";
+        r.message = "no steady state at path " + formatNumber(P) + " m: no fibre length in [" + formatNumber(lo) + ", " +
+                    formatNumber(hi) + "] m balances the tendon";
         return r;
     }
     const BrentResult root = findRootBrent(imbalance, lo, hi, flo, fhi, kSteadyTolL * l0, 200);
     r.evaluations = root.evaluations;
     if (!root.converged) {
-        r.message = "steady solve did not converge in 200 iterations at path " + fmtNum(P) + " m";
+        r.message = "steady solve did not converge in 200 iterations at path " + formatNumber(P) + " m";
         return r;
     }
     r.converged = true;

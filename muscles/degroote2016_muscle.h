@@ -25,7 +25,7 @@ namespace armsim {
 /// Everything that defines one De Groote-Fregly 2016 muscle. Defaults are OpenSim 4's
 /// (DeGrooteFregly2016Muscle::constructProperties); the shipped values are assets/muscles/degroote2016.yaml.
 struct DeGroote2016Parameters {
-    std::string name;                        ///< e.g. "BIClong"
+    std::string name;                        ///< the muscle's name in its model file
     double maxIsometricForce = 0;            ///< F0^M [N]
     double optimalFiberLength = 0;           ///< l0^M [m]
     double tendonSlackLength = 0;            ///< l^T_s [m]

@@ -45,7 +45,7 @@ public:
 
     /// The registry name of the model ("virtual_muscle", "thelen2003").
     virtual const char* getModelName() const = 0;
-    /// The muscle's name ("BIClong").
+    /// The muscle's name, as its model file gives it.
     virtual const std::string& getName() const = 0;
     virtual int getNumStates() const = 0;
     /// Names of the state entries, in order.

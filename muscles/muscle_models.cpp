@@ -1,11 +1,11 @@
 #include "muscles/muscle_models.h"
 
 #include "basics/errors.h"
+#include "basics/format.h"
 #include "muscles/degroote2016_muscle.h"
 #include "muscles/thelen2003_muscle.h"
 
 #include <cmath>
-#include <sstream>
 
 namespace armsim {
 
@@ -44,15 +44,9 @@ HillMorphometry calcHillMorphometry(const MuscleParameters& m) {
 }
 
 void checkPathWithin(double P, double maxPath, const std::string& muscle) {
-    auto fmt = [](double v) {
-        std::ostringstream s;
-        s.precision(6);
-        s << v;
-        return s.str();
-    };
-    if (!(P > 0) || !std::isfinite(P)) throw InputError("path length = " + fmt(P) + " m: expected > 0");
+    if (!(P > 0) || !std::isfinite(P)) throw InputError("path length = " + formatNumber(P) + " m: expected > 0");
     if (P > maxPath)
-        throw InputError("path length = " + fmt(P) + " m exceeds max_path_length = " + fmt(maxPath) + " m of muscle '" +
+        throw InputError("path length = " + formatNumber(P) + " m exceeds max_path_length = " + formatNumber(maxPath) + " m of muscle '" +
                          muscle + "': expected a path no longer than the anatomical limit");
 }
 

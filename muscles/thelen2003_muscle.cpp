@@ -2,6 +2,7 @@
 
 #include "basics/bound.h"
 #include "basics/errors.h"
+#include "basics/format.h"
 #include "muscles/muscle_models.h"
 #include "numerics/brent.h"
 
@@ -26,12 +27,6 @@ double calcToeStrain(double eps0) {
     return 99.0 * eps0 * e3 / (166.0 * e3 - 67.0);
 }
 
-std::string fmtNum(double v) {
-    std::ostringstream s;
-    s.precision(6);
-    s << v;
-    return s.str();
-}
 
 }  // namespace
 
@@ -42,7 +37,7 @@ void Thelen2003Parameters::validate() const {
     checkField(q + "tendon_slack_length", tendonSlackLength, Bound::positive("m"));
     checkField(q + "pennation_angle", pennationAngleAtOptimal, {0, kPi / 2, false, true, "rad"});
     if (!(maxPathLength > 0))
-        throw FieldError(q + "max_path_length", "max_path_length = " + fmtNum(maxPathLength) + ": expected > 0 (m)");
+        throw FieldError(q + "max_path_length", "max_path_length = " + formatNumber(maxPathLength) + ": expected > 0 (m)");
     checkField(q + "max_contraction_velocity", maxContractionVelocity, Bound::positive("optimal fibre lengths/s"));
     checkField(q + "fmax_tendon_strain", fmaxTendonStrain, Bound::open(0, 1));
     checkField(q + "fmax_muscle_strain", fmaxMuscleStrain, Bound::positive());
@@ -53,9 +48,9 @@ void Thelen2003Parameters::validate() const {
     checkField(q + "fv_linear_extrap_threshold", fvLinearExtrapThreshold, {1 / flen, 1, true, false, ""});
     checkField(q + "maximum_pennation_angle", maximumPennationAngle, Bound::closed(0, kPi / 2, "rad"));
     if (pennationAngleAtOptimal > maximumPennationAngle)
-        throw FieldError(q + "pennation_angle", "pennation_angle = " + fmtNum(pennationAngleAtOptimal) +
+        throw FieldError(q + "pennation_angle", "pennation_angle = " + formatNumber(pennationAngleAtOptimal) +
                                                     " rad: expected <= maximum_pennation_angle = " +
-                                                    fmtNum(maximumPennationAngle) + " rad");
+                                                    formatNumber(maximumPennationAngle) + " rad");
     checkField(q + "activation_time_constant", activationTimeConstant, Bound::positive("s"));
     checkField(q + "deactivation_time_constant", deactivationTimeConstant, Bound::positive("s"));
     // OpenSim refuses a_min < 0.01: below it the fibre velocity's singularity at a -> 0 is too near.
@@ -229,7 +224,7 @@ double Thelen2003Muscle::calcFascicleVelocity(double P, double U, const double* 
 
 SteadyState Thelen2003Muscle::calcSteadyState(double P, double U) const {
     checkPathLength(P);
-    if (!(U >= 0 && U <= 1)) throw InputError("activation U = " + fmtNum(U) + ": expected in [0, 1]");
+    if (!(U >= 0 && U <= 1)) throw InputError("activation U = " + formatNumber(U) + ": expected in [0, 1]");
     SteadyState r;
     const double a = std::clamp(U, p_.minimumActivation, 1.0), l0 = p_.optimalFiberLength;
     // (a f_L + f_PE) cos phi - f_SE at fibre length lM (V = 0, so f_V = 1).
@@ -251,7 +246,7 @@ SteadyState Thelen2003Muscle::calcSteadyState(double P, double U) const {
         // minimum length ("fibre at its lower bound"), a rest the derivative keeps; without pennation
         // the minimum is 0, where no fibre can rest.
         if (minFiberLength_ <= 0) {
-            r.message = "no steady state at path " + fmtNum(P) + " m: the fibre would shorten to zero length "
+            r.message = "no steady state at path " + formatNumber(P) + " m: the fibre would shorten to zero length "
                         "(the path is too short for this muscle's tendon)";
             return r;
         }
@@ -262,7 +257,7 @@ SteadyState Thelen2003Muscle::calcSteadyState(double P, double U) const {
         const BrentResult root = findRootBrent(imbalance, lo, hi, flo, fhi, kSteadyTolL * l0, 200);
         r.evaluations = root.evaluations;
         if (!root.converged) {
-            r.message = "steady solve did not converge in 200 iterations at path " + fmtNum(P) + " m";
+            r.message = "steady solve did not converge in 200 iterations at path " + formatNumber(P) + " m";
             return r;
         }
         lM = root.x;

@@ -35,7 +35,7 @@ namespace armsim {
 /// (Thelen2003Muscle::constructProperties; Muscle's max_contraction_velocity); the shipped values are
 /// assets/muscles/thelen2003.yaml.
 struct Thelen2003Parameters {
-    std::string name;                       ///< e.g. "BIClong"
+    std::string name;                       ///< the muscle's name in its model file
     double maxIsometricForce = 0;           ///< F0^M [N]
     double optimalFiberLength = 0;          ///< l0^M [m]
     double tendonSlackLength = 0;           ///< l^T_s [m]
