@@ -208,6 +208,8 @@ void writeHeatMapPng(const std::string& path, const HeatMapSpec& spec) {
     if (nx == 0 || ny == 0 || spec.z.size() != nx * ny)
         throw std::invalid_argument("heat map '" + spec.title + "': need nx, ny >= 1 and nx * ny values");
     if (spec.width < 100 || spec.height < 100) throw std::invalid_argument("plot size below 100 pixels");
+    if ((!spec.xNames.empty() && spec.xNames.size() != nx) || (!spec.yNames.empty() && spec.yNames.size() != ny))
+        throw std::invalid_argument("heat map '" + spec.title + "': need one name per column and row (or none)");
     auto spacing = [&](const std::vector<double>& v, const char* axis) {
         const double d = v.size() > 1 ? (v.back() - v.front()) / double(v.size() - 1) : 1.0;
         for (std::size_t i = 1; i < v.size(); ++i)
@@ -227,12 +229,15 @@ void writeHeatMapPng(const std::string& path, const HeatMapSpec& spec) {
     const double x0 = spec.x.front() - dx / 2, x1 = spec.x.back() + dx / 2;
     const double y0 = spec.y.front() - dy / 2, y1 = spec.y.back() + dy / 2;
 
-    // Image rows: blank (NaN) cells get a value outside [zmin, zmax], which plimagefr skips.
-    std::vector<std::vector<PLFLT>> rows(nx, std::vector<PLFLT>(ny));
-    std::vector<PLFLT*> image(nx);
-    for (std::size_t i = 0; i < nx; ++i) {
-        for (std::size_t j = 0; j < ny; ++j) {
-            const double v = spec.z[i * ny + j];
+    // plimagefr maps idata[0][0] and idata[nx-1][ny-1] to the corners (xmin, ymin), (xmax, ymax) and
+    // colours the (nx-1) x (ny-1) quads between points by their lower-left point: cell (i, j) is point
+    // [i][j] of an (nx+1) x (ny+1) image whose last row and column repeat (and are never seen).
+    // Blank (NaN) cells get a value outside [zmin, zmax], which plimagefr skips.
+    std::vector<std::vector<PLFLT>> rows(nx + 1, std::vector<PLFLT>(ny + 1));
+    std::vector<PLFLT*> image(nx + 1);
+    for (std::size_t i = 0; i <= nx; ++i) {
+        for (std::size_t j = 0; j <= ny; ++j) {
+            const double v = spec.z[std::min(i, nx - 1) * ny + std::min(j, ny - 1)];
             rows[i][j] = std::isfinite(v) ? v : zmax + 10 * (zmax - zmin);
         }
         image[i] = rows[i].data();
@@ -251,12 +256,20 @@ void writeHeatMapPng(const std::string& path, const HeatMapSpec& spec) {
         plcol0(1);
         plschr(0, 1.1);
         pladv(0);
-        plvpor(0.12, 0.80, 0.12, 0.90);
+        // Names need room: the left margin grows with the longest row name (about 14.5 px a character).
+        std::size_t longest = 0;
+        for (const std::string& name : spec.yNames) longest = std::max(longest, name.size());
+        const double left = spec.yNames.empty() ? 0.12 : std::min(0.45, 0.05 + 0.0145 * double(longest) * 1000.0 / spec.width);
+        plvpor(left, 0.80, 0.12, 0.90);
         plwind(x0, x1, y0, y1);
-        plimagefr(image.data(), PLINT(nx), PLINT(ny), x0, x1, y0, y1, zmin, zmax, zmin, zmax, nullptr, nullptr);
+        plimagefr(image.data(), PLINT(nx + 1), PLINT(ny + 1), x0, x1, y0, y1, zmin, zmax, zmin, zmax, nullptr, nullptr);
         plcol0(1);
-        plbox("bcnst", 0, 0, "bcnstv", 0, 0);
+        plbox(spec.xNames.empty() ? "bcnst" : "bc", 0, 0, spec.yNames.empty() ? "bcnstv" : "bc", 0, 0);
         pllab(spec.xLabel.c_str(), spec.yLabel.c_str(), spec.title.c_str());
+        for (std::size_t i = 0; i < spec.xNames.size(); ++i)
+            plmtex("b", 1.5, (spec.x[i] - x0) / (x1 - x0), 0.5, spec.xNames[i].c_str());
+        for (std::size_t j = 0; j < spec.yNames.size(); ++j)
+            plmtex("lv", 0.8, (spec.y[j] - y0) / (y1 - y0), 1.0, spec.yNames[j].c_str());
         if (spec.cellLabels) {
             plschr(0, 0.75);
             for (std::size_t i = 0; i < nx; ++i)

@@ -43,6 +43,8 @@ struct HeatMapSpec {
     std::vector<double> x;        ///< cell centres along x: nx >= 1 values, increasing, evenly spaced
     std::vector<double> y;        ///< cell centres along y: ny >= 1 values, increasing, evenly spaced
     std::vector<double> z;        ///< nx * ny values, z[i * ny + j] at (x[i], y[j]); NaN = blank cell
+    /// Names of the columns / rows (empty, or one per cell centre): drawn instead of the numbers.
+    std::vector<std::string> xNames, yNames;
     bool cellLabels = true;       ///< print each cell's value in it
     int labelDecimals = 0;        ///< decimals of the cell labels
     int width = 1000, height = 800;   ///< pixels

@@ -91,9 +91,10 @@ void runStudyCommand(const StudyOptions& o) {
     const StudyOutcome& r = done->second;
     if (r.shards > 0)
         std::printf("shard %d/%d: ", r.shard, r.shards);
-    std::printf("study '%s': %ld tasks (%d subjects x %zu protocols x %zu noise levels x %zu methods); %ld computed "
+    const std::string truths = study.truths.size() > 1 ? std::to_string(study.truths.size()) + " truths x " : "";
+    std::printf("study '%s': %ld tasks (%s%d subjects x %zu protocols x %zu noise levels x %zu methods); %ld computed "
                 "in %.1f s on %d rank%s x %d thread%s, %ld resumed from the journal\n",
-                study.name.c_str(), r.total, study.subjects, study.protocols.size(), study.noiseLevels.size(),
+                study.name.c_str(), r.total, truths.c_str(), study.subjects, study.protocols.size(), study.noiseLevels.size(),
                 study.methods.size(), r.computed, r.wallTime, r.ranks, r.ranks == 1 ? "" : "s", r.threads,
                 r.threads == 1 ? "" : "s", r.resumed);
     if (r.computed > 0)

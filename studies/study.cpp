@@ -25,7 +25,7 @@ namespace {
 
 constexpr long kMaxTasks = 1000000000L;
 // Changes whenever a result's meaning or format changes, so old journals are not resumed into new files.
-constexpr const char* kResultsVersion = "armsim-study-results-1";
+constexpr const char* kResultsVersion = "armsim-study-results-2";
 
 std::uint64_t hashFnv1a(const std::string& text, std::uint64_t h = 1469598103934665603ULL) {
     for (unsigned char c : text) h = (h ^ c) * 1099511628211ULL;
@@ -89,15 +89,33 @@ std::string resolveStudyFile(const ParamNode& n, const std::string& field, const
 
 }  // namespace
 
+void Study::setPopulation(const Population& population, const std::string& reference) {
+    truths = {StudyTruth{reference, population.name, population}};
+    priorReference.clear();
+    prior = population;
+}
+
 void Study::validate() const {
-    population.validate();
+    if (truths.empty()) throw FieldError("truths", "is empty: expected at least one truth population");
+    if (truths.size() > 1 && priorReference.empty())
+        throw FieldError("prior", "is missing: several truths need the population the identifiers assume (`prior:`)");
     prior.validate();
     prior.base.requireVirtualMuscles("the identifiers (prior population '" + prior.name + "')");
-    const std::string& truthPrimary = population.base.muscles.at(population.base.primary).params.name;
     const std::string& priorPrimary = prior.base.muscles.at(prior.base.primary).params.name;
-    if (truthPrimary != priorPrimary)
-        throw FieldError("prior", "identifies muscle '" + priorPrimary + "' but the truth's primary muscle is '" +
-                                      truthPrimary + "': expected the same muscle");
+    for (std::size_t i = 0; i < truths.size(); ++i) {
+        const std::string field = truths.size() == 1 ? std::string("truth") : "truths[" + std::to_string(i) + "]";
+        truths[i].population.validate();
+        const Population& t = truths[i].population;
+        const std::string& truthPrimary = t.base.muscles.at(t.base.primary).params.name;
+        if (truthPrimary != priorPrimary)
+            throw FieldError(field, "= '" + truths[i].reference + "': its primary muscle is '" + truthPrimary +
+                                        "' but the prior identifies '" + priorPrimary + "': expected the same muscle");
+        if (truths[i].label.empty()) throw FieldError(field + ".label", "is empty: expected a name");
+        for (std::size_t j = 0; j < i; ++j)
+            if (truths[j].label == truths[i].label)
+                throw FieldError(field + ".label", "= '" + truths[i].label + "': also truths[" + std::to_string(j) +
+                                                       "]'s label: expected unique labels (set `label:`)");
+    }
     checkField("subjects", subjects, Bound::closed(1, 1e7));
     if (protocols.empty()) throw FieldError("protocols", "is empty: expected at least one protocol");
     if (noiseLevels.empty()) throw FieldError("noise_levels", "is empty: expected at least one noise level");
@@ -125,6 +143,7 @@ void Study::validate() const {
         }
     };
     checkName("name", name);
+    for (std::size_t i = 0; i < truths.size(); ++i) checkName("truths[" + std::to_string(i) + "].label", truths[i].label);
     for (std::size_t i = 0; i < protocols.size(); ++i)
         checkName("protocols[" + std::to_string(i) + "].name", protocols[i].protocol.name);
     for (std::size_t i = 0; i < methods.size(); ++i) checkName("methods[" + std::to_string(i) + "].label", methods[i].label);
@@ -145,7 +164,7 @@ void Study::validate() const {
             checkField(f + ".noise_level", methods[i].options.noiseLevel, Bound{0, 0.5, true, false});
     }
     if (getNumTasks() > kMaxTasks)
-        throw FieldError("subjects", "x protocols x noise levels x methods = " + std::to_string(getNumTasks()) +
+        throw FieldError("subjects", "x truths x protocols x noise levels x methods = " + std::to_string(getNumTasks()) +
                                          " tasks: expected at most " + std::to_string(kMaxTasks));
 }
 
@@ -158,17 +177,36 @@ Study readStudy(const std::string& path) {
                          "': expected 'study' (a study file starts with `kind: study`)");
     s.name = n.getString("name", std::filesystem::path(path).stem().string());
     s.description = n.getString("description", "");
-    if (n.has("population") && n.has("truth"))
-        throw InputError(n.where("truth") + ": give 'population' (in family) or 'truth' (with 'prior'), not both");
-    const char* truthKey = n.has("truth") ? "truth" : "population";
-    auto loadStudyPopulation = [&](const char* key, const std::string& reference) {
+    const int truthKeys = int(n.has("population")) + int(n.has("truth")) + int(n.has("truths"));
+    if (truthKeys > 1)
+        throw InputError(n.where(n.has("truths") ? "truths" : "truth") +
+                         ": give one of 'population' (in family), 'truth' or 'truths' (with 'prior'), not several");
+    auto loadStudyPopulation = [](const ParamNode& node, const char* key, const std::string& reference) {
         return reference == "default" ? loadDefaultPopulation()
-                                      : loadPopulation(resolveStudyFile(n, key, reference, "population file"));
+                                      : loadPopulation(resolveStudyFile(node, key, reference, "population file"));
     };
-    s.populationReference = n.getString(truthKey, "default");
-    s.population = loadStudyPopulation(truthKey, s.populationReference);
+    if (n.has("truths")) {
+        if (!n.has("prior"))
+            throw InputError(n.where("truths") + ": field 'truths' needs 'prior' (the population the identifiers assume)");
+        for (const ParamNode& t : n.children("truths")) {
+            StudyTruth truth;
+            truth.reference = t.getString("population");
+            truth.population = loadStudyPopulation(t, "population", truth.reference);
+            truth.label = t.getString("label", truth.population.name);
+            t.finish();
+            s.truths.push_back(std::move(truth));
+        }
+        if (s.truths.empty()) throw InputError(n.where("truths") + ": field 'truths' is an empty list: expected at least one");
+    } else {
+        const char* truthKey = n.has("truth") ? "truth" : "population";
+        StudyTruth truth;
+        truth.reference = n.getString(truthKey, "default");
+        truth.population = loadStudyPopulation(n, truthKey, truth.reference);
+        truth.label = truth.population.name;
+        s.truths.push_back(std::move(truth));
+    }
     s.priorReference = n.getString("prior", "");
-    s.prior = s.priorReference.empty() ? s.population : loadStudyPopulation("prior", s.priorReference);
+    s.prior = s.priorReference.empty() ? s.truths.front().population : loadStudyPopulation(n, "prior", s.priorReference);
     s.subjects = capForQuickRun(n.getInt("subjects", 1, 10000000), kQuickSubjects, "study subjects");
     s.seed = unsigned(n.getInt("seed", 0, 2147483647, 1));
     const std::vector<std::string> protocols = n.getStrings("protocols");
@@ -181,7 +219,7 @@ Study readStudy(const std::string& path) {
         s.protocols.push_back(p);
     }
     s.noiseLevels = n.has("noise_levels") ? n.getNumbers("noise_levels", Bound{0, 0.5, false, true, "relative sd"})
-                                          : std::vector<double>{s.population.transducerNoise};
+                                          : std::vector<double>{s.truths.front().population.transducerNoise};
     for (const ParamNode& m : n.children("methods")) {
         ElbowMethod e;
         e.kind = m.getChoice("method", getElbowMethodKinds(), "");
@@ -208,18 +246,22 @@ std::string calcStudyFingerprint(const Study& s) {
           << m.options.freeSlowFraction << ' ' << m.options.includeSynergists << ' '
           << (std::isfinite(m.options.noiseLevel) ? formatNumber(m.options.noiseLevel) : "");
     for (const StudyProtocol& p : s.protocols) t << "\nprotocol\n" << formatTorqueProtocol(p.protocol);
-    if (!s.population.file.empty()) t << "\npopulation\n" << readFileText(s.population.file);
-    if (!s.priorReference.empty()) {  // out of family (an in-family study's fingerprint is as before)
+    for (const StudyTruth& truth : s.truths) {
+        const Population& pop = truth.population;
+        t << "\ntruth " << truth.label << '\n';
+        if (!pop.file.empty()) t << "population\n" << readFileText(pop.file);
+        if (!pop.base.file.empty()) t << "\nmodel\n" << readFileText(pop.base.file);
+        for (const MuscleSpec& m : pop.base.muscles) {
+            const MuscleParameters& p = m.params;
+            t << "\nmuscle " << p.name << ' ' << formatNumber(p.mass) << ' ' << formatNumber(p.optimalFascicleLength)
+              << ' ' << formatNumber(p.optimalTendonLength) << ' ' << formatNumber(p.maxPathLength) << ' '
+              << formatNumber(p.slowFraction) << ' ' << p.numSlowUnits << ' ' << p.numFastUnits;
+        }
+    }
+    if (!s.priorReference.empty()) {  // out of family
         t << "\nprior " << s.priorReference << '\n';
         if (!s.prior.file.empty()) t << readFileText(s.prior.file);
         if (!s.prior.base.file.empty()) t << "\nprior model\n" << readFileText(s.prior.base.file);
-    }
-    if (!s.population.base.file.empty()) t << "\nmodel\n" << readFileText(s.population.base.file);
-    for (const MuscleSpec& m : s.population.base.muscles) {
-        const MuscleParameters& p = m.params;
-        t << "\nmuscle " << p.name << ' ' << formatNumber(p.mass) << ' ' << formatNumber(p.optimalFascicleLength) << ' '
-          << formatNumber(p.optimalTendonLength) << ' ' << formatNumber(p.maxPathLength) << ' '
-          << formatNumber(p.slowFraction) << ' ' << p.numSlowUnits << ' ' << p.numFastUnits;
     }
     return toHex(hashFnv1a(t.str()));
 }
@@ -235,15 +277,18 @@ StudyTask getStudyTask(const Study& s, long index) {
     t.noise = int(index % N);
     index /= N;
     t.protocol = int(index % P);
-    t.subject = int(index / P);
+    index /= P;
+    t.subject = int(index % long(s.subjects));
+    t.truth = int(index / long(s.subjects));
     return t;
 }
 
 std::vector<StudyResult> runStudyGroup(const Study& study, long group, const std::vector<long>& tasks, int rank) {
     checkInterruption();
     using Clock = std::chrono::steady_clock;
-    const int P = int(study.protocols.size());
-    const int subject = int(group / P), protocol = int(group % P);
+    const long P = long(study.protocols.size());
+    const int protocol = int(group % P), subject = int((group / P) % study.subjects);
+    const StudyTruth& truth = study.truths.at(std::size_t(group / P / study.subjects));
     const TorqueProtocol& pr = study.protocols[protocol].protocol;
     const auto t0 = Clock::now();
     VirtualSubject v;
@@ -251,7 +296,7 @@ std::vector<StudyResult> runStudyGroup(const Study& study, long group, const std
     std::vector<ChannelObservation> channels;
     std::string synthesisError;
     try {
-        v = drawSubject(study.population, study.seed, subject);
+        v = drawSubject(truth.population, study.seed, subject);
         clean = synthesizeTorqueData(v, pr, study.seed, 1);
         if (pr.hasChannels()) channels = synthesizeChannelData(v, pr, clean, study.seed);
     } catch (const InterruptedError&) {
@@ -288,6 +333,7 @@ std::vector<StudyResult> runStudyGroup(const Study& study, long group, const std
         }
         StudyResult r;
         r.task = index;
+        r.truth = truth.label;
         r.protocol = pr.name;
         r.rank = rank;
         r.synthesisTime = synthesisShare;
@@ -306,7 +352,7 @@ std::vector<StudyResult> runStudyGroup(const Study& study, long group, const std
         }
         if (synthesisError.empty()) {
             try {
-                r.row = makeElbowValidationRow(study.population, v, level, m.label, e);
+                r.row = makeElbowValidationRow(truth.population, v, level, m.label, e);
             } catch (const std::exception& x) {
                 r.status = "failed";
                 r.reason = std::string("recording: ") + x.what();
@@ -320,8 +366,8 @@ std::vector<StudyResult> runStudyGroup(const Study& study, long group, const std
             r.row.noise = level;
             r.row.method = m.label;
             r.row.estimate = e;
-            r.row.trueMass = r.row.trueTendonLength = r.row.voluntaryActivation = r.row.coContraction =
-                r.row.strengthLevel = 0.0 / 0.0;
+            r.row.trueMass = r.row.trueTendonLength = r.row.trueMaxForce = r.row.voluntaryActivation =
+                r.row.coContraction = r.row.strengthLevel = 0.0 / 0.0;
         }
         r.identificationTime = std::chrono::duration<double>(Clock::now() - t1).count();
         out.push_back(std::move(r));
@@ -329,27 +375,86 @@ std::vector<StudyResult> runStudyGroup(const Study& study, long group, const std
     return out;
 }
 
+namespace {
+
+// results.csv's columns; the journal's lines hold the same, read back by name.
+const std::vector<std::string>& getResultColumns() {
+    static const std::vector<std::string> columns = {
+        "task", "truth", "subject", "protocol", "method", "noise", "status", "true_mass_kg", "mass_kg", "mass_lower_kg",
+        "mass_upper_kg", "mass_error", "mass_covered", "true_tendon_length_m", "tendon_length_m", "tendon_lower_m",
+        "tendon_upper_m", "tendon_error_m", "tendon_covered", "true_max_force_N", "max_force_N", "max_force_lower_N",
+        "max_force_upper_N", "max_force_error", "max_force_covered", "noise_estimate", "rms_residual_Nm", "iterations",
+        "parameters", "mass_tendon_correlation", "voluntary_activation", "co_contraction", "strength_level",
+        "biceps_short_scale", "synergist_scale", "reason"};
+    return columns;
+}
+
+// The position of a results column (a programming error when it has none).
+std::size_t getResultColumn(const char* name) {
+    static const std::map<std::string, std::size_t> index = [] {
+        std::map<std::string, std::size_t> m;
+        for (std::size_t i = 0; i < getResultColumns().size(); ++i) m[getResultColumns()[i]] = i;
+        return m;
+    }();
+    const auto it = index.find(name);
+    if (it == index.end()) throw std::logic_error(std::string("study results: no column ") + name);
+    return it->second;
+}
+
+}  // namespace
+
 std::string getStudyResultsHeader() {
-    return "task,subject,protocol,method,noise,status,true_mass_kg,mass_kg,mass_lower_kg,mass_upper_kg,mass_error,"
-           "mass_covered,true_tendon_length_m,tendon_length_m,tendon_lower_m,tendon_upper_m,tendon_error_m,"
-           "tendon_covered,noise_estimate,rms_residual_Nm,iterations,parameters,mass_tendon_correlation,"
-           "voluntary_activation,co_contraction,strength_level,biceps_short_scale,synergist_scale,reason";
+    std::string header;
+    for (const std::string& c : getResultColumns()) header += (header.empty() ? "" : ",") + c;
+    return header;
 }
 
 std::string formatStudyResult(const StudyResult& r) {
     const ElbowValidationRow& w = r.row;
     const MuscleEstimate& e = w.estimate;
-    auto flag = [](CsvRow& row, int c) -> CsvRow& { return c < 0 ? row.addEmpty() : row.addInteger(c); };
-    CsvRow row;
-    row.addInteger(r.task).addInteger(w.subject).addText(r.protocol).addText(w.method).addNumber(w.noise);
-    row.addText(r.status).addNumber(w.trueMass).addNumber(e.mass).addNumber(e.massLower).addNumber(e.massUpper);
-    flag(row.addNumber(w.massError), w.massCovered).addNumber(w.trueTendonLength).addNumber(e.tendonLength);
-    row.addNumber(e.tendonLower).addNumber(e.tendonUpper);
-    flag(row.addNumber(w.tendonError), w.tendonCovered).addNumber(e.noiseLevel).addNumber(e.rmsResidual);
-    row.addInteger(e.iterations).addInteger(e.numParameters).addNumber(e.massTendonCorrelation);
-    row.addNumber(w.voluntaryActivation).addNumber(w.coContraction).addNumber(w.strengthLevel);
-    row.addNumber(w.bicepsShortScale).addNumber(w.synergistScale).addText(r.reason);
-    return row.getText();
+    std::vector<std::string> cells(getResultColumns().size());
+    auto set = [&cells](const char* column, std::string text) { cells[getResultColumn(column)] = std::move(text); };
+    auto number = [&set](const char* column, double v) { set(column, CsvRow().addNumber(v).getText()); };
+    auto flag = [&set](const char* column, int v) { set(column, v < 0 ? "" : std::to_string(v)); };
+    set("task", std::to_string(r.task));
+    set("truth", CsvRow().addText(r.truth).getText());
+    set("subject", std::to_string(w.subject));
+    set("protocol", CsvRow().addText(r.protocol).getText());
+    set("method", CsvRow().addText(w.method).getText());
+    number("noise", w.noise);
+    set("status", CsvRow().addText(r.status).getText());
+    number("true_mass_kg", w.trueMass);
+    number("mass_kg", e.mass);
+    number("mass_lower_kg", e.massLower);
+    number("mass_upper_kg", e.massUpper);
+    number("mass_error", w.massError);
+    flag("mass_covered", w.massCovered);
+    number("true_tendon_length_m", w.trueTendonLength);
+    number("tendon_length_m", e.tendonLength);
+    number("tendon_lower_m", e.tendonLower);
+    number("tendon_upper_m", e.tendonUpper);
+    number("tendon_error_m", w.tendonError);
+    flag("tendon_covered", w.tendonCovered);
+    number("true_max_force_N", w.trueMaxForce);
+    number("max_force_N", e.maxForce);
+    number("max_force_lower_N", e.maxForceLower);
+    number("max_force_upper_N", e.maxForceUpper);
+    number("max_force_error", w.maxForceError);
+    flag("max_force_covered", w.maxForceCovered);
+    number("noise_estimate", e.noiseLevel);
+    number("rms_residual_Nm", e.rmsResidual);
+    set("iterations", std::to_string(e.iterations));
+    set("parameters", std::to_string(e.numParameters));
+    number("mass_tendon_correlation", e.massTendonCorrelation);
+    number("voluntary_activation", w.voluntaryActivation);
+    number("co_contraction", w.coContraction);
+    number("strength_level", w.strengthLevel);
+    number("biceps_short_scale", w.bicepsShortScale);
+    number("synergist_scale", w.synergistScale);
+    set("reason", CsvRow().addText(r.reason).getText());
+    std::string line;
+    for (std::size_t i = 0; i < cells.size(); ++i) line += (i ? "," : "") + cells[i];
+    return line;
 }
 
 std::string formatStudyJournalLine(const StudyResult& r) {
@@ -366,34 +471,42 @@ bool parseStudyJournalLine(const std::string& line, StudyResult& r) {
     if (tab == std::string::npos) return false;
     const std::vector<std::string> c = splitCsvRecord(body.substr(0, tab)),
                                    timing = splitCsvRecord(body.substr(tab + 1));
-    if (c.size() != 29 || timing.size() != 3) return false;
+    if (c.size() != getResultColumns().size() || timing.size() != 3) return false;
     r = StudyResult();
     ElbowValidationRow& w = r.row;
     MuscleEstimate& e = w.estimate;
     long subject = 0, iterations = 0, parameters = 0, rank = 0;
-    auto flag = [](const std::string& s, int& v) {
+    auto cell = [&c](const char* column) -> const std::string& { return c[getResultColumn(column)]; };
+    auto number = [&cell](const char* column, double& v) { return parseDouble(cell(column), v); };
+    auto flag = [&cell](const char* column, int& v) {
+        const std::string& s = cell(column);
         if (s.empty()) return v = -1, true;
         if (s != "0" && s != "1") return false;
         return v = s == "1", true;
     };
-    bool ok = parseLong(c[0], r.task) && parseLong(c[1], subject) && parseDouble(c[4], w.noise) &&
-              parseDouble(c[6], w.trueMass) && parseDouble(c[7], e.mass) && parseDouble(c[8], e.massLower) &&
-              parseDouble(c[9], e.massUpper) && parseDouble(c[10], w.massError) && flag(c[11], w.massCovered) &&
-              parseDouble(c[12], w.trueTendonLength) && parseDouble(c[13], e.tendonLength) &&
-              parseDouble(c[14], e.tendonLower) && parseDouble(c[15], e.tendonUpper) &&
-              parseDouble(c[16], w.tendonError) && flag(c[17], w.tendonCovered) && parseDouble(c[18], e.noiseLevel) &&
-              parseDouble(c[19], e.rmsResidual) && parseLong(c[20], iterations) && parseLong(c[21], parameters) &&
-              parseDouble(c[22], e.massTendonCorrelation) && parseDouble(c[23], w.voluntaryActivation) &&
-              parseDouble(c[24], w.coContraction) && parseDouble(c[25], w.strengthLevel) &&
-              parseDouble(c[26], w.bicepsShortScale) && parseDouble(c[27], w.synergistScale) &&
-              parseDouble(timing[0], r.synthesisTime) && parseDouble(timing[1], r.identificationTime) &&
-              parseLong(timing[2], rank);
+    bool ok = parseLong(cell("task"), r.task) && parseLong(cell("subject"), subject) && number("noise", w.noise) &&
+              number("true_mass_kg", w.trueMass) && number("mass_kg", e.mass) && number("mass_lower_kg", e.massLower) &&
+              number("mass_upper_kg", e.massUpper) && number("mass_error", w.massError) &&
+              flag("mass_covered", w.massCovered) && number("true_tendon_length_m", w.trueTendonLength) &&
+              number("tendon_length_m", e.tendonLength) && number("tendon_lower_m", e.tendonLower) &&
+              number("tendon_upper_m", e.tendonUpper) && number("tendon_error_m", w.tendonError) &&
+              flag("tendon_covered", w.tendonCovered) && number("true_max_force_N", w.trueMaxForce) &&
+              number("max_force_N", e.maxForce) && number("max_force_lower_N", e.maxForceLower) &&
+              number("max_force_upper_N", e.maxForceUpper) && number("max_force_error", w.maxForceError) &&
+              flag("max_force_covered", w.maxForceCovered) && number("noise_estimate", e.noiseLevel) &&
+              number("rms_residual_Nm", e.rmsResidual) && parseLong(cell("iterations"), iterations) &&
+              parseLong(cell("parameters"), parameters) && number("mass_tendon_correlation", e.massTendonCorrelation) &&
+              number("voluntary_activation", w.voluntaryActivation) && number("co_contraction", w.coContraction) &&
+              number("strength_level", w.strengthLevel) && number("biceps_short_scale", w.bicepsShortScale) &&
+              number("synergist_scale", w.synergistScale) && parseDouble(timing[0], r.synthesisTime) &&
+              parseDouble(timing[1], r.identificationTime) && parseLong(timing[2], rank);
     if (!ok) return false;
     w.subject = int(subject);
-    r.protocol = c[2];
-    w.method = e.method = c[3];
-    r.status = c[5];
-    r.reason = c[28];
+    r.truth = cell("truth");
+    r.protocol = cell("protocol");
+    w.method = e.method = cell("method");
+    r.status = cell("status");
+    r.reason = cell("reason");
     e.converged = r.status == "ok";
     e.iterations = int(iterations);
     e.numParameters = int(parameters);
@@ -557,29 +670,34 @@ std::vector<StudySummaryRow> summarizeStudy(const Study& study, const std::vecto
     return sum.getRows();
 }
 
-StudySummaryAccumulator::StudySummaryAccumulator(const Study& study) : protocols_(study.protocols.size()) {
-    for (std::size_t p = 0; p < study.protocols.size(); ++p) protocols_[p].name = study.protocols[p].protocol.name;
+StudySummaryAccumulator::StudySummaryAccumulator(const Study& study) {
+    for (const StudyTruth& t : study.truths)
+        for (const StudyProtocol& p : study.protocols) {
+            cells_.emplace_back();
+            cells_.back().truth = t.label;
+            cells_.back().protocol = p.protocol.name;
+        }
 }
 
 void StudySummaryAccumulator::add(const StudyResult& r) {
-    for (Protocol& p : protocols_) {
-        if (r.protocol != p.name) continue;
+    for (Cell& p : cells_) {
+        if (r.protocol != p.protocol || r.truth != p.truth) continue;
         Counts& c = p.counts[{r.row.method, r.row.noise}];
         c.notConverged += r.status == "not-converged";
         c.failed += r.status == "failed";
         if (r.status == "skipped") return;
         if (r.status != "failed") return p.stats.add(r.row);
         ElbowValidationRow row = r.row;
-        row.massError = row.tendonError = 0.0 / 0.0;
+        row.massError = row.tendonError = row.maxForceError = 0.0 / 0.0;
         return p.stats.add(row);
     }
 }
 
 std::vector<StudySummaryRow> StudySummaryAccumulator::getRows() const {
     std::vector<StudySummaryRow> out;
-    for (const Protocol& p : protocols_)
+    for (const Cell& p : cells_)
         for (const ElbowValidationSummary& x : p.stats.getSummaries()) {
-            StudySummaryRow row{p.name, x};
+            StudySummaryRow row{p.truth, p.protocol, x};
             const auto it = p.counts.find({x.method, x.noise});
             if (it != p.counts.end()) row.notConverged = it->second.notConverged, row.failed = it->second.failed;
             out.push_back(row);
@@ -588,16 +706,21 @@ std::vector<StudySummaryRow> StudySummaryAccumulator::getRows() const {
 }
 
 std::string formatStudySummaryCsv(const std::vector<StudySummaryRow>& rows) {
-    CsvText csv({"protocol", "method", "noise", "tasks", "ok", "not_converged", "failed", "mass_bias", "mass_rmse",
-                 "mass_coverage", "mass_interval_width", "tendon_bias_m", "tendon_rmse_m", "tendon_coverage",
-                 "tendon_interval_width_m"});
+    CsvText csv({"truth", "protocol", "method", "noise", "tasks", "ok", "not_converged", "failed", "mass_bias",
+                 "mass_bias_se", "mass_rmse", "mass_rmse_se", "mass_coverage", "mass_coverage_se", "mass_interval_width",
+                 "tendon_bias_m", "tendon_bias_se_m", "tendon_rmse_m", "tendon_rmse_se_m", "tendon_coverage",
+                 "tendon_coverage_se", "tendon_interval_width_m", "max_force_bias", "max_force_rmse",
+                 "max_force_coverage"});
     for (const StudySummaryRow& r : rows) {
         const ElbowValidationSummary& x = r.stats;
         CsvRow row;
-        row.addText(r.protocol).addText(x.method).addNumber(x.noise).addInteger(x.subjects).addInteger(x.converged);
-        row.addInteger(r.notConverged).addInteger(r.failed).addNumber(x.massBias).addNumber(x.massRmse);
-        row.addNumber(x.massCoverage).addNumber(x.massIntervalWidth).addNumber(x.tendonBias).addNumber(x.tendonRmse);
-        row.addNumber(x.tendonCoverage).addNumber(x.tendonIntervalWidth);
+        row.addText(r.truth).addText(r.protocol).addText(x.method).addNumber(x.noise).addInteger(x.subjects);
+        row.addInteger(x.converged).addInteger(r.notConverged).addInteger(r.failed);
+        row.addNumber(x.massBias).addNumber(x.massBiasSe).addNumber(x.massRmse).addNumber(x.massRmseSe);
+        row.addNumber(x.massCoverage).addNumber(x.massCoverageSe).addNumber(x.massIntervalWidth);
+        row.addNumber(x.tendonBias).addNumber(x.tendonBiasSe).addNumber(x.tendonRmse).addNumber(x.tendonRmseSe);
+        row.addNumber(x.tendonCoverage).addNumber(x.tendonCoverageSe).addNumber(x.tendonIntervalWidth);
+        row.addNumber(x.maxForceBias).addNumber(x.maxForceRmse).addNumber(x.maxForceCoverage);
         csv.addRow(row);
     }
     return csv.getText();

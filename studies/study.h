@@ -1,18 +1,19 @@
 // Population studies (issue 13): Monte Carlo over virtual subjects. A study file names the truth (a
 // population of virtual subjects around a model: `population:`, or `truth:` with `prior:`, the
-// population the identifiers assume, for a study out of family), the protocols, the identifiers with their options,
+// population the identifiers assume, for a study out of family; or several truths, `truths:` with
+// `prior:`, each drawn and identified against the same prior), the protocols, the identifiers with their options,
 // the transducer noise levels, the number of subjects, the seed and the output folder. Every
 // (subject, protocol, noise, method) cell is one task: the subject's data are synthesized, read at the
 // noise level and identified; the estimate, the truth, the 95 % intervals, the residual, the iterations
-// and a status are recorded. The cells of one (subject, protocol) share one synthesis, so they are
+// and a status are recorded. The cells of one (truth, subject, protocol) share one synthesis, so they are
 // scheduled together as a group while there are enough groups for the threads asking for work; past
 // that (the end of a run, a study of few subjects) a group's cells are split over the idle threads, each
 // piece synthesizing the subject again. Each cell is recorded (and resumed) on its own. Rank 0 keeps one status byte per cell
 // and streams results to the journal; the final files are written from it in task order, a bounded
 // range of tasks per pass, so its memory does not grow with the results.
 //
-// Results are a function of the study alone: a cell depends only on (seed, subject, protocol, noise,
-// method), numbers are written in shortest round-trip form and the table is sorted by task, so the
+// Results are a function of the study alone: a cell depends only on (seed, truth, subject, protocol,
+// noise, method), numbers are written in shortest round-trip form and the table is sorted by task, so the
 // result files are byte-identical for any number of ranks or threads and any completion order. Times
 // (which are not) go to timing.csv.
 //
@@ -46,23 +47,32 @@ struct StudyProtocol {
     TorqueProtocol protocol;   ///< its conditions; protocol.name labels its results
 };
 
+/// A population the subjects of a study are drawn from.
+struct StudyTruth {
+    std::string reference = "default";  ///< "default" or the population file as written
+    std::string label;                  ///< names its results (default: the population's name)
+    Population population;
+};
+
 /// A study (units SI; noise levels relative).
 struct Study {
     std::string name;                       ///< labels outputs
     std::string description;
     std::string file;                       ///< the study file ("" when built in code)
-    std::string populationReference = "default";  ///< "default" or the population file as written
-    Population population;                  ///< the truth: subjects are drawn from it (`population:` or `truth:`)
+    /// The truths (`population:` or `truth:`: one; `truths:`: several): subjects are drawn from each.
+    std::vector<StudyTruth> truths;
     std::string priorReference;             ///< `prior:` as written; "" = the truth population (in family)
     Population prior;                       ///< the identifiers' prior and model (the truth unless `prior:`)
-    int subjects = 20;                      ///< persons 0 .. subjects-1 of the population
+    int subjects = 20;                      ///< persons 0 .. subjects-1 of each truth
     unsigned seed = 1;                      ///< population, synthesis noise and VA-measurement seed
     std::vector<StudyProtocol> protocols;   ///< at least one
     std::vector<double> noiseLevels;        ///< transducer noise (relative sd) [1]; at least one
     std::vector<ElbowMethod> methods;       ///< identifiers (unique labels); at least one
     std::string output;                     ///< output folder (relative to the working directory)
 
-    long getNumGroups() const { return long(subjects) * long(protocols.size()); }
+    /// One truth, in family (prior = truth): what code building a study by hand usually wants.
+    void setPopulation(const Population& population, const std::string& reference = "default");
+    long getNumGroups() const { return long(truths.size()) * long(subjects) * long(protocols.size()); }
     int getCellsPerGroup() const { return int(noiseLevels.size() * methods.size()); }
     long getNumTasks() const { return getNumGroups() * getCellsPerGroup(); }
     /// FieldError naming the field for an empty list, a duplicate label or a value out of range.
@@ -75,20 +85,24 @@ struct Study {
 Study readStudy(const std::string& path);
 
 /// A 16-hex-digit fingerprint of everything that decides the results: the study's settings (not its
-/// output folder), every protocol's conditions and the population's distributions and base model.
+/// output folder), every protocol's conditions and each truth's and the prior's distributions and base model.
 std::string calcStudyFingerprint(const Study& study);
 
-/// One cell. Tasks are numbered subject-major: ((subject x P + protocol) x N + noise) x K + method.
+/// One cell. Tasks are numbered truth- then subject-major:
+/// (((truth x S + subject) x P + protocol) x N + noise) x K + method.
 struct StudyTask {
     long index = 0;
-    int subject = 0, protocol = 0, noise = 0, method = 0;
-    long getGroup(const Study& study) const { return long(subject) * long(study.protocols.size()) + protocol; }
+    int truth = 0, subject = 0, protocol = 0, noise = 0, method = 0;
+    long getGroup(const Study& study) const {
+        return (long(truth) * long(study.subjects) + subject) * long(study.protocols.size()) + protocol;
+    }
 };
 StudyTask getStudyTask(const Study& study, long index);
 
 /// What one task recorded.
 struct StudyResult {
     long task = 0;
+    std::string truth;             ///< the truth's label
     std::string protocol;          ///< the protocol's name
     std::string status;            ///< "ok", "not-converged", "failed" or "skipped" (channels on a torque-only protocol)
     std::string reason;            ///< why not ok (the solver's report or the error); "" when ok
@@ -153,13 +167,14 @@ std::string summarizeStudyJournalDrops(const std::vector<StudyJournalDrop>& drop
 /// Every dropped line, one per text line: "line 5 (task 4): damaged: ...".
 std::string formatStudyJournalDrops(const std::vector<StudyJournalDrop>& dropped);
 
-/// One cell of the summary: a protocol, method and noise level over the subjects.
+/// One cell of the summary: a truth, protocol, method and noise level over the subjects.
 struct StudySummaryRow {
+    std::string truth;
     std::string protocol;
     ElbowValidationSummary stats;  ///< bias, RMSE, coverage over the tasks with an estimate (ok, not-converged)
     int notConverged = 0, failed = 0;
 };
-/// Per (protocol, method, noise), in the study's order.
+/// Per (truth, protocol, method, noise), in the study's order.
 std::vector<StudySummaryRow> summarizeStudy(const Study& study, const std::vector<StudyResult>& results);
 /// summarizeStudy one result at a time (add them in task order: the sums then match summarizeStudy's to
 /// the bit), in memory independent of the number of results.
@@ -173,14 +188,15 @@ private:
     struct Counts {
         int notConverged = 0, failed = 0;
     };
-    struct Protocol {
-        std::string name;
+    struct Cell {  // one (truth, protocol)
+        std::string truth, protocol;
         ElbowValidationAccumulator stats;
         std::map<std::pair<std::string, double>, Counts> counts;  // by (method, noise)
     };
-    std::vector<Protocol> protocols_;
+    std::vector<Cell> cells_;
 };
-/// summary.csv: counts by status, bias, RMSE, coverage and interval width.
+/// summary.csv: counts by status, bias, RMSE, coverage and interval width of the mass, L0T and F0,
+/// with standard errors over the subjects.
 std::string formatStudySummaryCsv(const std::vector<StudySummaryRow>& rows);
 
 /// Progress of a run, reported by the coordinator (rank 0).

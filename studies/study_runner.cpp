@@ -471,9 +471,10 @@ private:
     std::deque<GroupWork> pieces_;
 };
 
-// Per (protocol, method): a statistic of the summary against the noise level.
+// Per (truth, protocol, method): a statistic of the summary against the noise level.
 void writeNoisePlot(const std::string& path, const std::string& title, const std::string& yLabel,
-                    const std::vector<StudySummaryRow>& summary, double (*statistic)(const ElbowValidationSummary&)) {
+                    const std::vector<StudySummaryRow>& summary, double (*statistic)(const ElbowValidationSummary&),
+                    bool severalTruths) {
     PlotSpec spec;
     spec.title = title;
     spec.xLabel = "transducer noise (% of the torque)";
@@ -482,7 +483,7 @@ void writeNoisePlot(const std::string& path, const std::string& title, const std
     for (const StudySummaryRow& r : summary) {
         const double y = statistic(r.stats);
         if (!std::isfinite(y)) continue;
-        const std::string key = r.protocol + " / " + r.stats.method;
+        const std::string key = (severalTruths ? r.truth + " / " : std::string()) + r.protocol + " / " + r.stats.method;
         if (!seriesOf.count(key)) {
             seriesOf[key] = spec.series.size();
             spec.series.push_back({key, {}, {}, false, int(spec.series.size() % 8)});
@@ -494,6 +495,47 @@ void writeNoisePlot(const std::string& path, const std::string& title, const std
     if (spec.series.empty()) return;
     for (PlotSeries& s : spec.series) s.markers = s.x.size() == 1;
     writePlotPng(path, spec);
+}
+
+// A statistic of the summary as a table: a row per truth, a column per (protocol, method[, noise]).
+void writeTruthHeatMap(const std::string& path, const std::string& title, const std::string& zLabel,
+                       const Study& study, const std::vector<StudySummaryRow>& summary,
+                       double (*statistic)(const ElbowValidationSummary&), int decimals) {
+    std::vector<std::string> columns;
+    for (const StudySummaryRow& r : summary) {
+        std::string c = (study.protocols.size() > 1 ? r.protocol + " / " : std::string()) + r.stats.method;
+        if (study.noiseLevels.size() > 1) c += " / " + formatNumber(100 * r.stats.noise) + " %";
+        if (std::find(columns.begin(), columns.end(), c) == columns.end()) columns.push_back(c);
+    }
+    HeatMapSpec spec;
+    spec.title = title;
+    spec.zLabel = zLabel;
+    spec.xLabel = "identifier";
+    spec.yLabel = "";
+    spec.labelDecimals = decimals;
+    spec.xNames = columns;
+    for (std::size_t i = 0; i < columns.size(); ++i) spec.x.push_back(double(i));
+    const std::size_t nt = study.truths.size();
+    for (std::size_t j = 0; j < nt; ++j) {  // first truth on top
+        spec.y.push_back(double(j));
+        spec.yNames.push_back(study.truths[nt - 1 - j].label);
+    }
+    spec.z.assign(columns.size() * nt, 0.0 / 0.0);
+    bool any = false;
+    for (const StudySummaryRow& r : summary) {
+        std::string c = (study.protocols.size() > 1 ? r.protocol + " / " : std::string()) + r.stats.method;
+        if (study.noiseLevels.size() > 1) c += " / " + formatNumber(100 * r.stats.noise) + " %";
+        const std::size_t i = std::size_t(std::find(columns.begin(), columns.end(), c) - columns.begin());
+        std::size_t t = 0;
+        while (t < nt && study.truths[t].label != r.truth) ++t;
+        const double z = statistic(r.stats);
+        if (t == nt || !std::isfinite(z)) continue;
+        spec.z[i * nt + (nt - 1 - t)] = z;
+        any = true;
+    }
+    if (!any) return;
+    spec.height = std::max(500, 140 + 60 * int(nt));
+    writeHeatMapPng(path, spec);
 }
 
 // The journal's results in task order, a range of tasks at a time: f(result) for each. A journal that
@@ -578,22 +620,47 @@ std::vector<std::string> writeStudyFiles(const Study& study, const std::string& 
         writeFileAtomically(dir + "/study.yaml", readFileText(study.file));
         files.push_back("study.yaml");
     }
+    const std::string& primary = study.prior.base.muscles.at(study.prior.base.primary).params.name;
     const struct {
         const char* file;
         const char* title;
         const char* yLabel;
         double (*statistic)(const ElbowValidationSummary&);
     } plots[] = {
-        {"mass_rmse_vs_noise.png", "Biceps long-head mass: RMSE of the identified mass", "mass RMSE (%)",
+        {"mass_rmse_vs_noise.png", "mass: RMSE of the identified mass", "mass RMSE (%)",
          [](const ElbowValidationSummary& x) { return 100 * x.massRmse; }},
-        {"mass_coverage_vs_noise.png", "Biceps long-head mass: coverage of the 95 % interval", "coverage of the true mass",
+        {"mass_coverage_vs_noise.png", "mass: coverage of the 95 % interval", "coverage of the true mass",
          [](const ElbowValidationSummary& x) { return x.massCoverage; }},
-        {"tendon_rmse_vs_noise.png", "Optimal tendon length: RMSE", "L0T RMSE (mm)",
+        {"tendon_rmse_vs_noise.png", "L0T: RMSE", "L0T RMSE (mm)",
          [](const ElbowValidationSummary& x) { return 1000 * x.tendonRmse; }},
     };
     for (const auto& p : plots) {
-        writeNoisePlot(dir + "/" + p.file, p.title, p.yLabel, summary, p.statistic);
+        writeNoisePlot(dir + "/" + p.file, primary + " " + p.title, p.yLabel, summary, p.statistic, study.truths.size() > 1);
         if (doesPathExist(dir + "/" + p.file)) files.push_back(p.file);
+    }
+    if (study.truths.size() > 1) {
+        const struct {
+            const char* file;
+            const char* title;
+            const char* zLabel;
+            double (*statistic)(const ElbowValidationSummary&);
+            int decimals;
+        } maps[] = {
+            {"mass_bias_by_truth.png", "mass: bias by truth", "mass bias (%)",
+             [](const ElbowValidationSummary& x) { return 100 * x.massBias; }, 1},
+            {"mass_rmse_by_truth.png", "mass: RMSE by truth", "mass RMSE (%)",
+             [](const ElbowValidationSummary& x) { return 100 * x.massRmse; }, 1},
+            {"mass_coverage_by_truth.png", "mass: coverage of the 95 % interval", "coverage",
+             [](const ElbowValidationSummary& x) { return x.massCoverage; }, 2},
+            {"tendon_rmse_by_truth.png", "L0T: RMSE by truth", "L0T RMSE (mm)",
+             [](const ElbowValidationSummary& x) { return 1000 * x.tendonRmse; }, 1},
+            {"max_force_rmse_by_truth.png", "F0: RMSE by truth", "F0 RMSE (%)",
+             [](const ElbowValidationSummary& x) { return 100 * x.maxForceRmse; }, 1},
+        };
+        for (const auto& m : maps) {
+            writeTruthHeatMap(dir + "/" + m.file, primary + " " + m.title, m.zLabel, study, summary, m.statistic, m.decimals);
+            if (doesPathExist(dir + "/" + m.file)) files.push_back(m.file);
+        }
     }
     return files;
 }

@@ -31,7 +31,7 @@ constexpr int kCellsPerGroup = 2;
 Study makeCoordinatorStudy(int groups) {
     Study s;
     s.name = "coordinator";
-    s.population = s.prior = loadDefaultPopulation();
+    s.setPopulation(loadDefaultPopulation());
     s.subjects = groups;
     StudyProtocol one{"one.yaml", TorqueProtocol()};
     one.protocol.name = "one";

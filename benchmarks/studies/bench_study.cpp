@@ -18,7 +18,7 @@ const Study& benchStudy() {
     static const Study s = [] {
         Study x;
         x.name = "bench";
-        x.population = x.prior = loadDefaultPopulation();
+        x.setPopulation(loadDefaultPopulation());
         x.subjects = 8;
         x.protocols = {{"thesis", TorqueProtocol()}};
         x.noiseLevels = {0.02};

@@ -5,6 +5,7 @@
 // study files.
 #include "basics/errors.h"
 #include "basics/files.h"
+#include "basics/plot.h"
 #include "studies/study.h"
 #include "tests/support/temp_files.h"
 
@@ -32,7 +33,7 @@ std::string readText(const fs::path& p) { return armsim::testing::readFileText(p
 Study makeSmallStudy() {
     Study s;
     s.name = "small";
-    s.population = s.prior = loadDefaultPopulation();
+    s.setPopulation(loadDefaultPopulation());
     s.subjects = 3;
     s.seed = 5;
     StudyProtocol thesis{"thesis", TorqueProtocol()};
@@ -92,7 +93,7 @@ TEST(Study, CellsEqualTheElbowValidationOfTheSameSubjects) {
     v.noiseLevels = s.noiseLevels;
     v.activationSd = 0.02;
     v.jobs = 2;
-    const std::vector<ElbowValidationRow> rows = runElbowValidation(s.population, v);
+    const std::vector<ElbowValidationRow> rows = runElbowValidation(s.truths[0].population, v);
     int compared = 0;
     for (int subject = 0; subject < 2; ++subject) {
         const long group = long(subject) * 2;  // the thesis protocol
@@ -322,6 +323,23 @@ TEST(Study, ReadsAStudyFileAndNamesTheFileLineAndFieldOfEveryError) {
          "field 'methods[0].label' = 'caf\\xe9': not UTF-8 text"},
         {"kind: study\nname: r\xe9sum\xe9\nsubjects: 2\nprotocols: [thesis]\nmethods:\n  - {method: thesis}\n",
          "field 'name' = 'r\\xe9sum\\xe9': not UTF-8 text"},
+        // Several truths (issue 31): a prior, unique labels, known keys, one way of naming the truth.
+        {"kind: study\nsubjects: 2\ntruths:\n  - {population: default}\nprotocols: [thesis]\nmethods:\n  - {method: thesis}\n",
+         "needs 'prior'"},
+        {"kind: study\nsubjects: 2\nprior: default\ntruths:\n  - {population: default}\n  - {population: default}\n"
+         "protocols: [thesis]\nmethods:\n  - {method: thesis}\n",
+         "truths[1].label' = 'default': also truths[0]'s label"},
+        {"kind: study\nsubjects: 2\nprior: default\ntruths:\n  - {population: default, lable: x}\n"
+         "protocols: [thesis]\nmethods:\n  - {method: thesis}\n",
+         "lable"},
+        {"kind: study\nsubjects: 2\nprior: default\ntruths:\n  - {population: nowhere.yaml}\n"
+         "protocols: [thesis]\nmethods:\n  - {method: thesis}\n",
+         "nowhere.yaml"},
+        {"kind: study\nsubjects: 2\nprior: default\ntruths: []\nprotocols: [thesis]\nmethods:\n  - {method: thesis}\n",
+         "empty list"},
+        {"kind: study\nsubjects: 2\nprior: default\ntruth: default\ntruths:\n  - {population: default}\n"
+         "protocols: [thesis]\nmethods:\n  - {method: thesis}\n",
+         "not several"},
     };
     for (std::size_t i = 0; i < cases.size(); ++i) {
         const fs::path p = d / ("bad" + std::to_string(i) + ".yaml");
@@ -349,14 +367,14 @@ TEST(Study, TruthAndPriorInAStudyFileAreTheOutOfFamilyValidation) {
     std::ofstream(dir / "both.yaml") << "kind: study\nname: oof\npopulation: default\ntruth: " << stronger << "\n" << body;
     const Study oof = readStudy((dir / "oof.yaml").string()), fam = readStudy((dir / "fam.yaml").string());
     EXPECT_EQ(oof.prior.name, "default");
-    EXPECT_EQ(oof.population.name, "stronger");
+    EXPECT_EQ(oof.truths.at(0).population.name, "stronger");
     EXPECT_NE(calcStudyFingerprint(oof), calcStudyFingerprint(fam));
     ElbowValidationSettings v;
     v.subjects = 1;
     v.seed = 3;
     v.noiseLevels = {0.02};
     v.activationSd = 0;
-    const std::vector<ElbowValidationRow> rows = runElbowValidation(oof.population, oof.prior, v);
+    const std::vector<ElbowValidationRow> rows = runElbowValidation(oof.truths[0].population, oof.prior, v);
     int compared = 0;
     for (const StudyResult& r : runStudyGroup(oof, 0, {0})) {
         for (const ElbowValidationRow& w : rows)
@@ -371,9 +389,71 @@ TEST(Study, TruthAndPriorInAStudyFileAreTheOutOfFamilyValidation) {
         readStudy((dir / "both.yaml").string());
         FAIL() << "population and truth together were accepted";
     } catch (const InputError& e) {
-        EXPECT_NE(std::string(e.what()).find("not both"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("not several"), std::string::npos) << e.what();
     }
     fs::remove_all(dir);
+}
+
+// Several truths in one study (issue 31's out-of-family study): tasks are truth-major, every truth's
+// cells equal runElbowValidation(that truth, prior) of the same subjects, results and summary carry the
+// truth's label, and the by-truth heat maps are drawn.
+TEST(Study, SeveralTruthsAreEachTheOutOfFamilyValidationOfTheirSubjects) {
+    const fs::path dir = freshDir("truths");
+    const std::string mismatch = std::string(ARMSIM_ASSET_DIR) + "/subjects/mismatch/";
+    std::ofstream(dir / "truths.yaml")
+        << "kind: study\nname: truths\nprior: default\ntruths:\n  - {population: default, label: in family}\n"
+           "  - {population: " << mismatch << "stronger.yaml}\n  - {population: " << mismatch << "weaker.yaml}\n"
+           "subjects: 2\nseed: 3\nprotocols: [thesis]\nnoise_levels: [0.02]\nmethods:\n  - {method: synergist}\n";
+    const Study s = readStudy((dir / "truths.yaml").string());
+    ASSERT_EQ(s.truths.size(), 3u);
+    EXPECT_EQ(s.truths[0].label, "in family");
+    EXPECT_EQ(s.truths[1].label, "stronger");  // the population's name
+    EXPECT_EQ(s.truths[2].label, "weaker");
+    ASSERT_EQ(s.getNumTasks(), 3 * 2);
+    for (long i = 0; i < s.getNumTasks(); ++i) {
+        const StudyTask t = getStudyTask(s, i);
+        EXPECT_EQ(t.truth * 2 + t.subject, i);
+        EXPECT_EQ(t.getGroup(s), i);
+    }
+    // The last truth's second subject, against the validation of that truth with the same prior.
+    ElbowValidationSettings v;
+    v.subjects = 2;
+    v.seed = 3;
+    v.noiseLevels = {0.02};
+    v.activationSd = 0;
+    const std::vector<ElbowValidationRow> rows = runElbowValidation(s.truths[2].population, s.prior, v);
+    const std::vector<StudyResult> cell = runStudyGroup(s, 5, {5});
+    ASSERT_EQ(cell.size(), 1u);
+    EXPECT_EQ(cell[0].truth, "weaker");
+    int compared = 0;
+    for (const ElbowValidationRow& w : rows)
+        if (w.subject == 1 && w.method == "synergist") {
+            EXPECT_EQ(cell[0].row.estimate.mass, w.estimate.mass);  // bitwise: the same computation
+            EXPECT_EQ(cell[0].row.trueMass, w.trueMass);
+            EXPECT_EQ(cell[0].row.trueMaxForce, w.trueMaxForce);
+            ++compared;
+        }
+    EXPECT_EQ(compared, 1);
+
+    StudyRunOptions o;
+    o.output = (dir / "out").string();
+    o.threads = 2;
+    runStudy(s, o);
+    const std::string results = readText(dir / "out" / "results.csv");
+    EXPECT_EQ(results.rfind("task,truth,subject,protocol,method,", 0), 0u) << results.substr(0, 80);
+    EXPECT_NE(results.find("\n5,weaker,1,thesis_mvc,synergist,"), std::string::npos) << results;
+    const std::string summary = readText(dir / "out" / "summary.csv");
+    for (const char* label : {"\nin family,thesis_mvc,synergist,", "\nstronger,thesis_mvc,synergist,", "\nweaker,thesis_mvc,synergist,"})
+        EXPECT_NE(summary.find(label), std::string::npos) << label << " in\n" << summary;
+    for (const char* png : {"mass_bias_by_truth.png", "mass_rmse_by_truth.png", "mass_coverage_by_truth.png",
+                            "tendon_rmse_by_truth.png"})
+        EXPECT_TRUE(isWholePng((dir / "out" / png).string())) << png;
+    // Resumed from its journal, the files are the same.
+    const std::string first = results + summary;
+    StudyRunOptions again = o;
+    const StudyOutcome resumed = runStudy(s, again);
+    EXPECT_EQ(resumed.computed, 0);
+    EXPECT_EQ(readText(dir / "out" / "results.csv") + readText(dir / "out" / "summary.csv"), first);
 }
 
 
