@@ -2,10 +2,13 @@
 // curves as CSV + PNG), score it against anatomy targets, calibrate a model's muscle strength to the elbow
 // target curves.
 #include "basics/errors.h"
+#include "basics/files.h"
 #include "basics/format.h"
 #include "cli/commands.h"
 #include "experiments/model_check.h"
 #include "experiments/model_report.h"
+#include "experiments/osim_report.h"
+#include "muscles/muscle_file.h"
 #include "model/anatomy_calibration.h"
 #include "model/strength_calibration.h"
 
@@ -76,14 +79,42 @@ void addModelCommands(CLI::App& app) {
         CLI::App* c = model->add_subcommand(
             "show", "muscle table, moment arms and steady MVC torque-angle curves (CSV + PNG)");
         auto muscleModel = std::make_shared<std::string>();
-        c->add_option("--model", *name, "model name or file")->capture_default_str();
+        c->add_option("--model", *name, "model name or file (an armsim .yaml or an OpenSim .osim)")->capture_default_str();
         c->add_option("--muscle-model", *muscleModel,
                       "every muscle's model: virtual_muscle, thelen2003 or degroote2016 (default: the model file's)");
         c->add_option("--out", *out, "output directory")->capture_default_str();
         c->add_option("--step", *step, "angle step [deg]")->capture_default_str();
         c->add_option("--reference", *reference,
                       "published reference data (default assets/measured/elbow_reference.yaml)");
+        auto coordinate = std::make_shared<std::string>();
+        c->add_option("--coordinate", *coordinate,
+                      "an OpenSim model's coordinate to sweep (default: its only moving one)");
         c->callback([=] {
+            // An OpenSim model: a file ending .osim, or a shipped name with only an .osim file.
+            std::string osim;
+            if (name->size() > 5 && name->compare(name->size() - 5, 5, ".osim") == 0) osim = *name;
+            else if (name->find('/') == std::string::npos &&
+                     !doesPathExist(getAssetDirectory() + "/models/" + *name + ".yaml") &&
+                     doesPathExist(getAssetDirectory() + "/models/" + *name + ".osim"))
+                osim = getAssetDirectory() + "/models/" + *name + ".osim";
+            if (!osim.empty()) {
+                if (!doesPathExist(osim)) throw InputError("--model '" + *name + "': no such .osim file");
+                const OsimModel m = readOsimFile(osim);
+                OsimReportSettings s;
+                s.coordinate = *coordinate;
+                s.stepDeg = *step;
+                s.muscleModel = *muscleModel;
+                const OsimReportFiles r = writeOsimModelReport(m, s, *out);
+                std::printf("model %s (%s): %zu muscles; swept %s\n", m.name.c_str(), osim.c_str(), m.muscles.size(),
+                            r.coordinate.c_str());
+                std::printf("steady torque, + direction muscles fully excited: peak %.1f N m at %.1f deg\n", r.peakPositive,
+                            r.peakPositiveDeg);
+                std::printf("steady torque, - direction muscles fully excited: peak %.1f N m at %.1f deg\n", r.peakNegative,
+                            r.peakNegativeDeg);
+                for (const std::string& f : r.files) std::printf("wrote %s\n", f.c_str());
+                return;
+            }
+            if (!coordinate->empty()) throw InputError("--coordinate '" + *coordinate + "': only for OpenSim models (.osim)");
             const ElbowReference ref = reference->empty() ? loadDefaultElbowReference() : loadElbowReference(*reference);
             showModel(loadModelWithMuscles(*name, *muscleModel), *out, *step, ref);
         });

@@ -3,7 +3,7 @@
 #include "basics/errors.h"
 #include "basics/output_folder.h"
 #include "basics/parallel.h"
-#include "experiments/data_files.h"
+#include "basics/storage_file.h"
 #include "experiments/protocol_run.h"
 #include "model/geometry.h"
 

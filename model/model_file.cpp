@@ -378,8 +378,8 @@ ArmSetup loadModel(const std::string& nameOrFile) {
     std::string file = nameOrFile;
     const bool looksLikeName = nameOrFile.find('/') == std::string::npos &&
                                nameOrFile.find(".yaml") == std::string::npos;
-    const std::string osimNote = "an OpenSim model: armsim reads .osim files as data (model/osim_file.h) but cannot "
-                                 "simulate them yet; expected an armsim model file (.yaml)";
+    const std::string osimNote = "an OpenSim model: `armsim forward --model` simulates .osim files (OpenSim's Forward "
+                                 "tool); this command takes an armsim model file (.yaml) yet";
     if (looksLikeName) {
         const std::string asset = getAssetDirectory() + "/models/" + nameOrFile + ".yaml";
         if (!doesPathExist(asset)) {

@@ -134,14 +134,7 @@ void DeGroote2016Muscle::calcMovingStateDerivative(double P, double dP, double U
 }
 
 void DeGroote2016Muscle::checkStates(double t, const double* y) const {
-    const char* names[] = {"activation", "normalized_tendon_force"};
-    for (int i = 0; i < 2; ++i)
-        if (!std::isfinite(y[i])) {
-            std::ostringstream msg;
-            msg << "t = " << t << " s: muscle '" << p_.name << "' state " << names[i] << " is " << y[i]
-                << " (not finite)";
-            throw SimulationError(msg.str());
-        }
+    checkFiniteStates(t, y, {"activation", "normalized_tendon_force"}, p_.name);
     // The tendon curve's asymptote is -c3; the activation must stay positive (f_V divides by a f_L).
     if (!(y[kTendonForce] > -c3) || !(y[kActivation] > 0)) {
         std::ostringstream msg;
@@ -209,12 +202,6 @@ SteadyState DeGroote2016Muscle::calcSteadyState(double P, double U) const {
     r.force = p_.maxIsometricForce * r.normalizedForce;
     r.states = {a, r.normalizedForce};
     return r;
-}
-
-std::vector<double> DeGroote2016Muscle::calcInitialState(double P) const {
-    const SteadyState s = calcSteadyState(P, 0.0);
-    if (!s.converged) throw InputError("muscle '" + p_.name + "': " + s.message);
-    return s.states;
 }
 
 // ---- Registry --------------------------------------------------------------------------------------

@@ -59,8 +59,9 @@ public:
 
     /// Throws InputError unless 0 < P <= getMaxPathLength().
     virtual void checkPathLength(double pathLength) const = 0;
-    /// A state to start an integration from at path P with no drive.
-    virtual std::vector<double> calcInitialState(double pathLength) const = 0;
+    /// A state to start an integration from at path P with no drive. Default: the steady state at U = 0
+    /// (InputError naming the muscle when there is none).
+    virtual std::vector<double> calcInitialState(double pathLength) const;
     /// Tendon (output) force [N] at path P for state y.
     virtual double calcForce(double pathLength, const double* y) const = 0;
     /// dy/dt at path P, input U. Optionally fills outputs.

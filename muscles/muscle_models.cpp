@@ -4,8 +4,10 @@
 #include "basics/format.h"
 #include "muscles/degroote2016_muscle.h"
 #include "muscles/thelen2003_muscle.h"
+#include "muscles/thelen2003_opensim2_muscle.h"
 
 #include <cmath>
+#include <sstream>
 
 namespace armsim {
 
@@ -28,6 +30,8 @@ const std::vector<MuscleModelType>& getMuscleModelTypes() {
          "thelen2003.yaml", &buildThelen2003Muscle},
         {"degroote2016", "De Groote-Fregly 2016 Hill-type muscle as OpenSim 4's DeGrooteFregly2016Muscle",
          getDeGroote2016CoefficientKeys(), "degroote2016.yaml", &buildDeGroote2016Muscle},
+        {"thelen2003_opensim2", "Thelen 2003 Hill-type muscle as OpenSim 2.x's Thelen2003Muscle (its tutorials' results)",
+         getThelen2003Opensim2CoefficientKeys(), "thelen2003_opensim2.yaml", &buildThelen2003Opensim2Muscle},
     };
     return types;
 }
@@ -48,6 +52,25 @@ void checkPathWithin(double P, double maxPath, const std::string& muscle) {
     if (P > maxPath)
         throw InputError("path length = " + formatNumber(P) + " m exceeds max_path_length = " + formatNumber(maxPath) + " m of muscle '" +
                          muscle + "': expected a path no longer than the anatomical limit");
+}
+
+void checkFiniteStates(double t, const double* y, std::initializer_list<const char*> names, const std::string& muscle) {
+    int i = 0;
+    for (const char* name : names) {
+        if (!std::isfinite(y[i])) {
+            std::ostringstream msg;
+            msg << "t = " << t << " s: muscle '" << muscle << "' state " << name << " is " << y[i] << " (not finite)";
+            throw SimulationError(msg.str());
+        }
+        ++i;
+    }
+}
+
+void checkPositiveFiberLength(double t, double L, const std::string& muscle) {
+    if (L > 0) return;
+    std::ostringstream msg;
+    msg << "t = " << t << " s: muscle '" << muscle << "' fibre length " << L << " optimal lengths: expected > 0";
+    throw SimulationError(msg.str());
 }
 
 void throwUnknownCoefficient(const std::string& muscle, const std::string& model, const std::string& key,

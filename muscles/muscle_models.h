@@ -8,6 +8,7 @@
 #include "muscles/muscle_model.h"
 #include "muscles/virtual_muscle.h"
 
+#include <initializer_list>
 #include <map>
 #include <memory>
 #include <string>
@@ -56,6 +57,12 @@ HillMorphometry calcHillMorphometry(const MuscleParameters& params);
 /// InputError "muscle 'M': MODEL has no coefficient 'KEY': expected one of ...".
 /// Throws InputError unless 0 < P <= maxPathLength (the muscle's anatomical limit).
 void checkPathWithin(double pathLength, double maxPathLength, const std::string& muscle);
+
+/// For checkStates of the Hill-type models: SimulationError "t = T s: muscle 'M' state NAME is V (not
+/// finite)" for the first state that is not finite.
+void checkFiniteStates(double t, const double* y, std::initializer_list<const char*> names, const std::string& muscle);
+/// SimulationError "t = T s: muscle 'M' fibre length L optimal lengths: expected > 0" unless L > 0.
+void checkPositiveFiberLength(double t, double L, const std::string& muscle);
 
 [[noreturn]] void throwUnknownCoefficient(const std::string& muscle, const std::string& model, const std::string& key,
                                           const std::vector<std::string>& keys);

@@ -19,19 +19,33 @@ constexpr int kArcSamplesPerRadian = 8;
 
 double cross2(const Vec2& a, const Vec2& b) { return a[0] * b[1] - a[1] * b[0]; }
 
+// Whether the segment p-q passes inside the circle of radius R about the origin (2D).
+bool segmentCutsCircle(const Vec2& p, const Vec2& q, double R) {
+    const Vec2 d = q - p;
+    const double dd = d.normSqr();
+    if (dd == 0) return false;
+    const double t = -dot(p, d) / dd;
+    return t > 0 && t < 1 && (p + t * d).norm() < R;
+}
+
 // Tangent points, arc and polyline of one surface between the fixed points a and b (Ground).
 struct SurfaceWrap {
     bool active = false;
     Vec3 ta{0}, tb{0};
-    double length = 0;  // |ta - a| + arc + |b - tb|
+    double length = 0;     // |ta - a| + arc + |b - tb|
+    double arcLength = 0;  // the part on the surface
     std::vector<Vec3> arc;
 };
 
 [[noreturn]] void throwInside(const std::string& muscle, const PathElement& e, double distance) {
     std::ostringstream msg;
     msg << "muscle '" << muscle << "': a path point lies inside the wrapping surface '" << e.label
-        << "' (distance " << distance << " m from its axis or centre, radius " << e.radius
-        << " m): move the point or shrink the surface";
+        << "' (distance " << distance << " m from its axis or centre, ";
+    if (e.kind == PathElement::Kind::Ellipsoid)
+        msg << "semi-axes " << e.radii[0] << ", " << e.radii[1] << ", " << e.radii[2];
+    else
+        msg << "radius " << e.radius;
+    msg << " m): move the point or shrink the surface";
     throw SimulationError(msg.str());
 }
 
@@ -47,6 +61,7 @@ SurfaceWrap liftWrap(const CircleWrap& w, const Vec3& c, const UnitVec3& e1, con
     out.ta = c + w.tp[0] * e1 + w.tp[1] * e2 + zTp * e3;
     out.tb = c + w.tq[0] * e1 + w.tq[1] * e2 + zTq * e3;
     out.length = std::sqrt(planar * planar + dz * dz);
+    out.arcLength = R * w.angle * (planar > 0 ? out.length / planar : 1.0);  // the helix's share
     if (withArc) {
         const double th0 = std::atan2(w.tp[1], w.tp[0]);
         const int n = std::max(2, int(std::ceil(w.angle * kArcSamplesPerRadian)));
@@ -59,9 +74,12 @@ SurfaceWrap liftWrap(const CircleWrap& w, const Vec3& c, const UnitVec3& e1, con
     return out;
 }
 
-SurfaceWrap wrapSurface(const PathElement& e, const State& s, const Vec3& a, const Vec3& b,
+SurfaceWrap wrapEllipsoid(const PathElement& e, const Transform& X_GB, const Vec3& a, const Vec3& b,
+                          const std::string& muscle, bool withArc);
+
+SurfaceWrap wrapSurface(const PathElement& e, const Transform& X_GB, const Vec3& a, const Vec3& b,
                         const std::string& muscle, bool withArc) {
-    const Transform& X_GB = e.body.getBodyTransform(s);
+    if (e.kind == PathElement::Kind::Ellipsoid) return wrapEllipsoid(e, X_GB, a, b, muscle, withArc);
     const Vec3 c = X_GB * e.location;
     const Vec3 side = X_GB.R() * e.side;
     const Vec3 p = a - c, q = b - c;
@@ -70,24 +88,153 @@ SurfaceWrap wrapSurface(const PathElement& e, const State& s, const Vec3& a, con
         const UnitVec3 e1 = e3.perp();
         const UnitVec3 e2(e3 % e1, true);
         const Vec2 p2(dot(p, e1), dot(p, e2)), q2(dot(q, e1), dot(q, e2)), s2(dot(side, e1), dot(side, e2));
-        if (p2.norm() <= e.radius) throwInside(muscle, e, p2.norm());
-        if (q2.norm() <= e.radius) throwInside(muscle, e, q2.norm());
+        if (std::min(p2.norm(), q2.norm()) <= e.radius) {
+            if (e.passWhenInside) return {};
+            throwInside(muscle, e, std::min(p2.norm(), q2.norm()));
+        }
         const CircleWrap w = calcCircleWrap(p2, q2, e.radius, s2, s2.norm() > 0, e.winds);
         if (!w.active) return {};
-        return liftWrap(w, c, e1, e2, Vec3(e3), dot(p, e3), dot(q, e3), e.radius, withArc);
+        SurfaceWrap out = liftWrap(w, c, e1, e2, Vec3(e3), dot(p, e3), dot(q, e3), e.radius, withArc);
+        if (e.length > 0 && std::abs(dot(out.ta - c, e3)) > e.length / 2 && std::abs(dot(out.tb - c, e3)) > e.length / 2)
+            return {};  // both tangent points beyond the cylinder's ends
+        return out;
     }
     // Sphere: the great circle in the plane of the centre, a and b.
-    if (p.norm() <= e.radius) throwInside(muscle, e, p.norm());
-    if (q.norm() <= e.radius) throwInside(muscle, e, q.norm());
+    if (std::min(p.norm(), q.norm()) <= e.radius) {
+        if (e.passWhenInside) return {};
+        throwInside(muscle, e, std::min(p.norm(), q.norm()));
+    }
     Vec3 n = p % q;
     if (n.norm() <= 1e-12 * p.norm() * q.norm()) n = p % side;
     if (n.norm() <= 1e-12 * p.norm() * (side.norm() + 1e-300)) n = UnitVec3(p).perp().asVec3();
     const UnitVec3 e1(p), e3(n);
     const UnitVec3 e2(e3 % e1, true);
     const Vec2 p2(p.norm(), 0), q2(dot(q, e1), dot(q, e2)), s2(dot(side, e1), dot(side, e2));
+    if (e.onlyWhenCut && !segmentCutsCircle(p2, q2, e.radius)) return {};
     const CircleWrap w = calcCircleWrap(p2, q2, e.radius, s2, s2.norm() > 0, e.winds);
     if (!w.active) return {};
     return liftWrap(w, c, e1, e2, Vec3(0), 0, 0, e.radius, withArc);
+}
+
+// Length of the ellipse arc x(th) = E (cos th u + sin th v), th from th0 over `angle` in direction
+// `direction` (E: the map from the unit sphere's space to Ground, u, v orthonormal there): Gauss-Legendre
+// with 16 nodes on pieces of at most pi/8.
+double calcEllipseArcLength(const Mat33& E, const Vec3& u, const Vec3& v, double th0, double angle, int direction) {
+    static const double x[8] = {0.0950125098376374, 0.2816035507792589, 0.4580167776572274, 0.6178762444026438,
+                                0.7554044083550030, 0.8656312023878318, 0.9445750230732326, 0.9894009349916499};
+    static const double w[8] = {0.1894506104550685, 0.1826034150449236, 0.1691565193950025, 0.1495959888165767,
+                                0.1246289712555339, 0.0951585116824928, 0.0622535239386479, 0.0271524594117541};
+    const int pieces = std::max(1, int(std::ceil(angle / (kTwoPi / 16))));
+    const double h = angle / pieces;
+    // Nodes by the angle-addition formulas: one sine and cosine per node offset and per piece.
+    double co[8], si[8];
+    for (int j = 0; j < 8; ++j) co[j] = std::cos(x[j] * 0.5 * h), si[j] = direction * std::sin(x[j] * 0.5 * h);
+    const Vec3 Eu = E * u, Ev = E * v;
+    double length = 0;
+    for (int k = 0; k < pieces; ++k) {
+        const double mid = th0 + direction * (k + 0.5) * h;
+        const double cm = std::cos(mid), sm = std::sin(mid);
+        for (int j = 0; j < 8; ++j)
+            for (int sgn : {-1, 1}) {
+                const double c = cm * co[j] - sm * sgn * si[j], sn = sm * co[j] + cm * sgn * si[j];
+                length += w[j] * 0.5 * h * (-sn * Eu + c * Ev).norm();
+            }
+    }
+    return length;
+}
+
+// The ellipsoid's planar wrap between a and b (Ground), through the unit sphere's construction.
+SurfaceWrap wrapEllipsoid(const PathElement& e, const Transform& X_GB, const Vec3& a, const Vec3& b,
+                          const std::string& muscle, bool withArc) {
+    const Vec3 c = X_GB * e.location;
+    const Rotation R_GE = X_GB.R() * e.orientation;
+    const Mat33 D(e.radii[0], 0, 0, 0, e.radii[1], 0, 0, 0, e.radii[2]);
+    const Mat33 Dinv(1 / e.radii[0], 0, 0, 0, 1 / e.radii[1], 0, 0, 0, 1 / e.radii[2]);
+    const Mat33 toSphere = Dinv * ~R_GE.asMat33(), fromSphere = R_GE.asMat33() * D;
+    const Vec3 p = toSphere * (a - c), q = toSphere * (b - c), side = toSphere * (X_GB.R() * e.side);
+    if (p.norm() <= 1 || q.norm() <= 1) {
+        if (e.passWhenInside) return {};
+        throwInside(muscle, e, (p.norm() <= 1 ? a - c : b - c).norm());
+    }
+    Vec3 n = p % q;
+    if (n.norm() <= 1e-12 * p.norm() * q.norm()) n = p % side;
+    if (n.norm() <= 1e-12 * p.norm() * (side.norm() + 1e-300)) n = UnitVec3(p).perp().asVec3();
+    const UnitVec3 e1(p), e3(n);
+    const UnitVec3 e2(e3 % e1, true);
+    const Vec2 p2(p.norm(), 0), q2(dot(q, e1), dot(q, e2)), s2(dot(side, e1), dot(side, e2));
+    if (e.onlyWhenCut && !segmentCutsCircle(p2, q2, 1.0)) return {};
+    const CircleWrap w = calcCircleWrap(p2, q2, 1.0, s2, s2.norm() > 0, e.winds);
+    if (!w.active) return {};
+    SurfaceWrap out;
+    out.active = true;
+    out.ta = c + fromSphere * (w.tp[0] * e1 + w.tp[1] * e2);
+    out.tb = c + fromSphere * (w.tq[0] * e1 + w.tq[1] * e2);
+    const double th0 = std::atan2(w.tp[1], w.tp[0]);
+    out.arcLength = calcEllipseArcLength(fromSphere, Vec3(e1), Vec3(e2), th0, w.angle, w.direction);
+    out.length = (out.ta - a).norm() + out.arcLength + (b - out.tb).norm();
+    if (withArc) {
+        const int m = std::max(2, int(std::ceil(w.angle * kArcSamplesPerRadian)));
+        for (int k = 1; k < m; ++k) {
+            const double th = th0 + w.direction * w.angle * double(k) / m;
+            out.arc.push_back(c + fromSphere * (std::cos(th) * e1 + std::sin(th) * e2));
+        }
+    }
+    return out;
+}
+
+// Several surfaces between the fixed points a and b, in path order (OpenSim applies several wrap
+// objects to one segment in turn, up to 8 passes): each wraps between its active neighbours' tangent
+// points (or a, b), in passes until no tangent point moves by more than 1e-13 m (at most 200 passes).
+struct ChainWrap {
+    std::vector<SurfaceWrap> wraps;
+    double length = 0;
+    int active = 0;
+};
+
+ChainWrap wrapChain(const std::vector<const PathElement*>& es, const std::vector<Transform>& X, const Vec3& a,
+                    const Vec3& b, const std::string& muscle, bool withArc) {
+    const int K = int(es.size());
+    ChainWrap c;
+    c.wraps.assign(K, SurfaceWrap());
+    auto ends = [&](int k) {
+        Vec3 from = a, to = b;
+        for (int r = k - 1; r >= 0; --r)
+            if (c.wraps[r].active) {
+                from = c.wraps[r].tb;
+                break;
+            }
+        for (int r = k + 1; r < K; ++r)
+            if (c.wraps[r].active) {
+                to = c.wraps[r].ta;
+                break;
+            }
+        return std::make_pair(from, to);
+    };
+    for (int pass = 0; pass < 200; ++pass) {
+        double change = 0;
+        for (int k = 0; k < K; ++k) {
+            const auto [from, to] = ends(k);
+            SurfaceWrap w = wrapSurface(*es[k], X[k], from, to, muscle, false);
+            const SurfaceWrap& old = c.wraps[k];
+            if (w.active != old.active) change = 1;
+            else if (w.active) change = std::max({change, (w.ta - old.ta).norm(), (w.tb - old.tb).norm()});
+            c.wraps[k] = std::move(w);
+        }
+        if (change <= 1e-13) break;
+    }
+    Vec3 at = a;
+    for (int k = 0; k < K; ++k) {
+        if (!c.wraps[k].active) continue;
+        ++c.active;
+        if (withArc) {
+            const auto [from, to] = ends(k);
+            c.wraps[k] = wrapSurface(*es[k], X[k], from, to, muscle, true);
+        }
+        c.length += (c.wraps[k].ta - at).norm() + c.wraps[k].arcLength;
+        at = c.wraps[k].tb;
+    }
+    c.length += (b - at).norm();
+    return c;
 }
 
 }  // namespace
@@ -185,10 +332,11 @@ MusclePath::MusclePath(std::vector<PathElement> elements) : elements_(std::move(
     for (int k = 0; k < n; ++k) {
         const PathElement& e = elements_[k];
         if (!e.isSurface()) continue;
-        if (elements_[k + 1].isSurface())
-            throw InputError("muscle path: wrapping surfaces '" + e.label + "' and '" + elements_[k + 1].label +
-                             "' follow each other; put a via point between them (one surface between two points)");
-        checkField(e.label + ".radius", e.radius, Bound::positive("m"));
+        if (e.kind == PathElement::Kind::Ellipsoid) {
+            for (int d = 0; d < 3; ++d) checkField(e.label + ".radii[" + std::to_string(d) + "]", e.radii[d], Bound::positive("m"));
+        } else {
+            checkField(e.label + ".radius", e.radius, Bound::positive("m"));
+        }
     }
     for (int k = 0; k < n; ++k) {
         if (!elements_[k].isConditional()) continue;
@@ -217,40 +365,147 @@ PathGeometry MusclePath::calcGeometry(const State& s, const std::string& muscleN
         const double q = e.joint.getOneQ(s, MobilizerQIndex(0));
         return q >= e.activeMin && q <= e.activeMax;
     };
+    // Loads of an active ellipsoid alone between a and b: the gradient of its planar length (central
+    // differences) at the points, and on its body what rigid invariance leaves (a force and a couple
+    // about its centre).
+    auto addEllipsoidLoads = [&](int i, int k, int j, const Vec3& a, const Vec3& b, const SurfaceWrap& w) {
+        const PathElement& e = elements_[k];
+        const Transform& X_GB = e.body.getBodyTransform(s);
+        const Vec3 c = X_GB * e.location;
+        const double h = 1e-5 * std::min({e.radii[0], e.radii[1], e.radii[2]});
+        auto lengthAt = [&](const Vec3& pa, const Vec3& pb) {
+            const SurfaceWrap x = wrapEllipsoid(e, X_GB, pa, pb, muscleName, false);
+            return x.active ? x.length : (pb - pa).norm();
+        };
+        Vec3 ga(0), gb(0);
+        const Vec3 normal = (a - c) % (b - c);
+        if (normal.norm() > 1e-6 * (a - c).norm() * (b - c).norm()) {
+            // Within the plane of c, a and b the path is that plane's shortest: the gradient is the unit
+            // vector from the tangent point (envelope theorem). Only the plane's tilt needs differences.
+            const UnitVec3 n(normal);
+            const double dna = (lengthAt(a + h * n, b) - lengthAt(a - h * n, b)) / (2 * h);
+            const double dnb = (lengthAt(a, b + h * n) - lengthAt(a, b - h * n)) / (2 * h);
+            auto inPlane = [&](const Vec3& v) { return v - dot(v, n) * n; };
+            ga = inPlane(UnitVec3(a - w.ta).asVec3()) + dna * n;
+            gb = inPlane(UnitVec3(b - w.tb).asVec3()) + dnb * n;
+        } else {
+            for (int d = 0; d < 3; ++d) {
+                Vec3 dx(0);
+                dx[d] = h;
+                ga[d] = (lengthAt(a + dx, b) - lengthAt(a - dx, b)) / (2 * h);
+                gb[d] = (lengthAt(a, b + dx) - lengthAt(a, b - dx)) / (2 * h);
+            }
+        }
+        addLoad(k, c, ga + gb);
+        g.loads.back().moment = (a - c) % ga + (b - c) % gb;
+        addLoad(i, a, -ga);
+        addLoad(j, b, -gb);
+    };
+    // Loads of one active cylinder or sphere: the tension at its tangent points (the path is a geodesic).
+    auto addTangentLoads = [&](int i, int k, int j, const Vec3& a, const Vec3& b, const SurfaceWrap& w) {
+        addLoad(k, w.ta, Vec3(UnitVec3(a - w.ta).asVec3()));
+        addLoad(k, w.tb, Vec3(UnitVec3(b - w.tb).asVec3()));
+        addLoad(i, a, Vec3(UnitVec3(w.ta - a).asVec3()));
+        addLoad(j, b, Vec3(UnitVec3(w.tb - b).asVec3()));
+    };
     int i = 0;
     Vec3 a = pointInGround(0);
     if (withPolyline) g.polyline.push_back(a);
     while (i < n - 1) {
         int next = i + 1;
-        while (!isActive(next)) ++next;   // conditional points lie between points: next is a point
-        const int k = elements_[next].isSurface() ? next : -1;  // the surface between two points
-        const int j = k >= 0 ? next + 1 : next;
+        while (!isActive(next)) ++next;   // conditional points lie between points: next is a point or a surface
+        int j = next;                     // the surfaces between two points are next .. j - 1
+        while (elements_[j].isSurface()) ++j;
         const Vec3 b = pointInGround(j);
-        SurfaceWrap w;
-        if (k >= 0) {
-            w = wrapSurface(elements_[k], s, a, b, muscleName, withPolyline);
-            if (w.active) {
-                g.wrapping[k] = true;
-                addLoad(k, w.ta, Vec3(UnitVec3(a - w.ta).asVec3()));
-                addLoad(k, w.tb, Vec3(UnitVec3(b - w.tb).asVec3()));
-            }
-        }
-        if (w.active) {
-            g.length += w.length;
-            addLoad(i, a, Vec3(UnitVec3(w.ta - a).asVec3()));
-            addLoad(j, b, Vec3(UnitVec3(w.tb - b).asVec3()));
-            if (withPolyline) {
-                g.polyline.push_back(w.ta);
-                g.polyline.insert(g.polyline.end(), w.arc.begin(), w.arc.end());
-                g.polyline.push_back(w.tb);
-            }
-        } else {
+        auto addStraight = [&] {
             const Vec3 d = b - a;
             const double len = d.norm();
             g.length += len;
             const Vec3 u = len > 0 ? Vec3(d / len) : Vec3(0);
             addLoad(i, a, u);
             addLoad(j, b, -u);
+        };
+        auto addArc = [&](const SurfaceWrap& w) {
+            if (!withPolyline) return;
+            g.polyline.push_back(w.ta);
+            g.polyline.insert(g.polyline.end(), w.arc.begin(), w.arc.end());
+            g.polyline.push_back(w.tb);
+        };
+        if (j - next == 0) {
+            addStraight();
+        } else if (j - next == 1) {  // one surface (the common case)
+            const int k = next;
+            const SurfaceWrap w = wrapSurface(elements_[k], elements_[k].body.getBodyTransform(s), a, b, muscleName, withPolyline);
+            if (!w.active) {
+                addStraight();
+            } else {
+                g.wrapping[k] = true;
+                g.length += w.length;
+                if (elements_[k].kind == PathElement::Kind::Ellipsoid) addEllipsoidLoads(i, k, j, a, b, w);
+                else addTangentLoads(i, k, j, a, b, w);
+                addArc(w);
+            }
+        } else {
+            std::vector<int> ks;
+            std::vector<const PathElement*> es;
+            std::vector<Transform> X;
+            for (int k = next; k < j; ++k) {
+                ks.push_back(k);
+                es.push_back(&elements_[k]);
+                X.push_back(elements_[k].body.getBodyTransform(s));
+            }
+            const ChainWrap c = wrapChain(es, X, a, b, muscleName, withPolyline);
+            if (c.active == 0) {
+                addStraight();
+            } else {
+                g.length += c.length;
+                for (std::size_t m = 0; m < ks.size(); ++m) g.wrapping[ks[m]] = c.wraps[m].active;
+                if (c.active == 1) {
+                    std::size_t m = 0;
+                    while (!c.wraps[m].active) ++m;
+                    if (elements_[ks[m]].kind == PathElement::Kind::Ellipsoid) addEllipsoidLoads(i, ks[m], j, a, b, c.wraps[m]);
+                    else addTangentLoads(i, ks[m], j, a, b, c.wraps[m]);
+                } else {
+                    // Several surfaces in use: loads from the gradient of the chain's length (central
+                    // differences) with respect to a, b and each active surface's pose (a force and a
+                    // couple about its centre), whatever their kinds.
+                    auto chainLength = [&](const Vec3& pa, const Vec3& pb, const std::vector<Transform>& XX) {
+                        return wrapChain(es, XX, pa, pb, muscleName, false).length;
+                    };
+                    const double h = 1e-7, hr = 1e-6;  // m, rad
+                    Vec3 ga(0), gb(0);
+                    for (int d = 0; d < 3; ++d) {
+                        Vec3 dx(0);
+                        dx[d] = h;
+                        ga[d] = (chainLength(a + dx, b, X) - chainLength(a - dx, b, X)) / (2 * h);
+                        gb[d] = (chainLength(a, b + dx, X) - chainLength(a, b - dx, X)) / (2 * h);
+                    }
+                    addLoad(i, a, -ga);
+                    addLoad(j, b, -gb);
+                    for (std::size_t m = 0; m < ks.size(); ++m) {
+                        if (!c.wraps[m].active) continue;
+                        const Vec3 centre = X[m] * elements_[ks[m]].location;
+                        Vec3 force(0), moment(0);
+                        for (int d = 0; d < 3; ++d) {
+                            std::vector<Transform> plus = X, minus = X;
+                            Vec3 dx(0);
+                            dx[d] = h;
+                            plus[m].updP() += dx;
+                            minus[m].updP() -= dx;
+                            force[d] = -(chainLength(a, b, plus) - chainLength(a, b, minus)) / (2 * h);
+                            for (int sign : {1, -1}) {
+                                const Rotation R(sign * hr, CoordinateAxis(d));
+                                (sign > 0 ? plus : minus)[m] = Transform(R * X[m].R(), centre + R * (X[m].p() - centre));
+                            }
+                            moment[d] = -(chainLength(a, b, plus) - chainLength(a, b, minus)) / (2 * hr);
+                        }
+                        addLoad(ks[m], centre, force);
+                        g.loads.back().moment = moment;
+                    }
+                }
+                for (const SurfaceWrap& w : c.wraps)
+                    if (w.active) addArc(w);
+            }
         }
         if (withPolyline) g.polyline.push_back(b);
         i = j;
@@ -271,7 +526,7 @@ double MusclePath::calcLengtheningSpeed(const State& s, const PathGeometry& g) c
     double power = 0;
     for (const PathLoad& l : g.loads) {
         const SpatialVec V = elements_[l.element].body.getBodyVelocity(s);
-        power += dot(l.force, V[1] + cross(V[0], l.arm));
+        power += dot(l.force, V[1] + cross(V[0], l.arm)) + dot(l.moment, V[0]);
     }
     return -power;
 }
@@ -279,7 +534,7 @@ double MusclePath::calcLengtheningSpeed(const State& s, const PathGeometry& g) c
 void MusclePath::applyTension(const PathGeometry& g, double tension, Vector_<SpatialVec>& bodyForces) {
     for (const PathLoad& l : g.loads) {
         const Vec3 f = tension * l.force;
-        bodyForces[l.body] += SpatialVec(l.arm % f, f);
+        bodyForces[l.body] += SpatialVec(l.arm % f + tension * l.moment, f);
     }
 }
 
@@ -306,6 +561,9 @@ void appendPathDecorations(const MusclePath& path, const PathGeometry& g, const 
             const Rotation R_BC(e.axis, YAxis);
             geometry.push_back(DecorativeCylinder(e.radius, kCylinderHalfLength).setBodyId(body)
                                    .setTransform(Transform(R_BC, e.location)).setColor(surfaceColor).setOpacity(opacity));
+        } else if (e.kind == PathElement::Kind::Ellipsoid) {
+            geometry.push_back(DecorativeEllipsoid(e.radii).setBodyId(body).setTransform(Transform(e.orientation, e.location))
+                                   .setColor(surfaceColor).setOpacity(opacity));
         } else {
             geometry.push_back(DecorativeSphere(e.radius).setBodyId(body).setTransform(Transform(e.location))
                                    .setColor(surfaceColor).setOpacity(opacity));

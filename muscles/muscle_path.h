@@ -11,7 +11,14 @@
 //     (tangent, arc, tangent) around the circle; the axial coordinate is linear in the projected arc
 //     length (a helix on the developed surface), so P = sqrt(Lplanar^2 + dz^2);
 //   - sphere: the shortest path lies in the plane through the centre and the two neighbouring points
-//     (a great circle), where it is the same 2D construction.
+//     (a great circle), where it is the same 2D construction;
+//   - ellipsoid (OpenSim's WrapEllipsoid): the map x -> D^-1 R^T (x - c) takes the ellipsoid to the unit
+//     sphere and keeps lines, planes and tangency, so the sphere's construction there, mapped back, is
+//     the shortest path within the plane through the centre and the two points (tangent, elliptic arc,
+//     tangent; the arc's length by Gauss-Legendre quadrature). That planar path is not the geodesic of
+//     a general ellipsoid (nor OpenSim's iterative one), so its loads are not the tangent-point forces:
+//     they come from the length's exact gradient (forces at the two points, a force and a moment on the
+//     surface's body), and the moment arm stays -dP/dq.
 // The path is a local shortest path, so the tension's body forces (at the fixed points and at the
 // tangent points of each active surface) do virtual work T dP: the moment arm from these forces
 // equals -dP/dq, which tests check against finite differences.
@@ -33,16 +40,27 @@ namespace armsim {
 
 /// One element of a muscle path, fixed on a body (all vectors in that body's frame, metres).
 struct PathElement {
-    enum class Kind { Point, Cylinder, Sphere };
+    enum class Kind { Point, Cylinder, Sphere, Ellipsoid };
     Kind kind = Kind::Point;
     SimTK::MobilizedBody body;        ///< body the element is fixed to
     SimTK::Vec3 location{0};          ///< the point, or the surface's centre [m]
     SimTK::UnitVec3 axis{0, 0, 1};    ///< cylinder axis (unit) [1]
+    /// Cylinder length [m]; 0: unbounded. With a length, as OpenSim's WrapCylinder, the path does not wrap
+    /// when both tangent points lie beyond its ends (more than length / 2 from the centre along the axis).
+    double length = 0;
     double radius = 0;                ///< cylinder or sphere radius [m]
+    SimTK::Vec3 radii{0};             ///< ellipsoid semi-axes along its own x, y, z [m]
+    SimTK::Rotation orientation;      ///< ellipsoid: its axes in the body's frame (R_BE)
     SimTK::Vec3 side{0};              ///< the path passes on this side of the surface; 0 = shorter way
     /// With a side: the path may wind round the surface by more than half a turn (a rotator round the
     /// radius), so a straight segment passing by the centre on the far side still wraps.
     bool winds = false;
+    /// OpenSim's rule: while a neighbouring path point lies inside the surface, the path does not wrap
+    /// it (false: that is an error naming the muscle, the rule of armsim's own model files).
+    bool passWhenInside = false;
+    /// OpenSim's rule for WrapSphere and WrapEllipsoid: wrap only while the straight segment cuts the
+    /// surface (the side then only chooses the way round), not when it passes behind it.
+    bool onlyWhenCut = false;
     /// A via point used only while `joint`'s coordinate is in [activeMin, activeMax] (OpenSim's
     /// conditional path point); its neighbours must be points. Empty joint = always.
     SimTK::MobilizedBody joint;
@@ -59,6 +77,7 @@ struct PathLoad {
     SimTK::Vec3 point{0};             ///< where it acts, Ground [m]
     SimTK::Vec3 arm{0};               ///< point minus the body origin, Ground [m]
     SimTK::Vec3 force{0};             ///< direction and size per newton of tension, Ground [1]
+    SimTK::Vec3 moment{0};            ///< a couple on the body per newton of tension, Ground [m] (ellipsoids)
 };
 
 /// The path at one configuration.
@@ -76,8 +95,10 @@ public:
     /// A straight path from origin to insertion.
     MusclePath(const SimTK::MobilizedBody& originBody, const SimTK::Vec3& origin,
                const SimTK::MobilizedBody& insertionBody, const SimTK::Vec3& insertion);
-    /// A path from a list of elements: first and last must be points, no two surfaces in a row, radii
-    /// positive, axes non-zero. Throws InputError naming the element otherwise.
+    /// A path from a list of elements: first and last must be points, radii positive, axes non-zero.
+    /// Surfaces in a row (several wrap objects on one segment) are wrapped in turn until the path
+    /// settles; while two or more of them are in use, the loads come from the gradient of the length by
+    /// central differences. Throws InputError naming the element otherwise.
     explicit MusclePath(std::vector<PathElement> elements);
 
     const std::vector<PathElement>& getElements() const { return elements_; }

@@ -196,20 +196,8 @@ void Thelen2003Muscle::calcStateDerivative(double P, double U, const double* y, 
 }
 
 void Thelen2003Muscle::checkStates(double t, const double* y) const {
-    const char* names[] = {"activation", "fiber_length"};
-    for (int i = 0; i < 2; ++i)
-        if (!std::isfinite(y[i])) {
-            std::ostringstream msg;
-            msg << "t = " << t << " s: muscle '" << p_.name << "' state " << names[i] << " is " << y[i]
-                << " (not finite)";
-            throw SimulationError(msg.str());
-        }
-    if (!(y[kFiberLength] > 0)) {
-        std::ostringstream msg;
-        msg << "t = " << t << " s: muscle '" << p_.name << "' fibre length " << y[kFiberLength]
-            << " optimal lengths: expected > 0";
-        throw SimulationError(msg.str());
-    }
+    checkFiniteStates(t, y, {"activation", "fiber_length"}, p_.name);
+    checkPositiveFiberLength(t, y[kFiberLength], p_.name);
 }
 
 double Thelen2003Muscle::calcFascicleLength(double, const double* y) const {
@@ -270,12 +258,6 @@ SteadyState Thelen2003Muscle::calcSteadyState(double P, double U) const {
     r.force = p_.maxIsometricForce * r.normalizedForce;
     r.states = {a, r.L};
     return r;
-}
-
-std::vector<double> Thelen2003Muscle::calcInitialState(double P) const {
-    const SteadyState s = calcSteadyState(P, 0.0);
-    if (!s.converged) throw InputError("muscle '" + p_.name + "': " + s.message);
-    return s.states;
 }
 
 // ---- Registry --------------------------------------------------------------------------------------

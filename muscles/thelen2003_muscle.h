@@ -100,7 +100,6 @@ public:
     static constexpr int kFiberLength = 1;
 
     void checkPathLength(double pathLength) const override;
-    std::vector<double> calcInitialState(double pathLength) const override;
     double calcForce(double pathLength, const double* y) const override;
     void calcStateDerivative(double pathLength, double U, const double* y, double* ydot,
                              MuscleOutputs* outputs = nullptr) const override;

@@ -4,6 +4,7 @@
 #include "model/geometry.h"
 #include "model/muscle_arm.h"
 #include "model/mvc_curve.h"
+#include "model/osim_forward.h"
 #include "model/trial.h"
 
 #include <benchmark/benchmark.h>
@@ -196,5 +197,30 @@ void BM_LoadElbowModel(benchmark::State& state) {
     std::filesystem::remove(file);
 }
 BENCHMARK(BM_LoadElbowModel)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+
+// arm26 (.osim) forward dynamics, 1 s, driven by the OpenSim tutorial's controls, 200 Hz states, CPodes
+// at OpenSim's tolerance 1e-5 (issue 29's goal: <= 50 ms): under OpenSim 2.x's Thelen from the
+// reference's first row (the comparison the tests make), and under the file's own OpenSim 4 Thelen from
+// equilibrium. The model is read once; each iteration builds the System and integrates.
+void BM_Arm26Forward(benchmark::State& state, const char* muscleModel) {
+    const OsimModel model = readOsimFile(std::string(ARMSIM_ASSET_DIR) + "/models/arm26.osim");
+    const std::string dir = std::string(ARMSIM_ASSET_DIR) + "/../tests/data/opensim/arm26_forward/";
+    const OsimStorage controls = readOsimStorage(dir + "arm26_controls.sto");
+    const OsimStorage initial = readOsimStorage(dir + "arm26_states.sto");
+    OsimForwardSettings s;
+    s.finalTime = 1.0;
+    s.muscleModel = muscleModel;
+    int steps = 0, realizations = 0;
+    for (auto _ : state) {
+        const OsimForwardResult r = runOsimForward(model, controls, *muscleModel ? &initial : nullptr, s);
+        steps = r.stats.steps;
+        realizations = r.stats.realizations;
+        benchmark::DoNotOptimize(r.states.getNumRows());
+    }
+    state.counters["steps"] = steps;
+    state.counters["realizations"] = realizations;
+}
+BENCHMARK_CAPTURE(BM_Arm26Forward, thelen2003_opensim2, "thelen2003_opensim2")->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_Arm26Forward, thelen2003, "")->Unit(benchmark::kMillisecond);
 
 }  // namespace

@@ -593,3 +593,45 @@ TEST(Cli, TheInstalledCommandRunsAndFindsItsPlugins) {
 #endif
     fs::remove_all(d);
 }
+
+// armsim forward from a Forward tool setup file as its only argument: the model, controls, times and
+// results folder come from the file (paths relative to it); states.sto has OpenSim's header and column
+// names, one row per 1/200 s, and matches a run given the same settings as options.
+TEST(Cli, ForwardRunsAnOsimModelFromASetupFile) {
+    const fs::path d = freshDir("forward");
+    const std::string data = std::string(ARMSIM_SOURCE_DIR) + "/tests/data/opensim/arm26_forward/";
+    fs::copy_file(data + "arm26_controls.sto", d / "controls.sto");
+    fs::copy_file(std::string(ARMSIM_ASSET_DIR) + "/models/arm26.osim", d / "arm26.osim");
+    std::ofstream(d / "setup.xml")
+        << "<?xml version=\"1.0\"?>\n<OpenSimDocument Version=\"40000\">\n<ForwardTool name=\"arm26\">\n"
+           "<model_file>arm26.osim</model_file>\n<results_directory>Results</results_directory>\n"
+           "<initial_time>0</initial_time>\n<final_time>0.25</final_time>\n"
+           "<integrator_error_tolerance>1e-05</integrator_error_tolerance>\n<ControllerSet><objects>\n"
+           "<ControlSetController><controls_file>controls.sto</controls_file></ControlSetController>\n"
+           "</objects></ControllerSet>\n</ForwardTool>\n</OpenSimDocument>\n";
+    const CommandResult r = runArmsim("forward " + (d / "setup.xml").string());
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    EXPECT_NE(r.output.find("forward: arm26, 0 to 0.25 s"), std::string::npos) << r.output;
+    std::ifstream in(d / "Results" / "states.sto");
+    std::string first, line;
+    std::getline(in, first);
+    EXPECT_EQ(first, "arm26_states");
+    for (int k = 0; k < 5; ++k) std::getline(in, line);
+    EXPECT_EQ(line, "endheader");
+    std::getline(in, line);
+    EXPECT_EQ(line.rfind("time\tr_shoulder_elev\tr_elbow_flex\tr_shoulder_elev_u\tr_elbow_flex_u\tTRIlong.activation\tTRIlong.fiber_length", 0), 0u)
+        << line;
+    int rows = 0;
+    while (std::getline(in, line)) rows += !line.empty();
+    EXPECT_EQ(rows, 51);
+    for (const char* f : {"states.csv", "coordinates.png", "activations.png", "index.html"})
+        EXPECT_TRUE(fs::exists(d / "Results" / f)) << f;
+    const CommandResult same = runArmsim("forward --model " + (d / "arm26.osim").string() + " --controls " +
+                                         (d / "controls.sto").string() + " --final-time 0.25 --out " + (d / "same").string());
+    ASSERT_EQ(same.exitCode, 0) << same.output;
+    std::ifstream a(d / "Results" / "states.csv"), b(d / "same" / "states.csv");
+    std::stringstream ta, tb;
+    ta << a.rdbuf();
+    tb << b.rdbuf();
+    EXPECT_EQ(ta.str(), tb.str());
+}

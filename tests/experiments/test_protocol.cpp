@@ -4,7 +4,7 @@
 #include "basics/csv.h"
 #include "basics/errors.h"
 #include "basics/files.h"
-#include "experiments/data_files.h"
+#include "basics/storage_file.h"
 #include "experiments/protocol.h"
 #include "model/geometry.h"
 #include "tests/support/temp_files.h"

@@ -1,4 +1,4 @@
-#include "experiments/data_files.h"
+#include "basics/storage_file.h"
 
 #include "basics/errors.h"
 #include "basics/files.h"

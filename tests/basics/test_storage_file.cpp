@@ -1,6 +1,6 @@
 // Result files: OpenSim storage header and read-back, CSV read-back, malformed storage files.
 #include "basics/errors.h"
-#include "experiments/data_files.h"
+#include "basics/storage_file.h"
 
 #include <gtest/gtest.h>
 

@@ -1,0 +1,134 @@
+#include "experiments/osim_report.h"
+
+#include "basics/errors.h"
+#include "basics/files.h"
+#include "basics/format.h"
+#include "basics/output_folder.h"
+#include "basics/plot.h"
+#include "basics/table.h"
+#include "model/osim_arm.h"
+
+#include <cmath>
+
+namespace armsim {
+
+namespace {
+
+constexpr double kDeg = 3.14159265358979323846 / 180;
+
+int findSwept(const OsimArm& arm, const std::string& name) {
+    std::string names;
+    for (int i = 0; i < arm.getNumCoordinates(); ++i) names += (i ? ", " : "") + arm.getCoordinate(i).name;
+    if (name.empty()) {
+        if (arm.getNumCoordinates() == 1) return 0;
+        throw InputError("--coordinate: model " + arm.getModel().name + " has " + std::to_string(arm.getNumCoordinates()) +
+                         " coordinates (" + names + "): name the one to sweep");
+    }
+    const int i = arm.findCoordinate(name);
+    if (i < 0) throw InputError("--coordinate '" + name + "': not a coordinate of " + arm.getModel().name + " (" + names + ")");
+    if (!arm.getCoordinate(i).rotational)
+        throw InputError("--coordinate '" + name + "': translational; expected a rotational coordinate");
+    return i;
+}
+
+}  // namespace
+
+OsimReportFiles writeOsimModelReport(const OsimModel& model, const OsimReportSettings& settings, const std::string& outDir) {
+    if (!(settings.stepDeg > 0 && settings.stepDeg <= 90))
+        throw InputError("--step " + formatNumber(settings.stepDeg) + ": expected in (0, 90] deg");
+    const OsimArm arm(model, {}, settings.muscleModel);
+    const int j = findSwept(arm, settings.coordinate);
+    OsimReportFiles r;
+    r.coordinate = arm.getCoordinate(j).name;
+    const int n = arm.getNumMuscles();
+
+    Table muscles({"F0_N", "optimal_fiber_length_m", "tendon_slack_length_m", "pennation_angle_rad"});
+    std::string text = "muscle,muscle_model,F0_N,optimal_fiber_length_m,tendon_slack_length_m,pennation_angle_rad\n";
+    for (int i = 0; i < n; ++i) {
+        const OsimMuscle& m = model.muscles[i];
+        text += m.name + "," + arm.getMuscleForce(i).getMuscle().getModelName() + "," + formatNumber(m.maxIsometricForce) + "," +
+                formatNumber(m.optimalFiberLength) + "," + formatNumber(m.tendonSlackLength) + "," +
+                formatNumber(m.pennationAngleAtOptimal) + "\n";
+    }
+
+    // The sweep over the coordinate's range (whole steps from its lower end, and its upper end).
+    const auto range = arm.getCoordinate(j).range;
+    std::vector<double> anglesDeg;
+    for (double a = range[0] / kDeg; a < range[1] / kDeg - 1e-9; a += settings.stepDeg) anglesDeg.push_back(a);
+    anglesDeg.push_back(range[1] / kDeg);
+    std::vector<std::string> armCols = {"flexion_deg"}, mvcCols = {"flexion_deg", "torque_total_Nm"};
+    for (int i = 0; i < n; ++i) armCols.push_back("moment_arm_" + arm.getMuscleName(i) + "_m");
+    for (int i = 0; i < n; ++i) armCols.push_back("path_length_" + arm.getMuscleName(i) + "_m");
+    for (int i = 0; i < n; ++i) mvcCols.push_back("torque_" + arm.getMuscleName(i) + "_Nm");
+    for (int i = 0; i < n; ++i) mvcCols.push_back("fibre_length_" + arm.getMuscleName(i));
+    Table arms(armCols), positive(mvcCols), negative(mvcCols);
+    SimTK::State s = arm.getDefaultState();
+    for (double deg : anglesDeg) {
+        arm.setCoordinateValue(s, j, deg * kDeg);
+        arm.getSystem().realize(s, SimTK::Stage::Position);
+        std::vector<double> row = {deg}, P(n), R(n);
+        for (int i = 0; i < n; ++i) R[i] = arm.calcMomentArm(s, i, j), P[i] = arm.calcPathLength(s, i);
+        row.insert(row.end(), R.begin(), R.end());
+        row.insert(row.end(), P.begin(), P.end());
+        arms.appendRow(row);
+        for (int direction : {1, -1}) {
+            std::vector<double> torque(n), fibre(n);
+            double total = 0;
+            for (int i = 0; i < n; ++i) {
+                const MuscleModel& m = arm.getMuscleForce(i).getMuscle();
+                const SteadyState ss = m.calcSteadyState(P[i], direction * R[i] > 0 ? 1.0 : 0.0);
+                if (!ss.converged)
+                    throw SimulationError("muscle " + arm.getMuscleName(i) + " at " + r.coordinate + " = " + formatNumber(deg) +
+                                          " deg: " + ss.message);
+                torque[i] = ss.force * R[i];
+                fibre[i] = ss.fascicleLength / m.getOptimalFascicleLength();
+                total += torque[i];
+            }
+            std::vector<double> mvc = {deg, total};
+            mvc.insert(mvc.end(), torque.begin(), torque.end());
+            mvc.insert(mvc.end(), fibre.begin(), fibre.end());
+            (direction > 0 ? positive : negative).appendRow(mvc);
+            if (direction > 0 && total > r.peakPositive) r.peakPositive = total, r.peakPositiveDeg = deg;
+            if (direction < 0 && -total > r.peakNegative) r.peakNegative = -total, r.peakNegativeDeg = deg;
+        }
+    }
+
+    OutputFolder out(outDir, OutputFolder::Mode::AddFiles);
+    out.write("muscles.csv", text);
+    out.write("moment_arms.csv", arms.toCsv(12));
+    out.write("mvc_flexion.csv", positive.toCsv(12));
+    out.write("mvc_extension.csv", negative.toCsv(12));
+    auto plotColumns = [&](const Table& t, const std::string& prefix, double scale, const std::string& title,
+                           const std::string& yLabel, bool total) {
+        PlotSpec p;
+        p.title = title;
+        p.xLabel = r.coordinate + " (deg)";
+        p.yLabel = yLabel;
+        const std::vector<double> x = t.getColumn("flexion_deg");
+        if (total) {
+            std::vector<double> y = t.getColumn("torque_total_Nm");
+            for (double& v : y) v = std::abs(v);
+            p.series.push_back({"total", x, y, false, 7});
+        }
+        for (int i = 0; i < n; ++i) {
+            std::vector<double> y = t.getColumn(prefix + arm.getMuscleName(i) + (prefix == "moment_arm_" ? "_m" : "_Nm"));
+            for (double& v : y) v *= scale;
+            p.series.push_back({arm.getMuscleName(i), x, y, false, int(i % 7)});
+        }
+        return p;
+    };
+    const PlotSpec armPlot = plotColumns(arms, "moment_arm_", 100, "Moment arms about " + r.coordinate + ", " + model.name +
+                                         " (virtual work)", "moment arm (cm, + = positive direction)", false);
+    out.writeWith("moment_arms.png", [&](const std::string& p) { writePlotPng(p, armPlot); });
+    const PlotSpec flex = plotColumns(positive, "torque_", 1, "Steady torque, + " + r.coordinate + " muscles fully excited, " +
+                                      model.name, "torque (N m)", true);
+    out.writeWith("mvc_flexion.png", [&](const std::string& p) { writePlotPng(p, flex); });
+    const PlotSpec ext = plotColumns(negative, "torque_", 1, "Steady torque, - " + r.coordinate + " muscles fully excited, " +
+                                     model.name, "torque (N m)", true);
+    out.writeWith("mvc_extension.png", [&](const std::string& p) { writePlotPng(p, ext); });
+    out.commit();
+    for (const std::string& f : out.getFiles()) r.files.push_back(out.getTargetPath(f));
+    return r;
+}
+
+}  // namespace armsim

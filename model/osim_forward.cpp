@@ -1,0 +1,224 @@
+#include "model/osim_forward.h"
+
+#include "basics/bound.h"
+#include "basics/errors.h"
+#include "basics/files.h"
+#include "basics/format.h"
+#include "model/osim_arm.h"
+#include "muscles/simbody_isometric.h"
+
+#include <tinyxml2.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <map>
+#include <sstream>
+
+namespace armsim {
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+// A muscle's column in a controls file: "BIClong" or "/forceset/BIClong".
+std::string stripForceset(const std::string& column) {
+    const std::string prefix = "/forceset/";
+    return column.rfind(prefix, 0) == 0 ? column.substr(prefix.size()) : column;
+}
+
+}  // namespace
+
+OsimStorage readOsimStorage(const std::string& path) {
+    OsimStorage s;
+    s.file = path;
+    s.table = readStorage(path, &s.header);
+    if (s.table.getNumRows() == 0) throw InputError(path + ": no rows after the column labels");
+    return s;
+}
+
+void OsimForwardSettings::validate() const {
+    if (std::isfinite(initialTime) && !(finalTime > initialTime))
+        throw FieldError("final_time", "final time " + formatNumber(finalTime) + " s: expected after the initial time " +
+                                           formatNumber(initialTime) + " s");
+    checkField("final_time", finalTime, Bound{-1e9, 1e9, true, true, "s"});
+    checkField("sample_rate", sampleRate, Bound::positive("Hz"));
+    integration.validate();
+}
+
+OsimForwardResult runOsimForward(const OsimModel& model, const OsimStorage& controls, const OsimStorage* initial,
+                                 const OsimForwardSettings& settings) {
+    settings.validate();
+    OsimForwardResult result;
+    const Table& c = controls.table;
+    const double t0 = std::isfinite(settings.initialTime) ? settings.initialTime : c.get(0, 0);
+    if (!(settings.finalTime > t0))
+        throw InputError("final time " + formatNumber(settings.finalTime) + " s: expected after the initial time " +
+                         formatNumber(t0) + " s");
+
+    // Excitations: each muscle's column, piecewise linear through the rows.
+    std::map<std::string, ActivationProfile> excitations;
+    const std::vector<double> times = c.getColumn("time");
+    for (int k = 1; k < c.getNumColumns(); ++k) {
+        const std::string muscle = stripForceset(c.getColumnNames()[k]);
+        if (std::none_of(model.muscles.begin(), model.muscles.end(), [&](const OsimMuscle& m) { return m.name == muscle; }))
+            throw InputError(controls.file + ": column '" + c.getColumnNames()[k] + "' names no muscle of " + model.file +
+                             " (expected a muscle's name or /forceset/<muscle>)");
+        std::vector<double> values = c.getColumn(c.getColumnNames()[k]);
+        for (std::size_t r = 0; r < values.size(); ++r)
+            if (!(values[r] >= 0 && values[r] <= 1))
+                throw InputError(controls.file + ": column '" + c.getColumnNames()[k] + "' at t = " + formatNumber(times[r]) +
+                                 " s: excitation " + formatNumber(values[r]) + ": expected in [0, 1]");
+        excitations[muscle] = ActivationProfile(times, values, "controls column " + muscle);
+    }
+    for (const OsimMuscle& m : model.muscles)
+        if (!excitations.count(m.name)) result.notes.push_back("muscle " + m.name + " has no control column: excitation 0");
+
+    const OsimArm arm(model, excitations, settings.muscleModel);
+    SimTK::State s = arm.getDefaultState();
+    s.setTime(t0);
+
+    // Initial states: the row at or before t0 (the Forward tool's rule), else defaults and equilibrium.
+    std::map<std::string, double> given;
+    if (initial) {
+        const Table& st = initial->table;
+        int row = -1;
+        for (int r = 0; r < st.getNumRows(); ++r)
+            if (st.get(r, 0) <= t0 + 1e-12) row = r;
+        if (row < 0)
+            throw InputError(initial->file + ": no row at or before the initial time " + formatNumber(t0) + " s (first: " +
+                             formatNumber(st.get(0, 0)) + " s)");
+        for (int k = 1; k < st.getNumColumns(); ++k) given[st.getColumnNames()[k]] = st.get(row, k);
+    }
+    auto lookup = [&](const std::vector<std::string>& names, double& value) {
+        for (const std::string& n : names) {
+            const auto it = given.find(n);
+            if (it != given.end()) return value = it->second, true;
+        }
+        return false;
+    };
+    std::map<std::string, std::string> jointOf;  // coordinate -> joint, for 4.x column names
+    for (const OsimJoint& j : model.joints)
+        for (const OsimCoordinate& k : j.coordinates) jointOf[k.name] = j.name;
+    const double degree = initial && initial->header.inDegrees ? kPi / 180 : 1.0;
+    for (int i = 0; i < arm.getNumCoordinates(); ++i) {
+        const std::string& n = arm.getCoordinate(i).name;
+        const std::string path = "/jointset/" + jointOf[n] + "/" + n;
+        double v;
+        if (lookup({n, path + "/value"}, v)) arm.setCoordinateValue(s, i, v * (arm.getCoordinate(i).rotational ? degree : 1));
+        if (lookup({n + "_u", path + "/speed"}, v)) arm.setCoordinateSpeed(s, i, v * (arm.getCoordinate(i).rotational ? degree : 1));
+    }
+    arm.getSystem().realize(s, SimTK::Stage::Velocity);
+    for (int i = 0; i < arm.getNumMuscles(); ++i) {
+        const MuscleForce& f = arm.getMuscleForce(i);
+        const MuscleModel& m = f.getMuscle();
+        const std::vector<std::string> names = m.getStateNames();
+        std::vector<double> y(names.size());
+        bool all = true;
+        for (std::size_t k = 0; k < names.size(); ++k) {
+            const std::string& muscle = arm.getMuscleName(i);
+            double v;
+            if (lookup({muscle + "." + names[k], "/forceset/" + muscle + "/" + names[k]}, v))
+                y[k] = names[k] == "fiber_length" ? v / m.getOptimalFascicleLength() : v;
+            else
+                all = false;
+        }
+        if (all) f.setMuscleStates(s, y);
+        else f.setSteadyMuscleStates(s);  // equilibrium at the excitation of t0 (solve_for_equilibrium)
+    }
+
+    // The states table.
+    std::vector<std::string> columns = {"time"};
+    for (int i = 0; i < arm.getNumCoordinates(); ++i) columns.push_back(arm.getCoordinate(i).name);
+    for (int i = 0; i < arm.getNumCoordinates(); ++i) columns.push_back(arm.getCoordinate(i).name + "_u");
+    for (int i = 0; i < arm.getNumMuscles(); ++i)
+        for (const std::string& n : arm.getMuscleForce(i).getMuscle().getStateNames())
+            columns.push_back(arm.getMuscleName(i) + "." + n);
+    result.states = Table(columns);
+    auto sample = [&](const SimTK::State& x) {
+        std::vector<double> row = {x.getTime()};
+        for (int i = 0; i < arm.getNumCoordinates(); ++i) row.push_back(arm.getCoordinateValue(x, i));
+        for (int i = 0; i < arm.getNumCoordinates(); ++i) row.push_back(arm.getCoordinateSpeed(x, i));
+        for (int i = 0; i < arm.getNumMuscles(); ++i) {
+            const MuscleForce& f = arm.getMuscleForce(i);
+            const std::vector<std::string> names = f.getMuscle().getStateNames();
+            const std::vector<double> y = f.getMuscleStates(x);
+            for (std::size_t k = 0; k < names.size(); ++k)
+                row.push_back(names[k] == "fiber_length" ? y[k] * f.getMuscle().getOptimalFascicleLength() : y[k]);
+        }
+        result.states.appendRow(row);
+    };
+    // The excitations are continuous (linear between rows): the solver's error control takes their kinks
+    // without restarts; a restart is needed only where a control jumps (two rows at one time).
+    std::vector<double> breakpoints;
+    for (std::size_t r = 1; r < times.size(); ++r)
+        if (times[r] == times[r - 1] && times[r] > t0 && times[r] < settings.finalTime) breakpoints.push_back(times[r]);
+    breakpoints.erase(std::unique(breakpoints.begin(), breakpoints.end()), breakpoints.end());
+    auto check = [&](const SimTK::State& x) {
+        for (int i = 0; i < arm.getNumMuscles(); ++i) {
+            const MuscleForce& f = arm.getMuscleForce(i);
+            const std::vector<double> y = f.getMuscleStates(x);
+            f.getMuscle().checkStates(x.getTime(), y.data());
+        }
+    };
+    result.stats = simulateSampled(arm.getSystem(), s, settings.finalTime - t0, settings.sampleRate, breakpoints,
+                                   settings.integration, sample, check);
+    return result;
+}
+
+OsimForwardSetup readOsimForwardSetup(const std::string& path) {
+    using namespace tinyxml2;
+    if (!isRegularFile(path)) throw InputError(path + ": no such Forward tool setup file");
+    XMLDocument doc;
+    if (doc.LoadFile(path.c_str()) != XML_SUCCESS)
+        throw OsimError(path + ":" + std::to_string(doc.ErrorLineNum()) + ": not XML: " + doc.ErrorStr());
+    const XMLElement* root = doc.RootElement();
+    const XMLElement* tool = root ? (std::string(root->Name()) == "ForwardTool" ? root : root->FirstChildElement("ForwardTool")) : nullptr;
+    if (!tool) throw OsimError(path + ": no <ForwardTool>: expected an OpenSim Forward tool setup file");
+    const std::string folder = std::filesystem::path(path).parent_path().string();
+    auto text = [&](const XMLElement* e, const char* tag) {
+        const XMLElement* c = e->FirstChildElement(tag);
+        std::string v = c && c->GetText() ? c->GetText() : "";
+        const std::size_t b = v.find_first_not_of(" \t\r\n");
+        return b == std::string::npos ? std::string() : v.substr(b, v.find_last_not_of(" \t\r\n") - b + 1);
+    };
+    auto file = [&](const std::string& name) {
+        if (name.empty()) return name;
+        const std::filesystem::path p(name);
+        return p.is_absolute() || folder.empty() ? name : (std::filesystem::path(folder) / p).string();
+    };
+    auto number = [&](const char* tag, double fallback) {
+        const std::string v = text(tool, tag);
+        if (v.empty()) return fallback;
+        std::istringstream in(v);
+        double x;
+        if (!(in >> x) || !std::isfinite(x))
+            throw OsimError(path + ":" + std::to_string(tool->FirstChildElement(tag)->GetLineNum()) + ": <" + tag + "> '" + v +
+                            "': expected a number");
+        return x;
+    };
+    OsimForwardSetup s;
+    s.modelFile = file(text(tool, "model_file"));
+    if (s.modelFile.empty())
+        throw OsimError(path + ":" + std::to_string(tool->GetLineNum()) + ": <ForwardTool>: no <model_file>");
+    s.resultsDirectory = file(text(tool, "results_directory"));
+    s.initialTime = number("initial_time", 0);
+    s.finalTime = number("final_time", 1);
+    s.tolerance = number("integrator_error_tolerance", 1e-5);
+    s.statesFile = file(text(tool, "states_file"));
+    for (const XMLElement* e = tool->FirstChildElement("ControllerSet"); e; e = nullptr)
+        if (const XMLElement* objects = e->FirstChildElement("objects"))
+            for (const XMLElement* ctl = objects->FirstChildElement(); ctl; ctl = ctl->NextSiblingElement()) {
+                const std::string f = text(ctl, "controls_file");
+                if (f.empty()) continue;
+                if (f.size() >= 4 && f.substr(f.size() - 4) == ".xml")
+                    throw OsimError(path + ":" + std::to_string(ctl->GetLineNum()) + ": <" + ctl->Name() + ">: controls file '" +
+                                    f + "' is an XML ControlSet: not supported yet (expected a .sto storage file)");
+                s.controlsFile = file(f);
+            }
+    if (s.controlsFile.empty())
+        throw OsimError(path + ":" + std::to_string(tool->GetLineNum()) + ": <ForwardTool>: no controls_file in its ControllerSet");
+    return s;
+}
+
+}  // namespace armsim

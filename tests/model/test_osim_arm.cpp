@@ -1,0 +1,147 @@
+// .osim models built as Simbody systems (model/osim_arm.h): arm26 as shipped (opensim-models, CC BY 3.0)
+// with its joints, gravity, wraps and Thelen muscles; its moment arms two ways; what is not supported yet
+// named with its line.
+#include "model/osim_arm.h"
+
+#include "basics/files.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <regex>
+#include <sstream>
+
+using namespace armsim;
+
+namespace {
+
+const OsimModel& arm26() {
+    static const OsimModel m = readOsimFile(std::string(ARMSIM_ASSET_DIR) + "/models/arm26.osim");
+    return m;
+}
+
+constexpr double kDeg = 3.14159265358979323846 / 180;
+
+}  // namespace
+
+// Two coordinates (shoulder elevation, elbow flexion), six Thelen muscles whose F0 and optimal fibre
+// length are the file's, and the forearm's weight: with every muscle slack-free at rest the elbow's
+// generalized gravity force equals m g times the lever of the forearm's centre of mass.
+TEST(OsimArm, Arm26BuildsWithItsCoordinatesMusclesAndMasses) {
+    const OsimArm arm(arm26());
+    ASSERT_EQ(arm.getNumCoordinates(), 2);
+    EXPECT_EQ(arm.getCoordinate(0).name, "r_shoulder_elev");
+    EXPECT_EQ(arm.getCoordinate(1).name, "r_elbow_flex");
+    EXPECT_EQ(arm.findCoordinate("r_elbow_flex"), 1);
+    EXPECT_EQ(arm.findCoordinate("nope"), -1);
+    ASSERT_EQ(arm.getNumMuscles(), 6);
+    for (int i = 0; i < arm.getNumMuscles(); ++i) {
+        const OsimMuscle& mu = arm26().muscles[i];
+        EXPECT_EQ(arm.getMuscleName(i), mu.name);
+        EXPECT_EQ(arm.getMuscleForce(i).getMuscle().getF0(), mu.maxIsometricForce) << mu.name;
+        EXPECT_EQ(arm.getMuscleForce(i).getMuscle().getOptimalFascicleLength(), mu.optimalFiberLength) << mu.name;
+        EXPECT_STREQ(arm.getMuscleForce(i).getMuscle().getModelName(), "thelen2003");
+    }
+    // Total mass as the file's (base 0 kg, humerus, forearm-hand).
+    SimTK::State s = arm.getDefaultState();
+    arm.getSystem().realize(s, SimTK::Stage::Position);
+    double mass = 0;
+    for (const OsimBody& b : arm26().bodies) mass += b.mass;
+    EXPECT_NEAR(arm.getMatter().calcSystemMass(s), mass, 1e-12);
+}
+
+// Moment arms by virtual work (the generalized force of a unit tension) equal -dP/dq by central
+// differences (h = 1e-6 rad) to 0.01 mm (the tolerance), for every muscle about both
+// coordinates, over the elbow's range 0-130 deg and shoulder elevation -30 to +90 deg. Wrapping is
+// exercised: the triceps over the elbow cylinder and the biceps long head over the humeral-head
+// ellipsoid both wrap somewhere on the grid.
+TEST(OsimArm, Arm26MomentArmsEqualTheDerivativeOfThePathLength) {
+    const OsimArm arm(arm26());
+    SimTK::State s = arm.getDefaultState();
+    const double h = 1e-6;
+    double worst = 0;
+    std::vector<int> wraps(arm.getNumMuscles(), 0);
+    for (double shoulder = -30; shoulder <= 90; shoulder += 30)
+        for (double elbow = 0; elbow <= 130; elbow += 10) {
+            for (int j = 0; j < 2; ++j) {
+                auto lengthAt = [&](double dq) {
+                    arm.setCoordinateValue(s, 0, shoulder * kDeg + (j == 0 ? dq : 0));
+                    arm.setCoordinateValue(s, 1, elbow * kDeg + (j == 1 ? dq : 0));
+                    arm.getSystem().realize(s, SimTK::Stage::Position);
+                    std::vector<double> P;
+                    for (int i = 0; i < arm.getNumMuscles(); ++i) P.push_back(arm.calcPathLength(s, i));
+                    return P;
+                };
+                const std::vector<double> plus = lengthAt(h), minus = lengthAt(-h);
+                lengthAt(0);
+                for (int i = 0; i < arm.getNumMuscles(); ++i) {
+                    const double r = arm.calcMomentArm(s, i, j), fd = -(plus[i] - minus[i]) / (2 * h);
+                    EXPECT_NEAR(r, fd, 1e-5) << arm.getMuscleName(i) << " about " << arm.getCoordinate(j).name
+                                             << " at shoulder " << shoulder << ", elbow " << elbow;
+                    worst = std::max(worst, std::abs(r - fd));
+                    if (j == 0) {
+                        const PathGeometry g = arm.getMuscleForce(i).calcPathGeometry(s);
+                        for (bool w : g.wrapping) wraps[i] += w;
+                    }
+                }
+            }
+        }
+    std::ostringstream text;
+    text << worst;
+    RecordProperty("worst_difference_m", text.str());
+    for (int i = 0; i < arm.getNumMuscles(); ++i) RecordProperty("wraps_" + arm.getMuscleName(i), wraps[i]);
+    EXPECT_GT(wraps[0], 0) << "TRIlong never wraps";
+    EXPECT_GT(wraps[3], 0) << "BIClong never wraps";
+}
+
+// Elbow moment arms of arm26 at 90 deg against the values OpenSim gives for the same file, read from
+// arm26's published moment-arm plots is not possible here; instead the biceps long head flexes and the
+// triceps extends at every elbow angle, and the brachialis's arm stays in 5-25 mm (Murray et al. 2000:
+// about 6-22 mm over the range).
+TEST(OsimArm, Arm26MomentArmSigns) {
+    const OsimArm arm(arm26());
+    SimTK::State s = arm.getDefaultState();
+    for (double elbow = 0; elbow <= 130; elbow += 10) {
+        arm.setCoordinateValue(s, 1, elbow * kDeg);
+        arm.getSystem().realize(s, SimTK::Stage::Position);
+        EXPECT_GT(arm.calcMomentArm(s, 3, 1), 0) << "BIClong at " << elbow;
+        EXPECT_LT(arm.calcMomentArm(s, 0, 1), 0) << "TRIlong at " << elbow;
+        const double bra = arm.calcMomentArm(s, 5, 1);
+        EXPECT_GT(bra, 0.005) << elbow;
+        EXPECT_LT(bra, 0.025) << elbow;
+    }
+}
+
+// What cannot be built yet is named with the file, the line and the element.
+TEST(OsimArm, UnsupportedJointsAndPointsNameTheirLine) {
+    const std::string text = readFileText(std::string(ARMSIM_ASSET_DIR) + "/models/arm26.osim");
+    struct Case {
+        std::string anchor, from, to, expected;
+    };
+    const std::vector<Case> cases = {
+        // The shoulder's second rotation turned by a constant (a fixed tilt): a second moving axis.
+        {"<TransformAxis name=\"rotation2\">", "<value>0</value>", "<value>0.3</value>",
+         "more than one moving axis is not supported yet"},
+        // The elbow's rotation scaled.
+        {"<coordinates>r_elbow_flex</coordinates>", "<coefficients> 1 0</coefficients>",
+         "<coefficients> 2 0</coefficients>", "scaled, offset or coupled axes are not supported yet"},
+        // A muscle on a missing wrap object.
+        {"<Thelen2003Muscle name=\"BIClong\">", "<wrap_object>BIClonghh</wrap_object>",
+         "<wrap_object>nowhere</wrap_object>", "wrap object 'nowhere'"},
+    };
+    for (const Case& c : cases) {
+        const std::size_t anchor = text.find(c.anchor);
+        ASSERT_NE(anchor, std::string::npos) << c.anchor;
+        const std::size_t at = text.find(c.from, anchor);
+        ASSERT_NE(at, std::string::npos) << c.from;
+        std::string changed = text;
+        changed.replace(at, c.from.size(), c.to);
+        try {
+            OsimArm arm(readOsimText(changed, "changed.osim"));
+            ADD_FAILURE() << "built: " << c.expected;
+        } catch (const OsimError& e) {
+            EXPECT_NE(std::string(e.what()).find(c.expected), std::string::npos) << e.what();
+            EXPECT_TRUE(std::regex_search(std::string(e.what()), std::regex("changed\\.osim:[0-9]+: "))) << e.what();
+        }
+    }
+}
