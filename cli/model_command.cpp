@@ -9,6 +9,7 @@
 #include "experiments/model_report.h"
 #include "experiments/osim_report.h"
 #include "muscles/muscle_file.h"
+#include "muscles/muscle_models.h"
 #include "model/anatomy_calibration.h"
 #include "model/strength_calibration.h"
 
@@ -29,13 +30,14 @@ void printSummary(const char* effort, const MvcCurveSummary& s) {
 void showModel(const ArmSetup& setup, const std::string& out, double step, const ElbowReference& ref) {
     const ModelReportFiles r = writeModelReport(setup, out, step, ref);
     const Table& t = r.muscles;
-    std::printf("model %s: %s\n%-9s %-8s %8s %7s %7s %7s %6s  calibration k f t\n", setup.name.c_str(),
-                setup.description.c_str(), "muscle", "group", "F0 (N)", "L0 (m)", "L0T (m)", "M (kg)", "slow");
+    std::printf("model %s: %s\n%-9s %-8s %-14s %8s %7s %7s %7s %6s  calibration k f t\n", setup.name.c_str(),
+                setup.description.c_str(), "muscle", "group", "muscle model", "F0 (N)", "L0 (m)", "L0T (m)", "M (kg)", "slow");
     for (int i = 0; i < t.getNumRows(); ++i) {
         const std::vector<double> row = t.getRow(i);
-        std::printf("%-9s %-8s %8.1f %7.4f %7.4f %7.4f %6.3f  %.3f %.3f %.3f\n", setup.muscles[i].params.name.c_str(),
-                    getMuscleGroupName(setup.muscles[i].group), row[0], row[1], row[2], row[3], row[5], row[7], row[8],
-                    row[9]);
+        const std::string& model = setup.muscles[i].muscleModel;
+        std::printf("%-9s %-8s %-14s %8.1f %7.4f %7.4f %7.4f %6.3f  %.3f %.3f %.3f\n", setup.muscles[i].params.name.c_str(),
+                    getMuscleGroupName(setup.muscles[i].group), model.empty() ? kDefaultMuscleModel : model.c_str(), row[0],
+                    row[1], row[2], row[3], row[5], row[7], row[8], row[9]);
     }
     printSummary("flexion", r.flexion);
     printSummary("extension", r.extension);

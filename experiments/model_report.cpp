@@ -1,5 +1,7 @@
 #include "experiments/model_report.h"
 
+#include "muscles/muscle_models.h"
+
 #include "basics/files.h"
 #include "basics/param_node.h"
 #include "basics/plot.h"
@@ -214,11 +216,12 @@ ModelReportFiles writeModelReport(const ArmSetup& setup, const std::string& outD
 
     out.muscles = calcMuscleTable(setup);
     const Table& muscles = out.muscles;
-    std::string text = "muscle";
+    std::string text = "muscle,muscle_model";
     for (const std::string& c : muscles.getColumnNames()) text += "," + c;
     text += "\n";
     for (int i = 0; i < muscles.getNumRows(); ++i) {
-        text += setup.muscles[i].params.name;
+        const std::string& model = setup.muscles[i].muscleModel;
+        text += setup.muscles[i].params.name + "," + (model.empty() ? std::string(kDefaultMuscleModel) : model);
         for (double v : muscles.getRow(i)) text += "," + formatNumber(v);
         text += "\n";
     }

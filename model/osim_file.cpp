@@ -270,7 +270,7 @@ private:
             k.name = c->Attribute("name") ? c->Attribute("name") : "";
             k.line = c->GetLineNum();
             k.defaultValue = number(c, "default_value", false, 0);
-            const std::vector<double> r = numbers(c, "range", 2, false, {-1e300, 1e300});
+            const std::vector<double> r = numbers(c, "range", 2, false, {-10, 10});
             k.range = {r[0], r[1]};
             if (!(k.range[0] <= k.range[1])) fail(child(c, "range"), "range not increasing");
             k.locked = flag(c, "locked", false);

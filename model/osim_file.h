@@ -65,7 +65,7 @@ struct OsimCoordinate {
     std::string name;
     bool rotational = true;            ///< false: translational (from the joint's axis kind)
     double defaultValue = 0;           ///< [rad or m]
-    std::array<double, 2> range{};     ///< [rad or m]
+    std::array<double, 2> range{};     ///< [rad or m]; absent in the file: OpenSim's default [-10, 10]
     bool locked = false;
     bool clamped = false;
     int line = 0;

@@ -247,6 +247,14 @@ TEST(Cli, ModelShowWritesTablesAndPlots) {
             if (!line.empty()) rates.push_back(std::stod(armsim::splitCsvRecord(line).at(std::size_t(column))));
         return rates;
     };
+    {  // which muscle model each muscle is
+        std::ifstream in(d / "muscles.csv");
+        std::string line;
+        std::getline(in, line);
+        EXPECT_EQ(line.rfind("muscle,muscle_model,", 0), 0u) << line;
+        std::getline(in, line);
+        EXPECT_EQ(armsim::splitCsvRecord(line).at(1), "virtual_muscle") << line;
+    }
     const std::vector<double> elbowRates = firingRates(d / "muscles.csv");
     EXPECT_EQ(elbowRates, std::vector<double>(7, 2.0));
     const fs::path twin = freshDir("model_show_twin");

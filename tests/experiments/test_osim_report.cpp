@@ -17,28 +17,6 @@
 using namespace armsim;
 namespace fs = std::filesystem;
 
-namespace {
-
-// CSV text as a table (header, then numbers).
-Table readCsvTable(const std::string& path) {
-    std::ifstream in(path);
-    std::string line;
-    std::getline(in, line);
-    std::vector<std::string> names;
-    std::stringstream h(line);
-    for (std::string c; std::getline(h, c, ',');) names.push_back(c);
-    Table t(names);
-    while (std::getline(in, line)) {
-        std::vector<double> row;
-        std::stringstream r(line);
-        for (std::string c; std::getline(r, c, ',');) row.push_back(std::stod(c));
-        t.appendRow(row);
-    }
-    return t;
-}
-
-}  // namespace
-
 TEST(OsimReport, Arm26ElbowSweepWritesModelShowsFilesAndItsTorqueIsTheIntegratedOne) {
     const OsimModel model = readOsimFile(std::string(ARMSIM_ASSET_DIR) + "/models/arm26.osim");
     const fs::path dir = fs::temp_directory_path() / ("armsim_osim_report_" + std::to_string(::getpid()));
@@ -51,8 +29,8 @@ TEST(OsimReport, Arm26ElbowSweepWritesModelShowsFilesAndItsTorqueIsTheIntegrated
     for (const char* f : {"muscles.csv", "moment_arms.csv", "moment_arms.png", "mvc_flexion.csv", "mvc_flexion.png",
                           "mvc_extension.csv", "mvc_extension.png"})
         EXPECT_TRUE(fs::exists(dir / f)) << f;
-    const Table arms = readCsvTable((dir / "moment_arms.csv").string());
-    const Table flexion = readCsvTable((dir / "mvc_flexion.csv").string());
+    const Table arms = Table::readCsv((dir / "moment_arms.csv").string());
+    const Table flexion = Table::readCsv((dir / "mvc_flexion.csv").string());
     ASSERT_TRUE(arms.hasColumn("flexion_deg"));
     ASSERT_TRUE(flexion.hasColumn("torque_total_Nm"));
     ASSERT_TRUE(flexion.hasColumn("fibre_length_BIClong"));

@@ -160,6 +160,10 @@ TEST(OsimFile, Version30000LayoutReadsToTheSameData) {
     EXPECT_EQ(m.muscles[0].path[1].coordinate, "flex");
     EXPECT_EQ(m.muscles[0].path[2].body, "forearm");
     EXPECT_EQ(m.muscles[0].properties.at("FmaxTendonStrain"), 0.033);
+    // Without <range> a coordinate has OpenSim's default range (Coordinate.cpp: -10 .. 10).
+    std::string noRange = v3;
+    noRange.replace(noRange.find("<range>0 2.26</range>"), 21, "");
+    EXPECT_EQ(readOsimText(noRange, "v3.osim").joints[0].coordinates[0].range, (std::array<double, 2>{-10, 10}));
 }
 
 TEST(OsimFile, ProblemsAreNamedWithFileLineAndElement) {
