@@ -5,7 +5,6 @@
 #include "basics/format.h"
 #include "basics/output_folder.h"
 #include "basics/plot.h"
-#include "muscles/muscle_file.h"
 #include "cli/commands.h"
 #include "model/osim_forward.h"
 
@@ -29,17 +28,6 @@ struct ForwardOptions {
     std::string out;
 };
 
-// A shipped model's name (assets/models/NAME.osim) or a path.
-std::string resolveOsim(const std::string& model) {
-    if (model.find('/') == std::string::npos && model.find(".osim") == std::string::npos) {
-        const std::string asset = getAssetDirectory() + "/models/" + model + ".osim";
-        if (!isRegularFile(asset)) throw InputError("--model '" + model + "': no shipped OpenSim model assets/models/" + model + ".osim");
-        return asset;
-    }
-    if (!isRegularFile(model)) throw InputError("--model '" + model + "': no such .osim file");
-    return model;
-}
-
 // outOption: the command's --out, given the folder used (the setup's or the default) so the folder's
 // index.html report is written as for any other command.
 void runForward(const ForwardOptions& given, CLI::Option* outOption) {
@@ -60,7 +48,7 @@ void runForward(const ForwardOptions& given, CLI::Option* outOption) {
     if (o.out.empty()) o.out = "out/forward";
     if (given.out.empty()) outOption->default_val(o.out);
     checkOutputFolder("--out", o.out);
-    const OsimModel model = readOsimFile(resolveOsim(o.model));
+    const OsimModel model = readOsimFile(findOsimModelFile(o.model));
     const OsimStorage controls = readOsimStorage(o.controls);
     OsimStorage initial;
     if (!o.initialStates.empty()) initial = readOsimStorage(o.initialStates);

@@ -8,6 +8,7 @@
 #include "experiments/model_check.h"
 #include "experiments/model_report.h"
 #include "experiments/osim_report.h"
+#include "model/osim_forward.h"
 #include "muscles/muscle_file.h"
 #include "muscles/muscle_models.h"
 #include "model/anatomy_calibration.h"
@@ -93,14 +94,12 @@ void addModelCommands(CLI::App& app) {
                       "an OpenSim model's coordinate to sweep (default: its only moving one)");
         c->callback([=] {
             // An OpenSim model: a file ending .osim, or a shipped name with only an .osim file.
-            std::string osim;
-            if (name->size() > 5 && name->compare(name->size() - 5, 5, ".osim") == 0) osim = *name;
-            else if (name->find('/') == std::string::npos &&
-                     !doesPathExist(getAssetDirectory() + "/models/" + *name + ".yaml") &&
-                     doesPathExist(getAssetDirectory() + "/models/" + *name + ".osim"))
-                osim = getAssetDirectory() + "/models/" + *name + ".osim";
-            if (!osim.empty()) {
-                if (!doesPathExist(osim)) throw InputError("--model '" + *name + "': no such .osim file");
+            const bool isOsim = (name->size() > 5 && name->compare(name->size() - 5, 5, ".osim") == 0) ||
+                                (name->find('/') == std::string::npos &&
+                                 !doesPathExist(getAssetDirectory() + "/models/" + *name + ".yaml") &&
+                                 doesPathExist(getAssetDirectory() + "/models/" + *name + ".osim"));
+            if (isOsim) {
+                const std::string osim = findOsimModelFile(*name);
                 const OsimModel m = readOsimFile(osim);
                 OsimReportSettings s;
                 s.coordinate = *coordinate;

@@ -5,6 +5,7 @@
 #include "basics/files.h"
 #include "basics/format.h"
 #include "model/osim_arm.h"
+#include "muscles/muscle_file.h"
 #include "muscles/simbody_isometric.h"
 
 #include <tinyxml2.h>
@@ -35,6 +36,17 @@ OsimStorage readOsimStorage(const std::string& path) {
     s.table = readStorage(path, &s.header);
     if (s.table.getNumRows() == 0) throw InputError(path + ": no rows after the column labels");
     return s;
+}
+
+std::string findOsimModelFile(const std::string& model, const std::string& option) {
+    if (model.find('/') == std::string::npos && model.find(".osim") == std::string::npos) {
+        const std::string asset = getAssetDirectory() + "/models/" + model + ".osim";
+        if (!isRegularFile(asset))
+            throw InputError(option + " '" + model + "': no shipped OpenSim model assets/models/" + model + ".osim");
+        return asset;
+    }
+    if (!isRegularFile(model)) throw InputError(option + " '" + model + "': no such .osim file");
+    return model;
 }
 
 void OsimForwardSettings::validate() const {

@@ -25,6 +25,9 @@ struct OsimStorage {
 };
 /// readStorage(path) kept with its path.
 OsimStorage readOsimStorage(const std::string& path);
+/// The .osim file a user named: a path, or a shipped model's name (assets/models/NAME.osim). InputError
+/// naming `option` and the text when there is none.
+std::string findOsimModelFile(const std::string& nameOrFile, const std::string& option = "--model");
 
 /// What to run.
 struct OsimForwardSettings {

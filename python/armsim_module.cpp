@@ -6,6 +6,7 @@
 #include "basics/bound.h"
 #include "basics/files.h"
 #include "studies/study.h"
+#include "model/osim_forward.h"
 #include "model/mvc_curve.h"
 #include "model/trial.h"
 #include "muscles/simbody_isometric.h"
@@ -264,6 +265,43 @@ PYBIND11_MODULE(_armsim, mod) {
         "arrays: time_s, activation, force_N, fce_N, fascicle_length_m, fascicle_velocity_mps,\n"
         "tendon_length_m, active_fraction, and the states (views of one buffer, strided: np.ascontiguousarray\n"
         "copies one column out). Releases the GIL; Ctrl-C raises KeyboardInterrupt.");
+
+    mod.def(
+        "forward",
+        [](const std::string& model, const py::object& controls, const py::object& initialStates, double finalTime,
+           std::optional<double> initialTime, double rate, const std::string& muscleModel, double accuracy) {
+            const OsimModel m = readOsimFile(findOsimModelFile(model, "model"));
+            // A storage file's path (str or os.PathLike) or a dict of equal-length columns, time first.
+            auto storageOf = [](const py::object& o, const char* what) {
+                if (py::isinstance<py::dict>(o)) {
+                    OsimStorage s;
+                    s.file = what;
+                    s.table = toTable(o.cast<py::dict>(), what);
+                    return s;
+                }
+                return readOsimStorage(py::str(py::module_::import("os").attr("fspath")(o)).cast<std::string>());
+            };
+            const OsimStorage c = storageOf(controls, "controls");
+            OsimStorage initial;
+            if (!initialStates.is_none()) initial = storageOf(initialStates, "initial_states");
+            OsimForwardSettings s;
+            s.finalTime = finalTime;
+            if (initialTime) s.initialTime = *initialTime;
+            s.sampleRate = rate;
+            s.muscleModel = muscleModel;
+            s.integration.accuracy = accuracy;
+            OsimForwardResult r;
+            runInterruptible([&] { r = runOsimForward(m, c, initialStates.is_none() ? nullptr : &initial, s); });
+            return toDict(std::move(r.states));
+        },
+        py::arg("model"), py::arg("controls"), py::arg("initial_states") = py::none(), py::arg("final_time") = 1.0,
+        py::arg("initial_time") = py::none(), py::arg("rate") = 200.0, py::arg("muscle_model") = "",
+        py::arg("accuracy") = 1e-5,
+        "Forward dynamics of an OpenSim model, as `armsim forward`: model is an .osim path or a shipped name\n"
+        "('arm26'); controls and initial_states are storage-file paths (.sto) or dicts of equal-length arrays\n"
+        "(time first, then one excitation per muscle; states by OpenSim's column names). Returns a dict of\n"
+        "float64 arrays with OpenSim's column names: time, each coordinate (rad), <coordinate>_u,\n"
+        "<muscle>.activation, <muscle>.fiber_length (m). Releases the GIL; Ctrl-C raises KeyboardInterrupt.");
 
     mod.def(
         "arm_trial",

@@ -33,8 +33,8 @@ def _use_installed_assets():
 
 _use_installed_assets()
 
-from ._armsim import (Model, arm_trial, design_protocol, identify, identify_torque, muscle_trial, read_torque_data,
-                      run_protocol, run_study, steady_state, validate, validate_elbow, __version__)
+from ._armsim import (Model, arm_trial, design_protocol, forward, identify, identify_torque, muscle_trial,
+                      read_torque_data, run_protocol, run_study, steady_state, validate, validate_elbow, __version__)
 
 
 def render_video(model, series, path, fps=30.0, width=1280, height=720, playback_speed=1.0, overlay=True,
@@ -59,5 +59,5 @@ def render_frame(model, series, time, width=640, height=360, overlay=True, super
     return _render.render_frame(model, series, time, width, height, overlay, supersample, color_by)
 
 
-__all__ = ["__version__", "Model", "arm_trial", "design_protocol", "identify", "identify_torque", "muscle_trial", "read_torque_data", "render_frame",
+__all__ = ["__version__", "Model", "arm_trial", "design_protocol", "forward", "identify", "identify_torque", "muscle_trial", "read_torque_data", "render_frame",
            "render_video", "run_protocol", "run_study", "steady_state", "validate", "validate_elbow"]

@@ -198,3 +198,25 @@ def test_with_muscle_model_swaps_the_equations_and_keeps_f0(thesis):
         thesis.with_muscle_model("hill")
     with pytest.raises(ValueError, match="no coefficient 'tau'"):
         thesis.with_muscle_model("thelen2003", tau=0.1)
+
+
+def test_forward_runs_an_osim_model_as_the_command_does(tmp_path):
+    """armsim.forward on arm26 with the OpenSim tutorial's controls (a path, then the same controls as a
+    dict of arrays): OpenSim's column names, one row per 1/rate s, the same numbers both ways, and the
+    elbow flexing; a control column naming no muscle raises ValueError with the column."""
+    data = pathlib.Path(__file__).resolve().parents[1] / "data" / "opensim" / "arm26_forward"
+    states = armsim.forward("arm26", data / "arm26_controls.sto", final_time=0.2, rate=100)
+    assert list(states)[:5] == ["time", "r_shoulder_elev", "r_elbow_flex", "r_shoulder_elev_u", "r_elbow_flex_u"]
+    assert "BIClong.activation" in states and "BIClong.fiber_length" in states
+    assert states["time"].dtype == np.float64 and states["time"].shape == (21,)
+    assert states["r_elbow_flex"][-1] > states["r_elbow_flex"][0] + 0.1  # flexes (rad)
+    lines = (data / "arm26_controls.sto").read_text().splitlines()
+    start = lines.index("endheader") + 1
+    names = lines[start].split("\t")
+    rows = np.array([[float(x) for x in line.split()] for line in lines[start + 1:] if line.strip()])
+    as_dict = armsim.forward("arm26", {n: rows[:, k] for k, n in enumerate(names)}, final_time=0.2, rate=100)
+    for name in states:
+        np.testing.assert_array_equal(as_dict[name], states[name])
+    with pytest.raises(ValueError) as e:
+        armsim.forward("arm26", {"time": np.array([0.0, 1.0]), "BIC": np.array([0.1, 0.1])}, final_time=0.1)
+    assert "column 'BIC' names no muscle" in str(e.value)
