@@ -23,7 +23,7 @@ struct ForwardOptions {
     std::string controls, initialStates;
     double initialTime = 0.0 / 0.0, finalTime = 0.0 / 0.0;
     double rate = 200;
-    double accuracy = 1e-5;
+    double accuracy = 0.0 / 0.0;  ///< NaN: the setup's tolerance, else 1e-5
     std::string muscleModel;
     std::string out;
 };
@@ -40,11 +40,12 @@ void runForward(const ForwardOptions& given, CLI::Option* outOption) {
         if (!std::isfinite(o.initialTime)) o.initialTime = s.initialTime;
         if (!std::isfinite(o.finalTime)) o.finalTime = s.finalTime;
         if (o.out.empty()) o.out = s.resultsDirectory;
-        o.accuracy = s.tolerance;
+        if (!std::isfinite(o.accuracy)) o.accuracy = s.tolerance;
     }
     if (o.model.empty()) throw InputError("forward: no model: give --model FILE.osim (or a Forward tool setup file)");
     if (o.controls.empty()) throw InputError("forward: no controls: give --controls FILE.sto (or a Forward tool setup file)");
     if (!std::isfinite(o.finalTime)) throw InputError("forward: no final time: give --final-time SECONDS");
+    if (!std::isfinite(o.accuracy)) o.accuracy = 1e-5;  // OpenSim's Forward tool default
     if (o.out.empty()) o.out = "out/forward";
     if (given.out.empty()) outOption->default_val(o.out);
     checkOutputFolder("--out", o.out);
@@ -110,8 +111,9 @@ void addForwardCommand(CLI::App& app) {
     c->add_option("--initial-time", o->initialTime, "[s] (default: the controls' first time)");
     c->add_option("--final-time", o->finalTime, "[s]");
     c->add_option("--rate", o->rate, "rows of states.sto per second [Hz]")->capture_default_str()->check(CLI::Range(1e-3, 1e6));
-    c->add_option("--accuracy", o->accuracy, "integrator relative accuracy (OpenSim's integrator_error_tolerance)")
-        ->capture_default_str()->check(CLI::Range(1e-12, 1e-1));
+    c->add_option("--accuracy", o->accuracy,
+                  "integrator relative accuracy (default: the setup's integrator_error_tolerance, else 1e-5)")
+        ->check(CLI::Range(1e-12, 1e-1));
     c->add_option("--muscle-model", o->muscleModel,
                   "every muscle under this model: thelen2003, thelen2003_opensim2 (OpenSim 2.x's equations) or "
                   "degroote2016 (default: each muscle's type in the file)");
