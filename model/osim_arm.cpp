@@ -208,6 +208,9 @@ OsimArm::OsimArm(OsimModel model, const std::map<std::string, ActivationProfile>
 
     // Wrap objects as path surfaces on their bodies.
     auto surfaceOf = [&](const OsimWrapObject& o) {
+        if (!bodies.count(o.body))
+            throw OsimError(where(m, o.line, "<Wrap name=\"" + o.name + "\">") + "its body '" + o.body +
+                            "' has no joint to ground: not built");
         PathElement e;
         e.body = bodies.at(o.body);
         e.location = toVec3(o.translation);
