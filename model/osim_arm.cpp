@@ -157,9 +157,9 @@ OsimArm::OsimArm(OsimModel model, const std::map<std::string, ActivationProfile>
                  const std::string& muscleModel)
     : model_(std::move(model)), matter_(system_), forces_subsystem_(system_) {
     const OsimModel& m = model_;
-    for (const auto& [name, profile] : excitations) {
-        (void)profile;
-        if (std::none_of(m.muscles.begin(), m.muscles.end(), [&](const OsimMuscle& x) { return x.name == name; }))
+    for (const auto& excitation : excitations) {
+        const std::string& name = excitation.first;
+        if (std::none_of(m.muscles.begin(), m.muscles.end(), [&name](const OsimMuscle& x) { return x.name == name; }))
             throw InputError(m.file + ": no muscle '" + name + "' to excite");
     }
     // Bodies: ground, then each joint's child once its parent exists (any file order).
@@ -188,7 +188,8 @@ OsimArm::OsimArm(OsimModel model, const std::map<std::string, ActivationProfile>
                 bodies[b->name] = MobilizedBody::Weld(parent, X_PF, mass, X_BM);
             } else {
                 if (j.coordinates.size() != 1)
-                    throw OsimError(at + std::to_string(j.coordinates.size()) + " coordinates: expected one");
+                    throw OsimError(at + std::to_string(j.coordinates.size()) + " coordinates: joints with more than one "
+                                    "coordinate are not supported yet (expected one rotation)");
                 if (!(b->mass > 0)) throw OsimError(at + "body '" + b->name + "' has no mass but moves: expected a mass > 0 kg");
                 if (j.kind == OsimJoint::Kind::Custom) {
                     const Rotation R_FJ(findPinAxis(m, j), ZAxis);  // the pin's z along the axis
