@@ -131,3 +131,33 @@ TEST(DeGroote2016Muscle, RegistryBuildsItAndRefusesBadCoefficients) {
     EXPECT_EQ(type.coefficientFile, "degroote2016.yaml");
     EXPECT_NE(std::find(type.coefficientKeys.begin(), type.coefficientKeys.end(), "fiber_damping"), type.coefficientKeys.end());
 }
+
+// Activation dynamics as De Groote et al. 2016 eqs. (1)-(2) write them (their b = 0.1 smoothing): da/dt =
+// [f / (tau_a (0.5 + 1.5 a)) + (1 - f)(0.5 + 1.5 a) / tau_d] (u - a), f = 0.5 + 0.5 tanh(b (u - a)),
+// evaluated by hand at points of rise and fall, with the excitation floored at minimum_activation; the
+// derivative the model returns equals it, and with a steep switch (b = 100) rise and fall take the
+// activation and deactivation time constants.
+TEST(DeGroote2016Muscle, ActivationDynamicsAreThePapersEquations) {
+    for (double b : {0.1, 100.0}) {
+        DeGroote2016Parameters p = bicLong();
+        p.activationDynamicsSmoothing = b;
+        const DeGroote2016Muscle muscle(p);
+        const double P = 0.38;
+        for (double a : {0.05, 0.3, 0.9})
+            for (double U : {0.0, 0.2, 1.0}) {
+                const SteadyState ss = muscle.calcSteadyState(P, 0.5);
+                ASSERT_TRUE(ss.converged);
+                const double y[2] = {a, ss.states[1]};
+                double ydot[2];
+                muscle.calcStateDerivative(P, U, y, ydot);
+                const double u = std::max(U, p.minimumActivation), z = 0.5 + 1.5 * a;
+                const double f = 0.5 + 0.5 * std::tanh(b * (u - a));
+                const double expected = (f / (p.activationTimeConstant * z) + (1 - f) * z / p.deactivationTimeConstant) * (u - a);
+                EXPECT_NEAR(ydot[0], expected, 1e-12 * std::abs(expected) + 1e-15) << "b " << b << " a " << a << " U " << U;
+                if (b == 100 && std::abs(u - a) > 0.1) {  // the switch is a step: one time constant or the other
+                    const double tau = u > a ? p.activationTimeConstant * z : p.deactivationTimeConstant / z;
+                    EXPECT_NEAR(ydot[0], (u - a) / tau, 1e-6 * std::abs(ydot[0])) << "a " << a << " U " << U;
+                }
+            }
+    }
+}

@@ -74,6 +74,14 @@ TEST(Thelen2003Curves, ForceVelocityFollowsEquations6And7AndInvertsEverywhere) {
         // The inverse returns the multiplier (clamped at 0 below zero force).
         EXPECT_NEAR(calcThelenForceVelocity(p, a, fal, v), std::max(0.0, Fm / afl), 1e-9) << Fm;
     }
+    // Interior points against eqs. 6-7 written out: shortening v = k (Fm - a fL) / (a fL + Fm / Af),
+    // lengthening v = k (Fm - a fL) / ((2 + 2 / Af)(a fL Flen - Fm) / (Flen - 1)), k = 0.25 + 0.75 a.
+    const double k = 0.25 + 0.75 * a;
+    for (double Fm : {0.1 * afl, 0.5 * afl, 0.9 * afl})
+        EXPECT_NEAR(calcThelenFiberVelocity(p, a, fal, Fm), k * (Fm - afl) / (afl + Fm / p.af), kCurveTol) << Fm;
+    for (double Fm : {1.05 * afl, 1.15 * afl, 1.25 * afl})  // below the extrapolation at 0.95 Flen a fL
+        EXPECT_NEAR(calcThelenFiberVelocity(p, a, fal, Fm),
+                    k * (Fm - afl) / ((2 + 2 / p.af) * (afl * p.flen - Fm) / (p.flen - 1)), kCurveTol) << Fm;
     for (double edge : {0.0, p.fvLinearExtrapThreshold * p.flen * afl}) {
         const double h = 1e-7;
         const double left = (calcThelenFiberVelocity(p, a, fal, edge) - calcThelenFiberVelocity(p, a, fal, edge - h)) / h;
@@ -97,6 +105,28 @@ TEST(Thelen2003Muscle, ActivationRisesAsTheClosedFormSolution) {
         const double a = column(t, "active_fraction", row);
         const double time = tau * (2 * std::log((1 - a0) / (1 - a)) - 1.5 * (a - a0));
         EXPECT_NEAR(time, column(t, "time_s", row), 1e-5) << row;
+    }
+}
+
+TEST(Thelen2003Muscle, ActivationFallsAsTheClosedFormSolution) {
+    // U = 0 from a = 1, the excitation floored at a_min = m (OpenSim's min_control): da/dt =
+    // (m - a)(0.5 + 1.5 a) / tau_d, so t(a) = tau_d / (0.5 + 1.5 m) ln[g(a0) / g(a)], g(a) = (a - m) / (0.5 + 1.5 a).
+    const Thelen2003Muscle muscle(triLong());
+    MuscleIsometricSettings s;
+    s.pathLength = 0.28;
+    const double off = 0.01;  // [s] U = 1 (the steady start: a = 1) until then, 0 after
+    s.activation = ActivationProfile::step(off, 1.0, 0.0);
+    s.startSteady = true;
+    s.duration = 0.1;
+    s.sampleRate = 1000;
+    s.integration.accuracy = 1e-8;
+    const Table t = runMuscleIsometric(muscle, s);
+    const double tau = muscle.getParameters().deactivationTimeConstant, m = muscle.getParameters().minimumActivation;
+    auto g = [m](double a) { return (a - m) / (0.5 + 1.5 * a); };
+    ASSERT_NEAR(column(t, "active_fraction", 0), 1.0, 1e-12);
+    for (int row : {20, 50, 100}) {
+        const double a = column(t, "active_fraction", row);
+        EXPECT_NEAR(off + tau / (0.5 + 1.5 * m) * std::log(g(1.0) / g(a)), column(t, "time_s", row), 1e-5) << row;
     }
 }
 
