@@ -11,6 +11,12 @@
 //
 // One addition: the excitation is clamped to [minimum_activation, 1] (default 0.01, as Thelen2003Muscle):
 // OpenSim's explicit mode divides by a f_L, and at a = 0 the fibre velocity is not defined.
+//
+// Kept as OpenSim has them (no guard added): the tendon curve f_T = c1 e^(kT (l~T - c2)) - c3 goes
+// below zero for a tendon shorter than its slack length (a slack tendon "pushes", down to -c3 = -0.2
+// F0), so the state and the output force can be negative; and on a path shorter than the tendon the
+// fibre's length along the tendon is negative, and cos(phi) with it. checkStates stops a run whose
+// tendon force reaches -c3 (the curve's asymptote, where the tendon length is undefined).
 #pragma once
 
 #include "muscles/muscle_model.h"
