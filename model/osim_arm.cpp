@@ -210,7 +210,7 @@ OsimArm::OsimArm(OsimModel model, const std::map<std::string, ActivationProfile>
     // Wrap objects as path surfaces on their bodies.
     auto surfaceOf = [&](const OsimWrapObject& o) {
         if (!bodies.count(o.body))
-            throw OsimError(where(m, o.line, "<Wrap name=\"" + o.name + "\">") + "its body '" + o.body +
+            throw OsimError(where(m, o.line, std::string(o.kind == OsimWrapObject::Kind::Cylinder ? "<WrapCylinder" : o.kind == OsimWrapObject::Kind::Sphere ? "<WrapSphere" : "<WrapEllipsoid") + " name=\"" + o.name + "\">") + "its body '" + o.body +
                             "' has no joint to ground: not built");
         PathElement e;
         e.body = bodies.at(o.body);
@@ -287,7 +287,7 @@ OsimArm::OsimArm(OsimModel model, const std::map<std::string, ActivationProfile>
         std::vector<std::vector<std::pair<double, PathElement>>> wrapAfter(points.size());
         for (const OsimPathWrap& w : mu.wraps) {
             const OsimWrapObject* o = findWrap(w.wrapObject);
-            const std::string at = where(m, w.line, "<PathWrap>");
+            const std::string at = where(m, w.line, "<PathWrap>") + "muscle '" + mu.name + "': ";
             if (!o) throw OsimError(at + "wrap object '" + w.wrapObject + "' does not exist");
             if (!o->active) continue;
             const int n = int(points.size());

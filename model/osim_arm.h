@@ -14,12 +14,15 @@
 //     forces in OpenSim's forward dynamics either (no CoordinateLimitForce is read).
 //   - Path points on their bodies; a ConditionalPathPoint is a via point active while its coordinate is
 //     within its range. MovingPathPoint is refused (not supported yet).
-//   - Wrap objects: WrapCylinder (its z axis; OpenSim's finite length is not used), WrapSphere and
-//     WrapEllipsoid, with the quadrant as the side the path passes (all: the shorter way). OpenSim picks,
-//     at every configuration, the segment of the wrap's point range that the object intersects (else the
-//     one whose wrap lengthens the path least); here each wrap is placed once, on the segment of its
-//     range whose straight line passes nearest the object in the default pose, and stays there. Two
-//     wraps placed on one segment are refused (not supported yet).
+//   - Wrap objects: WrapCylinder (its z axis; no wrap when both tangent points lie beyond its length,
+//     as OpenSim), WrapSphere and WrapEllipsoid, with the quadrant as the side the path passes (all: the
+//     shorter way); as in OpenSim a wrap is off while a neighbouring path point lies inside its object,
+//     and a sphere or ellipsoid wraps only while the straight segment cuts it. OpenSim picks, at every
+//     configuration, the segment of the wrap's point range that the object intersects (else the one whose
+//     wrap lengthens the path least); here each wrap is placed once, on the segment of its range whose
+//     straight line passes nearest the object's centre in the default pose, and stays there. Several
+//     wraps on one segment are wrapped in turn, in the order their centres lie along it, until the path
+//     settles (muscles/muscle_path.h, with its limitation where the passes do not settle).
 //   - Muscles: Thelen2003Muscle (thelen2003) and DeGrooteFregly2016Muscle (degroote2016) with the
 //     file's properties, or every muscle under another model (buildOsimMuscleModel);
 //     Millard2012EquilibriumMuscle is refused.
@@ -61,7 +64,7 @@ public:
     /// Coordinates at their defaults, speeds 0, muscle states 0 (set them before integrating).
     const SimTK::State& getDefaultState() const { return defaultState_; }
 
-    /// @name Coordinates (radians; one per moving joint, in file order)
+    /// @name Coordinates (radians; one per moving joint, in the order the joints are built from ground)
     /// @{
     int getNumCoordinates() const { return int(coordinates_.size()); }
     const OsimCoordinate& getCoordinate(int i) const { return coordinates_.at(i).spec; }

@@ -63,26 +63,70 @@ OsimForwardResult runOsimForward(const OsimModel& model, const OsimStorage& cont
     settings.validate();
     OsimForwardResult result;
     const Table& c = controls.table;
-    const double t0 = std::isfinite(settings.initialTime) ? settings.initialTime : c.get(0, 0);
+    double t0 = std::isfinite(settings.initialTime) ? settings.initialTime : c.get(0, 0);
+    // Initial states: the row at or before t0, or the first row when t0 is before it; the run starts at
+    // that row's time (the Forward tool's rule). Else defaults and equilibrium.
+    std::map<std::string, double> given;
+    if (initial) {
+        const Table& st = initial->table;
+        int row = 0;
+        for (int r = 0; r < st.getNumRows(); ++r)
+            if (st.get(r, 0) <= t0 + 1e-12) row = r;
+        if (st.get(row, 0) != t0)
+            result.notes.push_back(initial->file + ": the run starts at its row's time " + formatNumber(st.get(row, 0)) +
+                                   " s (asked: " + formatNumber(t0) + " s), as OpenSim's Forward tool does");
+        t0 = st.get(row, 0);
+        for (int k = 1; k < st.getNumColumns(); ++k) given[st.getColumnNames()[k]] = st.get(row, k);
+    }
     if (!(settings.finalTime > t0))
         throw InputError("final time " + formatNumber(settings.finalTime) + " s: expected after the initial time " +
-                         formatNumber(t0) + " s");
+                         formatNumber(t0) + " s" + (initial ? " (from " + initial->file + ")" : std::string()));
 
-    // Excitations: each muscle's column, piecewise linear through the rows.
+    // Excitations as OpenSim's ControlLinear: linear between the rows (a row repeating a time replaces the
+    // earlier one), extrapolated linearly beyond the first and last rows and clamped to [0, 1] (the
+    // muscles' min and max control).
+    std::vector<int> rows;  // the rows kept, by time
+    for (int r = 0; r < c.getNumRows(); ++r) {
+        if (!rows.empty() && c.get(rows.back(), 0) == c.get(r, 0)) rows.back() = r;
+        else rows.push_back(r);
+    }
     std::map<std::string, ActivationProfile> excitations;
-    const std::vector<double> times = c.getColumn("time");
     for (int k = 1; k < c.getNumColumns(); ++k) {
         const std::string muscle = stripForceset(c.getColumnNames()[k]);
         if (std::none_of(model.muscles.begin(), model.muscles.end(), [&](const OsimMuscle& m) { return m.name == muscle; }))
             throw InputError(controls.file + ": column '" + c.getColumnNames()[k] + "' names no muscle of " + model.file +
                              " (expected a muscle's name or /forceset/<muscle>)");
-        std::vector<double> values = c.getColumn(c.getColumnNames()[k]);
-        for (std::size_t r = 0; r < values.size(); ++r)
-            if (!(values[r] >= 0 && values[r] <= 1))
-                throw InputError(controls.file + ": column '" + c.getColumnNames()[k] + "' at t = " + formatNumber(times[r]) +
-                                 " s: excitation " + formatNumber(values[r]) + ": expected in [0, 1]");
+        std::vector<double> times, values;
+        for (int r : rows) {
+            const double v = c.get(r, k);
+            if (!(v >= 0 && v <= 1))
+                throw InputError(controls.file + ": column '" + c.getColumnNames()[k] + "' at t = " + formatNumber(c.get(r, 0)) +
+                                 " s: excitation " + formatNumber(v) + ": expected in [0, 1]");
+            times.push_back(c.get(r, 0));
+            values.push_back(v);
+        }
+        auto extrapolate = [&](std::size_t i, std::size_t j, double t) {  // the line through rows i, j at t
+            const double slope = times[j] != times[i] ? (values[j] - values[i]) / (times[j] - times[i]) : 0.0;
+            return std::clamp(values[i] + slope * (t - times[i]), 0.0, 1.0);
+        };
+        const std::size_t n = times.size();
+        if (t0 < times.front()) {
+            const double v = n > 1 ? extrapolate(0, 1, t0) : values.front();
+            times.insert(times.begin(), t0);
+            values.insert(values.begin(), v);
+        }
+        if (settings.finalTime > times.back()) {
+            const std::size_t m = times.size();
+            const double v = n > 1 ? extrapolate(m - 2, m - 1, settings.finalTime) : values.back();
+            times.push_back(settings.finalTime);
+            values.push_back(v);
+        }
         excitations[muscle] = ActivationProfile(times, values, "controls column " + muscle);
     }
+    if (settings.finalTime > c.get(c.getNumRows() - 1, 0) || t0 < c.get(0, 0))
+        result.notes.push_back(controls.file + ": controls from " + formatNumber(c.get(0, 0)) + " to " +
+                               formatNumber(c.get(c.getNumRows() - 1, 0)) +
+                               " s, extrapolated linearly beyond (OpenSim's ControlLinear), clamped to [0, 1]");
     for (const OsimMuscle& m : model.muscles)
         if (!excitations.count(m.name)) result.notes.push_back("muscle " + m.name + " has no control column: excitation 0");
 
@@ -90,18 +134,6 @@ OsimForwardResult runOsimForward(const OsimModel& model, const OsimStorage& cont
     SimTK::State s = arm.getDefaultState();
     s.setTime(t0);
 
-    // Initial states: the row at or before t0 (the Forward tool's rule), else defaults and equilibrium.
-    std::map<std::string, double> given;
-    if (initial) {
-        const Table& st = initial->table;
-        int row = -1;
-        for (int r = 0; r < st.getNumRows(); ++r)
-            if (st.get(r, 0) <= t0 + 1e-12) row = r;
-        if (row < 0)
-            throw InputError(initial->file + ": no row at or before the initial time " + formatNumber(t0) + " s (first: " +
-                             formatNumber(st.get(0, 0)) + " s)");
-        for (int k = 1; k < st.getNumColumns(); ++k) given[st.getColumnNames()[k]] = st.get(row, k);
-    }
     auto lookup = [&](const std::vector<std::string>& names, double& value) {
         for (const std::string& n : names) {
             const auto it = given.find(n);
@@ -161,11 +193,8 @@ OsimForwardResult runOsimForward(const OsimModel& model, const OsimStorage& cont
         result.states.appendRow(row);
     };
     // The excitations are continuous (linear between rows): the solver's error control takes their kinks
-    // without restarts; a restart is needed only where a control jumps (two rows at one time).
-    std::vector<double> breakpoints;
-    for (std::size_t r = 1; r < times.size(); ++r)
-        if (times[r] == times[r - 1] && times[r] > t0 && times[r] < settings.finalTime) breakpoints.push_back(times[r]);
-    breakpoints.erase(std::unique(breakpoints.begin(), breakpoints.end()), breakpoints.end());
+    // without restarts.
+    const std::vector<double> breakpoints;
     auto check = [&](const SimTK::State& x) {
         for (int i = 0; i < arm.getNumMuscles(); ++i) {
             const MuscleForce& f = arm.getMuscleForce(i);

@@ -1,7 +1,8 @@
 // Forward dynamics of an .osim model as OpenSim's Forward tool runs it: the free model driven by the
-// excitations of a controls file (each muscle's column interpolated linearly between rows, as
-// ControlLinear does; constant before the first and after the last row), from the initial states of a
-// states file (the row at or before the initial time, as the tool takes it) or from the model's defaults
+// excitations of a controls file (each muscle's column as ControlLinear reads it: linear between rows, a
+// row repeating a time replacing the earlier one, extrapolated linearly beyond the first and last rows,
+// clamped to [0, 1]), from the initial states of a states file (the row at or before the initial time,
+// or the first row, the run starting at that row's time, as the tool does) or from the model's defaults
 // with every muscle in equilibrium, integrated by CPodes (BDF) and sampled at a fixed rate into a states
 // table with OpenSim's column names: each coordinate (rad), then `<coordinate>_u` (rad/s), then each
 // muscle's `<muscle>.<state>` (`activation`; `fiber_length` in metres; De Groote:

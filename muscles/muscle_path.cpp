@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 
 using namespace SimTK;
@@ -151,7 +152,8 @@ SurfaceWrap wrapEllipsoid(const PathElement& e, const Transform& X_GB, const Vec
     const Mat33 D(e.radii[0], 0, 0, 0, e.radii[1], 0, 0, 0, e.radii[2]);
     const Mat33 Dinv(1 / e.radii[0], 0, 0, 0, 1 / e.radii[1], 0, 0, 0, 1 / e.radii[2]);
     const Mat33 toSphere = Dinv * ~R_GE.asMat33(), fromSphere = R_GE.asMat33() * D;
-    const Vec3 p = toSphere * (a - c), q = toSphere * (b - c), side = toSphere * (X_GB.R() * e.side);
+    // The half-space s . x > 0 maps to n . x' > 0 with n = D R^T s (a normal maps by the inverse transpose).
+    const Vec3 p = toSphere * (a - c), q = toSphere * (b - c), side = D * (~R_GE.asMat33() * (X_GB.R() * e.side));
     if (p.norm() <= 1 || q.norm() <= 1) {
         if (e.passWhenInside) return {};
         throwInside(muscle, e, (p.norm() <= 1 ? a - c : b - c).norm());
@@ -184,56 +186,71 @@ SurfaceWrap wrapEllipsoid(const PathElement& e, const Transform& X_GB, const Vec
 
 // Several surfaces between the fixed points a and b, in path order (OpenSim applies several wrap
 // objects to one segment in turn, up to 8 passes): each wraps between its active neighbours' tangent
-// points (or a, b), in passes until no tangent point moves by more than 1e-13 m (at most 200 passes).
+// points (or a, b), in passes until no tangent point moves by more than 1e-13 m (at most 40). Where two
+// paths alternate from pass to pass, the longer of two successive passes' paths is taken (a path that
+// wraps more is clear of more surfaces), not the one the pass count's parity lands on. Limitation: the
+// passes can settle on different paths from nearby configurations (arm26's TRIlong over its glenoid
+// cylinder and humeral-head ellipsoid at 108-121 deg shoulder elevation: two paths 27 mm apart, both
+// with both surfaces in use); OpenSim's own passes do not settle there either.
 struct ChainWrap {
     std::vector<SurfaceWrap> wraps;
     double length = 0;
     int active = 0;
+    bool settled = true;
 };
 
 ChainWrap wrapChain(const std::vector<const PathElement*>& es, const std::vector<Transform>& X, const Vec3& a,
                     const Vec3& b, const std::string& muscle, bool withArc) {
+    constexpr int kMaxPasses = 40;
     const int K = int(es.size());
-    ChainWrap c;
-    c.wraps.assign(K, SurfaceWrap());
+    std::vector<SurfaceWrap> wraps(K);
     auto ends = [&](int k) {
         Vec3 from = a, to = b;
         for (int r = k - 1; r >= 0; --r)
-            if (c.wraps[r].active) {
-                from = c.wraps[r].tb;
+            if (wraps[r].active) {
+                from = wraps[r].tb;
                 break;
             }
         for (int r = k + 1; r < K; ++r)
-            if (c.wraps[r].active) {
-                to = c.wraps[r].ta;
+            if (wraps[r].active) {
+                to = wraps[r].ta;
                 break;
             }
         return std::make_pair(from, to);
     };
-    for (int pass = 0; pass < 200; ++pass) {
+    auto pass = [&] {  // one pass; the largest move of a tangent point (1 when a surface switched)
         double change = 0;
         for (int k = 0; k < K; ++k) {
             const auto [from, to] = ends(k);
-            SurfaceWrap w = wrapSurface(*es[k], X[k], from, to, muscle, false);
-            const SurfaceWrap& old = c.wraps[k];
+            SurfaceWrap w = wrapSurface(*es[k], X[k], from, to, muscle, withArc);
+            const SurfaceWrap& old = wraps[k];
             if (w.active != old.active) change = 1;
             else if (w.active) change = std::max({change, (w.ta - old.ta).norm(), (w.tb - old.tb).norm()});
-            c.wraps[k] = std::move(w);
+            wraps[k] = std::move(w);
         }
-        if (change <= 1e-13) break;
+        return change;
+    };
+    auto lengthOf = [&](const std::vector<SurfaceWrap>& w) {
+        double length = 0;
+        Vec3 at = a;
+        for (const SurfaceWrap& x : w)
+            if (x.active) {
+                length += (x.ta - at).norm() + x.arcLength;
+                at = x.tb;
+            }
+        return length + (b - at).norm();
+    };
+    ChainWrap c;
+    c.settled = false;
+    for (int n = 0; n < kMaxPasses && !c.settled; ++n) c.settled = pass() <= 1e-13;
+    if (!c.settled) {
+        const std::vector<SurfaceWrap> first = wraps;
+        pass();
+        if (lengthOf(first) > lengthOf(wraps)) wraps = first;
     }
-    Vec3 at = a;
-    for (int k = 0; k < K; ++k) {
-        if (!c.wraps[k].active) continue;
-        ++c.active;
-        if (withArc) {
-            const auto [from, to] = ends(k);
-            c.wraps[k] = wrapSurface(*es[k], X[k], from, to, muscle, true);
-        }
-        c.length += (c.wraps[k].ta - at).norm() + c.wraps[k].arcLength;
-        at = c.wraps[k].tb;
-    }
-    c.length += (b - at).norm();
+    c.wraps = std::move(wraps);
+    c.length = lengthOf(c.wraps);
+    for (const SurfaceWrap& x : c.wraps) c.active += x.active;
     return c;
 }
 
@@ -462,7 +479,7 @@ PathGeometry MusclePath::calcGeometry(const State& s, const std::string& muscleN
                 for (std::size_t m = 0; m < ks.size(); ++m) g.wrapping[ks[m]] = c.wraps[m].active;
                 if (c.active == 1) {
                     std::size_t m = 0;
-                    while (!c.wraps[m].active) ++m;
+                    while (m + 1 < c.wraps.size() && !c.wraps[m].active) ++m;
                     if (elements_[ks[m]].kind == PathElement::Kind::Ellipsoid) addEllipsoidLoads(i, ks[m], j, a, b, c.wraps[m]);
                     else addTangentLoads(i, ks[m], j, a, b, c.wraps[m]);
                 } else {

@@ -25,8 +25,7 @@ constexpr double kDeg = 3.14159265358979323846 / 180;
 }  // namespace
 
 // Two coordinates (shoulder elevation, elbow flexion), six Thelen muscles whose F0 and optimal fibre
-// length are the file's, and the forearm's weight: with every muscle slack-free at rest the elbow's
-// generalized gravity force equals m g times the lever of the forearm's centre of mass.
+// length are the file's, and the system's mass the sum of the file's body masses.
 TEST(OsimArm, Arm26BuildsWithItsCoordinatesMusclesAndMasses) {
     const OsimArm arm(arm26());
     ASSERT_EQ(arm.getNumCoordinates(), 2);

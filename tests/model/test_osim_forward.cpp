@@ -139,7 +139,7 @@ TEST(OsimForward, StatesRoundTripThroughAStorageFile) {
 }
 
 // A control column naming no muscle, an excitation outside [0, 1] and a states file starting after the
-// initial time are refused naming the file, column and value.
+// final time are refused naming the file, column and value.
 TEST(OsimForward, BadControlsAndStatesNameTheFileAndColumn) {
     const OsimModel model = readOsimFile(std::string(ARMSIM_ASSET_DIR) + "/models/arm26.osim");
     const fs::path dir = fs::temp_directory_path() / ("armsim_forward_bad_" + std::to_string(::getpid()));
@@ -172,7 +172,10 @@ TEST(OsimForward, BadControlsAndStatesNameTheFileAndColumn) {
         runOsimForward(model, readOsimStorage(data("arm26_controls.sto")), &late, s);
         ADD_FAILURE() << "a states file after the initial time was accepted";
     } catch (const InputError& e) {
-        EXPECT_NE(std::string(e.what()).find("s.sto: no row at or before the initial time 0 s"), std::string::npos) << e.what();
+        // The run starts at the states file's first row (OpenSim's rule), after the final time.
+        EXPECT_NE(std::string(e.what()).find("final time 0.1 s: expected after the initial time 0.5 s (from"), std::string::npos)
+            << e.what();
+        EXPECT_NE(std::string(e.what()).find("s.sto)"), std::string::npos) << e.what();
     }
     fs::remove_all(dir);
 }
@@ -209,5 +212,30 @@ TEST(OsimForward, ForwardToolSetupFile) {
         EXPECT_NE(std::string(e.what()).find(":10: <ControlSetController>: controls file 'arm26_controls.xml' is an XML ControlSet"),
                   std::string::npos) << e.what();
     }
+    fs::remove_all(dir);
+}
+
+// Controls as OpenSim's ControlLinear reads them: a row repeating a time replaces the earlier one (no
+// step), and past the last row the excitation goes on along the last two rows' line, clamped to [0, 1].
+// Under OpenSim 2.x's Thelen (da/dt = (u - a) / 0.01 s while rising) the activation follows u(t) with a
+// lag of tau x du/dt.
+TEST(OsimForward, ControlsReplaceRepeatedTimesAndExtrapolateLinearly) {
+    const OsimModel model = readOsimFile(std::string(ARMSIM_ASSET_DIR) + "/models/arm26.osim");
+    const fs::path dir = fs::temp_directory_path() / ("armsim_forward_controls_" + std::to_string(::getpid()));
+    fs::create_directories(dir);
+    std::ofstream(dir / "c.sto") << "c\nversion=1\nnRows=4\nnColumns=2\ninDegrees=no\nendheader\ntime\tBIClong\n"
+                                    "0\t0.1\n1\t0.1\n1\t0.5\n2\t0.6\n";
+    const OsimStorage controls = readOsimStorage((dir / "c.sto").string());
+    OsimForwardSettings s;
+    s.finalTime = 3.0;
+    s.sampleRate = 10;
+    s.muscleModel = "thelen2003_opensim2";
+    const OsimForwardResult r = runOsimForward(model, controls, nullptr, s);
+    auto activationAt = [&](double t) { return r.states.get(int(std::lround(t * 10)), r.states.findColumn("BIClong.activation")); };
+    EXPECT_NEAR(activationAt(0.5), 0.3 - 0.01 * 0.4, 2e-3);  // u = 0.1 -> 0.5 linearly over 0..1 s (not a step at 1 s)
+    EXPECT_NEAR(activationAt(2.5), 0.65 - 0.01 * 0.1, 2e-3); // extrapolated: 0.6 + 0.1 (t - 2)
+    bool noted = false;
+    for (const std::string& n : r.notes) noted = noted || n.find("extrapolated linearly") != std::string::npos;
+    EXPECT_TRUE(noted);
     fs::remove_all(dir);
 }
