@@ -169,6 +169,10 @@ TEST(EllipsoidWrap, TwoSurfacesInARowDoTheVirtualWorkOfTheLength) {
         rig.setAngle(q);
         const PathGeometry g = path.calcGeometry(rig.state);
         both += g.wrapping[1] && g.wrapping[2];
+        // Drawing the path (its polyline) gives the same path (it once wrapped again and could differ).
+        const PathGeometry drawn = path.calcGeometry(rig.state, "", true);
+        EXPECT_EQ(drawn.length, g.length) << "q = " << q;
+        EXPECT_GE(drawn.polyline.size(), 2u);
         const double dPdq = (plus - minus) / (2 * h);
         EXPECT_NEAR(rig.calcMomentArm(g), -dPdq, 1e-8) << "q = " << q;
         rig.body.setOneU(rig.state, 0, u);
