@@ -42,7 +42,6 @@ OsimReportFiles writeOsimModelReport(const OsimModel& model, const OsimReportSet
     r.coordinate = arm.getCoordinate(j).name;
     const int n = arm.getNumMuscles();
 
-    Table muscles({"F0_N", "optimal_fiber_length_m", "tendon_slack_length_m", "pennation_angle_rad"});
     std::string text = "muscle,muscle_model,F0_N,optimal_fiber_length_m,tendon_slack_length_m,pennation_angle_rad\n";
     for (int i = 0; i < n; ++i) {
         const OsimMuscle& m = model.muscles[i];

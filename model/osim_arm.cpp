@@ -74,6 +74,15 @@ double property(const OsimMuscle& mu, const char* name, double fallback) {
     return it == mu.properties.end() ? fallback : it->second;
 }
 
+const char* wrapElementName(OsimWrapObject::Kind kind) {
+    switch (kind) {
+        case OsimWrapObject::Kind::Cylinder: return "WrapCylinder";
+        case OsimWrapObject::Kind::Sphere: return "WrapSphere";
+        case OsimWrapObject::Kind::Ellipsoid: return "WrapEllipsoid";
+    }
+    return "Wrap";
+}
+
 // The file's morphometry into a Hill model's parameters.
 template <class Params>
 Params makeMorphometry(const OsimMuscle& mu) {
@@ -210,7 +219,7 @@ OsimArm::OsimArm(OsimModel model, const std::map<std::string, ActivationProfile>
     // Wrap objects as path surfaces on their bodies.
     auto surfaceOf = [&](const OsimWrapObject& o) {
         if (!bodies.count(o.body))
-            throw OsimError(where(m, o.line, std::string(o.kind == OsimWrapObject::Kind::Cylinder ? "<WrapCylinder" : o.kind == OsimWrapObject::Kind::Sphere ? "<WrapSphere" : "<WrapEllipsoid") + " name=\"" + o.name + "\">") + "its body '" + o.body +
+            throw OsimError(where(m, o.line, std::string("<") + wrapElementName(o.kind) + " name=\"" + o.name + "\">") + "its body '" + o.body +
                             "' has no joint to ground: not built");
         PathElement e;
         e.body = bodies.at(o.body);

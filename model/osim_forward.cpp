@@ -22,7 +22,7 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-// A muscle's column in a controls file: "BIClong" or "/forceset/BIClong".
+// A muscle's column in a controls file: "<muscle>" or "/forceset/<muscle>".
 std::string stripForceset(const std::string& column) {
     const std::string prefix = "/forceset/";
     return column.rfind(prefix, 0) == 0 ? column.substr(prefix.size()) : column;
@@ -153,19 +153,25 @@ OsimForwardResult runOsimForward(const OsimModel& model, const OsimStorage& cont
         if (lookup({n + "_u", path + "/speed"}, v)) arm.setCoordinateSpeed(s, i, v * (arm.getCoordinate(i).rotational ? degree : 1));
     }
     arm.getSystem().realize(s, SimTK::Stage::Velocity);
+    // Each muscle state's names and its storage unit per state unit (OpenSim writes fibre lengths in
+    // metres, armsim's Hill states hold them over l0).
+    std::vector<std::vector<std::string>> stateNames(arm.getNumMuscles());
+    std::vector<std::vector<double>> stateScales(arm.getNumMuscles());
+    for (int i = 0; i < arm.getNumMuscles(); ++i) {
+        const MuscleModel& m = arm.getMuscleForce(i).getMuscle();
+        stateNames[i] = m.getStateNames();
+        for (const std::string& n : stateNames[i]) stateScales[i].push_back(n == "fiber_length" ? m.getOptimalFascicleLength() : 1.0);
+    }
     for (int i = 0; i < arm.getNumMuscles(); ++i) {
         const MuscleForce& f = arm.getMuscleForce(i);
-        const MuscleModel& m = f.getMuscle();
-        const std::vector<std::string> names = m.getStateNames();
+        const std::vector<std::string>& names = stateNames[i];
+        const std::string& muscle = arm.getMuscleName(i);
         std::vector<double> y(names.size());
         bool all = true;
         for (std::size_t k = 0; k < names.size(); ++k) {
-            const std::string& muscle = arm.getMuscleName(i);
             double v;
-            if (lookup({muscle + "." + names[k], "/forceset/" + muscle + "/" + names[k]}, v))
-                y[k] = names[k] == "fiber_length" ? v / m.getOptimalFascicleLength() : v;
-            else
-                all = false;
+            if (lookup({muscle + "." + names[k], "/forceset/" + muscle + "/" + names[k]}, v)) y[k] = v / stateScales[i][k];
+            else all = false;
         }
         if (all) f.setMuscleStates(s, y);
         else f.setSteadyMuscleStates(s);  // equilibrium at the excitation of t0 (solve_for_equilibrium)
@@ -176,19 +182,15 @@ OsimForwardResult runOsimForward(const OsimModel& model, const OsimStorage& cont
     for (int i = 0; i < arm.getNumCoordinates(); ++i) columns.push_back(arm.getCoordinate(i).name);
     for (int i = 0; i < arm.getNumCoordinates(); ++i) columns.push_back(arm.getCoordinate(i).name + "_u");
     for (int i = 0; i < arm.getNumMuscles(); ++i)
-        for (const std::string& n : arm.getMuscleForce(i).getMuscle().getStateNames())
-            columns.push_back(arm.getMuscleName(i) + "." + n);
+        for (const std::string& n : stateNames[i]) columns.push_back(arm.getMuscleName(i) + "." + n);
     result.states = Table(columns);
     auto sample = [&](const SimTK::State& x) {
         std::vector<double> row = {x.getTime()};
         for (int i = 0; i < arm.getNumCoordinates(); ++i) row.push_back(arm.getCoordinateValue(x, i));
         for (int i = 0; i < arm.getNumCoordinates(); ++i) row.push_back(arm.getCoordinateSpeed(x, i));
         for (int i = 0; i < arm.getNumMuscles(); ++i) {
-            const MuscleForce& f = arm.getMuscleForce(i);
-            const std::vector<std::string> names = f.getMuscle().getStateNames();
-            const std::vector<double> y = f.getMuscleStates(x);
-            for (std::size_t k = 0; k < names.size(); ++k)
-                row.push_back(names[k] == "fiber_length" ? y[k] * f.getMuscle().getOptimalFascicleLength() : y[k]);
+            const std::vector<double> y = arm.getMuscleForce(i).getMuscleStates(x);
+            for (std::size_t k = 0; k < y.size(); ++k) row.push_back(y[k] * stateScales[i][k]);
         }
         result.states.appendRow(row);
     };

@@ -53,7 +53,7 @@ struct OsimForwardResult {
     std::vector<std::string> notes;     ///< e.g. muscles without a control column (excitation 0)
 };
 
-/// Runs the model. Controls columns name muscles (`BIClong` or `/forceset/BIClong`); a column naming no
+/// Runs the model. Controls columns name muscles (`<muscle>` or `/forceset/<muscle>`); a column naming no
 /// muscle is an InputError naming it and the file. States columns: coordinates by name or
 /// `/jointset/<joint>/<coordinate>/value`, speeds `<coordinate>_u` or `.../speed`, muscle states
 /// `<muscle>.<state>` or `/forceset/<muscle>/<state>`; columns it does not know are ignored.

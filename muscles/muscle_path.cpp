@@ -189,14 +189,13 @@ SurfaceWrap wrapEllipsoid(const PathElement& e, const Transform& X_GB, const Vec
 // points (or a, b), in passes until no tangent point moves by more than 1e-13 m (at most 40). Where two
 // paths alternate from pass to pass, the longer of two successive passes' paths is taken (a path that
 // wraps more is clear of more surfaces), not the one the pass count's parity lands on. Limitation: the
-// passes can settle on different paths from nearby configurations (arm26's TRIlong over its glenoid
-// cylinder and humeral-head ellipsoid at 108-121 deg shoulder elevation: two paths 27 mm apart, both
-// with both surfaces in use); OpenSim's own passes do not settle there either.
+// passes can settle on different paths from nearby configurations (a cylinder and an ellipsoid on one
+// segment can give two paths centimetres apart, both with both surfaces in use; README, OpenSim files);
+// OpenSim's own passes do not settle there either.
 struct ChainWrap {
     std::vector<SurfaceWrap> wraps;
     double length = 0;
     int active = 0;
-    bool settled = true;
 };
 
 ChainWrap wrapChain(const std::vector<const PathElement*>& es, const std::vector<Transform>& X, const Vec3& a,
@@ -240,14 +239,14 @@ ChainWrap wrapChain(const std::vector<const PathElement*>& es, const std::vector
             }
         return length + (b - at).norm();
     };
-    ChainWrap c;
-    c.settled = false;
-    for (int n = 0; n < kMaxPasses && !c.settled; ++n) c.settled = pass() <= 1e-13;
-    if (!c.settled) {
+    bool settled = false;
+    for (int n = 0; n < kMaxPasses && !settled; ++n) settled = pass() <= 1e-13;
+    if (!settled) {
         const std::vector<SurfaceWrap> first = wraps;
         pass();
         if (lengthOf(first) > lengthOf(wraps)) wraps = first;
     }
+    ChainWrap c;
     c.wraps = std::move(wraps);
     c.length = lengthOf(c.wraps);
     for (const SurfaceWrap& x : c.wraps) c.active += x.active;

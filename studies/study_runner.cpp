@@ -501,10 +501,14 @@ void writeNoisePlot(const std::string& path, const std::string& title, const std
 void writeTruthHeatMap(const std::string& path, const std::string& title, const std::string& zLabel,
                        const Study& study, const std::vector<StudySummaryRow>& summary,
                        double (*statistic)(const ElbowValidationSummary&), int decimals) {
-    std::vector<std::string> columns;
-    for (const StudySummaryRow& r : summary) {
+    auto columnOf = [&study](const StudySummaryRow& r) {
         std::string c = (study.protocols.size() > 1 ? r.protocol + " / " : std::string()) + r.stats.method;
         if (study.noiseLevels.size() > 1) c += " / " + formatNumber(100 * r.stats.noise) + " %";
+        return c;
+    };
+    std::vector<std::string> columns;
+    for (const StudySummaryRow& r : summary) {
+        const std::string c = columnOf(r);
         if (std::find(columns.begin(), columns.end(), c) == columns.end()) columns.push_back(c);
     }
     HeatMapSpec spec;
@@ -523,9 +527,7 @@ void writeTruthHeatMap(const std::string& path, const std::string& title, const 
     spec.z.assign(columns.size() * nt, 0.0 / 0.0);
     bool any = false;
     for (const StudySummaryRow& r : summary) {
-        std::string c = (study.protocols.size() > 1 ? r.protocol + " / " : std::string()) + r.stats.method;
-        if (study.noiseLevels.size() > 1) c += " / " + formatNumber(100 * r.stats.noise) + " %";
-        const std::size_t i = std::size_t(std::find(columns.begin(), columns.end(), c) - columns.begin());
+        const std::size_t i = std::size_t(std::find(columns.begin(), columns.end(), columnOf(r)) - columns.begin());
         std::size_t t = 0;
         while (t < nt && study.truths[t].label != r.truth) ++t;
         const double z = statistic(r.stats);
