@@ -39,13 +39,15 @@ struct DesignOptions {
 };
 
 void printPrediction(const ProtocolPrediction& p) {
-    std::printf("  %-10s %3d trials  sd(ln M) %5.1f %%  sd(L0T) %5.1f mm  sd(total flexor strength) %4.1f %%  "
-                "criterion %.2f  (prior: %.1f %%, %.1f mm, %.1f %%; %d draws)\n",
-                p.name.c_str(), p.trials, 100 * p.massSd, 1000 * p.tendonSd, 100 * p.flexorStrengthSd, p.criterion,
-                100 * p.priorMassSd, 1000 * p.priorTendonSd, 100 * p.priorFlexorStrengthSd, p.drawsUsed);
+    std::printf("  %-10s %3d trials  sd(ln M) %5.1f %%  sd(L0T) %5.1f mm  sd(ln F0) %5.1f %%  sd(total flexor strength) %4.1f %%  "
+                "criterion %.2f  (prior: %.1f %%, %.1f mm, %.1f %%, %.1f %%; %d draws)\n",
+                p.name.c_str(), p.trials, 100 * p.massSd, 1000 * p.tendonSd, 100 * p.maxForceSd, 100 * p.flexorStrengthSd,
+                p.criterion, 100 * p.priorMassSd, 1000 * p.priorTendonSd, 100 * p.priorMaxForceSd,
+                100 * p.priorFlexorStrengthSd, p.drawsUsed);
     if (std::isfinite(p.massSdConsidered))
         std::printf("             with what the fit shares or holds and people vary (the intervals' widening): "
-                    "sd(ln M) %.1f %%, sd(L0T) %.1f mm\n", 100 * p.massSdConsidered, 1000 * p.tendonSdConsidered);
+                    "sd(ln M) %.1f %%, sd(L0T) %.1f mm, sd(ln F0) %.1f %%\n", 100 * p.massSdConsidered,
+                    1000 * p.tendonSdConsidered, 100 * p.maxForceSdConsidered);
     std::printf("             posterior correlation of ln M with:");
     for (std::size_t j = 0; j < p.parameterNames.size(); ++j)
         if (std::abs(p.massCorrelation[j]) >= 0.3 && p.massCorrelation[j] < 0.999)

@@ -534,6 +534,70 @@ bool SynergistModel::calcConsideredCovariance(const std::vector<std::vector<doub
     return true;
 }
 
+ChannelFit SynergistModel::calcPriorCheck(const std::vector<std::vector<double>>& J, const std::vector<double>& x) const {
+    ChannelFit fit;
+    fit.channel = "prior";
+    fit.chiSquare = 0;
+    const int n = getNumParameters(), R = int(J.size());
+    const int nf = int(free_.size()), nh = int(held_.size()), nw = int(truthCovariance_.size()), nk = nw - nf - nh;
+    if (truthCovariance_.empty() || R == 0 || int(J[0].size()) != n + nk) return fit;
+    Eigen::MatrixXd G(R, nw), lambda(nf, nf), S(nw, nw);
+    for (int k = 0; k < R; ++k) {
+        for (int a = 0; a < nf; ++a) G(k, a) = J[k][free_[a]];
+        for (int a = 0; a < nh; ++a) G(k, nf + a) = J[k][held_[a]];
+        for (int a = 0; a < nk; ++a) G(k, nf + nh + a) = J[k][n + a];
+    }
+    for (int a = 0; a < nf; ++a)
+        for (int b = 0; b < nf; ++b) lambda(a, b) = freePrecision_[a][b];
+    for (int a = 0; a < nw; ++a)
+        for (int b = 0; b < nw; ++b) S(a, b) = truthCovariance_[a][b];
+    const Eigen::MatrixXd JF = G.leftCols(nf), H = JF.transpose() * JF;
+    const Eigen::LLT<Eigen::MatrixXd> hl(H + lambda);
+    if (hl.info() != Eigen::Success) return fit;
+    const Eigen::MatrixXd C0 = hl.solve(Eigen::MatrixXd::Identity(nf, nf));
+    const Eigen::MatrixXd M = JF.transpose() * G;
+    Eigen::MatrixXd D = C0 * (M * S * M.transpose() + H) * C0;
+    D = 0.5 * (D + D.transpose());
+    // The log-scale parameters the fit moves, off their bounds.
+    std::vector<int> use;
+    for (int a = 0; a < nf; ++a) {
+        const int j = free_[a];
+        if (j == kActivation || j == kCoContraction) continue;
+        if (!(x[j] > lower_[j] + 1e-9 && x[j] < upper_[j] - 1e-9)) continue;
+        use.push_back(a);
+    }
+    const int m = int(use.size());
+    if (m == 0) return fit;
+    Eigen::MatrixXd Ds(m, m), Ss(m, m);
+    Eigen::VectorXd d(m);
+    for (int a = 0; a < m; ++a) {
+        d(a) = x[free_[use[a]]] - priorMean_[free_[use[a]]];
+        for (int b = 0; b < m; ++b) Ds(a, b) = D(use[a], use[b]), Ss(a, b) = S(use[a], use[b]);
+    }
+    const Eigen::LLT<Eigen::MatrixXd> sl(Ss);
+    if (sl.info() != Eigen::Success) return fit;
+    const Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> ges(Ds, Ss);
+    if (ges.info() != Eigen::Success) return fit;
+    for (int i = 0; i < m; ++i) {
+        const double l = ges.eigenvalues()(i);
+        if (!(l >= kPriorCheckShare)) continue;
+        const double u = ges.eigenvectors().col(i).dot(d);  // eigenvectors: v' Ss v = 1
+        fit.chiSquare += u * u / l;
+        ++fit.n;
+    }
+    const std::vector<std::string> names = getParameterNames();
+    for (int a = 0; a < m; ++a) {
+        if (!(Ds(a, a) >= kPriorCheckShare * Ss(a, a))) continue;
+        const double z = d(a) / std::sqrt(Ds(a, a));
+        if (!(std::abs(z) <= std::abs(fit.worstResidual))) {
+            fit.worstResidual = z;
+            fit.worst = names[std::size_t(free_[use[a]])] + " from the prior mean";
+        }
+    }
+    if (fit.n > 0) fit.p = calcChiSquareSurvival(fit.chiSquare, fit.n);
+    return fit;
+}
+
 void SynergistModel::setDeviation(std::vector<MuscleDeviation>& deviations, const ConsiderParameter& c, double by) {
     MuscleDeviation& d = deviations.at(std::size_t(c.muscle));
     (c.kind == 0 ? d.lnTendon : c.kind == 1 ? d.lnFascicle : c.kind == 2 ? d.slowShift : d.lnMass) = by;
@@ -782,7 +846,11 @@ MuscleEstimate identifySynergistAware(const Population& prior, const std::vector
         }
         // C0: the Laplace covariance; C: the estimate's error covariance with the consider parameters.
         std::vector<std::vector<double>> C0 = m.covariance, C = m.covariance;
-        if (haveJacobian) model.calcConsideredCovariance(J, C0, C);
+        if (haveJacobian) {
+            model.calcConsideredCovariance(J, C0, C);
+            const ChannelFit check = model.calcPriorCheck(J, x);
+            if (check.n > 0) est.channelFits.push_back(check);
+        }
         // Degrees of freedom of each interval. The torque rows' sd is the noise level estimated with nu
         // dof; a quantity whose error variance owes the fraction f = g'C0 Ht C0 g / g'C g to the torque
         // rows (Ht = Jt'Jt, their whitened Jacobian) has that variance estimated with about nu / f^2 dof

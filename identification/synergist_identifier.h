@@ -159,6 +159,17 @@ public:
     /// false, leaving them, when a matrix is not positive definite.
     bool calcConsideredCovariance(const std::vector<std::vector<double>>& J, std::vector<std::vector<double>>& C0,
                                   std::vector<std::vector<double>>& C) const;
+    /// The prior's check (channel "prior"): is this person one the prior's population could hold? With
+    /// J as above and x the estimate, the estimate's deviation d = x - mu over the free log-scale
+    /// parameters (activation and co-contraction, and parameters at a bound, left out) has, under the
+    /// linearized fit and the prior's population (what the fit shares included), the covariance
+    /// D = C0 J_F' (G S G' + I) J_F C0 (G: the Jacobian over the truths' parameters, S their covariance).
+    /// In the directions v where the data explain at least kPriorCheckShare of the prior's variance
+    /// (D v = lambda S_F v), sum (v'd)^2 / lambda is chi-square with that many degrees of freedom; `worst`
+    /// names the parameter furthest from the prior mean in its own sd of D. n = 0 when no direction
+    /// qualifies or a matrix is not positive definite.
+    ChannelFit calcPriorCheck(const std::vector<std::vector<double>>& J, const std::vector<double>& x) const;
+    static constexpr double kPriorCheckShare = 0.2;
 
 private:
     static constexpr int kTendon = 0, kActivation = 1, kCoContraction = 2, kFascicle = 3, kSynergistTendon = 4,

@@ -282,6 +282,9 @@ py::dict toDict(const ProtocolPrediction& p) {
     d["prior_flexor_strength_sd"] = p.priorFlexorStrengthSd;
     d["mass_sd_considered"] = p.massSdConsidered;     // with what the fit shares (the intervals' widening)
     d["tendon_sd_considered"] = p.tendonSdConsidered;
+    d["max_force_sd"] = p.maxForceSd;                 // of ln F0
+    d["prior_max_force_sd"] = p.priorMaxForceSd;
+    d["max_force_sd_considered"] = p.maxForceSdConsidered;
     d["parameter_names"] = p.parameterNames;
     d["mass_correlation"] = toArray(p.massCorrelation);
     d["posterior_sd"] = toArray(p.posteriorSd);

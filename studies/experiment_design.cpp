@@ -50,8 +50,9 @@ struct Sensitivities {
     bool forearm = false;            // a forearm-axis row per condition after the channels
     ChannelNoise noise;
     Eigen::VectorXd flexorMean;    // weights of the mean of the flexors' ln mass scales
+    Eigen::VectorXd forceWeights;  // ln F0 = ln sigma + ln M - ln f_b - ln g (+ constants)
     Eigen::MatrixXd priorPrecision;
-    double priorMassSd = 0, priorTendonSd = 0, priorFlexorStrengthSd = 0, baseTendonLength = 0;
+    double priorMassSd = 0, priorTendonSd = 0, priorFlexorStrengthSd = 0, priorForceSd = 0, baseTendonLength = 0;
     double relativeSd = 0;         // sigma: relative sd of one trial's torque
     double activationSd = 0;
     std::vector<DrawSensitivity> draws;
@@ -147,6 +148,12 @@ Sensitivities calcSensitivities(const Population& prior, const std::vector<Torqu
     const std::vector<int> flexors = model.getFlexorMassIndices();
     for (int j : flexors) s.flexorMean(j) = 1.0 / double(flexors.size());
     s.priorFlexorStrengthSd = std::sqrt(s.flexorMean.dot(sigma * s.flexorMean));
+    s.forceWeights = Eigen::VectorXd::Zero(n);
+    s.forceWeights(s.massIndex) += 1;
+    s.forceWeights(SynergistModel::getSpecificTensionIndex()) += 1;
+    s.forceWeights(SynergistModel::getFascicleIndex()) -= 1;
+    s.forceWeights(s.sizeIndex) -= 1;
+    s.priorForceSd = std::sqrt(s.forceWeights.dot(sigma * s.forceWeights));
     s.baseTendonLength = prior.base.muscles[prior.base.primary].params.optimalTendonLength;
     s.priorMassSd = std::sqrt(sigma(s.massIndex, s.massIndex));
     s.priorTendonSd = s.baseTendonLength * std::sqrt(sigma(s.tendonIndex, s.tendonIndex) + sigma(s.sizeIndex, s.sizeIndex) +
@@ -288,7 +295,7 @@ ProtocolPrediction evaluate(const Sensitivities& s, const std::vector<int>& coun
     p.massCorrelation.assign(n, 0.0);
     p.posteriorSd.assign(n, 0.0);
     const double gT = kTendonGoal / s.baseTendonLength;
-    double crit = 0, vm = 0, vt = 0, vf = 0, wm = 0, wt = 0;
+    double crit = 0, vm = 0, vt = 0, vf = 0, vF = 0, wm = 0, wt = 0, wF = 0;
     int used = 0, widened = 0;
     for (std::size_t d = 0; d < s.draws.size(); ++d) {
         if (!s.draws[d].ok) continue;
@@ -304,6 +311,7 @@ ProtocolPrediction evaluate(const Sensitivities& s, const std::vector<int>& coun
         vm += cm;
         vt += ct;
         vf += s.flexorMean.dot(C * s.flexorMean);
+        vF += s.forceWeights.dot(C * s.forceWeights);
         for (int j = 0; j < n; ++j) {
             p.massCorrelation[j] += C(s.massIndex, j) / std::sqrt(cm * C(j, j));
             p.posteriorSd[j] += std::sqrt(C(j, j));
@@ -311,6 +319,8 @@ ProtocolPrediction evaluate(const Sensitivities& s, const std::vector<int>& coun
         if (considered && !W.empty()) {
             wm += wmm;
             wt += wtt;
+            for (int a = 0; a < n; ++a)
+                for (int b = 0; b < n; ++b) wF += s.forceWeights(a) * W[a][b] * s.forceWeights(b);
             ++widened;
         }
         ++used;
@@ -318,6 +328,7 @@ ProtocolPrediction evaluate(const Sensitivities& s, const std::vector<int>& coun
     if (widened > 0) {
         p.massSdConsidered = std::sqrt(wm / widened);
         p.tendonSdConsidered = s.baseTendonLength * std::sqrt(wt / widened);
+        p.maxForceSdConsidered = std::sqrt(wF / widened);
     }
     if (used == 0) throw SimulationError("experiment design: no prior draw has a steady state at every condition");
     p.drawsUsed = used;
@@ -325,6 +336,8 @@ ProtocolPrediction evaluate(const Sensitivities& s, const std::vector<int>& coun
     p.massSd = std::sqrt(vm / used);
     p.tendonSd = s.baseTendonLength * std::sqrt(vt / used);
     p.flexorStrengthSd = std::sqrt(vf / used);
+    p.maxForceSd = std::sqrt(vF / used);
+    p.priorMaxForceSd = s.priorForceSd;
     p.priorFlexorStrengthSd = s.priorFlexorStrengthSd;
     for (int j = 0; j < n; ++j) {
         p.massCorrelation[j] /= used;
@@ -715,7 +728,8 @@ std::string formatPredictionsCsv(const std::vector<ProtocolPrediction>& predicti
     std::vector<std::string> header = {"protocol", "trials", "draws_used", "criterion", "mass_sd_pct", "tendon_sd_mm",
                                        "flexor_strength_sd_pct", "prior_mass_sd_pct", "prior_tendon_sd_mm",
                                        "prior_flexor_strength_sd_pct", "mass_sd_considered_pct",
-                                       "tendon_sd_considered_mm"};
+                                       "tendon_sd_considered_mm", "max_force_sd_pct", "prior_max_force_sd_pct",
+                                       "max_force_sd_considered_pct"};
     for (const std::string& n : predictions.front().parameterNames) header.push_back("corr_lnM_" + n);
     for (const std::string& n : predictions.front().parameterNames) header.push_back("sd_" + n);
     CsvText csv(header);
@@ -725,6 +739,7 @@ std::string formatPredictionsCsv(const std::vector<ProtocolPrediction>& predicti
         row.addNumber(100 * p.massSd).addNumber(1000 * p.tendonSd).addNumber(100 * p.flexorStrengthSd);
         row.addNumber(100 * p.priorMassSd).addNumber(1000 * p.priorTendonSd).addNumber(100 * p.priorFlexorStrengthSd);
         row.addNumber(100 * p.massSdConsidered).addNumber(1000 * p.tendonSdConsidered);
+        row.addNumber(100 * p.maxForceSd).addNumber(100 * p.priorMaxForceSd).addNumber(100 * p.maxForceSdConsidered);
         for (double v : p.massCorrelation) row.addNumber(v);
         for (double v : p.posteriorSd) row.addNumber(v);
         csv.addRow(row);

@@ -91,6 +91,11 @@ struct ProtocolPrediction {
     /// [1], [m]. NaN where not computed (the greedy search's trial designs).
     double massSdConsidered = 0.0 / 0.0;
     double tendonSdConsidered = 0.0 / 0.0;
+    /// RMS over draws of the posterior sd of the primary's ln F0 (= ln sigma + ln M - ln L0 + const) [1],
+    /// its prior sd, and the same with the consider parameters (NaN where not computed).
+    double maxForceSd = 0.0 / 0.0;
+    double priorMaxForceSd = 0.0 / 0.0;
+    double maxForceSdConsidered = 0.0 / 0.0;
     std::vector<std::string> parameterNames;
     /// Mean over draws of the posterior correlation of ln M with each parameter.
     std::vector<double> massCorrelation;

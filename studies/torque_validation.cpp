@@ -25,6 +25,8 @@ ElbowValidationRow makeElbowValidationRow(const Population& population, const Vi
     if (std::isfinite(e.maxForceLower))
         row.maxForceCovered = row.trueMaxForce >= e.maxForceLower && row.trueMaxForce <= e.maxForceUpper;
     row.estimate = e;
+    for (const ChannelFit& f : e.channelFits)
+        if (f.channel == "prior") row.priorCheckP = f.p;
     row.massError = e.mass / row.trueMass - 1;
     row.tendonError = e.tendonLength - row.trueTendonLength;
     if (std::isfinite(e.massLower)) row.massCovered = row.trueMass >= e.massLower && row.trueMass <= e.massUpper;
@@ -176,6 +178,15 @@ void ElbowValidationAccumulator::add(const ElbowValidationRow& r) {
         ++c.tn, c.tc += r.tendonCovered;
         c.tw += r.estimate.tendonUpper - r.estimate.tendonLower;
     }
+    if (std::isfinite(r.priorCheckP)) {
+        ++c.pn;
+        if (r.priorCheckP < 0.05) {
+            ++c.pf;
+        } else {
+            if (r.massCovered >= 0) ++c.pmn, c.pmc += r.massCovered;
+            if (r.tendonCovered >= 0) ++c.ptn, c.ptc += r.tendonCovered;
+        }
+    }
 }
 
 std::vector<ElbowValidationSummary> ElbowValidationAccumulator::getSummaries() const {
@@ -195,6 +206,9 @@ std::vector<ElbowValidationSummary> ElbowValidationAccumulator::getSummaries() c
         if (c.fn > 0) s.maxForceBias = c.fb / c.fn, s.maxForceRmse = std::sqrt(c.fm / c.fn);
         if (c.fcn > 0) s.maxForceCoverage = double(c.fc) / c.fcn;
         if (c.tn > 0) s.tendonCoverage = double(c.tc) / c.tn, s.tendonIntervalWidth = c.tw / c.tn;
+        if (c.pn > 0) s.priorFlagged = double(c.pf) / c.pn;
+        if (c.pmn > 0) s.massCoveragePassed = double(c.pmc) / c.pmn;
+        if (c.ptn > 0) s.tendonCoveragePassed = double(c.ptc) / c.ptn;
         // Standard errors over subjects: the mean's, the RMSE's by the delta method (sd of the squared
         // error / (2 RMSE sqrt n)), a fraction's binomial sqrt(p (1 - p) / n).
         auto errors = [](const Running& e, const Running& e2, double rmse, double& biasSe, double& rmseSe) {
@@ -218,7 +232,7 @@ std::string formatElbowValidationCsv(const std::vector<ElbowValidationRow>& rows
                  "tendon_upper_m", "tendon_error_mm", "tendon_covered", "voluntary_activation", "co_contraction",
                  "strength_level", "biceps_short_scale", "synergist_scale", "noise_level_used", "rms_residual",
                  "true_max_force_N", "max_force_N", "max_force_lower_N", "max_force_upper_N", "max_force_error_pct",
-                 "max_force_covered"});
+                 "max_force_covered", "prior_check_p"});
     auto flag = [](CsvRow& row, int c) -> CsvRow& { return c < 0 ? row.addEmpty() : row.addInteger(c); };
     for (const ElbowValidationRow& r : rows) {
         const MuscleEstimate& e = r.estimate;
@@ -232,6 +246,7 @@ std::string formatElbowValidationCsv(const std::vector<ElbowValidationRow>& rows
         row.addNumber(r.bicepsShortScale).addNumber(r.synergistScale).addNumber(e.noiseLevel).addNumber(e.rmsResidual);
         row.addNumber(r.trueMaxForce).addNumber(e.maxForce).addNumber(e.maxForceLower).addNumber(e.maxForceUpper);
         flag(row.addNumber(100 * r.maxForceError), r.maxForceCovered);
+        row.addNumber(r.priorCheckP);
         csv.addRow(row);
     }
     return csv.getText();
@@ -241,7 +256,8 @@ std::string formatElbowValidationSummaryCsv(const std::vector<ElbowValidationSum
     CsvText csv({"method", "noise", "subjects", "converged", "mass_bias_pct", "mass_rmse_pct", "mass_coverage",
                  "tendon_bias_mm", "tendon_rmse_mm", "tendon_coverage", "mass_bias_se_pct", "mass_rmse_se_pct",
                  "mass_coverage_se", "tendon_bias_se_mm", "tendon_rmse_se_mm", "tendon_coverage_se",
-                 "max_force_bias_pct", "max_force_rmse_pct", "max_force_coverage"});
+                 "max_force_bias_pct", "max_force_rmse_pct", "max_force_coverage", "prior_flagged",
+                 "mass_coverage_prior_passed", "tendon_coverage_prior_passed"});
     for (const ElbowValidationSummary& s : summaries) {
         CsvRow row;
         row.addText(s.method).addNumber(s.noise).addInteger(s.subjects).addInteger(s.converged);
@@ -250,6 +266,7 @@ std::string formatElbowValidationSummaryCsv(const std::vector<ElbowValidationSum
         row.addNumber(100 * s.massBiasSe).addNumber(100 * s.massRmseSe).addNumber(s.massCoverageSe);
         row.addNumber(1000 * s.tendonBiasSe).addNumber(1000 * s.tendonRmseSe).addNumber(s.tendonCoverageSe);
         row.addNumber(100 * s.maxForceBias).addNumber(100 * s.maxForceRmse).addNumber(s.maxForceCoverage);
+        row.addNumber(s.priorFlagged).addNumber(s.massCoveragePassed).addNumber(s.tendonCoveragePassed);
         csv.addRow(row);
     }
     return csv.getText();

@@ -24,6 +24,8 @@ struct ElbowValidationRow {
     int tendonCovered = -1;
     double maxForceError = 0.0 / 0.0;  ///< F0 estimate / truth - 1 (methods that estimate F0) [1]
     int maxForceCovered = -1;
+    /// The prior's check (ChannelFit "prior"): its chi-square tail probability; NaN without one.
+    double priorCheckP = 0.0 / 0.0;
     // Nuisance truths, for error-vs-nuisance plots.
     double voluntaryActivation = 0, coContraction = 0, strengthLevel = 0;
     double bicepsShortScale = 0.0 / 0.0;  ///< second biceps head's mass scale / primary's [1]
@@ -50,6 +52,10 @@ struct ElbowValidationSummary {
     /// (delta method) and of the coverage (binomial); a 95 % interval is about +/- 2 of them.
     double massBiasSe = 0.0 / 0.0, massRmseSe = 0.0 / 0.0, massCoverageSe = 0.0 / 0.0;
     double tendonBiasSe = 0.0 / 0.0, tendonRmseSe = 0.0 / 0.0, tendonCoverageSe = 0.0 / 0.0;
+    /// Of the estimates with a prior check: the fraction it flags (p < 0.05; about 0.05 when the person
+    /// is one of the prior's population) and the mass and L0T coverage of those it passes [1].
+    double priorFlagged = 0.0 / 0.0;
+    double massCoveragePassed = 0.0 / 0.0, tendonCoveragePassed = 0.0 / 0.0;
 };
 
 /// Settings of runElbowValidation.
@@ -109,6 +115,7 @@ private:
         double noise = 0;
         int subjects = 0, converged = 0;
         int n = 0, mn = 0, mc = 0, tn = 0, tc = 0, fn = 0, fcn = 0, fc = 0;
+        int pn = 0, pf = 0, pmn = 0, pmc = 0, ptn = 0, ptc = 0;  // prior check: checked, flagged, passed coverage
         double mb = 0, mm = 0, tb = 0, tm = 0, mw = 0, tw = 0, fb = 0, fm = 0;
         Running massError, massSquare, tendonError, tendonSquare;
     };

@@ -316,7 +316,7 @@ TEST(CliIdentifyTorque, RecommendedProtocolChannelsAreSynthesizedAndFitted) {
     EXPECT_EQ(header, "method,channel,n,chi_square,p_value,verdict,worst,worst_residual_sd");
     int channels = 0;
     while (std::getline(in, line)) channels += line.rfind("channels,", 0) == 0;
-    EXPECT_EQ(channels, 6);  // torque, fascicle_length, emg, volume, upper_arm_length, activation
+    EXPECT_EQ(channels, 7);  // torque, fascicle_length, emg, volume, upper_arm_length, activation, prior
     std::ifstream est(d / "identify_channels" / "torque_estimates.csv");
     std::getline(est, header);
     EXPECT_NE(header.find("max_force_N"), std::string::npos) << header;

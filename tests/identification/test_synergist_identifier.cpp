@@ -228,7 +228,8 @@ TEST(ElbowIdentification, ChannelsRecoverAKnownPersonAndJudgeEachChannel) {
     EXPECT_GT(e.massUpper, truth.mass);
     const double f0 = truth.coefficients.sigma * truth.mass / (truth.coefficients.density * truth.optimalFascicleLength);
     EXPECT_NEAR(e.maxForce / f0 - 1, 0, 2 * kMassTol);
-    ASSERT_EQ(e.channelFits.size(), 5u);  // torque, fascicle_length, emg, volume, upper_arm_length
+    ASSERT_EQ(e.channelFits.size(), 6u);  // torque, fascicle_length, emg, volume, upper_arm_length, prior
+    EXPECT_EQ(e.channelFits.back().channel, "prior");
     for (const ChannelFit& f : e.channelFits) EXPECT_GT(f.p, 0.05) << f.channel;
 
     // One image 10 sd off: its channel is the misfit and names the angle.
@@ -451,7 +452,7 @@ TEST(ElbowIdentification, ForearmAxisDataRecoverAKnownPerson) {
     // the way in ln (1.047), so at least a quarter. Without forearm readings it stays at exactly 1 (below).
     constexpr double kMinShareOfTheWay = 0.25;
     EXPECT_GT(std::log(e.nuisance[it - e.nuisanceNames.begin()]), kMinShareOfTheWay * std::log(1.15));
-    ASSERT_EQ(e.channelFits.size(), 2u);
+    ASSERT_EQ(e.channelFits.size(), 3u);  // torque, forearm_torque, prior
     EXPECT_EQ(e.channelFits[1].channel, "forearm_torque");
     EXPECT_EQ(e.channelFits[1].n, int(conditions.size()));
     for (const ChannelFit& f : e.channelFits) EXPECT_GT(f.p, 0.05) << f.channel;
@@ -460,7 +461,7 @@ TEST(ElbowIdentification, ForearmAxisDataRecoverAKnownPerson) {
     std::vector<TorqueObservation> bad = data;
     bad[5].forearmTorque += 10 * kNoise * bad[5].getLoad();
     const MuscleEstimate b = identifySynergistAware(prior, bad, options);
-    ASSERT_EQ(b.channelFits.size(), 2u);
+    ASSERT_EQ(b.channelFits.size(), 3u);
     EXPECT_LT(b.channelFits[1].p, 0.05);
     EXPECT_NE(b.channelFits[1].worst.find("supination MVC at 90 deg, forearm at -60 deg"), std::string::npos)
         << b.channelFits[1].worst;

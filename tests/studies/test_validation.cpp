@@ -226,6 +226,47 @@ TEST(Validation, ChannelIntervalsCoverWhatThePopulationVariesAndTheFitShares) {
     EXPECT_GE(sd(zt), kMinZSd) << "L0T intervals too wide";
 }
 
+// The prior's check (ChannelFit "prior", SynergistModel::calcPriorCheck): for people of the prior's own
+// population its p-values are uniform (mean 1/2; over 100 subjects of the recommended protocol, 2 % below
+// 0.05 and quartiles 0.27 / 0.54 / 0.79), and it flags people whose muscles follow other equations (the
+// Thelen 2003 truth: 100 of 100 flagged; their L0T coverage is 0.32, README).
+TEST(Validation, PriorCheckIsUniformInFamilyAndFlagsPeopleOfAnotherMuscleModel) {
+    constexpr int kInFamily = 30;
+    constexpr double kMeanTol = 0.16;       // 3 sd of the mean of 30 uniforms (0.053)
+    constexpr int kMaxFlaggedInFamily = 5;  // P(>= 6 of 30 | 5 %) < 0.003
+    constexpr int kHill = 8;
+    constexpr int kMinFlaggedHill = 6;
+    const Population prior = loadDefaultPopulation();
+    ElbowValidationSettings v;
+    v.subjects = kInFamily;
+    v.noiseLevels = {0.02};
+    v.activationSd = 0;
+    v.jobs = 2;
+    v.protocol = readTorqueProtocol(findAsset("protocols/recommended.yaml"));
+    auto checks = [](const std::vector<ElbowValidationRow>& rows) {
+        std::vector<double> p;
+        for (const ElbowValidationRow& r : rows)
+            if (r.method == "channels") p.push_back(r.priorCheckP);
+        return p;
+    };
+    const std::vector<double> p = checks(runElbowValidation(prior, prior, v));
+    ASSERT_EQ(int(p.size()), kInFamily);
+    double mean = 0;
+    int flagged = 0;
+    for (double x : p) {
+        ASSERT_TRUE(std::isfinite(x));
+        mean += x / kInFamily;
+        flagged += x < 0.05;
+    }
+    EXPECT_NEAR(mean, 0.5, kMeanTol);
+    EXPECT_LE(flagged, kMaxFlaggedInFamily);
+
+    v.subjects = kHill;
+    const std::vector<double> h = checks(runElbowValidation(loadPopulation(findAsset("subjects/mismatch/hill_muscles.yaml")), prior, v));
+    ASSERT_EQ(int(h.size()), kHill);
+    EXPECT_GE(std::count_if(h.begin(), h.end(), [](double x) { return x < 0.05; }), kMinFlaggedHill);
+}
+
 // One subject alone (the main job's out-of-family person) gives that subject's rows of the whole
 // validation, bit for bit, and its clean data with noise added are what the rows were fitted to.
 TEST(Validation, OneSubjectAloneEqualsItsRowsOfTheWholeValidation) {
