@@ -38,6 +38,7 @@ void Table::appendRow(const std::vector<double>& row) {
     if (row.size() != names_.size())
         throw std::invalid_argument("table row has " + std::to_string(row.size()) + " values, expected " +
                                     std::to_string(names_.size()));
+    if ((numRows_ & 4095) == 0) checkInterruption();  // long recordings, sweeps and reads stop promptly
     data_.insert(data_.end(), row.begin(), row.end());
     ++numRows_;
 }
@@ -78,6 +79,7 @@ std::string Table::formatRows(char separator, int digits) const {
     std::string out;
     out.reserve(data_.size() * std::size_t(digits + 7));
     for (int i = 0; i < numRows_; ++i) {
+        if ((i & 4095) == 0) checkInterruption();  // millions of rows take seconds
         for (int c = 0; c < getNumColumns(); ++c) {
             if (c) out += separator;
             appendNumber(out, get(i, c), digits);

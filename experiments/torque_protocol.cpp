@@ -388,6 +388,9 @@ std::vector<TorqueObservation> makeTorqueData(const Table& t, const std::string&
     for (const char* c : {"flexion_deg", "torque_Nm"})
         if (!t.hasColumn(c)) throw InputError(path + ": missing column '" + std::string(c) + "'");
     if (t.getNumRows() == 0) throw InputError(path + ": no data rows");
+    if (t.getNumRows() > kMaxTorqueRows)
+        throw InputError(path + ": " + std::to_string(t.getNumRows()) + " data rows: expected at most " +
+                         std::to_string(kMaxTorqueRows) + " (one row per trial; a lab's protocol has tens to hundreds)");
     std::vector<TorqueObservation> data;
     std::map<ConditionKey, int> count;
     std::set<std::pair<ConditionKey, int>> seen;

@@ -166,10 +166,13 @@ std::vector<TorqueObservation> setTransducerNoise(std::vector<TorqueObservation>
 /// supination, NaN where not read) when a trial reads the forearm axis; with truth=true also activation,
 /// clean_torque_Nm (and clean_forearm_torque_Nm) (synthetic data).
 std::string formatTorqueData(const std::vector<TorqueObservation>& data, bool truth);
+/// The most rows a torque data file may have: each identification evaluates every row many times.
+constexpr int kMaxTorqueRows = 10000;
 /// Reads a torque data file (Table::readCsv: '#' comments, header line). Required columns flexion_deg
 /// and torque_Nm; effort (default 1), level (default 1), repetition (default: count per condition),
 /// rotation_deg and forearm_torque_Nm optional (a rotation effort needs its forearm torque); other
-/// columns are errors. Errors name file, line, column, value and the expected range.
+/// columns are errors; at most kMaxTorqueRows rows. Errors name file, line, column, value and the
+/// expected range.
 std::vector<TorqueObservation> readTorqueData(const std::string& path);
 /// The same from a table already in memory; `source` names it in messages.
 std::vector<TorqueObservation> makeTorqueData(const Table& table, const std::string& source);

@@ -1,10 +1,12 @@
 #include "model/mvc_curve.h"
 
 #include "basics/bound.h"
+#include "basics/errors.h"
 #include "model/geometry.h"
 #include "model/muscle_arm.h"
 
 #include <cmath>
+#include <map>
 #include <memory>
 #include <stdexcept>
 
@@ -31,10 +33,19 @@ MvcGeometry calcMvcGeometry(const ArmSetup& setup, const std::vector<double>& fl
         geometry.setForearmRotation(degToRad(g.rotationDeg));
     }
     const double lo = setup.arm.getMinFlexionDeg(), hi = setup.arm.getMaxFlexionDeg();
+    std::map<double, std::size_t> done;  // an angle met before: its row again (data repeat a few angles)
     for (double q : flexionDeg) {
         if (!(q >= lo - 1e-9 && q <= hi + 1e-9))
             throw InputError("flexion angle " + formatNumber(q) + " deg is outside the elbow's range [" +
                              formatNumber(lo) + ", " + formatNumber(hi) + "] deg of model '" + setup.name + "'");
+        if (const auto it = done.find(q); it != done.end()) {
+            g.pathLength.push_back(g.pathLength[it->second]);
+            g.momentArm.push_back(g.momentArm[it->second]);
+            g.forearmMomentArm.push_back(g.forearmMomentArm[it->second]);
+            continue;
+        }
+        if ((done.size() & 63) == 63) checkInterruption();
+        done.emplace(q, g.pathLength.size());
         geometry.setElbowAngle(elbowAngleFromFlexion(degToRad(q)));
         std::vector<double> P, h, r;
         for (int i = 0; i < setup.getNumMuscles(); ++i) {

@@ -17,6 +17,7 @@
 #include <memory>
 #include <sstream>
 #include <string>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -459,6 +460,40 @@ TEST(Cli, AnInterruptedProtocolLeavesNothingAndTheNextRunCleansUpAfterAKilledOne
     EXPECT_FALSE(fs::exists(d / (".quick.partial." + tag)));
     EXPECT_FALSE(fs::exists(d / (".quick.old." + tag)));
     EXPECT_TRUE(fs::exists(d / "quick" / "summary.csv"));
+    fs::remove_all(d);
+}
+
+// Issue 34: a long command stops within a bound of SIGTERM in whichever phase the signal finds it
+// (simulating, sweeping, reading or formatting millions of rows), exits 128 + 15 and leaves no output.
+// Before: `trial --hold 5000` formatted its 5e6-row CSV for 10+ s, `muscle sweep` finished its
+// 0.9e6 lengths (9.6 s) and `identify-torque` evaluated a million rows until the 10 s fallback.
+TEST(Cli, LongCommandsStopPromptlyOnSigtermAndLeaveNothing) {
+    namespace fs = std::filesystem;
+    constexpr double kMaxLatency = 2.0;  // s; measured 0.04-0.3 s
+    const fs::path d = armsim::testing::makeFreshDir("cli", "prompt_stop");
+    {
+        std::ofstream rows(d / "rows.csv");
+        rows << "flexion_deg,effort,level,repetition,torque_Nm\n";
+        for (int i = 0; i < 10000; ++i) rows << 30 + 15 * (i % 7) << ",1,1," << i / 7 << "," << 50 + (i % 13) << "\n";
+    }
+    const std::string exe = ARMSIM_EXE;
+    // (command, what it would write, seconds before the signal: the trial's simulation takes about 3 s
+    // here, then its CSV is formatted)
+    const std::vector<std::tuple<std::string, fs::path, int>> runs = {
+        {exe + " trial --hold 5000 --out " + (d / "trial.csv").string(), d / "trial.csv", 5},
+        {exe + " muscle sweep --step 0.00000017 --out " + (d / "sweep.csv").string(), d / "sweep.csv", 2},
+        {exe + " identify-torque " + (d / "rows.csv").string() + " --out " + (d / "fit").string(), d / "fit", 2},
+    };
+    for (const auto& [run, output, delay] : runs) {
+        const armsim::testing::CommandResult r = armsim::testing::runCommand(
+            "sh -c '" + run + " >/dev/null 2>&1 & pid=$!; sleep " + std::to_string(delay) +
+            "; t0=$(date +%s%N); kill -TERM $pid; wait $pid; rc=$?; t1=$(date +%s%N); echo rc=$rc ms=$(( (t1 - t0) / 1000000 ))'");
+        EXPECT_NE(r.output.find("rc=143"), std::string::npos) << run << "\n" << r.output;
+        const std::size_t at = r.output.find("ms=");
+        ASSERT_NE(at, std::string::npos) << r.output;
+        EXPECT_LE(std::stod(r.output.substr(at + 3)) / 1000, kMaxLatency) << run;
+        EXPECT_FALSE(fs::exists(output)) << run;
+    }
     fs::remove_all(d);
 }
 
