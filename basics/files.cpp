@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <mutex>
 #include <sstream>
 #include <stdexcept>
 #include <unistd.h>
@@ -83,6 +84,29 @@ bool areFilesUnchanged(const std::vector<FileSnapshot>& files) {
         }
     }
     return true;
+}
+
+namespace {
+std::mutex shownMutex;
+std::string shownStaging, shownTarget;
+}  // namespace
+
+ShownFolder::ShownFolder(const std::string& staging, const std::string& shown) {
+    std::lock_guard<std::mutex> lock(shownMutex);
+    shownStaging = staging;
+    shownTarget = shown;
+}
+
+ShownFolder::~ShownFolder() {
+    std::lock_guard<std::mutex> lock(shownMutex);
+    shownStaging.clear();
+    shownTarget.clear();
+}
+
+std::string showPath(const std::string& path) {
+    std::lock_guard<std::mutex> lock(shownMutex);
+    if (shownStaging.empty() || path.rfind(shownStaging, 0) != 0) return path;
+    return shownTarget + path.substr(shownStaging.size());
 }
 
 void writeFileAtomically(const std::string& path, const std::string& text) {

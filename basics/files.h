@@ -58,6 +58,18 @@ private:
 /// every lookup gives the same answer.
 bool areFilesUnchanged(const std::vector<FileSnapshot>& files);
 
+/// While alive, messages name files written under `staging` (a folder that will become `shown`) by
+/// where they will be: showPath maps them. One at a time per process (the main job's).
+class ShownFolder {
+public:
+    ShownFolder(const std::string& staging, const std::string& shown);
+    ~ShownFolder();
+    ShownFolder(const ShownFolder&) = delete;
+    ShownFolder& operator=(const ShownFolder&) = delete;
+};
+/// `path` as messages should name it (see ShownFolder); unchanged outside one.
+std::string showPath(const std::string& path);
+
 /// Writes text to path atomically: to a temporary beside it, then rename. Throws InputError naming
 /// the path when it cannot be written. Parent directories are created.
 void writeFileAtomically(const std::string& path, const std::string& text);

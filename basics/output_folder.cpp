@@ -7,6 +7,8 @@
 
 #include <atomic>
 #include <cerrno>
+#include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <stdexcept>
 
@@ -95,6 +97,22 @@ void OutputFolder::writeWith(const std::string& relative,
 std::vector<std::string> OutputFolder::getFiles() const {
     std::lock_guard<std::mutex> lock(mutex_);
     return {files_.begin(), files_.end()};
+}
+
+std::string OutputFolder::getStagingPath() const {
+    if (temp_.empty()) throw std::logic_error("OutputFolder::getStagingPath on a disabled folder");
+    return temp_.string();
+}
+
+void OutputFolder::addStagedFiles() {
+    if (temp_.empty()) throw std::logic_error("OutputFolder::addStagedFiles on a disabled folder");
+    std::error_code ec;
+    std::vector<std::string> found;
+    for (auto it = fs::recursive_directory_iterator(temp_, ec); !ec && it != fs::recursive_directory_iterator();
+         it.increment(ec))
+        if (it->is_regular_file(ec)) found.push_back(fs::relative(it->path(), temp_, ec).string());
+    std::lock_guard<std::mutex> lock(mutex_);
+    files_.insert(found.begin(), found.end());
 }
 
 void OutputFolder::commit() {
@@ -197,6 +215,87 @@ void OutputFolder::checkReplaceable() const {
     if (isFolder && (fs::is_empty(target_, ec) || (!marker_.empty() && fs::exists(target_ / marker_, ec)))) return;
     throw InputError(target_.string() + ": exists and is not an armsim run (no " + marker_ +
                      "): refusing to replace it; choose another output folder");
+}
+
+namespace {
+
+constexpr const char* kFilePrefix = ".armsim-partial-";
+std::atomic<int> fileCounter{0};
+
+// Staging files ".armsim-partial-<pid>-<n>-NAME" in `dir` of processes that are gone.
+void removeStaleFiles(const fs::path& dir) {
+    std::error_code ec;
+    std::vector<fs::path> stale;
+    const std::string prefix = kFilePrefix;
+    for (const fs::directory_entry& e : fs::directory_iterator(dir, ec)) {
+        const std::string name = e.path().filename().string();
+        if (name.rfind(prefix, 0) != 0) continue;
+        const std::string digits = name.substr(prefix.size(), name.find('-', prefix.size()) - prefix.size());
+        if (digits.empty() || digits.size() > 9 || digits.find_first_not_of("0123456789") != std::string::npos) continue;
+        const pid_t pid = pid_t(std::stol(digits));
+        if (pid != ::getpid() && ::kill(pid, 0) != 0 && errno == ESRCH) stale.push_back(e.path());
+    }
+    for (const fs::path& p : stale) fs::remove(p, ec);
+}
+
+}  // namespace
+
+OutputFiles::~OutputFiles() {
+    if (committed_) return;
+    std::error_code ec;
+    for (const Entry& e : entries_) fs::remove(e.staging, ec);
+}
+
+std::string OutputFiles::add(const std::string& option, const std::string& path) {
+    if (path.empty()) return "";
+    if (committed_) throw std::logic_error("OutputFiles::add after commit");
+    const fs::path target = fs::path(path).lexically_normal();
+    std::error_code ec;
+    const fs::path absolute = fs::absolute(target, ec).lexically_normal();
+    for (const Entry& e : entries_)
+        if (fs::absolute(e.target, ec).lexically_normal() == absolute)
+            throw InputError(option + " '" + path + "' is the file " + e.option +
+                             " writes: expected a path of its own");
+    if (target.filename().empty() || fs::is_directory(target, ec))
+        throw InputError(option + " '" + path + "' is a folder: expected a file path");
+    // Its folder may not exist yet: made at commit(), not now (a failed run leaves no empty folder).
+    // The staging file goes to the nearest folder that exists.
+    const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
+    fs::path existing = dir;
+    while (!fs::exists(existing, ec) && existing.has_parent_path() && existing.parent_path() != existing)
+        existing = existing.parent_path();
+    if (!fs::exists(existing, ec)) existing = ".";
+    if (!fs::is_directory(existing, ec))
+        throw InputError(option + " '" + path + "': cannot create its folder '" + dir.string() + "': '" +
+                         existing.string() + "' is a file");
+    if (::access(existing.c_str(), W_OK) != 0)
+        throw InputError(option + " '" + path + "': folder '" + existing.string() + "' is not writable");
+    removeStaleFiles(existing);
+    const std::string staging = (existing / (std::string(kFilePrefix) + std::to_string(::getpid()) + "-" +
+                                             std::to_string(fileCounter++) + "-" + target.filename().string()))
+                                    .string();
+    // A probe: the folder takes a new file (access() says yes to root in /proc, say).
+    std::FILE* probe = std::fopen(staging.c_str(), "wb");
+    if (!probe)
+        throw InputError(option + " '" + path + "': cannot write a file in folder '" + existing.string() + "' (" +
+                         std::strerror(errno) + ")");
+    std::fclose(probe);
+    fs::remove(staging, ec);
+    entries_.push_back({option, target.string(), staging});
+    return staging;
+}
+
+void OutputFiles::commit() {
+    if (committed_) throw std::logic_error("OutputFiles::commit twice");
+    std::error_code ec;
+    for (const Entry& e : entries_) {
+        if (!fs::exists(e.staging, ec)) continue;
+        const fs::path target(e.target);
+        if (target.has_parent_path()) fs::create_directories(target.parent_path(), ec);
+        fs::rename(e.staging, e.target, ec);
+        if (ec) throw InputError(e.target + ": cannot put the file in place (" + ec.message() + ")");
+    }
+    committed_ = true;
 }
 
 }  // namespace armsim

@@ -54,6 +54,11 @@ public:
     void writeWith(const std::string& relative, const std::function<void(const std::string& path)>& writer);
     /// Relative names of the files added so far, sorted.
     std::vector<std::string> getFiles() const;
+    /// The staging folder (for writers that take a folder: the main job's steps). std::logic_error on a
+    /// disabled folder.
+    std::string getStagingPath() const;
+    /// Adds every regular file found under the staging folder (written there without addFile).
+    void addStagedFiles();
     /// Moves the files into place, all or none: InputError naming the path when a rename fails, after
     /// restoring what was there (the earlier run, or the files the new ones were replacing).
     void commit();
@@ -69,6 +74,35 @@ private:
     bool committed_ = false;
     mutable std::mutex mutex_;
     std::set<std::string> files_;
+};
+
+/// Several result files named by options (`trial --out T.csv --plot P.png --video V.mp4`), put in place
+/// together: each is checked when added (before the work: distinct from the others, no folder in the
+/// way, its folder creatable), written to a staging file ".armsim-partial-<pid>-<n>-NAME" in the nearest
+/// existing folder of its path (the name keeps its extension, which writers may read), and commit()
+/// makes the missing folders and renames them all into place. Destroyed
+/// uncommitted (an error, an interruption), every staging file is removed and the targets are
+/// untouched. Leftovers of a process that no longer exists are removed by the next add() there.
+class OutputFiles {
+public:
+    OutputFiles() = default;
+    OutputFiles(const OutputFiles&) = delete;
+    OutputFiles& operator=(const OutputFiles&) = delete;
+    ~OutputFiles();
+    /// Registers the file `path` given with `option` (named in messages) and returns the path to write
+    /// it to. An empty path registers nothing and returns "". InputError naming both options when two
+    /// give the same file, and naming the option when a folder is in the way or its folder cannot be made.
+    std::string add(const std::string& option, const std::string& path);
+    /// Renames every staged file that was written into place (a registered file its writer never wrote
+    /// is left out). InputError naming the path when a rename fails.
+    void commit();
+
+private:
+    struct Entry {
+        std::string option, target, staging;
+    };
+    std::vector<Entry> entries_;
+    bool committed_ = false;
 };
 
 }  // namespace armsim

@@ -50,7 +50,7 @@ struct CommandRegistrar {
 
 /// Settings every main-job step receives.
 struct MainJobContext {
-    std::string outDir = "out";  ///< where results go
+    std::string outDir = "out";  ///< where results go (while the job runs: a staging folder; messages showPath)
     int jobs = 2;                ///< worker threads
     MuscleOptions muscle;        ///< the subject's biceps
 };

@@ -115,7 +115,7 @@ void printThesisCases(const MuscleParameters& base, const ForceModel& model, con
     std::printf("%s", formatThesisComparison(cases).c_str());
     const std::string path = outDir + "/thesis_cases_" + model.getName() + ".csv";
     writeFileAtomically(path, formatThesisCasesCsv(cases));
-    std::printf("wrote %s\n", path.c_str());
+    std::printf("wrote %s\n", showPath(path).c_str());
 }
 
 void runIdentify(const IdentifyOptions& o) {
@@ -517,9 +517,10 @@ void runIdentificationStep(const MainJobContext& ctx) {
                             " m): " + reference.describe() + "\n" + mvc.toCsv(10);
     const std::string dataPath = dir + "/mvc_five_angles.csv";
     writeFileAtomically(dataPath, csv);
-    std::printf("own MVC data (%s; truth %.2f g, %.3f cm), from 330 g / 22 cm:\n", dataPath.c_str(), 1000 * base.mass,
+    std::printf("own MVC data (%s; truth %.2f g, %.3f cm), from 330 g / 22 cm:\n", showPath(dataPath).c_str(), 1000 * base.mass,
                 100 * base.optimalTendonLength);
-    const IdentificationProblem own = problemFor(readArmObservations(dataPath, setup.arm));
+    IdentificationProblem own = problemFor(readArmObservations(dataPath, setup.arm));
+    own.data.source = showPath(dataPath);  // where the file will be (the job writes into a staging folder)
     for (Method m : {Method::LevenbergMarquardt, Method::IlcSignSearch}) {
         IdentificationOptions o;
         o.method = m;
@@ -533,7 +534,7 @@ void runIdentificationStep(const MainJobContext& ctx) {
     // 3. The thesis's cases with the steady model.
     std::printf("thesis cases (steady model) beside the thesis's numbers:\n");
     printThesisCases(base, SteadyForceModel(), dir);
-    std::printf("  wrote reports (JSON, history CSV, convergence PNG) to %s/\n", dir.c_str());
+    std::printf("  wrote reports (JSON, history CSV, convergence PNG) to %s/\n", showPath(dir).c_str());
 }
 
 // One virtual person out of family (subject 0 of the stronger mismatch population, the default population
@@ -588,7 +589,7 @@ void runOutOfFamilyPersonStep(const MainJobContext& ctx) {
         for (const ChannelFit& f : e.channelFits)
             std::printf("  %s fit, %-17s n %3d  chi2 %6.1f  p %.3f  %s\n", e.method.c_str(), f.channel.c_str(), f.n,
                         f.chiSquare, f.p, f.p >= 0.05 ? "noise" : ("misfit, worst: " + f.worst).c_str());
-    std::printf("  wrote torque and channel data, their plots, estimates.csv and mass_estimates.png to %s/\n", dir.c_str());
+    std::printf("  wrote torque and channel data, their plots, estimates.csv and mass_estimates.png to %s/\n", showPath(dir).c_str());
 }
 
 const CommandRegistrar registerIdentify(40, addIdentifyCommand);

@@ -44,7 +44,7 @@ void showModel(const ArmSetup& setup, const std::string& out, double step, const
     printSummary("extension", r.extension);
     std::printf("primary muscle (%s) share of the flexors' torque at 90 deg: %.1f %%\n",
                 setup.muscles[setup.primary].params.name.c_str(), 100 * r.primaryShareAt90);
-    for (const std::string& f : r.files) std::printf("wrote %s\n", f.c_str());
+    for (const std::string& f : r.files) std::printf("wrote %s\n", showPath(f).c_str());
 }
 
 // Writes the scorecard to out and prints the per-kind summary and every failed target.
@@ -60,7 +60,7 @@ void checkModel(const ArmSetup& setup, const std::vector<AnatomyTarget>& targets
                         s.muscle.c_str(), describeTargetCondition(s.target).c_str(),
                         std::isfinite(s.target.flexionDeg) ? (" at " + formatNumber(s.target.flexionDeg) + " deg").c_str() : "",
                         s.value, s.target.lower, s.target.upper, s.target.tolerance, s.target.where.c_str());
-    for (const std::string& f : r.files) std::printf("wrote %s\n", f.c_str());
+    for (const std::string& f : r.files) std::printf("wrote %s\n", showPath(f).c_str());
 }
 
 void addModelCommands(CLI::App& app) {
@@ -112,7 +112,7 @@ void addModelCommands(CLI::App& app) {
                             r.peakPositiveDeg);
                 std::printf("steady torque, - direction muscles fully excited: peak %.1f N m at %.1f deg\n", r.peakNegative,
                             r.peakNegativeDeg);
-                for (const std::string& f : r.files) std::printf("wrote %s\n", f.c_str());
+                for (const std::string& f : r.files) std::printf("wrote %s\n", showPath(f).c_str());
                 return;
             }
             if (!coordinate->empty()) throw InputError("--coordinate '" + *coordinate + "': only for OpenSim models (.osim)");

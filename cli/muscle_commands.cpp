@@ -1,5 +1,6 @@
 // armsim muscle steady | sweep | trial: the muscle alone, both path ends fixed.
 #include "basics/bound.h"
+#include "basics/output_folder.h"
 #include "basics/plot.h"
 #include "cli/commands.h"
 #include "model/arm_parameters.h"
@@ -155,6 +156,8 @@ void addMuscleCommands(CLI::App& app) {
                                  formatNumber(*to) + " m gives " + formatNumber(std::floor((*to - *from) / *step) + 1) +
                                  " path lengths: expected at most 1000001");
             if (!(*to >= *from)) throw InputError("--to must not be below --from");
+            OutputFiles files;  // both appear at the end, or neither
+            const std::string csvPath = files.add("--out", *out), plotPath = files.add("--plot", *plot);
             const std::shared_ptr<const MuscleModel> built = opts->build();
             const MuscleModel& m = *built;
             m.checkPathLength(*from);
@@ -172,17 +175,18 @@ void addMuscleCommands(CLI::App& app) {
                     y.push_back(s.force);
                 }
             }
-            t.writeCsv(*out);
-            std::printf("wrote %s (%d path lengths)\n", out->c_str(), n);
+            t.writeCsv(csvPath);
             if (!plot->empty()) {
                 PlotSpec spec;
                 spec.title = m.getName() + ": steady force vs path length";
                 spec.xLabel = "path length (cm)";
                 spec.yLabel = "force Fse (N)";
                 spec.series.push_back({"U = " + std::to_string(*U).substr(0, 4), x, y});
-                writePlotPng(*plot, spec);
-                std::printf("wrote %s\n", plot->c_str());
+                writePlotPng(plotPath, spec);
             }
+            files.commit();
+            std::printf("wrote %s (%d path lengths)\n", out->c_str(), n);
+            if (!plot->empty()) std::printf("wrote %s\n", plot->c_str());
         });
     }
 
@@ -215,6 +219,8 @@ void addMuscleCommands(CLI::App& app) {
             checkActivation(*U);
             checkField("--onset", *onset, Bound::nonNegative("s"));
             checkField("--rise", *rise, Bound::nonNegative("s"));
+            OutputFiles files;  // both appear at the end, or neither
+            const std::string csvPath = files.add("--out", *out), plotPath = files.add("--plot", *plot);
             const std::shared_ptr<const MuscleModel> built = opts->build();
             const MuscleModel& m = *built;
             MuscleIsometricSettings s = *settings;
@@ -224,19 +230,20 @@ void addMuscleCommands(CLI::App& app) {
             else s.activation = ActivationProfile::constant(*U);
             IntegrationStats stats;
             const Table t = runMuscleIsometric(m, s, &stats);
-            t.writeCsv(*out);
+            t.writeCsv(csvPath);
             const int last = t.getNumRows() - 1;
-            std::printf("final force %.4f N at t = %.3f s (%d steps, %d restarts); wrote %s\n", t.get(last, "force_N"),
-                        t.get(last, "time_s"), stats.steps, stats.restarts, out->c_str());
             if (!plot->empty()) {
                 PlotSpec spec;
                 spec.title = m.getName() + ": isometric trial at P = " + std::to_string(100 * s.pathLength).substr(0, 5) + " cm";
                 spec.xLabel = "time (s)";
                 spec.yLabel = "force Fse (N)";
                 spec.series.push_back({"force", t.getColumn("time_s"), t.getColumn("force_N")});
-                writePlotPng(*plot, spec);
-                std::printf("wrote %s\n", plot->c_str());
+                writePlotPng(plotPath, spec);
             }
+            files.commit();
+            std::printf("final force %.4f N at t = %.3f s (%d steps, %d restarts); wrote %s\n", t.get(last, "force_N"),
+                        t.get(last, "time_s"), stats.steps, stats.restarts, out->c_str());
+            if (!plot->empty()) std::printf("wrote %s\n", plot->c_str());
         });
     }
 }

@@ -2,6 +2,7 @@
 // protocol as a main-job step.
 #include "basics/errors.h"
 #include "basics/files.h"
+#include "basics/output_folder.h"
 #include "basics/parallel.h"
 #include "basics/table.h"
 #include "cli/commands.h"
@@ -33,9 +34,35 @@ struct ProtocolOptions {
     int videoWidth = 1280, videoHeight = 720;
 };
 
-/// Renders the video of every trial of a finished run (replaying trials/<id>.csv) into videos/.
-void renderProtocolVideos(const ProtocolOptions& o, const ArmSetup& subject, const ProtocolResult& r,
-                          const std::string& out) {
+#ifdef ARMSIM_WITH_RENDER
+TrialVideoSettings makeVideoSettings(const ProtocolOptions& o) {
+    TrialVideoSettings v;
+    v.fps = o.videoFps;
+    v.render.width = o.videoWidth;
+    v.render.height = o.videoHeight;
+    return v;
+}
+#endif
+
+/// The renderer loaded and the --video-* options checked, named as typed.
+void checkVideoOptions(const ProtocolOptions& o) {
+    const RenderPlugin& render = getRenderPlugin("--video");
+#ifdef ARMSIM_WITH_RENDER
+    try {
+        render.validate(makeVideoSettings(o));
+    } catch (const FieldError& e) {
+        const std::string& f = e.getField();
+        const std::string option = f == "fps" ? "--video-fps" : f == "width" ? "--video-width" : f == "height" ? "--video-height" : f;
+        throw InputError(option + " " + e.getDetail());
+    }
+#else
+    (void)render;
+#endif
+}
+
+/// Renders the video of every trial of a run (replaying trials/<id>.csv) into its videos/, before the
+/// run is put in place: the run and its videos appear together.
+void renderProtocolVideos(const ProtocolOptions& o, const ArmSetup& subject, const ProtocolResult& r, OutputFolder& dir) {
 #ifdef ARMSIM_WITH_RENDER
     const int n = int(r.trialIds.size());
     if (n == 0) {
@@ -43,22 +70,24 @@ void renderProtocolVideos(const ProtocolOptions& o, const ArmSetup& subject, con
         return;
     }
     const RenderPlugin& render = getRenderPlugin("--video");
-    createFolder(out + "/videos");
+    std::vector<std::string> csv(n), video(n), name(n);
+    for (int i = 0; i < n; ++i) {  // addFile records the names: on this thread, before the workers
+        csv[i] = dir.addFile("trials/" + r.trialIds[i] + ".csv");
+        video[i] = dir.addFile("videos/" + r.trialIds[i] + ".mp4");
+        name[i] = dir.getTargetPath("trials/" + r.trialIds[i] + ".csv");
+    }
     runParallel(
         n, o.jobs,
         [&](int i) {
-            const std::string csv = out + "/trials/" + r.trialIds[i] + ".csv";
-            TrialVideoSettings v;
-            v.videoPath = out + "/videos/" + r.trialIds[i] + ".mp4";
-            v.tableName = csv;
-            v.fps = o.videoFps;
-            v.render.width = o.videoWidth;
-            v.render.height = o.videoHeight;
-            render.renderTrialVideo(subject, Table::readCsv(csv), v, {});
+            TrialVideoSettings v = makeVideoSettings(o);
+            v.videoPath = video[i];
+            v.tableName = name[i];
+            render.renderTrialVideo(subject, Table::readCsv(csv[i]), v, {});
         },
         [](int d, int total) { printProgress("trial videos", d, total); });
-    std::printf("  wrote %d videos to %s/videos/\n", n, out.c_str());
+    std::printf("  rendered %d videos into videos/\n", n);
 #else
+    (void)o, (void)subject, (void)r, (void)dir;
     throw InputError("--video: this armsim was built without the renderer (-DARMSIM_RENDER=OFF)");
 #endif
 }
@@ -112,7 +141,7 @@ void printResult(const Protocol& p, const ProtocolResult& r, const std::string& 
         std::printf("  %d compositions; table in composition_matrix.csv, heat map composition_heatmap.png\n",
                     r.composition.getNumRows());
     }
-    if (!outDir.empty()) std::printf("  wrote %zu files to %s/\n", r.files.size(), outDir.c_str());
+    if (!outDir.empty()) std::printf("  wrote %zu files to %s/\n", r.files.size(), showPath(outDir).c_str());
 }
 
 std::string defaultOut(const Protocol& p) { return "out/" + p.name; }
@@ -150,7 +179,7 @@ void runTorqueProtocolCommand(const ProtocolOptions& o, const std::string& file)
 }
 
 void runProtocolCommand(const ProtocolOptions& o) {
-    if (o.video) getRenderPlugin("--video");  // before the run: a missing renderer fails first
+    if (o.video) checkVideoOptions(o);  // before the run: a missing renderer or a bad setting fails first
     const std::string file = findAsset(o.file);
     if (isTorqueProtocolFile(file)) return runTorqueProtocolCommand(o, file);
     const Protocol protocol = readProtocol(file);
@@ -159,10 +188,10 @@ void runProtocolCommand(const ProtocolOptions& o) {
     std::printf("protocol %s (%s): %s\n", protocol.name.c_str(), getProtocolKindName(protocol.kind).c_str(),
                 protocol.description.c_str());
     std::fflush(stdout);
-    const ProtocolResult r =
-        runProtocol(protocol, subject, {out, o.jobs, [&](int d, int n) { printProgress(protocol.name, d, n); }});
+    ProtocolRunOptions run{out, o.jobs, [&](int d, int n) { printProgress(protocol.name, d, n); }, {}};
+    if (o.video) run.beforeCommit = [&](OutputFolder& dir, const ProtocolResult& r) { renderProtocolVideos(o, subject, r, dir); };
+    const ProtocolResult r = runProtocol(protocol, subject, run);
     printResult(protocol, r, out);
-    if (o.video) renderProtocolVideos(o, subject, r, out);
 }
 
 void addProtocolCommand(CLI::App& app) {
@@ -187,7 +216,7 @@ void runMvcProtocol(const MainJobContext& ctx) {
     const ProtocolResult r =
         runProtocol(protocol, subject, {out, ctx.jobs, [](int d, int n) { printProgress("MVC protocol trials", d, n); }});
     printResult(protocol, r, out);
-    std::printf("  plots: %s/force_angle.png, force_length.png, emg_trial.png\n", out.c_str());
+    std::printf("  plots: %s/force_angle.png, force_length.png, emg_trial.png\n", showPath(out).c_str());
 }
 
 const CommandRegistrar registerProtocol(30, addProtocolCommand);

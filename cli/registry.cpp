@@ -1,4 +1,5 @@
 #include "basics/errors.h"
+#include "basics/files.h"
 #include "basics/output_folder.h"
 #include "cli/commands.h"
 
@@ -145,11 +146,19 @@ void addRegisteredCommands(CLI::App& app) {
     run->callback([ctx] {
         auto& s = steps();
         std::stable_sort(s.begin(), s.end(), [](const Step& a, const Step& b) { return a.order < b.order; });
+        // Every step writes into a staging folder; the results join --out together at the end, or (an
+        // error, an interruption) none of them does and the staging folder is removed.
+        OutputFolder folder(ctx->outDir, OutputFolder::Mode::AddFiles);
+        MainJobContext staged = *ctx;
+        staged.outDir = folder.getStagingPath();
+        const ShownFolder shown(staged.outDir, ctx->outDir);  // messages name where the files will be
         for (const auto& step : s) {
             std::printf("\n== %s ==\n", step.name.c_str());
             std::fflush(stdout);
-            step.run(*ctx);
+            step.run(staged);
         }
+        folder.addStagedFiles();
+        folder.commit();
         std::printf("\nAll results are in %s/\n", ctx->outDir.c_str());
     });
 }

@@ -1,5 +1,7 @@
 // armsim render: a video and/or PNG still of a recorded trial (replayed from its table); and the
 // main-job step that leaves an MVC video, a free-movement video and a still in the output directory.
+#include "basics/files.h"
+#include "basics/output_folder.h"
 #include "basics/param_node.h"
 #include "cli/commands.h"
 #include "cli/plugins.h"
@@ -56,21 +58,23 @@ void runRenderCommand(const RenderOptions& o) {
     v.scene.arrowScale = o.arrowScale;
     v.scene.floor = !o.noFloor;
     v.scene.handLoad = o.load;
-    v.videoPath = o.out;
     if (o.stillAtOption->count()) v.stillTime = o.stillAt;
-    v.stillPath = o.still;
     v.tableName = o.table;
-    if (v.videoPath.empty() && !v.stillTime)
+    if (o.out.empty() && !v.stillTime)
         throw InputError("armsim render: nothing to write: expected --out VIDEO and/or --still-at T --still FILE.png");
+    OutputFiles files;  // the video and the still appear together at the end, or neither
+    v.videoPath = files.add("--out", o.out);
+    v.stillPath = files.add("--still", o.still);
     getRenderPlugin("render").validate(v);  // before the table is read
 
     const ArmSetup setup = o.muscle.loadSetup();
     const Table table = Table::readCsv(o.table);
     const TrialVideoResult r =
         getRenderPlugin("render").renderTrialVideo(setup, table, v, [](int d, int n) { printProgress("rendering", d, n); });
-    if (!r.stillPath.empty()) std::printf("wrote %s (still at t = %.3f s)\n", r.stillPath.c_str(), *v.stillTime);
+    files.commit();
+    if (!r.stillPath.empty()) std::printf("wrote %s (still at t = %.3f s)\n", o.still.c_str(), *v.stillTime);
     if (!r.videoPath.empty())
-        std::printf("wrote %s (%d frames, %dx%d, %g fps, %s)\n", r.videoPath.c_str(), r.frames, v.render.width,
+        std::printf("wrote %s (%d frames, %dx%d, %g fps, %s)\n", o.out.c_str(), r.frames, v.render.width,
                     v.render.height, v.fps, v.codec.c_str());
 }
 
@@ -132,14 +136,14 @@ void runTrialVideos(const MainJobContext& ctx) {
     v.tableName = "trial_mvc_90deg.csv";
     const RenderPlugin& render = getRenderPlugin("videos");
     TrialVideoResult r = render.renderTrialVideo(subject, mvc, v, [](int d, int n) { printProgress("MVC video", d, n); });
-    std::printf("  wrote %s (%d frames) and %s\n", r.videoPath.c_str(), r.frames, r.stillPath.c_str());
+    std::printf("  wrote %s (%d frames) and %s\n", showPath(r.videoPath).c_str(), r.frames, showPath(r.stillPath).c_str());
 
     v.videoPath = ctx.outDir + "/video_free_movement.mp4";
     v.stillTime.reset();
     v.stillPath.clear();
     v.tableName = "trial_free_movement.csv";
     r = render.renderTrialVideo(setup, movement, v, [](int d, int n) { printProgress("free-movement video", d, n); });
-    std::printf("  wrote %s (%d frames)\n", r.videoPath.c_str(), r.frames);
+    std::printf("  wrote %s (%d frames)\n", showPath(r.videoPath).c_str(), r.frames);
 }
 
 const CommandRegistrar registerRender(60, addRenderCommand);

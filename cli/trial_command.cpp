@@ -1,4 +1,6 @@
 // armsim trial: one isometric or free-movement trial of the arm; and the MVC-per-angle main-job step.
+#include "basics/files.h"
+#include "basics/output_folder.h"
 #include "basics/param_node.h"
 #include "basics/plot.h"
 #include "cli/commands.h"
@@ -28,21 +30,40 @@ struct TrialOptions {
     std::string out = "out/trial.csv", plot, video;
 };
 
-// --video: renders the written table (a replay of the trial).
-void renderVideo(const TrialOptions& o, const ArmSetup& setup, const Table& table, double handLoad) {
 #ifdef ARMSIM_WITH_RENDER
+TrialVideoSettings makeVideoSettings(const TrialOptions& o, const std::string& path, double handLoad) {
     TrialVideoSettings v;
-    v.videoPath = o.video;
+    v.videoPath = path;
     v.tableName = o.out;
     v.scene.handLoad = handLoad;
-    const TrialVideoResult r = getRenderPlugin("--video").renderTrialVideo(setup, table, v, [](int d, int n) { printProgress("video", d, n); });
-    std::printf("wrote %s (%d frames)\n", r.videoPath.c_str(), r.frames);
+    return v;
+}
+#endif
+
+// --video: renders the written table (a replay of the trial) to `path` (the staged file); its frame count.
+int renderVideo(const TrialOptions& o, const std::string& path, const ArmSetup& setup, const Table& table, double handLoad) {
+#ifdef ARMSIM_WITH_RENDER
+    return getRenderPlugin("--video")
+        .renderTrialVideo(setup, table, makeVideoSettings(o, path, handLoad), [](int d, int n) { printProgress("video", d, n); })
+        .frames;
+#else
+    (void)o, (void)path, (void)setup, (void)table, (void)handLoad;
+    return 0;
 #endif
 }
 
 void runTrialCommand(const TrialOptions& o) {
-    if (!o.video.empty()) getRenderPlugin("--video");  // before the trial: a missing renderer fails first
+    // Every output checked and staged before the trial; all appear together at the end, or none.
+    OutputFiles files;
+    const std::string csvPath = files.add("--out", o.out), plotPath = files.add("--plot", o.plot),
+                      videoPath = files.add("--video", o.video);
+#ifdef ARMSIM_WITH_RENDER
+    if (!o.video.empty()) getRenderPlugin("--video").validate(makeVideoSettings(o, videoPath, o.load));
+#else
+    if (!o.video.empty()) getRenderPlugin("--video");  // a missing renderer fails first
+#endif
     const ArmSetup setup = o.muscle.loadSetup();
+    int frames = 0;
     std::string type = o.type;
     IsometricTrialSettings iso;
     FreeMovementSettings free;
@@ -78,9 +99,8 @@ void runTrialCommand(const TrialOptions& o) {
     spec.xLabel = "time (s)";
     if (type == "isometric") {
         const IsometricTrialResult r = runIsometricTrial(setup, iso);
-        r.series.writeCsv(o.out);
-        std::printf("wrote %s\n", o.out.c_str());
-        if (!o.video.empty()) renderVideo(o, setup, r.series, 0);
+        r.series.writeCsv(csvPath);
+        if (!o.video.empty()) frames = renderVideo(o, videoPath, setup, r.series, 0);
         const IsometricSummary& s = r.summary;
         std::printf("isometric trial at %.1f deg: path %.2f cm, moment arm %.2f cm\n", radToDeg(s.elbowAngle),
                     100 * s.pathLength, 100 * s.momentArm);
@@ -101,9 +121,8 @@ void runTrialCommand(const TrialOptions& o) {
     } else {
         IntegrationStats stats;
         const Table t = runFreeMovement(setup, free, &stats);
-        t.writeCsv(o.out);
-        std::printf("wrote %s\n", o.out.c_str());
-        if (!o.video.empty()) renderVideo(o, setup, t, free.handLoad);
+        t.writeCsv(csvPath);
+        if (!o.video.empty()) frames = renderVideo(o, videoPath, setup, t, free.handLoad);
         std::printf("free movement: elbow %.1f -> %.1f deg in %.2f s (%d integrator steps)\n",
                     t.get(0, "elbow_angle_deg"), t.get(t.getNumRows() - 1, "elbow_angle_deg"), free.duration,
                     stats.steps);
@@ -111,10 +130,11 @@ void runTrialCommand(const TrialOptions& o) {
         spec.yLabel = "elbow angle (deg)";
         spec.series.push_back({"elbow angle", t.getColumn("time_s"), t.getColumn("elbow_angle_deg")});
     }
-    if (!o.plot.empty()) {
-        writePlotPng(o.plot, spec);
-        std::printf("wrote %s\n", o.plot.c_str());
-    }
+    if (!o.plot.empty()) writePlotPng(plotPath, spec);
+    files.commit();
+    std::printf("wrote %s\n", o.out.c_str());
+    if (!o.video.empty()) std::printf("wrote %s (%d frames)\n", o.video.c_str(), frames);
+    if (!o.plot.empty()) std::printf("wrote %s\n", o.plot.c_str());
 }
 
 void addTrialCommand(CLI::App& app) {
@@ -180,7 +200,7 @@ void runMvcAngles(const MainJobContext& ctx) {
     t.writeCsv(ctx.outDir + "/mvc_angles.csv");
     writePlotPng(ctx.outDir + "/mvc_angles.png", spec);
     std::printf("  (thesis measured 450-600 N, quadratic peak 603.3 N at 101.2 deg; see README on short paths)\n");
-    std::printf("  wrote %s/mvc_angles.csv, mvc_angles.png\n", ctx.outDir.c_str());
+    std::printf("  wrote %s/mvc_angles.csv, mvc_angles.png\n", showPath(ctx.outDir).c_str());
 }
 
 /// Main job: the same five-angle MVC on the anatomical twin (the virtual subject: agonists at its
@@ -254,7 +274,7 @@ void runSubjectMvcAngles(const MainJobContext& ctx) {
     writePlotPng(ctx.outDir + "/mvc_angles_twin.png", spec);
     std::printf("  the estimate credits the biceps with the brachialis' and brachioradialis' torque, less the\n"
                 "  triceps' co-contraction; wrote %s/mvc_angles_twin.csv, mvc_angles_twin.png\n",
-                ctx.outDir.c_str());
+                showPath(ctx.outDir).c_str());
 }
 
 const CommandRegistrar registerTrial(20, addTrialCommand);

@@ -465,7 +465,7 @@ ProtocolResult runProtocol(const Protocol& protocol, const ArmSetup& subject, co
         runTrials(protocol, subject, muscle, dir, options.jobs, run, progress);
         fitResults(protocol, run.result);
     }
-    if (dir.isEnabled()) detail::writeProtocolFiles(dir, protocol, subject, muscle, run);
+    if (dir.isEnabled()) detail::writeProtocolFiles(dir, protocol, subject, muscle, run, options.beforeCommit);
     return std::move(run.result);
 }
 

@@ -31,6 +31,9 @@
 
 namespace armsim {
 
+class OutputFolder;
+struct ProtocolResult;
+
 enum class ProtocolKind { Mvc, Submaximal, ForceLength, Composition };
 
 /// "mvc", "submaximal", "force_length", "composition".
@@ -95,6 +98,9 @@ struct ProtocolRunOptions {
     std::string outDir;
     int jobs = 1;                                         ///< worker threads (results do not depend on it)
     std::function<void(int done, int total)> progress;    ///< called from the caller's thread
+    /// Extra files written into the run before it is put in place (the trials' videos): they appear
+    /// with the run or not at all, and manifest.json lists them. Called only when outDir is set.
+    std::function<void(OutputFolder& dir, const ProtocolResult& result)> beforeCommit;
 };
 
 /// What a run gives (also written to the run directory).

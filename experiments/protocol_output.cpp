@@ -280,7 +280,8 @@ void plotForceLength(OutputFolder& dir, const ProtocolResult& result) {
 }  // namespace
 
 void writeProtocolFiles(OutputFolder& dir, const Protocol& protocol, const ArmSetup& subject,
-                        const VirtualMuscle& muscle, ProtocolRun& run) {
+                        const VirtualMuscle& muscle, ProtocolRun& run,
+                        const std::function<void(OutputFolder&, const ProtocolResult&)>& beforeCommit) {
     ProtocolResult& result = run.result;
     nlohmann::ordered_json manifest;
     manifest["armsim_version"] = ARMSIM_VERSION;
@@ -322,6 +323,7 @@ void writeProtocolFiles(OutputFolder& dir, const Protocol& protocol, const ArmSe
     if (result.emgToActivation) results["emg_to_activation"] = fitJson(*result.emgToActivation);
     manifest["results"] = results;
     dir.write("protocol.yaml", protocol.sourceText);
+    if (beforeCommit) beforeCommit(dir, result);
     dir.addFile("manifest.json");
     result.files = dir.getFiles();
     manifest["files"] = result.files;

@@ -54,9 +54,10 @@ inline std::vector<double> uniqueSorted(std::vector<double> v) {
 /// Significant digits of the numbers in result files.
 constexpr int kCsvDigits = 10;
 
-/// Writes the run's tables, fits, plots, protocol.yaml and manifest.json into dir and commits it; fills
-/// run.result.files.
+/// Writes the run's tables, fits, plots, protocol.yaml, what beforeCommit adds and manifest.json into
+/// dir and commits it; fills run.result.files.
 void writeProtocolFiles(OutputFolder& dir, const Protocol& protocol, const ArmSetup& subject,
-                        const VirtualMuscle& muscle, ProtocolRun& run);
+                        const VirtualMuscle& muscle, ProtocolRun& run,
+                        const std::function<void(OutputFolder&, const ProtocolResult&)>& beforeCommit);
 
 }  // namespace armsim::detail

@@ -25,6 +25,7 @@ namespace {
 
 constexpr int kMinSize = 16;
 constexpr int kMaxSize = 4096;
+constexpr double kMinFps = 1;    // below: a slide show (and FFmpeg refuses tiny rates)
 constexpr double kMaxFps = 240;
 
 struct CodecInfo {
@@ -87,7 +88,7 @@ void removeQuietly(const std::string& path) {
 }  // namespace
 
 void VideoSettings::validate() const {
-    checkField("fps", fps, {0, kMaxFps, true, false, "1/s"});
+    checkField("fps", fps, Bound::closed(kMinFps, kMaxFps, "1/s"));
     checkEvenSize("width", width);
     checkEvenSize("height", height);
     CodecInfo info;

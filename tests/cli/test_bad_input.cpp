@@ -191,6 +191,20 @@ std::vector<BadInput> makeCatalogue() {
                                             "  averaging_window: 0.5\nconditions:\n  elbow_angles_deg: [90]\n"
                                             "  levels_pct_mvc: [50, 100]\nsensors:\n  emg:\n    internal_rate: 1.0e12\n")}},
          "protocol IN/p.yaml --out OUT/run", {"p.yaml", "internal_rate", "1e+12"}},
+        // ---- several outputs: checked before the work, written together or not at all (issue 34) ----
+        {"TrialPlotIsTheCsv", {}, "trial --hold 0.2 --out OUT/t.csv --plot OUT/t.csv",
+         {"--plot", "is the file --out writes", "expected a path of its own"}},
+        {"TrialPlotUnderAFile", {{"afile", "x"}}, "trial --hold 0.2 --out OUT/t.csv --plot IN/afile/p.png",
+         {"--plot", "afile/p.png", "is a file"}},
+        {"TrialVideoUnderAFile", {{"afile", "x"}}, "trial --hold 0.2 --out OUT/t.csv --video IN/afile/v.mp4",
+         {"--video", "afile/v.mp4", "is a file"}},
+        {"SweepPlotUnderAFile", {{"afile", "x"}}, "muscle sweep --out OUT/s.csv --plot IN/afile/p.png",
+         {"--plot", "afile/p.png", "is a file"}},
+        {"MuscleTrialPlotIsTheCsv", {}, "muscle trial --out OUT/m.csv --plot OUT/m.csv", {"--plot", "is the file --out writes"}},
+        {"RenderStillIsTheVideo", {{"t.csv", "time_s\n0\n"}}, "render IN/t.csv --out OUT/v.mp4 --still-at 0.1 --still OUT/v.mp4",
+         {"--still", "is the file --out writes"}},
+        {"ProtocolVideoFpsTiny", {}, "protocol protocols/mvc_force_angle.yaml --out OUT/run --video --video-fps 1e-9",
+         {"--video-fps", "1e-09", "[1, 240]"}},
     };
 }
 

@@ -463,6 +463,28 @@ TEST(Cli, AnInterruptedProtocolLeavesNothingAndTheNextRunCleansUpAfterAKilledOne
     fs::remove_all(d);
 }
 
+// Issue 34: the main job writes into a staging folder and its results join --out together at the end;
+// stopped part-way (SIGTERM after 1.5 s: the model report and more are written by then) it leaves
+// nothing: no new folder, no file added to an existing one, no staging folder. Before, every file
+// written so far stayed while the message said "unfinished output removed".
+TEST(Cli, AnInterruptedMainJobLeavesNothing) {
+    namespace fs = std::filesystem;
+    const fs::path d = armsim::testing::makeFreshDir("cli", "main_job_stop");
+    fs::create_directories(d / "existing");
+    std::ofstream(d / "existing" / "mine.txt") << "a user's file\n";
+    for (const std::string& out : {"fresh", "existing"}) {
+        const armsim::testing::CommandResult r = armsim::testing::runCommand(
+            "sh -c '" + std::string(ARMSIM_EXE) + " run --out " + (d / out).string() +
+            " >/dev/null 2>&1 & pid=$!; sleep 1.5; kill -TERM $pid; wait $pid; echo rc=$?'");
+        EXPECT_NE(r.output.find("rc=143"), std::string::npos) << out << "\n" << r.output;
+    }
+    std::vector<std::string> left;
+    for (const auto& e : fs::recursive_directory_iterator(d)) left.push_back(fs::relative(e.path(), d).string());
+    std::sort(left.begin(), left.end());
+    EXPECT_EQ(left, (std::vector<std::string>{"existing", "existing/mine.txt"}));
+    fs::remove_all(d);
+}
+
 // Issue 34: a long command stops within a bound of SIGTERM in whichever phase the signal finds it
 // (simulating, sweeping, reading or formatting millions of rows), exits 128 + 15 and leaves no output.
 // Before: `trial --hold 5000` formatted its 5e6-row CSV for 10+ s, `muscle sweep` finished its

@@ -157,7 +157,8 @@ TEST(VideoWriter, BadSettingsThrowBeforeAnythingIsWritten) {
         {"height", [](VideoSettings& v) { v.height = 0; }, "'height' = 0"},
         {"width", [](VideoSettings& v) { v.width = 321; }, "even"},
         {"height", [](VideoSettings& v) { v.height = 10000; }, "4096"},
-        {"fps", [](VideoSettings& v) { v.fps = 0; }, "'fps' = 0: expected in (0, 240]"},
+        {"fps", [](VideoSettings& v) { v.fps = 0; }, "'fps' = 0: expected in [1, 240]"},
+        {"fps", [](VideoSettings& v) { v.fps = 1e-9; }, "'fps' = 1e-09"},
         {"fps", [](VideoSettings& v) { v.fps = -5; }, "'fps' = -5"},
         {"codec", [](VideoSettings& v) { v.codec = "xvid"; }, "'codec' = 'xvid': expected one of"},
     };
