@@ -5,6 +5,7 @@
 #include <signal.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cerrno>
 #include <cstdio>
@@ -138,8 +139,11 @@ void OutputFolder::commit() {
 // Every destination is checked first; files replaced are moved aside (into old_) so that a rename
 // failing part-way puts everything back: the folder ends with all the new files or none.
 void OutputFolder::commitInto() {
-    const std::vector<std::string> files = getFiles();
     std::error_code ec;
+    std::vector<std::string> written;  // a writer may decline to write (a plot without data)
+    for (const std::string& f : getFiles())
+        if (fs::exists(temp_ / f, ec)) written.push_back(f);
+    const std::vector<std::string>& files = written;
     for (const std::string& f : files) {
         const fs::path to = target_ / f;
         if (fs::exists(to, ec) && !fs::is_regular_file(to, ec))
@@ -283,6 +287,22 @@ std::string OutputFiles::add(const std::string& option, const std::string& path)
     fs::remove(staging, ec);
     entries_.push_back({option, target.string(), staging});
     return staging;
+}
+
+void OutputFiles::writeWith(const std::string& staging, const std::function<void(const std::string& path)>& writer) {
+    if (std::none_of(entries_.begin(), entries_.end(), [&](const Entry& e) { return e.staging == staging; }))
+        throw std::logic_error("OutputFiles::writeWith: '" + staging + "' was not added");
+    try {
+        writer(staging);
+    } catch (const InputError& e) {  // any staging file named as the option and the file typed
+        std::string message = e.what();
+        for (const Entry& x : entries_) {
+            const std::string to = x.option + " '" + x.target + "'";
+            for (std::size_t at = message.find(x.staging); at != std::string::npos; at = message.find(x.staging, at + to.size()))
+                message.replace(at, x.staging.size(), to);
+        }
+        throw InputError(message);
+    }
 }
 
 void OutputFiles::commit() {

@@ -93,6 +93,9 @@ public:
     /// it to. An empty path registers nothing and returns "". InputError naming both options when two
     /// give the same file, and naming the option when a folder is in the way or its folder cannot be made.
     std::string add(const std::string& option, const std::string& path);
+    /// Runs writer(staging) for a path add() returned; an InputError it throws is reported naming the
+    /// option and the file as typed instead of any staging file.
+    void writeWith(const std::string& staging, const std::function<void(const std::string& path)>& writer);
     /// Renames every staged file that was written into place (a registered file its writer never wrote
     /// is left out). InputError naming the path when a rename fails.
     void commit();

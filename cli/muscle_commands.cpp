@@ -175,14 +175,14 @@ void addMuscleCommands(CLI::App& app) {
                     y.push_back(s.force);
                 }
             }
-            t.writeCsv(csvPath);
+            files.writeWith(csvPath, [&](const std::string& p) { t.writeCsv(p); });
             if (!plot->empty()) {
                 PlotSpec spec;
                 spec.title = m.getName() + ": steady force vs path length";
                 spec.xLabel = "path length (cm)";
                 spec.yLabel = "force Fse (N)";
                 spec.series.push_back({"U = " + std::to_string(*U).substr(0, 4), x, y});
-                writePlotPng(plotPath, spec);
+                files.writeWith(plotPath, [&](const std::string& p) { writePlotPng(p, spec); });
             }
             files.commit();
             std::printf("wrote %s (%d path lengths)\n", out->c_str(), n);
@@ -230,7 +230,7 @@ void addMuscleCommands(CLI::App& app) {
             else s.activation = ActivationProfile::constant(*U);
             IntegrationStats stats;
             const Table t = runMuscleIsometric(m, s, &stats);
-            t.writeCsv(csvPath);
+            files.writeWith(csvPath, [&](const std::string& p) { t.writeCsv(p); });
             const int last = t.getNumRows() - 1;
             if (!plot->empty()) {
                 PlotSpec spec;
@@ -238,7 +238,7 @@ void addMuscleCommands(CLI::App& app) {
                 spec.xLabel = "time (s)";
                 spec.yLabel = "force Fse (N)";
                 spec.series.push_back({"force", t.getColumn("time_s"), t.getColumn("force_N")});
-                writePlotPng(plotPath, spec);
+                files.writeWith(plotPath, [&](const std::string& p) { writePlotPng(p, spec); });
             }
             files.commit();
             std::printf("final force %.4f N at t = %.3f s (%d steps, %d restarts); wrote %s\n", t.get(last, "force_N"),

@@ -152,10 +152,25 @@ void addRegisteredCommands(CLI::App& app) {
         MainJobContext staged = *ctx;
         staged.outDir = folder.getStagingPath();
         const ShownFolder shown(staged.outDir, ctx->outDir);  // messages name where the files will be
-        for (const auto& step : s) {
-            std::printf("\n== %s ==\n", step.name.c_str());
-            std::fflush(stdout);
-            step.run(staged);
+        auto named = [&](const std::exception& e) {  // a message names files where they would have been
+            std::string m = e.what();
+            const std::string& from = staged.outDir;
+            for (std::size_t at = m.find(from); at != std::string::npos; at = m.find(from, at + ctx->outDir.size()))
+                m.replace(at, from.size(), ctx->outDir);
+            return m;
+        };
+        try {
+            for (const auto& step : s) {
+                std::printf("\n== %s ==\n", step.name.c_str());
+                std::fflush(stdout);
+                step.run(staged);
+            }
+        } catch (const FieldError& e) {
+            throw InputError(named(e));
+        } catch (const InputError& e) {
+            throw InputError(named(e));
+        } catch (const SimulationError& e) {
+            throw SimulationError(named(e));
         }
         folder.addStagedFiles();
         folder.commit();

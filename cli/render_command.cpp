@@ -69,8 +69,10 @@ void runRenderCommand(const RenderOptions& o) {
 
     const ArmSetup setup = o.muscle.loadSetup();
     const Table table = Table::readCsv(o.table);
-    const TrialVideoResult r =
-        getRenderPlugin("render").renderTrialVideo(setup, table, v, [](int d, int n) { printProgress("rendering", d, n); });
+    TrialVideoResult r;
+    files.writeWith(v.videoPath.empty() ? v.stillPath : v.videoPath, [&](const std::string&) {
+        r = getRenderPlugin("render").renderTrialVideo(setup, table, v, [](int d, int n) { printProgress("rendering", d, n); });
+    });
     files.commit();
     if (!r.stillPath.empty()) std::printf("wrote %s (still at t = %.3f s)\n", o.still.c_str(), *v.stillTime);
     if (!r.videoPath.empty())

@@ -99,8 +99,9 @@ void runTrialCommand(const TrialOptions& o) {
     spec.xLabel = "time (s)";
     if (type == "isometric") {
         const IsometricTrialResult r = runIsometricTrial(setup, iso);
-        r.series.writeCsv(csvPath);
-        if (!o.video.empty()) frames = renderVideo(o, videoPath, setup, r.series, 0);
+        files.writeWith(csvPath, [&](const std::string& p) { r.series.writeCsv(p); });
+        if (!o.video.empty())
+            files.writeWith(videoPath, [&](const std::string& p) { frames = renderVideo(o, p, setup, r.series, 0); });
         const IsometricSummary& s = r.summary;
         std::printf("isometric trial at %.1f deg: path %.2f cm, moment arm %.2f cm\n", radToDeg(s.elbowAngle),
                     100 * s.pathLength, 100 * s.momentArm);
@@ -121,8 +122,9 @@ void runTrialCommand(const TrialOptions& o) {
     } else {
         IntegrationStats stats;
         const Table t = runFreeMovement(setup, free, &stats);
-        t.writeCsv(csvPath);
-        if (!o.video.empty()) frames = renderVideo(o, videoPath, setup, t, free.handLoad);
+        files.writeWith(csvPath, [&](const std::string& p) { t.writeCsv(p); });
+        if (!o.video.empty())
+            files.writeWith(videoPath, [&](const std::string& p) { frames = renderVideo(o, p, setup, t, free.handLoad); });
         std::printf("free movement: elbow %.1f -> %.1f deg in %.2f s (%d integrator steps)\n",
                     t.get(0, "elbow_angle_deg"), t.get(t.getNumRows() - 1, "elbow_angle_deg"), free.duration,
                     stats.steps);
@@ -130,7 +132,7 @@ void runTrialCommand(const TrialOptions& o) {
         spec.yLabel = "elbow angle (deg)";
         spec.series.push_back({"elbow angle", t.getColumn("time_s"), t.getColumn("elbow_angle_deg")});
     }
-    if (!o.plot.empty()) writePlotPng(plotPath, spec);
+    if (!o.plot.empty()) files.writeWith(plotPath, [&](const std::string& p) { writePlotPng(p, spec); });
     files.commit();
     std::printf("wrote %s\n", o.out.c_str());
     if (!o.video.empty()) std::printf("wrote %s (%d frames)\n", o.video.c_str(), frames);

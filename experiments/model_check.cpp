@@ -1,5 +1,7 @@
 #include "experiments/model_check.h"
 
+#include "basics/output_folder.h"
+
 #include "basics/csv.h"
 #include "basics/files.h"
 #include "basics/plot.h"
@@ -45,8 +47,8 @@ ModelCheckResult writeModelCheck(const ArmSetup& setup, const std::vector<Anatom
     ModelCheckResult r;
     r.scores = scoreAnatomy(setup, targets);
     r.summary = summarizeScores(r.scores);
-    createFolder(outDir);
-    auto path = [&](const std::string& f) { return outDir + "/" + f; };
+    OutputFolder folder(outDir, OutputFolder::Mode::AddFiles);  // every file appears at the end, or none
+    auto path = [&](const std::string& f) { return folder.getTargetPath(f); };
 
     CsvText card({"kind", "muscle", "direction", "flexion_deg", "value", "lower", "upper", "tolerance", "unit", "pass",
                   "source", "where"});
@@ -59,7 +61,7 @@ ModelCheckResult writeModelCheck(const ArmSetup& setup, const std::vector<Anatom
         row.addText(getTargetSiUnit(t.kind)).addInteger(s.pass ? 1 : 0).addText(t.source).addText(t.where);
         card.addRow(row);
     }
-    writeFileAtomically(path("scorecard.csv"), card.getText());
+    folder.write("scorecard.csv", card.getText());
     CsvText summary({"kind", "muscle", "passed", "scored", "fraction"});
     for (const ScoreSummary& s : r.summary) {
         CsvRow row;
@@ -67,7 +69,7 @@ ModelCheckResult writeModelCheck(const ArmSetup& setup, const std::vector<Anatom
         row.addNumber(double(s.passed) / s.scored);
         summary.addRow(row);
     }
-    writeFileAtomically(path("score_summary.csv"), summary.getText());
+    folder.write("score_summary.csv", summary.getText());
     r.files = {path("scorecard.csv"), path("score_summary.csv")};
 
     // Moment arms: every muscle's curve, the bands of its targets in the same colour.
@@ -88,7 +90,7 @@ ModelCheckResult writeModelCheck(const ArmSetup& setup, const std::vector<Anatom
     for (const PlotSeries& c : arms.series)
         for (double y : c.y) top = std::max(top, y);
     arms.yMax = 2 * top;
-    writePlotPng(path("check_moment_arms.png"), arms);
+    folder.writeWith("check_moment_arms.png", [&](const std::string& p) { writePlotPng(p, arms); });
 
     PlotSpec mvc;
     mvc.title = "Steady MVC torque; markers: published band +/- tolerance";
@@ -107,9 +109,10 @@ ModelCheckResult writeModelCheck(const ArmSetup& setup, const std::vector<Anatom
     for (const PlotSeries& c : mvc.series)
         for (double y : c.y) highest = std::max(highest, y);
     mvc.yMax = 1.5 * highest;
-    writePlotPng(path("check_mvc.png"), mvc);
+    folder.writeWith("check_mvc.png", [&](const std::string& p) { writePlotPng(p, mvc); });
     r.files.push_back(path("check_moment_arms.png"));
     r.files.push_back(path("check_mvc.png"));
+    folder.commit();
     return r;
 }
 

@@ -1,5 +1,7 @@
 #include "experiments/model_report.h"
 
+#include "basics/output_folder.h"
+
 #include "muscles/muscle_models.h"
 
 #include "basics/files.h"
@@ -210,9 +212,9 @@ MvcCurveSummary summarizeMvcCurve(const SteadyMvcCurve& curve) {
 ModelReportFiles writeModelReport(const ArmSetup& setup, const std::string& outDir, double stepDeg,
                                   const ElbowReference& reference) {
     namespace fs = std::filesystem;
-    createFolder(outDir);
+    OutputFolder folder(outDir, OutputFolder::Mode::AddFiles);  // every file appears at the end, or none
     ModelReportFiles out;
-    auto path = [&](const std::string& f) { return (fs::path(outDir) / f).string(); };
+    auto path = [&](const std::string& f) { return folder.getTargetPath(f); };
 
     out.muscles = calcMuscleTable(setup);
     const Table& muscles = out.muscles;
@@ -225,11 +227,11 @@ ModelReportFiles writeModelReport(const ArmSetup& setup, const std::string& outD
         for (double v : muscles.getRow(i)) text += "," + formatNumber(v);
         text += "\n";
     }
-    writeFileAtomically(path("muscles.csv"), text);
+    folder.write("muscles.csv", text);
     out.files.push_back(path("muscles.csv"));
 
     const Table arms = calcMomentArmTable(setup, stepDeg);
-    arms.writeCsv(path("moment_arms.csv"));
+    folder.write("moment_arms.csv", arms.toCsv());
     out.files.push_back(path("moment_arms.csv"));
     PlotSpec armPlot;
     armPlot.title = "Moment arms, model " + setup.name + " (virtual work); markers: published ranges";
@@ -252,13 +254,13 @@ ModelReportFiles writeModelReport(const ArmSetup& setup, const std::string& outD
     }
     if (!refs.x.empty()) armPlot.series.push_back(refs);
     setRangeWithLegendRoom(armPlot);
-    writePlotPng(path("moment_arms.png"), armPlot);
+    folder.writeWith("moment_arms.png", [&](const std::string& p) { writePlotPng(p, armPlot); });
     out.files.push_back(path("moment_arms.png"));
 
     if (setup.arm.forearmRotation.enabled) {
         constexpr double kForearmFlexionDeg = 90;  // the usual forearm-rotation test posture (elbow at a right angle)
         const Table fa = calcForearmMomentArmTable(setup, kForearmFlexionDeg, stepDeg);
-        fa.writeCsv(path("forearm_moment_arms.csv"));
+        folder.write("forearm_moment_arms.csv", fa.toCsv());
         out.files.push_back(path("forearm_moment_arms.csv"));
         PlotSpec plot;
         plot.title = "Forearm-rotation moment arms at 90 deg flexion, model " + setup.name + " (virtual work)";
@@ -267,7 +269,7 @@ ModelReportFiles writeModelReport(const ArmSetup& setup, const std::string& outD
         plot.legend = PlotSpec::Legend::TopLeft;
         addMomentArmSeries(plot, setup, fa, "rotation_deg", "forearm_moment_arm_", true);  // those that rotate it
         setRangeWithLegendRoom(plot);
-        writePlotPng(path("forearm_moment_arms.png"), plot);
+        folder.writeWith("forearm_moment_arms.png", [&](const std::string& p) { writePlotPng(p, plot); });
         out.files.push_back(path("forearm_moment_arms.png"));
     }
 
@@ -278,7 +280,7 @@ ModelReportFiles writeModelReport(const ArmSetup& setup, const std::string& outD
         const double sign = flexion ? 1.0 : -1.0;  // plot the effort's torque as positive
         const SteadyMvcCurve curve = calcSteadyMvcCurve(setup, g, setup.effort, angles);
         const Table t = formatMvcCurve(setup, curve);
-        t.writeCsv(path("mvc_" + name + ".csv"));
+        folder.write("mvc_" + name + ".csv", t.toCsv());
         out.files.push_back(path("mvc_" + name + ".csv"));
         (flexion ? out.flexion : out.extension) = summarizeMvcCurve(curve);
         if (flexion)
@@ -320,9 +322,10 @@ ModelReportFiles writeModelReport(const ArmSetup& setup, const std::string& outD
             for (double v : ps.y) top = std::max(top, v);
         plot.yMin = 0;
         if (top > 0) plot.yMax = 1.7 * top;  // room for the legend above the curves (none: a model without the group)
-        writePlotPng(path("mvc_" + name + ".png"), plot);
+        folder.writeWith("mvc_" + name + ".png", [&](const std::string& p) { writePlotPng(p, plot); });
         out.files.push_back(path("mvc_" + name + ".png"));
     }
+    folder.commit();
     return out;
 }
 

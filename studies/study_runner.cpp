@@ -3,6 +3,7 @@
 #include "basics/bound.h"
 #include "basics/errors.h"
 #include "basics/files.h"
+#include "basics/output_folder.h"
 #include "basics/format.h"
 #include "basics/parallel.h"
 #include "basics/plot.h"
@@ -602,7 +603,9 @@ void forEachResultInTaskOrder(const std::string& journalPath, const std::string&
 
 std::vector<std::string> writeStudyFiles(const Study& study, const std::string& dir, const std::string& journalPath,
                                          long passBytes) {
-    AtomicFileWriter table(dir + "/results.csv"), timing(dir + "/timing.csv");
+    // The study's files join its folder (beside the journal) together at the end, or none of them.
+    OutputFolder folder(dir, OutputFolder::Mode::AddFiles);
+    AtomicFileWriter table(folder.addFile("results.csv")), timing(folder.addFile("timing.csv"));
     table.write(getStudyResultsHeader() + '\n');
     timing.write("task,rank,synthesis_s,identification_s\n");
     StudySummaryAccumulator sum(study);
@@ -616,10 +619,10 @@ std::vector<std::string> writeStudyFiles(const Study& study, const std::string& 
     const std::vector<StudySummaryRow> summary = sum.getRows();
     table.commit();
     timing.commit();
-    writeFileAtomically(dir + "/summary.csv", formatStudySummaryCsv(summary));
+    folder.write("summary.csv", formatStudySummaryCsv(summary));
     std::vector<std::string> files = {"results.csv", "summary.csv", "timing.csv"};
     if (!study.file.empty()) {
-        writeFileAtomically(dir + "/study.yaml", readFileText(study.file));
+        folder.write("study.yaml", readFileText(study.file));
         files.push_back("study.yaml");
     }
     const std::string& primary = study.prior.base.muscles.at(study.prior.base.primary).params.name;
@@ -637,8 +640,10 @@ std::vector<std::string> writeStudyFiles(const Study& study, const std::string& 
          [](const ElbowValidationSummary& x) { return 1000 * x.tendonRmse; }},
     };
     for (const auto& p : plots) {
-        writeNoisePlot(dir + "/" + p.file, primary + " " + p.title, p.yLabel, summary, p.statistic, study.truths.size() > 1);
-        if (doesPathExist(dir + "/" + p.file)) files.push_back(p.file);
+        folder.writeWith(p.file, [&](const std::string& path) {
+            writeNoisePlot(path, primary + " " + p.title, p.yLabel, summary, p.statistic, study.truths.size() > 1);
+            if (doesPathExist(path)) files.push_back(p.file);
+        });
     }
     if (study.truths.size() > 1) {
         const struct {
@@ -660,10 +665,13 @@ std::vector<std::string> writeStudyFiles(const Study& study, const std::string& 
              [](const ElbowValidationSummary& x) { return 100 * x.maxForceRmse; }, 1},
         };
         for (const auto& m : maps) {
-            writeTruthHeatMap(dir + "/" + m.file, primary + " " + m.title, m.zLabel, study, summary, m.statistic, m.decimals);
-            if (doesPathExist(dir + "/" + m.file)) files.push_back(m.file);
+            folder.writeWith(m.file, [&](const std::string& path) {
+                writeTruthHeatMap(path, primary + " " + m.title, m.zLabel, study, summary, m.statistic, m.decimals);
+                if (doesPathExist(path)) files.push_back(m.file);
+            });
         }
     }
+    folder.commit();
     return files;
 }
 

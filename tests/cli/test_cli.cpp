@@ -485,6 +485,46 @@ TEST(Cli, AnInterruptedMainJobLeavesNothing) {
     fs::remove_all(d);
 }
 
+// Issue 34: on a full disk (a 48 KiB tmpfs) every command that fails leaves no partial output: no
+// folder, no staging file; a study keeps only its journal (to resume from) and lock. Before, model
+// show left the files written before the failing one, and a study its results, summary and timing
+// as if complete. Skipped where tmpfs cannot be mounted (not root).
+TEST(Cli, AFullDiskLeavesNoPartialOutput) {
+    namespace fs = std::filesystem;
+    const fs::path d = armsim::testing::makeFreshDir("cli", "full_disk");
+    const fs::path small = d / "small";
+    fs::create_directories(small);
+    if (armsim::testing::runCommand("mount -t tmpfs -o size=48k tmpfs " + small.string()).exitCode != 0)
+        GTEST_SKIP() << "cannot mount a tmpfs here";
+    struct Unmount {
+        fs::path at;
+        ~Unmount() { armsim::testing::runCommand("umount " + at.string()); }
+    } unmount{small};
+    std::ofstream(d / "tiny.yaml") << "kind: study\nname: tiny\nsubjects: 2\nprotocols: [thesis]\nnoise_levels: [0.02]\n"
+                                      "methods:\n  - {method: thesis}\n";
+    const struct {
+        std::string args, expect;
+        std::vector<std::string> left;  // what may stay in small/ afterwards
+    } cases[] = {
+        {"model show --model twin --out " + (small / "ms").string(), "disk full", {}},
+        {"trial --hold 3 --out " + (small / "t.csv").string() + " --plot " + (small / "p.png").string(),
+         "--out '" + (small / "t.csv").string() + "': write failed (disk full?)", {}},
+        {"study " + (d / "tiny.yaml").string() + " --out " + (small / "st").string(), "disk full",
+         {"st", "st/.lock", "st/journal.log"}},
+        {"run --out " + (small / "run").string(), "disk full", {}},
+    };
+    for (const auto& c : cases) {
+        const CommandResult r = runArmsim(c.args);
+        EXPECT_EQ(r.exitCode, 2) << c.args << "\n" << r.output;
+        EXPECT_NE(r.output.find(c.expect), std::string::npos) << c.args << "\n" << r.output;
+        std::vector<std::string> left;
+        for (const auto& e : fs::recursive_directory_iterator(small)) left.push_back(fs::relative(e.path(), small).string());
+        std::sort(left.begin(), left.end());
+        EXPECT_EQ(left, c.left) << c.args;
+        for (const auto& e : fs::directory_iterator(small)) fs::remove_all(e.path());
+    }
+}
+
 // Issue 34: a long command stops within a bound of SIGTERM in whichever phase the signal finds it
 // (simulating, sweeping, reading or formatting millions of rows), exits 128 + 15 and leaves no output.
 // Before: `trial --hold 5000` formatted its 5e6-row CSV for 10+ s, `muscle sweep` finished its
