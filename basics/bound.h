@@ -25,6 +25,15 @@ struct Bound {
     std::string describe() const;   ///< e.g. "> 0 (kg)" or "in [0, 1]"
 };
 
+/// Bounds of quantities read in several places (command-line options, model, arm and trial files,
+/// render settings, Python), so that every entry point refuses the same values.
+namespace bounds {
+constexpr Bound kHandLoad{0, 50, false, false, "kg"};   ///< a load held in the hand
+constexpr Bound kMuscleMass{0, 10, true, false, "kg"};  ///< a muscle's mass (10 L; the largest muscles ~1 kg)
+constexpr Bound kTendonLength{0, 2, true, false, "m"};  ///< a muscle's optimal tendon length L0T
+constexpr Bound kMotorUnits{0, 1000, false, false, ""}; ///< motor units of one fibre type
+}  // namespace bounds
+
 /// Throws FieldError naming field, value and bound unless value is finite and inside bound.
 void checkField(const std::string& field, double value, const Bound& bound);
 

@@ -65,10 +65,14 @@ ArmSetup MuscleOptions::loadSetup() const {
             throw InputError(std::string("option ") + e.what());
         }
     };
-    if (slowUnits) check("--slow-units", *slowUnits, Bound::closed(0, 1000)), p.numSlowUnits = *slowUnits;
-    if (fastUnits) check("--fast-units", *fastUnits, Bound::closed(0, 1000)), p.numFastUnits = *fastUnits;
-    if (mass) check("--mass", *mass, Bound{0, 100, true, false, "kg"}), p.mass = *mass;
-    if (tendonLength) check("--tendon-length", *tendonLength, Bound{0, 2, true, false, "m"}), p.optimalTendonLength = *tendonLength;
+    if (slowUnits) check("--slow-units", *slowUnits, bounds::kMotorUnits), p.numSlowUnits = *slowUnits;
+    if (fastUnits) check("--fast-units", *fastUnits, bounds::kMotorUnits), p.numFastUnits = *fastUnits;
+    if ((slowUnits || fastUnits) && p.numSlowUnits + p.numFastUnits == 0)
+        throw InputError("options --slow-units " + std::to_string(p.numSlowUnits) + " and --fast-units " +
+                         std::to_string(p.numFastUnits) + ": expected at least one motor unit in all (without units "
+                         "a muscle makes no active force)");
+    if (mass) check("--mass", *mass, bounds::kMuscleMass), p.mass = *mass;
+    if (tendonLength) check("--tendon-length", *tendonLength, bounds::kTendonLength), p.optimalTendonLength = *tendonLength;
     if (maxPathLength) {
         check("--max-path", *maxPathLength, Bound{0, 3, true, false, "m"});
         p.maxPathLength = *maxPathLength;

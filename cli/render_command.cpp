@@ -14,6 +14,7 @@
 
 #include <cstdio>
 #include <future>
+#include <map>
 #include <memory>
 #endif
 
@@ -65,7 +66,19 @@ void runRenderCommand(const RenderOptions& o) {
     OutputFiles files;  // the video and the still appear together at the end, or neither
     v.videoPath = files.add("--out", o.out);
     v.stillPath = files.add("--still", o.still);
-    getRenderPlugin("render").validate(v);  // before the table is read
+    try {
+        getRenderPlugin("render").validate(v);  // before the table is read
+    } catch (const FieldError& e) {  // a setting from an option: named as typed
+        static const std::map<std::string, std::string> options = {
+            {"hand_load", "--load"}, {"fps", "--fps"}, {"codec", "--codec"}, {"playback_speed", "--speed"},
+            {"arrow_scale", "--arrow-scale"}, {"still_at", "--still-at"}, {"still", "--still"},
+            {"width", "--width"}, {"height", "--height"}, {"supersample", "--supersample"}};
+        const auto it = options.find(e.getField());
+        const bool fromFile = !o.renderSettingsFile.empty() && it != options.end() &&
+                              (it->first == "width" || it->first == "height" || it->first == "supersample");
+        if (it == options.end() || fromFile) throw;
+        throw InputError(it->second + " " + e.getDetail());
+    }
 
     const ArmSetup setup = o.muscle.loadSetup();
     const Table table = Table::readCsv(o.table);

@@ -87,6 +87,10 @@ void runTrialCommand(const TrialOptions& o) {
         checkField("--activation", o.activation, Bound::closed(0, 1));
         checkField("--onset", o.onset, Bound::nonNegative("s"));
         checkField("--rise", o.rise, Bound::nonNegative("s"));
+        if (o.activation > 0 && !(o.onset < o.duration))
+            throw InputError("--onset " + formatNumber(o.onset) + " s is not before the end of the movement (--duration " +
+                             formatNumber(o.duration) + " s): expected an onset before the end (the activation would "
+                             "never start)");
         free.activation = o.rise > 0 ? ActivationProfile::ramp(o.onset, o.onset + o.rise, 0.0, o.activation)
                                      : ActivationProfile::step(o.onset, 0.0, o.activation);
         free.duration = o.duration;

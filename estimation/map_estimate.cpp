@@ -1,9 +1,9 @@
 #include "estimation/map_estimate.h"
 
 #include "basics/errors.h"
+#include "estimation/ceres_logging.h"
 
 #include <ceres/ceres.h>
-#include <glog/logging.h>
 #include <Eigen/Cholesky>
 #include <Eigen/Dense>
 
@@ -79,10 +79,8 @@ std::vector<std::vector<double>> calcSmoothedCovariance(const MapProblem& proble
 
 MapResult calcMapEstimate(const MapProblem& problem) {
     // Ceres reports a singular covariance through glog's stderr as well as through Compute's result;
-    // armsim reports it in the message (and falls back on the smoothed Jacobian): glog stays quiet
-    // below FATAL.
-    static const bool quietGlog = (FLAGS_minloglevel = google::GLOG_FATAL, true);
-    (void)quietGlog;
+    // armsim reports it in the message (and falls back on the smoothed Jacobian).
+    quietCeresLogging();
     const int n = int(problem.priorMean.size());
     if (n == 0 || int(problem.priorCovariance.size()) != n)
         throw std::invalid_argument("calcMapEstimate: prior mean and covariance sizes differ");

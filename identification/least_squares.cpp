@@ -3,6 +3,7 @@
 #include "basics/format.h"
 #include "basics/portable_random.h"
 #include "identification/solver_context.h"
+#include "estimation/ceres_logging.h"
 #include "estimation/statistics.h"
 
 #include <ceres/ceres.h>
@@ -195,6 +196,7 @@ void addUncertainty(SolverContext& ctx, Run& run, const std::vector<double>& r, 
                                  "(armsim identify --force-sd; IdentificationOptions::forceSd) to get them";
         return;
     }
+    quietCeresLogging();  // a rank-deficient covariance is reported in uncertaintyNote, not on stderr
     ceres::Covariance::Options co;
     co.algorithm_type = ceres::DENSE_SVD;
     co.num_threads = 1;

@@ -6,6 +6,7 @@
 #include "model/arm_parameters.h"
 #include "model/geometry.h"
 
+#include <algorithm>
 #include <cmath>
 #include <set>
 #include <sstream>
@@ -132,6 +133,9 @@ ObservationSet makeObservations(const Table& t, const std::string& path, const O
     }
     if (set.points.empty())
         throw InputError(path + ": no data rows for subject " + std::to_string(options.subject));
+    if (std::none_of(set.points.begin(), set.points.end(), [](const Observation& o) { return o.force > 0; }))
+        throw InputError(path + ": column 'force_N' is 0 N in every row: expected a positive force in one row at "
+                                "least (nothing to fit: every mass and tendon length at their bounds would do)");
     validateObservations(set);
     return set;
 }

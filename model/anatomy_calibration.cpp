@@ -3,6 +3,8 @@
 #include "basics/errors.h"
 #include "basics/bound.h"
 
+#include "estimation/ceres_logging.h"
+
 #include <ceres/ceres.h>
 
 #include <algorithm>
@@ -145,6 +147,7 @@ AnatomyCalibrationResult calibrateToAnatomy(const ArmSetup& setup, const std::ve
         bound(3 * g + 2, options.fascicleMin, options.fascicleMax);
     }
     for (int m = 0; m < setup.getNumMuscles(); ++m) bound(3 * G + m, options.tendonMin, options.tendonMax);
+    quietCeresLogging();
     ceres::Solver::Options so;
     so.max_num_iterations = options.maxIterations;
     so.function_tolerance = 1e-8;

@@ -130,7 +130,7 @@ GeneralForceSubsystem& ArmModel::updForces() {
 
 void ArmModel::setHandLoad(double mass) {
     requireNotFinalized("setHandLoad");
-    checkField("hand_load", mass, Bound::nonNegative("kg"));
+    checkField("hand_load", mass, bounds::kHandLoad);
     params_.handLoad = mass;
     forearm_.setDefaultMassProperties(calcForearmMassProperties());
 }

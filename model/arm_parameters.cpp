@@ -51,7 +51,7 @@ void ArmParameters::validate() const {
         for (double c : r.axisPoint) checkField("forearm_rotation.axis_point", c, Bound::closed(-1, 1, "m"));
     }
     checkField("gravity", gravity, Bound::nonNegative("m/s^2"));
-    checkField("hand_load", handLoad, Bound::closed(0, 50, "kg"));   // as a trial's hand_load
+    checkField("hand_load", handLoad, bounds::kHandLoad);   // as a trial's hand_load
 }
 
 ArmParameters ArmParameters::scaled(double newBodyMass, double newBodyHeight) const {

@@ -2,6 +2,8 @@
 
 #include "basics/errors.h"
 
+#include "estimation/ceres_logging.h"
+
 #include <ceres/ceres.h>
 
 #include <algorithm>
@@ -125,6 +127,7 @@ StrengthCalibrationResult calibrateStrength(const ArmSetup& setup, const MvcTorq
         pr.SetParameterUpperBound(x.data(), j, hi);
     }
     if (!options.fitFascicleLength) pr.SetManifold(x.data(), new ceres::SubsetManifold(n + 2, {n}));
+    quietCeresLogging();
     ceres::Solver::Options so;
     so.max_num_iterations = options.maxIterations;
     so.function_tolerance = 1e-10;

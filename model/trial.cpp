@@ -327,10 +327,15 @@ void FreeMovementSettings::validate(const ArmParameters& arm) const {
     checkElbowAngle("initial_angle_deg", initialAngle, arm);
     checkField("initial_velocity_degps", cleanDegrees(initialVelocity), Bound::closed(-2000, 2000, "deg/s"));
     checkField("duration", duration, Bound::positive("s"));
-    checkField("hand_load", handLoad, Bound::closed(0, 50, "kg"));
+    checkField("hand_load", handLoad, bounds::kHandLoad);
     checkField("sample_rate", sampleRate, Bound::positive("Hz"));
     calcNumSamples(duration, sampleRate);
     integration.validate();
+    const std::vector<double>& t = activation.getBreakpoints();
+    if (activation.getValue(0) == 0 && activation.getMaxValue() > 0 && !t.empty() && t.front() >= duration)
+        throw FieldError("onset", "= " + formatNumber(t.front()) + " s is not before the end of the movement (duration " +
+                                      formatNumber(duration) + " s): expected an onset before the end (the activation "
+                                      "would never start)");
 }
 
 Table runFreeMovement(const ArmSetup& setup, const FreeMovementSettings& settings, IntegrationStats* stats) {

@@ -88,13 +88,16 @@ void MuscleCoefficients::validate(const std::string& p) const {
 }
 
 void MuscleParameters::validate() const {
-    checkField("mass", mass, Bound{0, 10, true, false, "kg"});   // the volume's bound, 10 L (the largest muscles: ~1 kg)
+    checkField("mass", mass, bounds::kMuscleMass);
     checkField("optimal_fascicle_length", optimalFascicleLength, Bound::positive("m"));
-    checkField("optimal_tendon_length", optimalTendonLength, Bound::positive("m"));
+    checkField("optimal_tendon_length", optimalTendonLength, bounds::kTendonLength);
     checkField("max_path_length", maxPathLength, Bound::positive("m"));
     checkField("fibre_fractions.slow", slowFraction, Bound::closed(0, 1));
-    checkField("motor_units.slow", numSlowUnits, Bound::closed(0, 1000));
-    checkField("motor_units.fast", numFastUnits, Bound::closed(0, 1000));
+    checkField("motor_units.slow", numSlowUnits, bounds::kMotorUnits);
+    checkField("motor_units.fast", numFastUnits, bounds::kMotorUnits);
+    if (numSlowUnits + numFastUnits == 0)
+        throw FieldError("motor_units", "slow + fast = 0: expected at least one motor unit (without units a muscle "
+                                        "makes no active force)");
     slow.validate("fibre_types.slow");
     fast.validate("fibre_types.fast");
     coefficients.validate("coefficients");

@@ -111,7 +111,7 @@ void TrialSceneSettings::validate() const {
     checkField("muscle_thickness", muscleThickness, {0, 64, true, false, "px"});
     checkField("force_scale", forceScale, Bound::nonNegative("N (0 = the table's peak force)"));
     checkField("arrow_scale", arrowScale, Bound::nonNegative("m/N (0 = automatic)"));
-    checkField("hand_load", handLoad, Bound::nonNegative("kg"));
+    checkField("hand_load", handLoad, bounds::kHandLoad);
 }
 
 void TrialVideoSettings::validate() const {

@@ -408,7 +408,7 @@ TEST(Cli, TheCommandDoesNotLoadTheRendererOrMpiUntilAskedTo) {
     const armsim::testing::CommandResult bad =
         runArmsim("render " + (d / "t.csv").string() + " --out " + (d / "v.mp4").string() + " --codec vp9");
     EXPECT_EQ(bad.exitCode, 2) << bad.output;
-    EXPECT_NE(bad.output.find("field 'codec' = 'vp9'"), std::string::npos) << bad.output;
+    EXPECT_NE(bad.output.find("--codec = 'vp9'"), std::string::npos) << bad.output;
 }
 
 // Issue 34: results printed to a standard output that cannot take them (a full disk: /dev/full) are
