@@ -2,6 +2,7 @@
 
 #include "basics/files.h"
 
+#include <yaml-cpp/depthguard.h>
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
@@ -65,6 +66,9 @@ ParamNode ParamNode::loadString(const std::string& text, const std::string& sour
     impl->source = sourceName;
     try {
         impl->node = YAML::Load(text);
+    } catch (const YAML::DeepRecursion& e) {  // yaml-cpp says only "bad file"
+        throw InputError(sourceName + ":" + std::to_string(e.mark.line + 1) + ": nested deeper than " +
+                         std::to_string(e.depth()) + " levels: expected a parameter file");
     } catch (const YAML::Exception& e) {
         throw InputError(sourceName + ":" + std::to_string(e.mark.line + 1) + ": invalid YAML: " + e.msg);
     }
