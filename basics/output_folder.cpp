@@ -87,17 +87,21 @@ void OutputFolder::writeWith(const std::string& relative,
     try {
         writer(path);
     } catch (const InputError& e) {  // the staging folder, or anything in it, named as the target
-        std::string message = e.what();
-        const std::string from = temp_.string(), to = target_.string();
-        for (std::size_t at = message.find(from); at != std::string::npos; at = message.find(from, at + to.size()))
-            message.replace(at, from.size(), to);
-        throw InputError(message);
+        throw InputError(showPaths(e.what()));
     }
 }
 
 std::vector<std::string> OutputFolder::getFiles() const {
     std::lock_guard<std::mutex> lock(mutex_);
     return {files_.begin(), files_.end()};
+}
+
+std::string OutputFolder::showPaths(std::string message) const {
+    if (temp_.empty()) return message;
+    const std::string from = temp_.string(), to = target_.string();
+    for (std::size_t at = message.find(from); at != std::string::npos; at = message.find(from, at + to.size()))
+        message.replace(at, from.size(), to);
+    return message;
 }
 
 std::string OutputFolder::getStagingPath() const {
@@ -112,6 +116,7 @@ void OutputFolder::addStagedFiles() {
     for (auto it = fs::recursive_directory_iterator(temp_, ec); !ec && it != fs::recursive_directory_iterator();
          it.increment(ec))
         if (it->is_regular_file(ec)) found.push_back(fs::relative(it->path(), temp_, ec).string());
+    if (ec) throw InputError(target_.string() + ": cannot list the results staged in " + temp_.string() + ": " + ec.message());
     std::lock_guard<std::mutex> lock(mutex_);
     files_.insert(found.begin(), found.end());
 }
@@ -250,7 +255,8 @@ OutputFiles::~OutputFiles() {
     for (const Entry& e : entries_) fs::remove(e.staging, ec);
 }
 
-std::string OutputFiles::add(const std::string& option, const std::string& path) {
+std::string OutputFiles::add(const std::string& option, const std::string& path, bool required) {
+    if (path.empty() && required) throw InputError(option + " is empty: expected a file path");
     if (path.empty()) return "";
     if (committed_) throw std::logic_error("OutputFiles::add after commit");
     const fs::path target = fs::path(path).lexically_normal();
@@ -308,14 +314,39 @@ void OutputFiles::writeWith(const std::string& staging, const std::function<void
 void OutputFiles::commit() {
     if (committed_) throw std::logic_error("OutputFiles::commit twice");
     std::error_code ec;
+    // Files a writer left out (it may decline) are skipped; a target replaced is first moved aside, and a
+    // rename failing part-way puts everything back: all the new files or none.
+    std::vector<std::pair<std::string, std::string>> moved, aside;  // (from, to)
+    auto rollback = [&] {
+        std::error_code ignored;
+        for (auto it = moved.rbegin(); it != moved.rend(); ++it) fs::rename(it->second, it->first, ignored);
+        for (auto it = aside.rbegin(); it != aside.rend(); ++it) fs::rename(it->second, it->first, ignored);
+    };
+    for (const Entry& e : entries_)  // every destination checked first
+        if (fs::exists(e.staging, ec) && fs::exists(e.target, ec) && !fs::is_regular_file(e.target, ec))
+            throw InputError(e.option + " '" + e.target + "': exists and is not a file: cannot replace it");
     for (const Entry& e : entries_) {
         if (!fs::exists(e.staging, ec)) continue;
         const fs::path target(e.target);
         if (target.has_parent_path()) fs::create_directories(target.parent_path(), ec);
-        fs::rename(e.staging, e.target, ec);
-        if (ec) throw InputError(e.target + ": cannot put the file in place (" + ec.message() + ")");
+        if (fs::exists(target, ec)) {
+            const std::string keep = e.staging + ".old";
+            fs::rename(target, keep, ec);
+            if (ec) {
+                rollback();
+                throw InputError(e.option + " '" + e.target + "': cannot replace the file there (" + ec.message() + ")");
+            }
+            aside.push_back({e.target, keep});
+        }
+        fs::rename(e.staging, target, ec);
+        if (ec) {
+            rollback();
+            throw InputError(e.option + " '" + e.target + "': cannot put the file in place (" + ec.message() + ")");
+        }
+        moved.push_back({e.staging, e.target});
     }
     committed_ = true;
+    for (const auto& a : aside) fs::remove(a.second, ec);
 }
 
 }  // namespace armsim

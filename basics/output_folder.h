@@ -57,6 +57,8 @@ public:
     /// The staging folder (for writers that take a folder: the main job's steps). std::logic_error on a
     /// disabled folder.
     std::string getStagingPath() const;
+    /// `message` with the staging folder named as the target (for errors of writers given addFile paths).
+    std::string showPaths(std::string message) const;
     /// Adds every regular file found under the staging folder (written there without addFile).
     void addStagedFiles();
     /// Moves the files into place, all or none: InputError naming the path when a rename fails, after
@@ -90,9 +92,10 @@ public:
     OutputFiles& operator=(const OutputFiles&) = delete;
     ~OutputFiles();
     /// Registers the file `path` given with `option` (named in messages) and returns the path to write
-    /// it to. An empty path registers nothing and returns "". InputError naming both options when two
-    /// give the same file, and naming the option when a folder is in the way or its folder cannot be made.
-    std::string add(const std::string& option, const std::string& path);
+    /// it to. An empty path registers nothing and returns "" (InputError when `required`). InputError
+    /// naming both options when two give the same file, and naming the option when a folder is in the
+    /// way or its folder cannot be made.
+    std::string add(const std::string& option, const std::string& path, bool required = false);
     /// Runs writer(staging) for a path add() returned; an InputError it throws is reported naming the
     /// option and the file as typed instead of any staging file.
     void writeWith(const std::string& staging, const std::function<void(const std::string& path)>& writer);

@@ -38,7 +38,7 @@ void Table::appendRow(const std::vector<double>& row) {
     if (row.size() != names_.size())
         throw std::invalid_argument("table row has " + std::to_string(row.size()) + " values, expected " +
                                     std::to_string(names_.size()));
-    if ((numRows_ & 4095) == 0) checkInterruption();  // long recordings, sweeps and reads stop promptly
+    if ((numRows_ & 255) == 0) checkInterruption();  // long recordings, sweeps and reads stop promptly
     data_.insert(data_.end(), row.begin(), row.end());
     ++numRows_;
 }

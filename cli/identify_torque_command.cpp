@@ -9,6 +9,7 @@
 #include "identification/torque_identification.h"
 #include "muscles/muscle_file.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -68,7 +69,16 @@ void runIdentifyTorque(const IdentifyTorqueOptions& o) {
     std::printf("verdict: 'noise' = residuals consistent with the measurement noise (chi-square p >= 0.05), "
                 "'misfit' = larger than the noise explains\n");
     for (const MuscleEstimate& e : estimates) {
-        if (e.channelFits.size() < 2) continue;  // torque alone: the table above
+        const auto besidesTorque = std::count_if(e.channelFits.begin(), e.channelFits.end(),
+                                                 [](const ChannelFit& f) { return f.channel != "prior"; });
+        if (besidesTorque < 2) {  // torque alone: the table above, and the prior's check in a line
+            for (const ChannelFit& f : e.channelFits)
+                if (f.channel == "prior")
+                    std::printf("%s: prior check chi2 %.1f / %d, p %.3f: %s\n", e.method.c_str(), f.chiSquare, f.n, f.p,
+                                f.p >= 0.05 ? "a person the prior's population holds"
+                                            : ("outside the prior's population, furthest: " + f.worst).c_str());
+            continue;
+        }
         if (e.method == "channels")
             std::printf("channels fit: F0 %.0f N [%.0f, %.0f] at specific tension %.1f N/cm^2\n", e.maxForce,
                         e.maxForceLower, e.maxForceUpper, 1e-4 * e.specificTension);
@@ -77,7 +87,8 @@ void runIdentifyTorque(const IdentifyTorqueOptions& o) {
         std::printf("%-17s %4s %10s %7s %8s   %s\n", "channel", "n", "chi2", "p", "verdict", "largest residual (sd): where");
         for (const ChannelFit& f : e.channelFits)
             std::printf("%-17s %4d %10.1f %7.3f %8s   %+.1f: %s\n", f.channel.c_str(), f.n, f.chiSquare, f.p,
-                        f.p >= 0.05 ? "noise" : "misfit", f.worstResidual, f.worst.c_str());
+                        f.channel == "prior" ? (f.p >= 0.05 ? "holds" : "conflict") : (f.p >= 0.05 ? "noise" : "misfit"),
+                        f.worstResidual, f.worst.c_str());
     }
     std::printf("%-10s %6s %7s %6s %4s %11s", "effort", "angle", "forearm", "level", "rep", "measured");
     for (const MuscleEstimate& e : estimates) std::printf(" %13s", e.method.c_str());

@@ -4,6 +4,7 @@
 // that cannot go on, 4 an internal error, 128 + signal when stopped by SIGINT, SIGTERM or SIGHUP (after
 // removing the partial output of the run in progress).
 #include "basics/errors.h"
+#include "estimation/ceres_logging.h"
 #include "cli/commands.h"
 #include "cli/report.h"
 #include "cli/plugins.h"
@@ -75,6 +76,7 @@ std::string findUnknownCommand(const CLI::App& app, int argc, char** argv) {
 
 int main(int argc, char** argv) {
     startSignalThread();
+    armsim::quietCeresLogging();  // once, before any thread: armsim reports what Ceres would log
     CLI::App app{"armsim: a Simbody elbow with a Virtual Muscle biceps (simulate, identify, render)"};
     app.require_subcommand(1);
     app.set_version_flag("--version", std::string("armsim ") + ARMSIM_VERSION);

@@ -93,6 +93,7 @@ void addModelCommands(CLI::App& app) {
         c->add_option("--coordinate", *coordinate,
                       "an OpenSim model's coordinate to sweep (default: its only moving one)");
         c->callback([=] {
+            checkOutputFolder("--out", *out);
             // An OpenSim model: a file ending .osim, or a shipped name with only an .osim file.
             const bool isOsim = (name->size() > 5 && name->compare(name->size() - 5, 5, ".osim") == 0) ||
                                 (name->find('/') == std::string::npos &&
@@ -133,7 +134,10 @@ void addModelCommands(CLI::App& app) {
                       "every muscle's model: virtual_muscle, thelen2003 or degroote2016 (default: the model file's)");
         c->add_option("--targets", *targets, "target file (default assets/reference/elbow_targets.yaml)");
         c->add_option("--out", *out, "output directory")->capture_default_str();
-        c->callback([=] { checkModel(loadModelWithMuscles(*name, *muscleModel), targets->empty() ? loadDefaultAnatomyTargets() : loadAnatomyTargets(*targets), *out); });
+        c->callback([=] {
+            checkOutputFolder("--out", *out);
+            checkModel(loadModelWithMuscles(*name, *muscleModel), targets->empty() ? loadDefaultAnatomyTargets() : loadAnatomyTargets(*targets), *out);
+        });
     }
 
     {

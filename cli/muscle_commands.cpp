@@ -161,7 +161,7 @@ void addMuscleCommands(CLI::App& app) {
                                  " path lengths: expected at most 1000001");
             if (!(*to >= *from)) throw InputError("--to must not be below --from");
             OutputFiles files;  // both appear at the end, or neither
-            const std::string csvPath = files.add("--out", *out), plotPath = files.add("--plot", *plot);
+            const std::string csvPath = files.add("--out", *out, true), plotPath = files.add("--plot", *plot);
             const std::shared_ptr<const MuscleModel> built = opts->build();
             const MuscleModel& m = *built;
             m.checkPathLength(*from);
@@ -224,7 +224,7 @@ void addMuscleCommands(CLI::App& app) {
             checkField("--onset", *onset, Bound::nonNegative("s"));
             checkField("--rise", *rise, Bound::nonNegative("s"));
             OutputFiles files;  // both appear at the end, or neither
-            const std::string csvPath = files.add("--out", *out), plotPath = files.add("--plot", *plot);
+            const std::string csvPath = files.add("--out", *out, true), plotPath = files.add("--plot", *plot);
             const std::shared_ptr<const MuscleModel> built = opts->build();
             const MuscleModel& m = *built;
             MuscleIsometricSettings s = *settings;

@@ -148,6 +148,7 @@ void addRegisteredCommands(CLI::App& app) {
         std::stable_sort(s.begin(), s.end(), [](const Step& a, const Step& b) { return a.order < b.order; });
         // Every step writes into a staging folder; the results join --out together at the end, or (an
         // error, an interruption) none of them does and the staging folder is removed.
+        checkOutputFolder("--out", ctx->outDir);
         OutputFolder folder(ctx->outDir, OutputFolder::Mode::AddFiles);
         MainJobContext staged = *ctx;
         staged.outDir = folder.getStagingPath();
@@ -171,6 +172,8 @@ void addRegisteredCommands(CLI::App& app) {
             throw InputError(named(e));
         } catch (const SimulationError& e) {
             throw SimulationError(named(e));
+        } catch (const std::filesystem::filesystem_error& e) {
+            throw InputError(named(e));
         }
         folder.addStagedFiles();
         folder.commit();

@@ -63,9 +63,8 @@ void runRenderCommand(const RenderOptions& o) {
     v.tableName = o.table;
     if (o.out.empty() && !v.stillTime)
         throw InputError("armsim render: nothing to write: expected --out VIDEO and/or --still-at T --still FILE.png");
-    OutputFiles files;  // the video and the still appear together at the end, or neither
-    v.videoPath = files.add("--out", o.out);
-    v.stillPath = files.add("--still", o.still);
+    v.videoPath = o.out;  // validated as typed, then staged
+    v.stillPath = o.still;
     try {
         getRenderPlugin("render").validate(v);  // before the table is read
     } catch (const FieldError& e) {  // a setting from an option: named as typed
@@ -79,6 +78,9 @@ void runRenderCommand(const RenderOptions& o) {
         if (it == options.end() || fromFile) throw;
         throw InputError(it->second + " " + e.getDetail());
     }
+    OutputFiles files;  // the video and the still appear together at the end, or neither
+    v.videoPath = files.add("--out", o.out);
+    v.stillPath = files.add("--still", o.still);
 
     const ArmSetup setup = o.muscle.loadSetup();
     const Table table = Table::readCsv(o.table);

@@ -55,7 +55,7 @@ int renderVideo(const TrialOptions& o, const std::string& path, const ArmSetup& 
 void runTrialCommand(const TrialOptions& o) {
     // Every output checked and staged before the trial; all appear together at the end, or none.
     OutputFiles files;
-    const std::string csvPath = files.add("--out", o.out), plotPath = files.add("--plot", o.plot),
+    const std::string csvPath = files.add("--out", o.out, true), plotPath = files.add("--plot", o.plot),
                       videoPath = files.add("--video", o.video);
 #ifdef ARMSIM_WITH_RENDER
     if (!o.video.empty()) getRenderPlugin("--video").validate(makeVideoSettings(o, videoPath, o.load));

@@ -1,5 +1,6 @@
 // The files of a protocol run: tables, fits, plots, protocol.yaml and manifest.json (protocol_run.h).
 #include "basics/csv.h"
+#include "basics/errors.h"
 #include "basics/plot.h"
 #include "experiments/protocol_run.h"
 
@@ -323,7 +324,15 @@ void writeProtocolFiles(OutputFolder& dir, const Protocol& protocol, const ArmSe
     if (result.emgToActivation) results["emg_to_activation"] = fitJson(*result.emgToActivation);
     manifest["results"] = results;
     dir.write("protocol.yaml", protocol.sourceText);
-    if (beforeCommit) beforeCommit(dir, result);
+    if (beforeCommit) {
+        try {
+            beforeCommit(dir, result);
+        } catch (const InputError& e) {  // the run's files named where they would have been
+            throw InputError(dir.showPaths(e.what()));
+        } catch (const SimulationError& e) {
+            throw SimulationError(dir.showPaths(e.what()));
+        }
+    }
     dir.addFile("manifest.json");
     result.files = dir.getFiles();
     manifest["files"] = result.files;

@@ -454,9 +454,11 @@ std::vector<TorqueObservation> makeTorqueData(const Table& t, const std::string&
             fail("forearm_torque_Nm", o.forearmTorque, "<= 0 for a pronation effort (+ = supination; a tared transducer)");
         data.push_back(o);
     }
-    if (std::none_of(data.begin(), data.end(), [](const TorqueObservation& o) { return o.torque != 0; }))
-        throw InputError(path + ": column 'torque_Nm' is 0 in every row: expected the tared torques measured "
-                                "(nothing to fit)");
+    if (std::none_of(data.begin(), data.end(), [](const TorqueObservation& o) {
+            return o.torque != 0 || (std::isfinite(o.forearmTorque) && o.forearmTorque != 0);
+        }))
+        throw InputError(path + ": column 'torque_Nm' (and forearm_torque_Nm) is 0 in every row: expected the tared "
+                                "torques measured (nothing to fit)");
     return data;
 }
 

@@ -72,7 +72,9 @@ std::string formatChannelFitsCsv(const std::vector<MuscleEstimate>& estimates) {
         for (const ChannelFit& f : e.channelFits) {
             CsvRow row;
             row.addText(e.method).addText(f.channel).addInteger(f.n).addNumber(f.chiSquare).addNumber(f.p);
-            row.addText(f.p >= 0.05 ? "noise" : "misfit").addText(f.worst).addNumber(f.worstResidual);
+            const bool prior = f.channel == "prior";  // the prior's check: the person fits the population or not
+            row.addText(f.p >= 0.05 ? (prior ? "holds" : "noise") : (prior ? "conflict" : "misfit"));
+            row.addText(f.worst).addNumber(f.worstResidual);
             csv.addRow(row);
         }
     return csv.getText();

@@ -149,6 +149,9 @@ void readMuscleFields(const ParamNode& root, MuscleParameters& p, bool required,
         const ParamNode mu = root.child("motor_units");
         p.numSlowUnits = mu.getInt("slow", 0, 1000);
         p.numFastUnits = mu.getInt("fast", 0, 1000);
+        if (p.numSlowUnits + p.numFastUnits == 0)  // (a composition grid's 0 + 0 cell is made in code, not read)
+            throw InputError(mu.where("fast") + ": motor_units slow + fast = 0: expected at least one motor unit "
+                                                "(without units a muscle makes no active force)");
         p.apportioning = mu.getChoice("apportioning", {"thesis", "equal"}, "thesis") == "equal"
                              ? Apportioning::Equal : Apportioning::Thesis;
         mu.finish();

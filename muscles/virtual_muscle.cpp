@@ -95,9 +95,6 @@ void MuscleParameters::validate() const {
     checkField("fibre_fractions.slow", slowFraction, Bound::closed(0, 1));
     checkField("motor_units.slow", numSlowUnits, bounds::kMotorUnits);
     checkField("motor_units.fast", numFastUnits, bounds::kMotorUnits);
-    if (numSlowUnits + numFastUnits == 0)
-        throw FieldError("motor_units", "slow + fast = 0: expected at least one motor unit (without units a muscle "
-                                        "makes no active force)");
     slow.validate("fibre_types.slow");
     fast.validate("fibre_types.fast");
     coefficients.validate("coefficients");

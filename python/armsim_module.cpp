@@ -2,6 +2,7 @@
 // population studies on the C++ libraries, numpy arrays out. SI units and the YAML files' names;
 // errors keep the C++ messages (InputError -> ValueError, a missing file -> FileNotFoundError,
 // SimulationError -> RuntimeError). Long calls release the GIL.
+#include "estimation/ceres_logging.h"
 #include "basics/angles.h"
 #include "basics/bound.h"
 #include "basics/files.h"
@@ -103,6 +104,7 @@ std::shared_ptr<const MuscleModel> buildMuscle(const Model& m, const py::object&
 }  // namespace
 
 PYBIND11_MODULE(_armsim, mod) {
+    armsim::quietCeresLogging();  // once, at import: armsim reports what Ceres would log
     mod.doc() = "armsim: a musculoskeletal arm simulator with Virtual Muscle force elements (C++ core).";
     mod.attr("__version__") = ARMSIM_VERSION;   // the CMake project's version
 

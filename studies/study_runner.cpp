@@ -601,10 +601,23 @@ void forEachResultInTaskOrder(const std::string& journalPath, const std::string&
         emitRange(scratch.dir + "/" + std::to_string(b), false, b * perBucket, std::min(numTasks, (b + 1) * perBucket));
 }
 
+std::vector<std::string> writeStudyFilesInto(OutputFolder& folder, const Study& study, const std::string& dir,
+                                             const std::string& journalPath, long passBytes);
+
+// The study's files join its folder (beside the journal) together at the end, or none of them; errors
+// name them where they would have been.
 std::vector<std::string> writeStudyFiles(const Study& study, const std::string& dir, const std::string& journalPath,
                                          long passBytes) {
-    // The study's files join its folder (beside the journal) together at the end, or none of them.
     OutputFolder folder(dir, OutputFolder::Mode::AddFiles);
+    try {
+        return writeStudyFilesInto(folder, study, dir, journalPath, passBytes);
+    } catch (const InputError& e) {
+        throw InputError(folder.showPaths(e.what()));
+    }
+}
+
+std::vector<std::string> writeStudyFilesInto(OutputFolder& folder, const Study& study, const std::string& dir,
+                                             const std::string& journalPath, long passBytes) {
     AtomicFileWriter table(folder.addFile("results.csv")), timing(folder.addFile("timing.csv"));
     table.write(getStudyResultsHeader() + '\n');
     timing.write("task,rank,synthesis_s,identification_s\n");

@@ -174,3 +174,65 @@ TEST_F(OutputFolderTest, AWritersErrorNamesTheFinalPath) {
     out.commit();
     EXPECT_TRUE(fs::exists(target / "ok.txt"));
 }
+
+namespace {
+
+std::string readAll(const fs::path& p) {
+    std::ifstream in(p);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+}  // namespace
+
+// OutputFiles: files named by several options appear together at commit(), in folders made then; none
+// before; an uncommitted set leaves nothing, and a commit that fails part-way puts back what was there.
+TEST_F(OutputFolderTest, OutputFilesAppearTogetherOrNotAtAll) {
+    const fs::path csv = root / "new" / "t.csv", png = root / "p.png";
+    {
+        OutputFiles files;
+        const std::string a = files.add("--out", csv.string(), true), b = files.add("--plot", png.string());
+        std::ofstream(a) << "csv\n";
+        std::ofstream(b) << "png\n";
+        EXPECT_FALSE(fs::exists(root / "new"));  // folders are made at commit
+        EXPECT_FALSE(fs::exists(png));
+    }
+    EXPECT_EQ(countEntries(root), 0);  // uncommitted: every staging file removed
+
+    OutputFiles files;
+    const std::string a = files.add("--out", csv.string()), b = files.add("--plot", png.string());
+    EXPECT_THROW(files.add("--still", png.string()), InputError);  // one file, two options
+    std::ofstream(a) << "csv\n";
+    std::ofstream(b) << "png\n";
+    files.commit();
+    EXPECT_EQ(readAll(csv), "csv\n");
+    EXPECT_EQ(readAll(png), "png\n");
+    EXPECT_EQ(countEntries(root), 2);  // new/ and p.png: no staging file beside them
+}
+
+TEST_F(OutputFolderTest, OutputFilesCommitFailingPartWayPutsBackWhatWasThere) {
+    const fs::path csv = root / "t.csv", png = root / "sub" / "p.png";
+    std::ofstream(csv) << "earlier\n";
+    {
+        OutputFiles files;
+        const std::string a = files.add("--out", csv.string()), b = files.add("--plot", png.string());
+        std::ofstream(a) << "new\n";
+        std::ofstream(b) << "png\n";
+        std::ofstream(root / "sub") << "a file where the plot's folder would go\n";  // after the check
+        EXPECT_THROW(files.commit(), InputError);  // t.csv was replaced, then p.png failed
+    }
+    EXPECT_EQ(readAll(csv), "earlier\n");
+    EXPECT_EQ(countEntries(root), 2);  // t.csv and sub: no staging file, no moved-aside copy
+    {
+        OutputFiles files;  // a folder in the way of a file: refused before anything moves
+        std::ofstream(files.add("--out", csv.string())) << "new\n";
+        const std::string b = files.add("--plot", (root / "q.png").string());
+        std::ofstream(b) << "png\n";
+        fs::create_directories(root / "q.png" / "x");
+        EXPECT_THROW(files.commit(), InputError);
+    }
+    EXPECT_EQ(readAll(csv), "earlier\n");
+    EXPECT_TRUE(fs::is_directory(root / "q.png" / "x"));
+    OutputFiles files;
+    EXPECT_THROW(files.add("--out", "", true), InputError);
+    EXPECT_EQ(files.add("--plot", ""), "");
+}

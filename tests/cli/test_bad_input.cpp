@@ -72,6 +72,10 @@ std::vector<BadInput> makeCatalogue() {
         {"UnknownModel", {}, "muscle steady --model no_such_model", {"no_such_model"}},
         // ---- muscle files ----------------------------------------------------------------------
         {"MuscleFileMissing", {}, "muscle steady --muscle IN/missing.yaml", {"missing.yaml"}},
+        {"MuscleFileNoMotorUnits", {{"m.yaml", "name: b\nmass: 0.3\noptimal_fascicle_length: 0.16\noptimal_tendon_length: 0.245\n"
+                                              "max_path_length: 0.43\nfibre_fractions: {slow: 0.3, fast: 0.7}\n"
+                                              "motor_units:\n  slow: 0\n  fast: 0\nfibre_types: muscles/human_fibre_types.yaml\n"}},
+         "muscle steady --muscle IN/m.yaml", {"m.yaml:9", "slow + fast = 0", "at least one motor unit"}},
         {"MuscleFileEmpty", {{"m.yaml", ""}}, "muscle steady --muscle IN/m.yaml", {"m.yaml"}},
         {"MuscleFileBinary", {{"m.yaml", binary}}, "muscle steady --muscle IN/m.yaml", {"m.yaml"}},
         {"MuscleFileNotYaml", {{"m.yaml", "mass: [1, 2\n"}}, "muscle steady --muscle IN/m.yaml", {"m.yaml:2", "invalid YAML"}},
