@@ -15,6 +15,9 @@ cmake -S . -B build-sanitize -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_COMPILER=clang
   -DARMSIM_BENCHMARKS=OFF -DARMSIM_PYTHON=OFF >/dev/null
 cmake --build build-sanitize -j2
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
+# Latency bounds in the tests (a stop within 2 s of SIGTERM) scale by this: ASan poisons every byte freed,
+# and a stopped 5e6-row trial frees gigabytes.
+export ARMSIM_TEST_TIME_SCALE=4
 mpi_tests="Mpi|TwoRanks|slurm[.]"  # the Slurm tests run MPI ranks under srun
 # Coverage statistics over many virtual subjects run in the plain build only (2.3 min here under the
 # sanitizers); every line they run is also run, under the sanitizers, by the single-fit tests.
