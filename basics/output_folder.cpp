@@ -145,14 +145,28 @@ void OutputFolder::commit() {
 // failing part-way puts everything back: the folder ends with all the new files or none.
 void OutputFolder::commitInto() {
     std::error_code ec;
-    std::vector<std::string> written;  // a writer may decline to write (a plot without data)
-    for (const std::string& f : getFiles())
-        if (fs::exists(temp_ / f, ec)) written.push_back(f);
-    const std::vector<std::string>& files = written;
+    // A staged top-level folder holding the marker is a run of its own (the main job's protocol run):
+    // it replaces an earlier run there as a whole, as ReplaceRun would, so no file of the earlier run
+    // stays beside the new one. Every other file joins the folder on its own.
+    std::set<std::string> runs;
+    if (!marker_.empty())
+        for (const fs::directory_entry& e : fs::directory_iterator(temp_, ec))
+            if (e.is_directory(ec) && fs::exists(e.path() / marker_, ec)) runs.insert(e.path().filename().string());
+    std::vector<std::string> files;  // a writer may decline to write (a plot without data)
+    for (const std::string& run : runs) files.push_back(run);
+    for (const std::string& f : getFiles()) {
+        const std::string top = fs::path(f).begin()->string();
+        if (!runs.count(top) && fs::exists(temp_ / f, ec)) files.push_back(f);
+    }
     for (const std::string& f : files) {
         const fs::path to = target_ / f;
-        if (fs::exists(to, ec) && !fs::is_regular_file(to, ec))
+        if (runs.count(f)) {
+            if (fs::exists(to, ec) && !(fs::is_directory(to, ec) && fs::exists(to / marker_, ec)))
+                throw InputError(to.string() + ": exists and is not an armsim run (no " + marker_ +
+                                 "): cannot replace it with the output folder");
+        } else if (fs::exists(to, ec) && !fs::is_regular_file(to, ec)) {
             throw InputError(to.string() + ": exists and is not a file: cannot replace it with the output file");
+        }
     }
     std::vector<std::pair<fs::path, fs::path>> moved, aside;  // (from, to)
     auto rollback = [&] {

@@ -30,7 +30,8 @@ public:
         /// as a whole by one rename; any other existing folder or file is refused (InputError).
         ReplaceRun,
         /// The files join the folder: each replaces a file of the same name by a rename; other files in
-        /// the folder are kept (a user's own results folder).
+        /// the folder are kept (a user's own results folder). With a `marker`, a staged top-level folder
+        /// holding it is a run of its own and replaces an earlier run (a folder holding the marker) whole.
         AddFiles,
     };
 

@@ -149,7 +149,7 @@ void addRegisteredCommands(CLI::App& app) {
         // Every step writes into a staging folder; the results join --out together at the end, or (an
         // error, an interruption) none of them does and the staging folder is removed.
         checkOutputFolder("--out", ctx->outDir);
-        OutputFolder folder(ctx->outDir, OutputFolder::Mode::AddFiles);
+        OutputFolder folder(ctx->outDir, OutputFolder::Mode::AddFiles, "manifest.json");  // protocol runs whole
         MainJobContext staged = *ctx;
         staged.outDir = folder.getStagingPath();
         const ShownFolder shown(staged.outDir, ctx->outDir);  // messages name where the files will be

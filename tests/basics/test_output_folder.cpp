@@ -236,3 +236,37 @@ TEST_F(OutputFolderTest, OutputFilesCommitFailingPartWayPutsBackWhatWasThere) {
     EXPECT_THROW(files.add("--out", "", true), InputError);
     EXPECT_EQ(files.add("--plot", ""), "");
 }
+
+// AddFiles with a marker (the main job): a staged folder holding the marker (a protocol run) replaces an
+// earlier run there whole, so none of the earlier run's files stays beside the new one; a folder there
+// that is not a run is refused and nothing moves; the folder's other files are kept.
+TEST_F(OutputFolderTest, AddFilesReplacesARunInsideWhole) {
+    const fs::path target = root / "out";
+    fs::create_directories(target / "run");
+    std::ofstream(target / "run" / "manifest.json") << "{}\n";
+    std::ofstream(target / "run" / "stale.csv") << "an earlier run's file\n";
+    std::ofstream(target / "mine.txt") << "a user's file\n";
+    {
+        OutputFolder out(target.string(), OutputFolder::Mode::AddFiles, "manifest.json");
+        out.write("run/manifest.json", "{\"new\": 1}\n");
+        out.write("run/a.csv", "1\n");
+        out.write("top.csv", "2\n");
+        out.commit();
+    }
+    EXPECT_TRUE(fs::exists(target / "run" / "a.csv"));
+    EXPECT_FALSE(fs::exists(target / "run" / "stale.csv"));
+    EXPECT_TRUE(fs::exists(target / "mine.txt"));
+    EXPECT_TRUE(fs::exists(target / "top.csv"));
+    EXPECT_EQ(countEntries(target), 3);  // run/, mine.txt, top.csv: nothing staged or moved aside left
+
+    fs::remove(target / "run" / "manifest.json");  // now a folder that is not a run
+    {
+        OutputFolder out(target.string(), OutputFolder::Mode::AddFiles, "manifest.json");
+        out.write("run/manifest.json", "{}\n");
+        out.write("top.csv", "3\n");
+        EXPECT_THROW(out.commit(), InputError);
+    }
+    EXPECT_EQ(readAll(target / "top.csv"), "2\n");
+    EXPECT_TRUE(fs::exists(target / "run" / "a.csv"));
+    EXPECT_EQ(countEntries(target), 3);
+}
