@@ -28,6 +28,44 @@ bool isLive(const fs::path& p) {
     return liveStaging.count(p.lexically_normal().string()) > 0;
 }
 
+std::string replaceAll(std::string text, const std::string& from, const std::string& to) {
+    for (std::size_t at = text.find(from); at != std::string::npos; at = text.find(from, at + to.size()))
+        text.replace(at, from.size(), to);
+    return text;
+}
+
+// One output put in place: `from` renamed to `to`; what is at `to` first moved to `aside`. `name` is how
+// messages call it.
+struct Placement {
+    fs::path from, to, aside;
+    std::string name;
+};
+
+// Every placement or none: a rename failing part-way puts back everything moved so far and throws
+// InputError naming the place. The moved-aside files stay for the caller to remove.
+void placeAllOrNone(const std::vector<Placement>& placements) {
+    std::error_code ec;
+    std::vector<std::pair<fs::path, fs::path>> moved, aside;  // (from, to)
+    auto fail = [&](const std::string& message) {
+        std::error_code ignored;
+        for (auto it = moved.rbegin(); it != moved.rend(); ++it) fs::rename(it->second, it->first, ignored);
+        for (auto it = aside.rbegin(); it != aside.rend(); ++it) fs::rename(it->second, it->first, ignored);
+        throw InputError(message);
+    };
+    for (const Placement& p : placements) {
+        if (p.to.has_parent_path()) fs::create_directories(p.to.parent_path(), ec);
+        if (fs::exists(p.to, ec)) {
+            if (p.aside.has_parent_path()) fs::create_directories(p.aside.parent_path(), ec);
+            fs::rename(p.to, p.aside, ec);
+            if (ec) fail(p.name + ": cannot move the earlier file aside: " + ec.message());
+            aside.push_back({p.to, p.aside});
+        }
+        fs::rename(p.from, p.to, ec);
+        if (ec) fail(p.name + ": cannot move the file into place: " + ec.message());
+        moved.push_back({p.from, p.to});
+    }
+}
+
 }  // namespace
 
 OutputFolder::OutputFolder(const std::string& outDir, Mode mode, std::string marker)
@@ -97,11 +135,7 @@ std::vector<std::string> OutputFolder::getFiles() const {
 }
 
 std::string OutputFolder::showPaths(std::string message) const {
-    if (temp_.empty()) return message;
-    const std::string from = temp_.string(), to = target_.string();
-    for (std::size_t at = message.find(from); at != std::string::npos; at = message.find(from, at + to.size()))
-        message.replace(at, from.size(), to);
-    return message;
+    return temp_.empty() ? message : replaceAll(std::move(message), temp_.string(), target_.string());
 }
 
 std::string OutputFolder::getStagingPath() const {
@@ -168,32 +202,10 @@ void OutputFolder::commitInto() {
             throw InputError(to.string() + ": exists and is not a file: cannot replace it with the output file");
         }
     }
-    std::vector<std::pair<fs::path, fs::path>> moved, aside;  // (from, to)
-    auto rollback = [&] {
-        std::error_code ignored;
-        for (auto it = moved.rbegin(); it != moved.rend(); ++it) fs::rename(it->second, it->first, ignored);
-        for (auto it = aside.rbegin(); it != aside.rend(); ++it) fs::rename(it->second, it->first, ignored);
-    };
-    for (const std::string& f : files) {
-        const fs::path to = target_ / f;
-        fs::create_directories(to.parent_path(), ec);
-        if (fs::exists(to, ec)) {
-            const fs::path keep = old_ / f;
-            fs::create_directories(keep.parent_path(), ec);
-            fs::rename(to, keep, ec);
-            if (ec) {
-                rollback();
-                throw InputError(to.string() + ": cannot move the earlier file aside: " + ec.message());
-            }
-            aside.push_back({to, keep});
-        }
-        fs::rename(temp_ / f, to, ec);
-        if (ec) {
-            rollback();
-            throw InputError(to.string() + ": cannot move the file into place: " + ec.message());
-        }
-        moved.push_back({temp_ / f, to});
-    }
+    std::vector<Placement> placements;
+    for (const std::string& f : files)
+        placements.push_back({temp_ / f, target_ / f, old_ / f, (target_ / f).string()});
+    placeAllOrNone(placements);
     committed_ = true;
     fs::remove_all(temp_, ec);
     fs::remove_all(old_, ec);
@@ -316,11 +328,7 @@ void OutputFiles::writeWith(const std::string& staging, const std::function<void
         writer(staging);
     } catch (const InputError& e) {  // any staging file named as the option and the file typed
         std::string message = e.what();
-        for (const Entry& x : entries_) {
-            const std::string to = x.option + " '" + x.target + "'";
-            for (std::size_t at = message.find(x.staging); at != std::string::npos; at = message.find(x.staging, at + to.size()))
-                message.replace(at, x.staging.size(), to);
-        }
+        for (const Entry& x : entries_) message = replaceAll(std::move(message), x.staging, x.option + " '" + x.target + "'");
         throw InputError(message);
     }
 }
@@ -328,39 +336,17 @@ void OutputFiles::writeWith(const std::string& staging, const std::function<void
 void OutputFiles::commit() {
     if (committed_) throw std::logic_error("OutputFiles::commit twice");
     std::error_code ec;
-    // Files a writer left out (it may decline) are skipped; a target replaced is first moved aside, and a
-    // rename failing part-way puts everything back: all the new files or none.
-    std::vector<std::pair<std::string, std::string>> moved, aside;  // (from, to)
-    auto rollback = [&] {
-        std::error_code ignored;
-        for (auto it = moved.rbegin(); it != moved.rend(); ++it) fs::rename(it->second, it->first, ignored);
-        for (auto it = aside.rbegin(); it != aside.rend(); ++it) fs::rename(it->second, it->first, ignored);
-    };
-    for (const Entry& e : entries_)  // every destination checked first
-        if (fs::exists(e.staging, ec) && fs::exists(e.target, ec) && !fs::is_regular_file(e.target, ec))
-            throw InputError(e.option + " '" + e.target + "': exists and is not a file: cannot replace it");
+    // Files a writer left out (it may decline) are skipped; every destination is checked first.
+    std::vector<Placement> placements;
     for (const Entry& e : entries_) {
         if (!fs::exists(e.staging, ec)) continue;
-        const fs::path target(e.target);
-        if (target.has_parent_path()) fs::create_directories(target.parent_path(), ec);
-        if (fs::exists(target, ec)) {
-            const std::string keep = e.staging + ".old";
-            fs::rename(target, keep, ec);
-            if (ec) {
-                rollback();
-                throw InputError(e.option + " '" + e.target + "': cannot replace the file there (" + ec.message() + ")");
-            }
-            aside.push_back({e.target, keep});
-        }
-        fs::rename(e.staging, target, ec);
-        if (ec) {
-            rollback();
-            throw InputError(e.option + " '" + e.target + "': cannot put the file in place (" + ec.message() + ")");
-        }
-        moved.push_back({e.staging, e.target});
+        if (fs::exists(e.target, ec) && !fs::is_regular_file(e.target, ec))
+            throw InputError(e.option + " '" + e.target + "': exists and is not a file: cannot replace it");
+        placements.push_back({e.staging, e.target, e.staging + ".old", e.option + " '" + e.target + "'"});
     }
+    placeAllOrNone(placements);
     committed_ = true;
-    for (const auto& a : aside) fs::remove(a.second, ec);
+    for (const Placement& p : placements) fs::remove(p.aside, ec);
 }
 
 }  // namespace armsim

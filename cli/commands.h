@@ -10,6 +10,7 @@
 #include <CLI/CLI.hpp>
 
 #include <functional>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -77,6 +78,10 @@ CLI::Option* addNameListOption(CLI::App& app, const std::string& name, std::vect
 /// can be created or written (it, or its nearest existing ancestor, is a writable folder): InputError
 /// naming the option, the path and the reason.
 void checkOutputFolder(const std::string& option, const std::string& dir);
+
+/// Runs f; a FieldError whose field the user set through an option (`optionOfField`: field -> option) is
+/// reported naming that option ("--fps = 0: expected in [1, 240] (1/s)"); other errors pass unchanged.
+void runNamingOptions(const std::map<std::string, std::string>& optionOfField, const std::function<void()>& f);
 
 /// Prints a one-line progress bar to stderr ("label [#####     ] 5/10"); nothing with --quiet.
 void printProgress(const std::string& label, int done, int total);

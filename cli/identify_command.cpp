@@ -25,7 +25,6 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <map>
 #include <memory>
 
 namespace armsim::cli {
@@ -174,17 +173,10 @@ void runIdentify(const IdentifyOptions& o) {
     io.forceTolerance = o.tolerance;
 
     IdentificationReport r;
-    try {
-        r = runIdentification(pr, io, setup.arm, o.model);
-    } catch (const FieldError& e) {  // an option the user typed, named as typed
-        static const std::map<std::string, std::string> options = {
-            {"options.max_iterations", "--max-iterations"}, {"options.force_tolerance", "--tolerance"},
-            {"options.force_sd", "--force-sd"},             {"options.relative_force_sd", "--force-sd"},
-            {"options.starts", "--multistart"}};
-        const auto it = options.find(e.getField());
-        if (it == options.end()) throw;
-        throw InputError(it->second + " " + e.getDetail());
-    }
+    runNamingOptions({{"options.max_iterations", "--max-iterations"}, {"options.force_tolerance", "--tolerance"},
+                      {"options.force_sd", "--force-sd"}, {"options.relative_force_sd", "--force-sd"},
+                      {"options.starts", "--multistart"}},
+                     [&] { r = runIdentification(pr, io, setup.arm, o.model); });
     std::printf("%s", formatReport(r).c_str());
     for (const std::string& p : writeReportFiles(r, o.out)) std::printf("wrote %s\n", p.c_str());
 }

@@ -48,13 +48,8 @@ TrialVideoSettings makeVideoSettings(const ProtocolOptions& o) {
 void checkVideoOptions(const ProtocolOptions& o) {
     const RenderPlugin& render = getRenderPlugin("--video");
 #ifdef ARMSIM_WITH_RENDER
-    try {
-        render.validate(makeVideoSettings(o));
-    } catch (const FieldError& e) {
-        const std::string& f = e.getField();
-        const std::string option = f == "fps" ? "--video-fps" : f == "width" ? "--video-width" : f == "height" ? "--video-height" : f;
-        throw InputError(option + " " + e.getDetail());
-    }
+    runNamingOptions({{"fps", "--video-fps"}, {"width", "--video-width"}, {"height", "--video-height"}},
+                     [&] { render.validate(makeVideoSettings(o)); });
 #else
     (void)render;
 #endif

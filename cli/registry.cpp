@@ -84,6 +84,16 @@ CLI::Option* addNameListOption(CLI::App& app, const std::string& name, std::vect
     return app.add_option(name, values, description)->delimiter(',')->allow_extra_args(false)->type_name("NAMES");
 }
 
+void runNamingOptions(const std::map<std::string, std::string>& optionOfField, const std::function<void()>& f) {
+    try {
+        f();
+    } catch (const FieldError& e) {
+        const auto it = optionOfField.find(e.getField());
+        if (it == optionOfField.end()) throw;
+        throw InputError(it->second + " " + e.getDetail());
+    }
+}
+
 void checkOutputFolder(const std::string& option, const std::string& dir) {
     namespace fs = std::filesystem;
     if (dir.empty()) throw InputError(option + " is empty: expected a folder path");
@@ -153,27 +163,18 @@ void addRegisteredCommands(CLI::App& app) {
         MainJobContext staged = *ctx;
         staged.outDir = folder.getStagingPath();
         const ShownFolder shown(staged.outDir, ctx->outDir);  // messages name where the files will be
-        auto named = [&](const std::exception& e) {  // a message names files where they would have been
-            std::string m = e.what();
-            const std::string& from = staged.outDir;
-            for (std::size_t at = m.find(from); at != std::string::npos; at = m.find(from, at + ctx->outDir.size()))
-                m.replace(at, from.size(), ctx->outDir);
-            return m;
-        };
         try {
             for (const auto& step : s) {
                 std::printf("\n== %s ==\n", step.name.c_str());
                 std::fflush(stdout);
                 step.run(staged);
             }
-        } catch (const FieldError& e) {
-            throw InputError(named(e));
-        } catch (const InputError& e) {
-            throw InputError(named(e));
+        } catch (const InputError& e) {  // files named where they would have been
+            throw InputError(folder.showPaths(e.what()));
         } catch (const SimulationError& e) {
-            throw SimulationError(named(e));
+            throw SimulationError(folder.showPaths(e.what()));
         } catch (const std::filesystem::filesystem_error& e) {
-            throw InputError(named(e));
+            throw InputError(folder.showPaths(e.what()));
         }
         folder.addStagedFiles();
         folder.commit();

@@ -65,19 +65,14 @@ void runRenderCommand(const RenderOptions& o) {
         throw InputError("armsim render: nothing to write: expected --out VIDEO and/or --still-at T --still FILE.png");
     v.videoPath = o.out;  // validated as typed, then staged
     v.stillPath = o.still;
-    try {
-        getRenderPlugin("render").validate(v);  // before the table is read
-    } catch (const FieldError& e) {  // a setting from an option: named as typed
-        static const std::map<std::string, std::string> options = {
-            {"hand_load", "--load"}, {"fps", "--fps"}, {"codec", "--codec"}, {"playback_speed", "--speed"},
-            {"arrow_scale", "--arrow-scale"}, {"still_at", "--still-at"}, {"still", "--still"},
-            {"width", "--width"}, {"height", "--height"}, {"supersample", "--supersample"}};
-        const auto it = options.find(e.getField());
-        const bool fromFile = !o.renderSettingsFile.empty() && it != options.end() &&
-                              (it->first == "width" || it->first == "height" || it->first == "supersample");
-        if (it == options.end() || fromFile) throw;
-        throw InputError(it->second + " " + e.getDetail());
-    }
+    // Settings from options named as typed (width, height and supersample come from --render-settings
+    // when it is given).
+    std::map<std::string, std::string> options = {
+        {"hand_load", "--load"}, {"fps", "--fps"}, {"codec", "--codec"}, {"playback_speed", "--speed"},
+        {"arrow_scale", "--arrow-scale"}, {"still_at", "--still-at"}, {"still", "--still"}};
+    if (o.renderSettingsFile.empty())
+        options.insert({{"width", "--width"}, {"height", "--height"}, {"supersample", "--supersample"}});
+    runNamingOptions(options, [&] { getRenderPlugin("render").validate(v); });  // before the table is read
     OutputFiles files;  // the video and the still appear together at the end, or neither
     v.videoPath = files.add("--out", o.out);
     v.stillPath = files.add("--still", o.still);

@@ -100,7 +100,7 @@ struct ProtocolRunOptions {
     std::function<void(int done, int total)> progress;    ///< called from the caller's thread
     /// Extra files written into the run before it is put in place (the trials' videos): they appear
     /// with the run or not at all, and manifest.json lists them. Called only when outDir is set.
-    std::function<void(OutputFolder& dir, const ProtocolResult& result)> beforeCommit;
+    std::function<void(OutputFolder& dir, const ProtocolResult& result)> beforeCommit = {};
 };
 
 /// What a run gives (also written to the run directory).

@@ -346,6 +346,12 @@ int SynergistModel::findMassIndex(int muscle) const {
 
 int SynergistModel::getMassIndex() const { return findMassIndex(base_->primary); }
 
+std::vector<double> SynergistModel::getLnMaxForceWeights() const {
+    std::vector<double> g(std::size_t(getNumParameters()), 0.0);
+    g[std::size_t(kSigma)] += 1, g[std::size_t(getMassIndex())] += 1, g[kFascicle] -= 1, g[kSize] -= 1;
+    return g;
+}
+
 std::vector<int> SynergistModel::getFlexorMassIndices() const {
     std::vector<int> out;
     for (std::size_t k = 0; k < biceps_.size() + synergists_.size(); ++k) out.push_back(kFirstMass + int(k));
@@ -496,6 +502,42 @@ void SynergistModel::prepareConsidered() {
         for (int b = 0; b < nw; ++b) truthCovariance_[a][b] = S(a, b);
 }
 
+namespace {
+
+// The linearized fit at J (the whitened data rows over the n parameters, then the consider parameters):
+// G = [J_free, J_held, J_considered] in the truths' order, S their covariance, lambda the prior precision
+// on the free ones, H = J_free' J_free and C0 = (H + lambda)^-1.
+struct LinearizedFit {
+    Eigen::MatrixXd G, S, lambda, H, C0;
+};
+
+// false when H + lambda is not positive definite.
+bool linearizeFit(const std::vector<std::vector<double>>& J, int n, const std::vector<int>& free,
+                  const std::vector<int>& held, const std::vector<std::vector<double>>& freePrecision,
+                  const std::vector<std::vector<double>>& truthCovariance, LinearizedFit& f) {
+    const int R = int(J.size()), nf = int(free.size()), nh = int(held.size()), nw = int(truthCovariance.size()),
+              nk = nw - nf - nh;
+    f.G.resize(R, nw);
+    for (int k = 0; k < R; ++k) {
+        for (int a = 0; a < nf; ++a) f.G(k, a) = J[k][free[a]];
+        for (int a = 0; a < nh; ++a) f.G(k, nf + a) = J[k][held[a]];
+        for (int a = 0; a < nk; ++a) f.G(k, nf + nh + a) = J[k][n + a];
+    }
+    f.lambda.resize(nf, nf);
+    for (int a = 0; a < nf; ++a)
+        for (int b = 0; b < nf; ++b) f.lambda(a, b) = freePrecision[a][b];
+    f.S.resize(nw, nw);
+    for (int a = 0; a < nw; ++a)
+        for (int b = 0; b < nw; ++b) f.S(a, b) = truthCovariance[a][b];
+    f.H = f.G.leftCols(nf).transpose() * f.G.leftCols(nf);
+    const Eigen::LLT<Eigen::MatrixXd> hl(f.H + f.lambda);
+    if (hl.info() != Eigen::Success) return false;
+    f.C0 = hl.solve(Eigen::MatrixXd::Identity(nf, nf));
+    return true;
+}
+
+}  // namespace
+
 bool SynergistModel::calcConsideredCovariance(const std::vector<std::vector<double>>& J,
                                               std::vector<std::vector<double>>& c0Out,
                                               std::vector<std::vector<double>>& cOut) const {
@@ -504,31 +546,18 @@ bool SynergistModel::calcConsideredCovariance(const std::vector<std::vector<doub
     if (truthCovariance_.empty()) return false;
     if (R > 0 && int(J[0].size()) != n + nk)
         throw std::logic_error("calcConsideredCovariance: expected " + std::to_string(n + nk) + " Jacobian columns");
-    Eigen::MatrixXd Jm(R, n + nk), lambda(nf, nf), S(nw, nw);
-    for (int k = 0; k < R; ++k)
-        for (int j = 0; j < n + nk; ++j) Jm(k, j) = J[k][j];
-    for (int a = 0; a < nf; ++a)
-        for (int b = 0; b < nf; ++b) lambda(a, b) = freePrecision_[a][b];
-    for (int a = 0; a < nw; ++a)
-        for (int b = 0; b < nw; ++b) S(a, b) = truthCovariance_[a][b];
-    Eigen::MatrixXd JF(R, nf), JO(R, nh + nk);
-    for (int a = 0; a < nf; ++a) JF.col(a) = Jm.col(free_[a]);
-    for (int a = 0; a < nh; ++a) JO.col(a) = Jm.col(held_[a]);
-    for (int a = 0; a < nk; ++a) JO.col(nh + a) = Jm.col(n + a);
-    const Eigen::MatrixXd H = JF.transpose() * JF;
-    const Eigen::LLT<Eigen::MatrixXd> hl(H + lambda);
-    if (hl.info() != Eigen::Success) return false;
-    const Eigen::MatrixXd C0 = hl.solve(Eigen::MatrixXd::Identity(nf, nf));
+    LinearizedFit f;
+    if (!linearizeFit(J, n, free_, held_, freePrecision_, truthCovariance_, f)) return false;
     Eigen::MatrixXd B(nf, nw);
-    B.leftCols(nf) = -lambda;
-    B.rightCols(nh + nk) = JF.transpose() * JO;
-    Eigen::MatrixXd C = C0 * (H + B * S * B.transpose()) * C0;
+    B.leftCols(nf) = -f.lambda;
+    B.rightCols(nh + nk) = f.G.leftCols(nf).transpose() * f.G.rightCols(nh + nk);
+    Eigen::MatrixXd C = f.C0 * (f.H + B * f.S * B.transpose()) * f.C0;
     C = 0.5 * (C + C.transpose());
     c0Out.assign(n, std::vector<double>(n, 0.0));
     cOut.assign(n, std::vector<double>(n, 0.0));
     for (int a = 0; a < nf; ++a)
         for (int b = 0; b < nf; ++b) {
-            c0Out[free_[a]][free_[b]] = C0(a, b);
+            c0Out[free_[a]][free_[b]] = f.C0(a, b);
             cOut[free_[a]][free_[b]] = C(a, b);
         }
     return true;
@@ -541,23 +570,12 @@ ChannelFit SynergistModel::calcPriorCheck(const std::vector<std::vector<double>>
     const int n = getNumParameters(), R = int(J.size());
     const int nf = int(free_.size()), nh = int(held_.size()), nw = int(truthCovariance_.size()), nk = nw - nf - nh;
     if (truthCovariance_.empty() || R == 0 || int(J[0].size()) != n + nk) return fit;
-    Eigen::MatrixXd G(R, nw), lambda(nf, nf), S(nw, nw);
-    for (int k = 0; k < R; ++k) {
-        for (int a = 0; a < nf; ++a) G(k, a) = J[k][free_[a]];
-        for (int a = 0; a < nh; ++a) G(k, nf + a) = J[k][held_[a]];
-        for (int a = 0; a < nk; ++a) G(k, nf + nh + a) = J[k][n + a];
-    }
-    for (int a = 0; a < nf; ++a)
-        for (int b = 0; b < nf; ++b) lambda(a, b) = freePrecision_[a][b];
-    for (int a = 0; a < nw; ++a)
-        for (int b = 0; b < nw; ++b) S(a, b) = truthCovariance_[a][b];
-    const Eigen::MatrixXd JF = G.leftCols(nf), H = JF.transpose() * JF;
-    const Eigen::LLT<Eigen::MatrixXd> hl(H + lambda);
-    if (hl.info() != Eigen::Success) return fit;
-    const Eigen::MatrixXd C0 = hl.solve(Eigen::MatrixXd::Identity(nf, nf));
-    const Eigen::MatrixXd M = JF.transpose() * G;
-    Eigen::MatrixXd D = C0 * (M * S * M.transpose() + H) * C0;
+    LinearizedFit f;
+    if (!linearizeFit(J, n, free_, held_, freePrecision_, truthCovariance_, f)) return fit;
+    const Eigen::MatrixXd M = f.G.leftCols(nf).transpose() * f.G;
+    Eigen::MatrixXd D = f.C0 * (M * f.S * M.transpose() + f.H) * f.C0;
     D = 0.5 * (D + D.transpose());
+    const Eigen::MatrixXd& S = f.S;
     // The log-scale parameters the fit moves, off their bounds.
     std::vector<int> use;
     for (int a = 0; a < nf; ++a) {
@@ -798,13 +816,11 @@ MuscleEstimate identifySynergistAware(const Population& prior, const std::vector
     for (ChannelFit& f : est.channelFits) f.p = calcChiSquareSurvival(f.chiSquare, f.n);
     if (!m.covariance.empty()) {
         const int n = int(m.covariance.size()), R = map.numResiduals;
-        const int it = P::kTendon, ig = P::kSize, is = P::kSigma, jf = P::kFascicle;
-        // Reported quantities as linear combinations of x: ln M; ln L0T = ln t_b + ln g;
-        // ln F0 = ln sigma + ln M - ln f_b - ln g (+ constants).
-        std::vector<double> gm(n, 0.0), gt(n, 0.0), gf(n, 0.0);
+        const int it = P::kTendon, ig = P::kSize;
+        // Reported quantities as linear combinations of x: ln M; ln L0T = ln t_b + ln g; ln F0.
+        std::vector<double> gm(n, 0.0), gt(n, 0.0), gf = model.getLnMaxForceWeights();
         gm[im] = 1;
         gt[it] += 1, gt[ig] += 1;
-        gf[is] += 1, gf[im] += 1, gf[jf] -= 1, gf[ig] -= 1;
         auto quadratic = [&](const std::vector<double>& a, const std::vector<std::vector<double>>& M,
                              const std::vector<double>& b) {
             double v = 0;

@@ -85,6 +85,8 @@ public:
     int getNumParameters() const { return getFirstRotatorIndex() + int(rotators_.size()); }
     std::vector<std::string> getParameterNames() const;
     int getMassIndex() const;                 ///< ln M of the primary muscle
+    /// The primary's ln F0 = ln sigma + ln M - ln f_b - ln g (+ constants) as weights on the parameters.
+    std::vector<double> getLnMaxForceWeights() const;
     std::vector<int> getFlexorMassIndices() const;  ///< the biceps heads' and synergists' ln mass scales
     static constexpr int getTendonIndex() { return kTendon; }          ///< ln t_b
     static constexpr int getActivationIndex() { return kActivation; }  ///< VA

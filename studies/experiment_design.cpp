@@ -148,11 +148,8 @@ Sensitivities calcSensitivities(const Population& prior, const std::vector<Torqu
     const std::vector<int> flexors = model.getFlexorMassIndices();
     for (int j : flexors) s.flexorMean(j) = 1.0 / double(flexors.size());
     s.priorFlexorStrengthSd = std::sqrt(s.flexorMean.dot(sigma * s.flexorMean));
-    s.forceWeights = Eigen::VectorXd::Zero(n);
-    s.forceWeights(s.massIndex) += 1;
-    s.forceWeights(SynergistModel::getSpecificTensionIndex()) += 1;
-    s.forceWeights(SynergistModel::getFascicleIndex()) -= 1;
-    s.forceWeights(s.sizeIndex) -= 1;
+    const std::vector<double> force = model.getLnMaxForceWeights();
+    s.forceWeights = Eigen::Map<const Eigen::VectorXd>(force.data(), n);
     s.priorForceSd = std::sqrt(s.forceWeights.dot(sigma * s.forceWeights));
     s.baseTendonLength = prior.base.muscles[prior.base.primary].params.optimalTendonLength;
     s.priorMassSd = std::sqrt(sigma(s.massIndex, s.massIndex));
