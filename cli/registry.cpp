@@ -3,6 +3,8 @@
 #include "basics/output_folder.h"
 #include "cli/commands.h"
 
+#include <malloc.h>
+
 #include <algorithm>
 #include <atomic>
 #include <cmath>
@@ -154,6 +156,12 @@ void addRegisteredCommands(CLI::App& app) {
     run->add_option("--jobs", ctx->jobs, "worker threads")->capture_default_str()->check(CLI::Range(1, 64));
     ctx->muscle.add(*run);
     run->callback([ctx] {
+        // glibc raises its mmap threshold (to 32 MB) each time a large block is freed, after which
+        // large temporaries (trial tables, frames) come from the heap, which then stays resident.
+        // Fixed thresholds give them back: the job's peak is ~180 MiB with them, ~190 without
+        // (docs/benchmarks.md, issue 30).
+        ::mallopt(M_MMAP_THRESHOLD, 1 << 20);
+        ::mallopt(M_TRIM_THRESHOLD, 1 << 20);
         auto& s = steps();
         std::stable_sort(s.begin(), s.end(), [](const Step& a, const Step& b) { return a.order < b.order; });
         // Every step writes into a staging folder; the results join --out together at the end, or (an

@@ -146,6 +146,7 @@ void RenderSettings::validate() const {
     checkEvenSize("width", width);
     checkEvenSize("height", height);
     checkField("supersample", supersample, Bound::closed(1, kMaxSupersample));
+    checkField("max_tile_side", maxTileSide, Bound::closed(64, kMaxBufferSide, "px"));
     if (width * supersample > kMaxBufferSide || height * supersample > kMaxBufferSide)
         throw FieldError("supersample", "= " + std::to_string(supersample) +
                                             ": expected width*supersample and height*supersample <= " +
@@ -439,20 +440,34 @@ private:
 // --------------------------------------------------------------------------------------------------
 // OSMesa drawing.
 
+// A frame is drawn in tiles of at most maxTileSide supersampled pixels a side, so OSMesa's buffers
+// (ours, its colour copy and depth) stay small: 5 MB at 1280 x 720 supersampled twice (12 tiles),
+// instead of 44 MB for one 2560 x 1440 buffer (docs/benchmarks.md, issue 30). Each tile's
+// projection maps its part of the picture onto the whole buffer; tile edges fall on pixel edges of
+// the supersampled grid, so tiles join without seams.
 struct OffscreenRenderer::Impl {
     RenderSettings settings;
-    int bufferWidth = 0, bufferHeight = 0;
+    int tilesX = 1, tilesY = 1;
+    int tileWidth = 0, tileHeight = 0;      // output pixels per tile (the last tile may use fewer)
+    int bufferWidth = 0, bufferHeight = 0;  // tile * supersample
     OSMesaContext context = nullptr;
     std::vector<unsigned char> buffer;  // RGBA, top row first
     MeshCache meshes;
     std::vector<Primitive> primitives, topPrimitives;
-    cv::Mat downsampled;                // RGBA at output size, reused
+    cv::Mat downsampled;                // RGBA at tile size, reused
+    cv::Mat frame;                      // BGR at output size, reused when the caller let go of it
     float maxLineWidth = 1;
 
     explicit Impl(const RenderSettings& s) : settings(s) {
         settings.validate();
-        bufferWidth = settings.width * settings.supersample;
-        bufferHeight = settings.height * settings.supersample;
+        const int ss = settings.supersample;
+        const int side = settings.maxTileSide;
+        tilesX = std::max(1, (settings.width * ss + side - 1) / side);
+        tilesY = std::max(1, (settings.height * ss + side - 1) / side);
+        tileWidth = (settings.width + tilesX - 1) / tilesX;
+        tileHeight = (settings.height + tilesY - 1) / tilesY;
+        bufferWidth = tileWidth * ss;
+        bufferHeight = tileHeight * ss;
         context = OSMesaCreateContextExt(OSMESA_RGBA, 24, 0, 0, nullptr);
         if (!context) throw std::runtime_error("OSMesa: could not create an RGBA context with a depth buffer");
         buffer.assign(size_t(bufferWidth) * bufferHeight * 4, 0);
@@ -592,22 +607,44 @@ struct OffscreenRenderer::Impl {
         makeCurrent();
         const Camera& cam = settings.camera;
         const Mat4 view = calcViewMatrix(cam);
-        setupScene(calcProjectionMatrix(cam, double(settings.width) / settings.height), view);
-        drawLayer(primitives, view);
-        if (!topPrimitives.empty()) {
-            glClear(GL_DEPTH_BUFFER_BIT);
-            drawLayer(topPrimitives, view);
-        }
-        glFinish();
-
-        // Downsample first (channels are independent), then drop alpha and swap to BGR.
-        const cv::Mat rgba(bufferHeight, bufferWidth, CV_8UC4, buffer.data());
-        cv::Mat out;
-        if (settings.supersample == 1) {
-            cv::cvtColor(rgba, out, cv::COLOR_RGBA2BGR);
-        } else {
-            cv::resize(rgba, downsampled, cv::Size(settings.width, settings.height), 0, 0, cv::INTER_AREA);
-            cv::cvtColor(downsampled, out, cv::COLOR_RGBA2BGR);
+        const Mat4 projection = calcProjectionMatrix(cam, double(settings.width) / settings.height);
+        const int ss = settings.supersample, width = settings.width, height = settings.height;
+        // The frame buffer is reused while no caller holds the previous frame (no 2.7 MB allocation
+        // and page faults per frame at 1280 x 720).
+        if (frame.empty() || frame.u->refcount > 1) frame = cv::Mat(height, width, CV_8UC3);
+        cv::Mat& out = frame;
+        for (int row = 0; row < tilesY; ++row) {
+            for (int col = 0; col < tilesX; ++col) {
+                const int x = col * tileWidth, y = row * tileHeight;
+                if (x >= width || y >= height) continue;
+                // The tile's range in normalized device coordinates (y up), stretched onto [-1, 1].
+                const double x0 = -1 + 2.0 * x / width, x1 = -1 + 2.0 * (x + tileWidth) / width;
+                const double y1 = 1 - 2.0 * y / height, y0 = 1 - 2.0 * (y + tileHeight) / height;
+                Mat4 tile{};
+                tile[0] = 2 / (x1 - x0);
+                tile[5] = 2 / (y1 - y0);
+                tile[10] = 1;
+                tile[12] = -(x0 + x1) / (x1 - x0);
+                tile[13] = -(y0 + y1) / (y1 - y0);
+                tile[15] = 1;
+                setupScene(multiply(tile, projection), view);
+                drawLayer(primitives, view);
+                if (!topPrimitives.empty()) {
+                    glClear(GL_DEPTH_BUFFER_BIT);
+                    drawLayer(topPrimitives, view);
+                }
+                glFinish();
+                // Downsample first (channels are independent), then drop alpha and swap to BGR.
+                const cv::Mat rgba(bufferHeight, bufferWidth, CV_8UC4, buffer.data());
+                const cv::Rect part(0, 0, std::min(tileWidth, width - x), std::min(tileHeight, height - y));
+                cv::Mat target = out(cv::Rect(x, y, part.width, part.height));
+                if (ss == 1) {
+                    cv::cvtColor(rgba(part), target, cv::COLOR_RGBA2BGR);
+                } else {
+                    cv::resize(rgba, downsampled, cv::Size(tileWidth, tileHeight), 0, 0, cv::INTER_AREA);
+                    cv::cvtColor(downsampled(part), target, cv::COLOR_RGBA2BGR);
+                }
+            }
         }
         return out;
     }

@@ -51,6 +51,10 @@ struct RenderSettings {
     double defaultLineThickness = 2.0;      ///< thickness of lines that do not set one (px), in (0, 64]
     double ambient = 0.35;                  ///< ambient light intensity (-), in [0, 1]
     double diffuse = 0.75;                  ///< intensity of the camera-fixed key light (-), in [0, 1]
+    int maxTileSide = 640;                  ///< the frame is drawn in tiles of at most this many
+                                            ///< supersampled px a side (bounds OSMesa's buffers to
+                                            ///< ~5 MB; 44 MB whole at 1280 x 720 x 2), in [64, 8192];
+                                            ///< C++ only (not a YAML key)
 
     /// Throws FieldError naming the field (YAML key, e.g. "camera.vertical_fov"), its value and the
     /// violated bound.

@@ -149,7 +149,7 @@ Camera calcSagittalCamera(const ArmParameters& arm, double aspect) {
 
 struct TrialRenderer::Impl {
     ArmSetup setup;
-    Table table;
+    const Table& table;   // the caller's (not copied: a 1000 Hz trial of ten muscles is ~6 MB)
     TrialVideoSettings settings;
     RenderSettings renderSettings;
     std::unique_ptr<MuscleArm> model;

@@ -90,6 +90,7 @@ public:
     /// Checks the table (columns time_s, activation, elbow_angle_deg, elbow_velocity_degps,
     /// muscle_force_N and the muscle's state columns; at least one row; times increasing) and the
     /// settings, then builds the arm. Throws InputError naming the column, row (source line) or field.
+    /// The renderer reads the table, which must outlive it (it is not copied).
     TrialRenderer(const ArmSetup& setup, const Table& table, const TrialVideoSettings& settings);
     ~TrialRenderer();
     TrialRenderer(const TrialRenderer&) = delete;

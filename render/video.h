@@ -1,4 +1,4 @@
-// Video and still-image output through OpenCV. Files are written whole or not at all: frames go to a
+// Video output through FFmpeg's libraries (libx264 in MP4, MJPEG in AVI) and PNG stills through libpng. Files are written whole or not at all: frames go to a
 // hidden temporary beside the target ("<dir>/.<name>.tmp-<pid>-<n>.<ext>") that close() renames into
 // place; a failure, discard() or destruction before close() removes the temporary. The target's
 // directory must already exist (it is not created).
@@ -22,7 +22,7 @@ struct VideoSettings {
     void validate() const;
 };
 
-/// Writes BGR frames to a video file through cv::VideoWriter (FFmpeg backend). Encoding runs on a
+/// Writes BGR frames to a video file through FFmpeg's libraries (x264 on one thread, no lookahead). Encoding runs on a
 /// worker thread owned by the writer, so rendering the next frame overlaps encoding this one: write()
 /// copies the frame into a queue of at most 3 frames and blocks while it is full. Use one writer from
 /// one thread at a time.

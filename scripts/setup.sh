@@ -18,6 +18,7 @@ packages=(
   libsimbody-dev libeigen3-dev libceres-dev libopencv-dev libosmesa6-dev
   libgtest-dev libgmock-dev libbenchmark-dev libyaml-cpp-dev libcli11-dev nlohmann-json3-dev
   libplplot-dev plplot-driver-cairo libfftw3-dev libfmt-dev libtinyxml2-dev
+  libavcodec-dev libavformat-dev libswscale-dev libpng-dev
   libopenmpi-dev openmpi-bin
   pybind11-dev python3-dev python3-numpy python3-pytest python3-matplotlib
 )

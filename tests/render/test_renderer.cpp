@@ -275,6 +275,30 @@ TEST(OffscreenRenderer, IsDeterministicAcrossCallsRenderersAndThreads) {
     EXPECT_EQ(cv::norm(a, d, cv::NORM_INF), 0);
 }
 
+// Tiles bound OSMesa's buffers (issue 30); they must join without seams: the same frame drawn in one
+// tile, in 6 and in 35 equals itself to one level of 255 at all but a few pixels of line ends.
+TEST(OffscreenRenderer, TiledFramesEqualTheFrameDrawnWhole) {
+    constexpr int kLevelTolerance = 1;          // rounding of the tile's projection (0-255)
+    constexpr double kMaxOffPixelShare = 1e-3;  // pixels beyond it (wide-line caps at tile edges)
+    PendulumScene scene;
+    RenderSettings s = pendulumSettings();
+    s.width = 640;
+    s.height = 480;
+    s.maxTileSide = 1280;   // 1280 x 960 supersampled: one tile
+    const SimTK::State state = scene.makeState(0.4, 0.3);
+    const cv::Mat whole = OffscreenRenderer(s).renderFrame(scene.getSystem(), state);
+    for (int side : {480, 200}) {   // 3 x 2 and 7 x 5 tiles, some cut short at the frame's edge
+        s.maxTileSide = side;
+        const cv::Mat tiled = OffscreenRenderer(s).renderFrame(scene.getSystem(), state);
+        cv::Mat diff;
+        cv::absdiff(whole, tiled, diff);
+        const cv::Mat off = diff.reshape(1) > kLevelTolerance;
+        EXPECT_LE(cv::countNonZero(off), kMaxOffPixelShare * whole.total() * 3) << "max tile side " << side;
+    }
+    s.maxTileSide = 63;
+    EXPECT_THROW(s.validate(), FieldError);
+}
+
 TEST(OffscreenRenderer, RejectsDecorationOnUnknownBody) {
     PendulumScene scene;
     OffscreenRenderer renderer(pendulumSettings());
