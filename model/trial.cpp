@@ -4,7 +4,11 @@
 #include "basics/param_node.h"
 #include "model/geometry.h"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <stdexcept>
+#include <string>
 
 using namespace SimTK;
 
@@ -338,6 +342,167 @@ void FreeMovementSettings::validate(const ArmParameters& arm) const {
                                       "would never start)");
 }
 
+namespace {
+
+// FreeMovementSolver::MuscleBlocks (trial.h): the free arm's ODE y' = f(t, y), y = [q u z], for CPodes.
+// A full evaluation realizes the System. The last full evaluation that was not a Jacobian column of
+// the joint (a state moved in q or u alone) is the base; a call at its time whose y differs from the
+// base's in muscle states only is a Jacobian column of those muscles: they are evaluated alone at the
+// base's path length and lengthening speed (-h u), and the elbow's acceleration changes by
+// sum h_i dF_i / M_ee (exact: given q and u the accelerations are linear in the tensions; the radius,
+// if any, is locked). Everything else is the base's.
+class CoupledMuscleOde {
+public:
+    CoupledMuscleOde(const MuscleArm& model, const State& initial, bool checkPartial)
+        : model_(model), system_(model.getSystem()), state_(initial), n_(model.getNumMuscles()),
+          checkPartial_(checkPartial) {
+        const int nqu = state_.getNQ() + state_.getNU();
+        nq_ = state_.getNQ();
+        ny_ = state_.getNY();
+        elbowU_ = nq_ + int(model.getArm().getForearm().getFirstUIndex(state_));
+        for (int i = 0; i < n_; ++i) {
+            muscles_.push_back(&model.getMuscle(i));
+            first_.push_back(nqu + model.getMuscleForce(i).getFirstStateIndex(state_));
+        }
+        activations_ = getActivationProfiles(model);
+        base_.resize(ny_);
+        baseYdot_.resize(ny_);
+        length_.resize(n_);
+        speed_.resize(n_);
+        momentArm_.resize(n_);
+        force_.resize(n_);
+    }
+
+    int getNumPartialEvaluations() const { return partial_; }
+
+    void operator()(double t, const double* y, double* ydot) {
+        if (haveBase_ && t == baseTime_) {
+            const bool jointMoved = !std::equal(y, y + nq_ + state_.getNU(), base_.data());
+            std::vector<int>& moved = moved_;
+            moved.clear();
+            for (int i = 0; i < n_; ++i) {
+                const int a = first_[i], b = a + muscles_[i]->getNumStates();
+                if (!std::equal(y + a, y + b, base_.data() + a)) moved.push_back(i);
+            }
+            if (!jointMoved && !moved.empty()) {
+                evaluateMuscles(t, y, ydot, moved);
+                if (checkPartial_) checkPartial(t, y, ydot);
+                return;
+            }
+            if (jointMoved && moved.empty()) {   // a joint column: the base stays
+                realize(t, y, ydot);
+                return;
+            }
+        }
+        realize(t, y, ydot);
+        std::copy(y, y + ny_, base_.begin());
+        std::copy(ydot, ydot + ny_, baseYdot_.begin());
+        baseTime_ = t;
+        haveBase_ = true;
+        haveGeometry_ = false;
+    }
+
+private:
+    // FreeMovementSettings::checkPartialEvaluations: the realized derivative must be the same.
+    void checkPartial(double t, const double* y, const double* ydot) {
+        std::vector<double> full(ny_);
+        realize(t, y, full.data());
+        for (int k = 0; k < ny_; ++k)
+            if (!(std::abs(full[k] - ydot[k]) <= 1e-9 * std::max(1.0, std::abs(full[k]))))
+            {
+                char text[200];
+                std::snprintf(text, sizeof text, "free movement: a one-muscle evaluation at t = %.17g differs from "
+                              "the realized derivative in entry %d: %.17g against %.17g", t, k, ydot[k], full[k]);
+                throw std::logic_error(text);
+            }
+    }
+    void realize(double t, const double* y, double* ydot) {
+        state_.setTime(t);
+        Vector& Y = state_.updY();
+        for (int k = 0; k < ny_; ++k) Y[k] = y[k];
+        system_.realize(state_, Stage::Acceleration);
+        const Vector& Yd = state_.getYDot();
+        for (int k = 0; k < ny_; ++k) ydot[k] = Yd[k];
+    }
+    // The base's path lengths, speeds, moment arms, tensions and the elbow's inertia.
+    void computeGeometry() {
+        realizeBase();
+        Matrix M;
+        system_.getMatterSubsystem().calcM(state_, M);
+        const int e = elbowU_ - nq_;
+        elbowInertia_ = M(e, e);
+        for (int i = 0; i < n_; ++i) {
+            length_[i] = model_.calcPathLength(state_, i);
+            momentArm_[i] = model_.calcMomentArm(state_, i);
+            speed_[i] = -momentArm_[i] * base_[elbowU_];
+            force_[i] = muscles_[i]->calcForce(length_[i], base_.data() + first_[i]);
+        }
+        haveGeometry_ = true;
+    }
+    void realizeBase() {
+        state_.setTime(baseTime_);
+        Vector& Y = state_.updY();
+        for (int k = 0; k < ny_; ++k) Y[k] = base_[k];
+        system_.realize(state_, Stage::Position);
+    }
+    void evaluateMuscles(double t, const double* y, double* ydot, const std::vector<int>& moved) {
+        if (!haveGeometry_) computeGeometry();
+        std::copy(baseYdot_.begin(), baseYdot_.end(), ydot);
+        double torque = 0;
+        for (int i : moved) {
+            const double* yi = y + first_[i];
+            muscles_[i]->calcMovingStateDerivative(length_[i], speed_[i], activations_[i]->getValue(t), yi,
+                                                   ydot + first_[i]);
+            torque += momentArm_[i] * (muscles_[i]->calcForce(length_[i], yi) - force_[i]);
+        }
+        ydot[elbowU_] += torque / elbowInertia_;
+        ++partial_;
+    }
+
+    const MuscleArm& model_;
+    const MultibodySystem& system_;
+    State state_;
+    int n_, nq_ = 0, ny_ = 0, elbowU_ = 0;
+    bool checkPartial_;
+    std::vector<const MuscleModel*> muscles_;
+    std::vector<int> first_;
+    std::vector<const ActivationProfile*> activations_;
+    bool haveBase_ = false, haveGeometry_ = false;
+    double baseTime_ = 0, elbowInertia_ = 1;
+    std::vector<double> base_, baseYdot_, length_, speed_, momentArm_, force_;
+    std::vector<int> moved_;
+    int partial_ = 0;
+};
+
+// Integrates the free arm from state (on return: the end state) with CoupledMuscleOde; sample gets a
+// State realized to Stage::Time at every sample time.
+IntegrationStats integrateCoupledMuscles(const MuscleArm& model, State& state, double duration, double sampleRate,
+                                         const std::vector<double>& breakpoints, const IntegrationSettings& integration,
+                                         bool checkPartial, const std::function<void(const State&)>& sample) {
+    const MultibodySystem& system = model.getSystem();
+    system.realize(state, Stage::Time);
+    CoupledMuscleOde f(model, state, checkPartial);
+    std::vector<double> y(state.getNY());
+    for (int k = 0; k < state.getNY(); ++k) y[k] = state.getY()[k];
+    State out = state;
+    auto toState = [&](double t, const double* yIn) -> const State& {
+        out.setTime(t);
+        Vector& Y = out.updY();
+        for (int k = 0; k < out.getNY(); ++k) Y[k] = yIn[k];
+        system.realize(out, Stage::Time);
+        return out;
+    };
+    IntegrationStats st = integrateSampled(
+        [&](double t, const double* yIn, double* ydot) { f(t, yIn, ydot); }, state.getTime(), y, duration, sampleRate,
+        breakpoints, integration, [&](double t, const double* yIn) { sample(toState(t, yIn)); },
+        [&](double t, const double* yIn) { model.checkMuscleStates(toState(t, yIn)); });
+    st.partialEvaluations = f.getNumPartialEvaluations();
+    state = toState(state.getTime() + duration, y.data());
+    return st;
+}
+
+}  // namespace
+
 Table runFreeMovement(const ArmSetup& setup, const FreeMovementSettings& settings, IntegrationStats* stats) {
     settings.validate(setup.arm);
     ArmSetup loaded = setup;
@@ -364,21 +529,26 @@ Table runFreeMovement(const ArmSetup& setup, const FreeMovementSettings& setting
     const double L0 = model.getMuscle(primary).getOptimalFascicleLength();
     std::vector<double> forces(n);
     const std::vector<const ActivationProfile*> activations = getActivationProfiles(model);
-    const IntegrationStats st = simulateSampled(
-        system, state, settings.duration, settings.sampleRate, settings.activation.getBreakpoints(),
-        settings.integration,
-        [&](const State& s) {
-            system.realize(s, Stage::Position);
-            const MuscleOutputs o = biceps.calcOutputs(s);
-            for (int i = 0; i < n; ++i) forces[i] = model.getMuscleForce(i).getForce(s);
-            std::vector<double> row{s.getTime(), biceps.getActivation(s), radToDeg(arm.getElbowAngle(s)),
-                                    radToDeg(arm.getElbowAngularVelocity(s)), model.calcPathLength(s, primary),
-                                    model.calcMomentArm(s, primary), o.Fse, o.L * L0, o.V * L0, o.activeFraction};
-            appendMuscleForces(row, activations, forces, s.getTime());
-            model.appendMuscleStates(s, row);
-            t.appendRow(std::move(row));
-        },
-        [&](const State& s) { model.checkMuscleStates(s); });
+    auto sample = [&](const State& s) {
+        system.realize(s, Stage::Position);
+        const MuscleOutputs o = biceps.calcOutputs(s);
+        for (int i = 0; i < n; ++i) forces[i] = model.getMuscleForce(i).getForce(s);
+        std::vector<double> row{s.getTime(), biceps.getActivation(s), radToDeg(arm.getElbowAngle(s)),
+                                radToDeg(arm.getElbowAngularVelocity(s)), model.calcPathLength(s, primary),
+                                model.calcMomentArm(s, primary), o.Fse, o.L * L0, o.V * L0, o.activeFraction};
+        appendMuscleForces(row, activations, forces, s.getTime());
+        model.appendMuscleStates(s, row);
+        t.appendRow(std::move(row));
+    };
+    IntegrationStats st;
+    if (settings.solver == FreeMovementSolver::SimbodySystem) {
+        st = simulateSampled(system, state, settings.duration, settings.sampleRate, settings.activation.getBreakpoints(),
+                             settings.integration, sample, [&](const State& s) { model.checkMuscleStates(s); });
+    } else {
+        st = integrateCoupledMuscles(model, state, settings.duration, settings.sampleRate,
+                                     settings.activation.getBreakpoints(), settings.integration,
+                                     settings.checkPartialEvaluations, sample);
+    }
     if (stats) *stats = st;
     return t;
 }

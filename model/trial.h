@@ -153,6 +153,20 @@ std::vector<IsometricTrialResult> runIsometricTrials(const ArmSetup& setup,
 
 /// Free movement: the elbow unlocked, an optional load in the hand, an activation profile for the
 /// flexors (the other muscles rest).
+/// How a free movement is integrated.
+enum class FreeMovementSolver {
+    /// Default: CPodes on the System's state vector [q u z] (integrateSampled). A right-hand side
+    /// realizes the System; a difference-quotient Jacobian column that moves one muscle's state
+    /// evaluates that muscle alone (its pure model at the column's path length and speed) and adds
+    /// its change of tension times its moment arm over the elbow's inertia to the elbow's
+    /// acceleration: the muscles are coupled only through the joint. A Jacobian then costs a few
+    /// realizations instead of one per state.
+    MuscleBlocks,
+    /// The whole Simbody System integrated by CPodesIntegrator (simulateSampled): the reference the
+    /// tests compare MuscleBlocks with (samples within 1e-6 relative).
+    SimbodySystem
+};
+
 struct FreeMovementSettings {
     double initialAngle = degToRad(150);  ///< theta at t = 0 [rad]
     double initialVelocity = 0.0;      ///< dtheta/dt at t = 0 [rad/s]
@@ -163,6 +177,11 @@ struct FreeMovementSettings {
     /// true: the muscle starts at its steady state for U(0) at the initial path (V = 0);
     /// false: the spec-5 initial state.
     bool startSteady = true;
+    FreeMovementSolver solver = FreeMovementSolver::MuscleBlocks;
+    /// MuscleBlocks, for tests: every one-muscle evaluation is also realized, and std::logic_error is
+    /// thrown unless the two agree to 1e-9 (relative, or absolute below 1; measured: 1e-16 relative,
+    /// 1e-12 absolute where a tendon-force derivative cancels near equilibrium).
+    bool checkPartialEvaluations = false;
     IntegrationSettings integration;
     void validate(const ArmParameters& arm) const;
 };

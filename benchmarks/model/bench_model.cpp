@@ -66,6 +66,19 @@ void BM_FreeMovement2s(benchmark::State& state) {
 }
 BENCHMARK(BM_FreeMovement2s)->Unit(benchmark::kMillisecond);
 
+// Issue 30: the seven-muscle elbow's 2 s free movement (from 150 deg, activation 0.5 from 0.2 s, into
+// the flexion stop); arg 0 = FreeMovementSolver::MuscleBlocks, 1 = the whole System (SimbodySystem).
+void BM_ElbowFreeMovement2s(benchmark::State& state) {
+    FreeMovementSettings s;
+    s.solver = state.range(0) == 0 ? FreeMovementSolver::MuscleBlocks : FreeMovementSolver::SimbodySystem;
+    IntegrationStats st;
+    for (auto _ : state) benchmark::DoNotOptimize(runFreeMovement(elbow(), s, &st));
+    state.counters["steps"] = st.steps;
+    state.counters["rhs"] = st.realizations;
+    state.counters["one_muscle"] = st.partialEvaluations;
+}
+BENCHMARK(BM_ElbowFreeMovement2s)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+
 // Issue 10: 0.5 s rest + 3 s hold at 90 deg flexion, agonists 0.95, antagonists 0.10; arg = sample rate.
 void BM_ElbowMvcTrial(benchmark::State& state) {
     IsometricTrialSettings s;
