@@ -139,6 +139,32 @@ BENCHMARK(BM_LockedMvcNMuscles)
     ->ArgsProduct({{1, 8, 16, 32}, {0}, {1000}})
     ->Unit(benchmark::kMillisecond);
 
+// Issue 30: a 1 s free movement (from 150 deg, activation 0.5 from 0.2 s, 100 Hz) of N copies of the
+// thesis's straight biceps; arg 0 = N, arg 1 = 0 for FreeMovementSolver::MuscleBlocks, 1 for the whole
+// System. The arm reaches the flexion stop sooner with more muscles: compare time per step.
+void BM_FreeMovementNMuscles(benchmark::State& state) {
+    ArmSetup setup = subject();
+    const MuscleSpec one = setup.muscles[0];
+    setup.muscles.clear();
+    for (int i = 0; i < int(state.range(0)); ++i) {
+        setup.muscles.push_back(one);
+        setup.muscles.back().params.name = "m" + std::to_string(i + 1);
+    }
+    FreeMovementSettings s;
+    s.duration = 1.0;
+    s.sampleRate = 100;
+    s.solver = state.range(1) == 0 ? FreeMovementSolver::MuscleBlocks : FreeMovementSolver::SimbodySystem;
+    IntegrationStats stats;
+    for (auto _ : state) benchmark::DoNotOptimize(runFreeMovement(setup, s, &stats));
+    state.counters["steps"] = stats.steps;
+    state.counters["rhs"] = stats.realizations;
+    state.counters["one_muscle"] = stats.partialEvaluations;
+}
+BENCHMARK(BM_FreeMovementNMuscles)
+    ->ArgsProduct({{1, 2, 4, 8, 16, 32, 64}, {0}})
+    ->ArgsProduct({{1, 2, 4, 8, 16}, {1}})
+    ->Unit(benchmark::kMillisecond);
+
 // Issue 14's floor: one right-hand side of the locked elbow is every muscle's state derivative at its
 // fixed path (90 deg flexion; agonists 0.95, antagonists 0.10); arg 0 = thesis arm, 1 = elbow.
 void BM_LockedArmDerivative(benchmark::State& state) {
