@@ -360,10 +360,20 @@ public:
         nq_ = state_.getNQ();
         ny_ = state_.getNY();
         elbowU_ = nq_ + int(model.getArm().getForearm().getFirstUIndex(state_));
+        int numMuscleStates = 0;
         for (int i = 0; i < n_; ++i) {
             muscles_.push_back(&model.getMuscle(i));
             first_.push_back(nqu + model.getMuscleForce(i).getFirstStateIndex(state_));
+            numMuscleStates += muscles_.back()->getNumStates();
         }
+        // What the one-muscle evaluation assumes: every z belongs to a muscle, the elbow is the only
+        // free mobility (the radius, if any, locked: its acceleration is 0 and the elbow's is its
+        // generalized force over M_ee).
+        const ArmModel& arm = model.getArm();
+        if (numMuscleStates != state_.getNZ() || state_.getNU() != (arm.hasForearmRotation() ? 2 : 1) ||
+            (arm.hasForearmRotation() && !arm.getRadius().isLocked(state_)))
+            throw std::logic_error("FreeMovementSolver::MuscleBlocks: the arm has states other than q, u and the "
+                                   "muscles', or a free mobility besides the elbow; use SimbodySystem");
         activations_ = getActivationProfiles(model);
         base_.resize(ny_);
         baseYdot_.resize(ny_);

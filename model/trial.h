@@ -151,8 +151,6 @@ std::vector<IsometricTrialResult> runIsometricTrials(const ArmSetup& setup,
                                                      int jobs,
                                                      const std::function<void(int, int)>& progress = {});
 
-/// Free movement: the elbow unlocked, an optional load in the hand, an activation profile for the
-/// flexors (the other muscles rest).
 /// How a free movement is integrated.
 enum class FreeMovementSolver {
     /// Default: CPodes on the System's state vector [q u z] (integrateSampled). A right-hand side
@@ -160,13 +158,17 @@ enum class FreeMovementSolver {
     /// evaluates that muscle alone (its pure model at the column's path length and speed) and adds
     /// its change of tension times its moment arm over the elbow's inertia to the elbow's
     /// acceleration: the muscles are coupled only through the joint. A Jacobian then costs a few
-    /// realizations instead of one per state.
+    /// realizations instead of one per state. Needs the elbow as the only free mobility (a forearm
+    /// rotation locked) and no states but q, u and the muscles' (std::logic_error otherwise).
     MuscleBlocks,
     /// The whole Simbody System integrated by CPodesIntegrator (simulateSampled): the reference the
-    /// tests compare MuscleBlocks with (samples within 1e-6 relative).
+    /// tests compare MuscleBlocks with. The two take different steps and differ by their
+    /// integration errors (at accuracy 1e-8: up to 6e-5 of a column's largest value).
     SimbodySystem
 };
 
+/// Free movement: the elbow unlocked, an optional load in the hand, an activation profile for the
+/// flexors (the other muscles rest).
 struct FreeMovementSettings {
     double initialAngle = degToRad(150);  ///< theta at t = 0 [rad]
     double initialVelocity = 0.0;      ///< dtheta/dt at t = 0 [rad/s]

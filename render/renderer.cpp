@@ -443,13 +443,17 @@ private:
 // A frame is drawn in tiles of at most maxTileSide supersampled pixels a side, so OSMesa's buffers
 // (ours, its colour copy and depth) stay small: 5 MB at 1280 x 720 supersampled twice (12 tiles),
 // instead of 44 MB for one 2560 x 1440 buffer (docs/benchmarks.md, issue 30). Each tile's
-// projection maps its part of the picture onto the whole buffer; tile edges fall on pixel edges of
-// the supersampled grid, so tiles join without seams.
+// projection maps its part of the picture, with a margin as wide as half the widest line, onto the
+// whole buffer, and the margin is dropped: tile edges fall on pixel edges of the supersampled grid and
+// lines (clipped by their centre) are whole, so tiles join without seams.
 struct OffscreenRenderer::Impl {
     RenderSettings settings;
     int tilesX = 1, tilesY = 1;
     int tileWidth = 0, tileHeight = 0;      // output pixels per tile (the last tile may use fewer)
-    int bufferWidth = 0, bufferHeight = 0;  // tile * supersample
+    int margin = 0;                         // output pixels drawn around a tile and dropped (wide lines
+                                            // are clipped by their centre: without it they lose their
+                                            // half beyond a tile's edge)
+    int bufferWidth = 0, bufferHeight = 0;  // (tile + 2 margin) * supersample
     OSMesaContext context = nullptr;
     std::vector<unsigned char> buffer;  // RGBA, top row first
     MeshCache meshes;
@@ -466,11 +470,9 @@ struct OffscreenRenderer::Impl {
         tilesY = std::max(1, (settings.height * ss + side - 1) / side);
         tileWidth = (settings.width + tilesX - 1) / tilesX;
         tileHeight = (settings.height + tilesY - 1) / tilesY;
-        bufferWidth = tileWidth * ss;
-        bufferHeight = tileHeight * ss;
         context = OSMesaCreateContextExt(OSMESA_RGBA, 24, 0, 0, nullptr);
         if (!context) throw std::runtime_error("OSMesa: could not create an RGBA context with a depth buffer");
-        buffer.assign(size_t(bufferWidth) * bufferHeight * 4, 0);
+        setMargin(0);
         makeCurrent();
         GLint maxWidth = 0, maxHeight = 0;
         OSMesaGetIntegerv(OSMESA_MAX_WIDTH, &maxWidth);
@@ -484,11 +486,25 @@ struct OffscreenRenderer::Impl {
         GLfloat range[2] = {1, 1};
         glGetFloatv(GL_ALIASED_LINE_WIDTH_RANGE, range);
         maxLineWidth = range[1];
+        if (tilesX * tilesY > 1) setMargin(calcMargin(settings.defaultLineThickness));   // made current per frame
     }
     ~Impl() {
         if (!context) return;
         if (OSMesaGetCurrentContext() == context) OSMesaMakeCurrent(nullptr, nullptr, 0, 0, 0);
         OSMesaDestroyContext(context);
+    }
+
+    // Output pixels a line of this thickness (and a point) reaches beyond its centre, plus one.
+    int calcMargin(double lineThickness) const {
+        const int ss = settings.supersample;
+        const double widest = std::max<double>({std::clamp(float(lineThickness) * ss, 1.0f, maxLineWidth), 2.0 * ss});
+        return int(std::ceil(0.5 * widest / ss)) + 1;
+    }
+    void setMargin(int m) {
+        margin = m;
+        bufferWidth = (tileWidth + 2 * m) * settings.supersample;
+        bufferHeight = (tileHeight + 2 * m) * settings.supersample;
+        buffer.assign(size_t(bufferWidth) * bufferHeight * 4, 0);
     }
 
     void makeCurrent() {
@@ -604,6 +620,12 @@ struct OffscreenRenderer::Impl {
         GeometryCollector topCollector(matter, state, meshes, settings.defaultLineThickness, topPrimitives);
         for (const auto& g : onTop) g.implementGeometry(topCollector);
 
+        if (tilesX * tilesY > 1) {   // a frame with wider lines than any before: a wider margin
+            double thickest = settings.defaultLineThickness;
+            for (const auto* layer : {&primitives, &topPrimitives})
+                for (const Primitive& p : *layer) thickest = std::max(thickest, p.lineThickness);
+            if (calcMargin(thickest) > margin) setMargin(calcMargin(thickest));
+        }
         makeCurrent();
         const Camera& cam = settings.camera;
         const Mat4 view = calcViewMatrix(cam);
@@ -617,9 +639,9 @@ struct OffscreenRenderer::Impl {
             for (int col = 0; col < tilesX; ++col) {
                 const int x = col * tileWidth, y = row * tileHeight;
                 if (x >= width || y >= height) continue;
-                // The tile's range in normalized device coordinates (y up), stretched onto [-1, 1].
-                const double x0 = -1 + 2.0 * x / width, x1 = -1 + 2.0 * (x + tileWidth) / width;
-                const double y1 = 1 - 2.0 * y / height, y0 = 1 - 2.0 * (y + tileHeight) / height;
+                // The tile and its margin in normalized device coordinates (y up), stretched onto [-1, 1].
+                const double x0 = -1 + 2.0 * (x - margin) / width, x1 = -1 + 2.0 * (x + tileWidth + margin) / width;
+                const double y1 = 1 - 2.0 * (y - margin) / height, y0 = 1 - 2.0 * (y + tileHeight + margin) / height;
                 Mat4 tile{};
                 tile[0] = 2 / (x1 - x0);
                 tile[5] = 2 / (y1 - y0);
@@ -636,12 +658,13 @@ struct OffscreenRenderer::Impl {
                 glFinish();
                 // Downsample first (channels are independent), then drop alpha and swap to BGR.
                 const cv::Mat rgba(bufferHeight, bufferWidth, CV_8UC4, buffer.data());
-                const cv::Rect part(0, 0, std::min(tileWidth, width - x), std::min(tileHeight, height - y));
+                const cv::Rect part(margin, margin, std::min(tileWidth, width - x), std::min(tileHeight, height - y));
                 cv::Mat target = out(cv::Rect(x, y, part.width, part.height));
                 if (ss == 1) {
                     cv::cvtColor(rgba(part), target, cv::COLOR_RGBA2BGR);
                 } else {
-                    cv::resize(rgba, downsampled, cv::Size(tileWidth, tileHeight), 0, 0, cv::INTER_AREA);
+                    cv::resize(rgba, downsampled, cv::Size(tileWidth + 2 * margin, tileHeight + 2 * margin), 0, 0,
+                               cv::INTER_AREA);
                     cv::cvtColor(downsampled(part), target, cv::COLOR_RGBA2BGR);
                 }
             }

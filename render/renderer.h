@@ -91,7 +91,9 @@ public:
     /// frame of MobilizedBodyIndex getBodyId(), 0 = Ground). The state is realized to
     /// Stage::Position if it is not already, and geometry of every stage the state has reached is
     /// drawn (Simbody's Visualizer does the same): realize to Dynamics first to include geometry that
-    /// force elements emit at Dynamics. Returns a width x height CV_8UC3 BGR image.
+    /// force elements emit at Dynamics. Returns a width x height CV_8UC3 BGR image (every render
+    /// call: its buffer is reused for the next frame once no cv::Mat refers to it any more, so keep
+    /// the cv::Mat, not its data pointer).
     /// Throws InputError for a decoration whose body id is not a body of the system.
     cv::Mat renderFrame(const SimTK::MultibodySystem& system, const SimTK::State& state,
                         const std::vector<SimTK::DecorativeGeometry>& extra = {});

@@ -110,11 +110,13 @@ std::string writePngFile(const std::string& path, const cv::Mat& frame) {
     png_structp png = png_create_write_struct(
         PNG_LIBPNG_VER_STRING, nullptr,
         [](png_structp p, png_const_charp text) {
-            std::snprintf(message, sizeof message, "%s", text);
+            const int error = errno;   // a failed fwrite (libpng says only "Write Error")
+            std::snprintf(message, sizeof message, "%s%s%s", text, error ? ": " : "", error ? std::strerror(error) : "");
             png_longjmp(p, 1);
         },
         [](png_structp, png_const_charp) {});
     png_infop info = png ? png_create_info_struct(png) : nullptr;
+    errno = 0;
     if (!png || !info) {
         png_destroy_write_struct(&png, &info);
         std::fclose(file);
@@ -156,7 +158,21 @@ std::string avError(int code) {
 class Encoder {
 public:
     Encoder(const std::string& path, const CodecInfo& info, const VideoSettings& s) {
-        av_log_set_level(AV_LOG_QUIET);   // failures are reported through exceptions
+        try {
+            open(path, info, s);
+        } catch (...) {
+            release();   // a throwing constructor runs no destructor
+            throw;
+        }
+    }
+    ~Encoder() { release(); }
+    Encoder(const Encoder&) = delete;
+    Encoder& operator=(const Encoder&) = delete;
+
+private:
+    void open(const std::string& path, const CodecInfo& info, const VideoSettings& s) {
+        // FFmpeg's own log lines are off for the whole process: failures come back as exceptions.
+        av_log_set_level(AV_LOG_QUIET);
         check(avformat_alloc_output_context2(&format_, nullptr, nullptr, path.c_str()), "choose a container");
         const AVCodec* codec = avcodec_find_encoder_by_name(info.encoder);
         if (!codec) throw std::runtime_error(std::string("FFmpeg has no '") + info.encoder + "' encoder");
@@ -197,17 +213,19 @@ public:
                                  SWS_BILINEAR, nullptr, nullptr, nullptr);
         if (!scaler_) throw std::runtime_error("no BGR to YUV conversion");
     }
-    ~Encoder() {
+    void release() {
         sws_freeContext(scaler_);
+        scaler_ = nullptr;
         av_packet_free(&packet_);
         av_frame_free(&frame_);
         avcodec_free_context(&context_);
         if (format_ && format_->pb) avio_closep(&format_->pb);
         avformat_free_context(format_);
+        format_ = nullptr;
+        stream_ = nullptr;
     }
-    Encoder(const Encoder&) = delete;
-    Encoder& operator=(const Encoder&) = delete;
 
+public:
     void write(const cv::Mat& bgr) {
         check(av_frame_make_writable(frame_), "reuse the frame");
         const uint8_t* source[1] = {bgr.data};

@@ -275,15 +275,18 @@ TEST(OffscreenRenderer, IsDeterministicAcrossCallsRenderersAndThreads) {
     EXPECT_EQ(cv::norm(a, d, cv::NORM_INF), 0);
 }
 
-// Tiles bound OSMesa's buffers (issue 30); they must join without seams: the same frame drawn in one
-// tile, in 6 and in 35 equals itself to one level of 255 at all but a few pixels of line ends.
+// Tiles bound OSMesa's buffers (issue 30); they must join without seams: the same frame, its lines 10 px
+// wide (OpenGL clips a wide line by its centre: without a margin a tile loses its half beyond the edge),
+// drawn in one tile, in 6 and in 35 equals itself to one level of 255 but at a line's end that falls
+// on a pixel edge and rounds either way (2 pixels; 30 pixels without the margin).
 TEST(OffscreenRenderer, TiledFramesEqualTheFrameDrawnWhole) {
-    constexpr int kLevelTolerance = 1;          // rounding of the tile's projection (0-255)
-    constexpr double kMaxOffPixelShare = 1e-3;  // pixels beyond it (wide-line caps at tile edges)
+    constexpr int kLevelTolerance = 1;   // rounding of the tile's projection (0-255)
+    constexpr int kMaxOffValues = 9;     // channel values beyond it: 3 pixels
     PendulumScene scene;
     RenderSettings s = pendulumSettings();
     s.width = 640;
     s.height = 480;
+    s.defaultLineThickness = 10;
     s.maxTileSide = 1280;   // 1280 x 960 supersampled: one tile
     const SimTK::State state = scene.makeState(0.4, 0.3);
     const cv::Mat whole = OffscreenRenderer(s).renderFrame(scene.getSystem(), state);
@@ -293,7 +296,11 @@ TEST(OffscreenRenderer, TiledFramesEqualTheFrameDrawnWhole) {
         cv::Mat diff;
         cv::absdiff(whole, tiled, diff);
         const cv::Mat off = diff.reshape(1) > kLevelTolerance;
-        EXPECT_LE(cv::countNonZero(off), kMaxOffPixelShare * whole.total() * 3) << "max tile side " << side;
+        EXPECT_LE(cv::countNonZero(off), kMaxOffValues) << "max tile side " << side;
+        double worst = 0;
+        cv::minMaxLoc(diff.reshape(1), nullptr, &worst);
+        std::printf("max tile side %d: %d values differ by more than %d levels (largest %g)\n", side,
+                    cv::countNonZero(off), kLevelTolerance, worst);
     }
     s.maxTileSide = 63;
     EXPECT_THROW(s.validate(), FieldError);
