@@ -502,9 +502,22 @@ IntegrationStats integrateCoupledMuscles(const MuscleArm& model, State& state, d
         system.realize(out, Stage::Time);
         return out;
     };
+    // Newton's systems as an arrow: [q u], then each muscle's states (in state order).
+    OdeArrow arrow;
+    arrow.f = [&](double t, const double* yIn, double* ydot) { f(t, yIn, ydot); };
+    arrow.numCoupled = state.getNQ() + state.getNU();
+    std::vector<std::pair<int, int>> blocks;
+    for (int i = 0; i < model.getNumMuscles(); ++i)
+        blocks.emplace_back(arrow.numCoupled + model.getMuscleForce(i).getFirstStateIndex(state),
+                            model.getMuscle(i).getNumStates());
+    std::sort(blocks.begin(), blocks.end());
+    for (const auto& [first, size] : blocks) {
+        arrow.first.push_back(first);
+        arrow.size.push_back(size);
+    }
     IntegrationStats st = integrateSampled(
-        [&](double t, const double* yIn, double* ydot) { f(t, yIn, ydot); }, state.getTime(), y, duration, sampleRate,
-        breakpoints, integration, [&](double t, const double* yIn) { sample(toState(t, yIn)); },
+        arrow, state.getTime(), y, duration, sampleRate, breakpoints, integration,
+        [&](double t, const double* yIn) { sample(toState(t, yIn)); },
         [&](double t, const double* yIn) { model.checkMuscleStates(toState(t, yIn)); });
     st.partialEvaluations = f.getNumPartialEvaluations();
     state = toState(state.getTime() + duration, y.data());

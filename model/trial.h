@@ -158,7 +158,8 @@ enum class FreeMovementSolver {
     /// evaluates that muscle alone (its pure model at the column's path length and speed) and adds
     /// its change of tension times its moment arm over the elbow's inertia to the elbow's
     /// acceleration: the muscles are coupled only through the joint. A Jacobian then costs a few
-    /// realizations instead of one per state. Needs the elbow as the only free mobility (a forearm
+    /// realizations instead of one per state, and Newton's systems are solved as an arrow (OdeArrow:
+    /// an LU per muscle and the joint's Schur complement), cost linear in the muscles. Needs the elbow as the only free mobility (a forearm
     /// rotation locked) and no states but q, u and the muscles' (std::logic_error otherwise).
     MuscleBlocks,
     /// The whole Simbody System integrated by CPodesIntegrator (simulateSampled): the reference the

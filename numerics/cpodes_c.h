@@ -81,6 +81,22 @@ int CPLapackBand(void* cpode_mem, int N, int mupper, int mlower);
 int CPode(void* cpode_mem, double tout, double* tret, NVector yout, NVector ypout, int mode);
 int CPodeGetDky(void* cpode_mem, double t, int k, NVector dky);
 int CPodeGetNumSteps(void* cpode_mem, long* nsteps);
+int CPodeGetCurrentStep(void* cpode_mem, double* hcur);
+int CPodeGetErrWeights(void* cpode_mem, NVector eweight);
+
+// cpodes_spgmr.h, cpodes_spils.h, sundials_iterative.h: the Krylov solver with a user preconditioner.
+constexpr int PREC_LEFT = 1;
+using CPSpilsPrecSetupExplFn = int (*)(double t, NVector y, NVector fy, booleantype jok, booleantype* jcurPtr,
+                                       double gamma, void* P_data, NVector tmp1, NVector tmp2, NVector tmp3);
+using CPSpilsPrecSolveExplFn = int (*)(double t, NVector y, NVector fy, NVector b, NVector x, double gamma,
+                                       double delta, int lr, void* P_data, NVector tmp);
+using CPSpilsJacTimesVecExplFn = int (*)(double t, NVector y, NVector fy, NVector v, NVector Jv, void* jac_data,
+                                         NVector tmp);
+int CPSpgmr(void* cpode_mem, int pretype, int maxl);
+int CPSpilsGetNumLinIters(void* cpode_mem, long* nliters);
+int CPodeGetNumNonlinSolvIters(void* cpode_mem, long* nniters);
+int CPSpilsSetPreconditioner(void* cpode_mem, void* pset, void* psolve, void* P_data);
+int CPSpilsSetJacTimesVecFn(void* cpode_mem, void* jtimes, void* jac_data);
 
 // nvector_serial.h: only for findCpodesLayoutMismatch.
 NVector N_VNew_Serial(long vec_length);

@@ -3,9 +3,13 @@
 #include "basics/bound.h"
 #include "numerics/cpodes_c.h"
 
+#include <Eigen/Dense>
+
 #include <algorithm>
+#include <cfloat>
 #include <cmath>
 #include <cstring>
+#include <memory>
 #include <stdexcept>
 #include <regex>
 #include <sstream>
@@ -102,6 +106,8 @@ public:
     const std::string& getLastError() const { return lastError_; }
     void clearLastError() { lastError_.clear(); }
     const std::string& getSolverMessage() const { return solverMessage_; }
+    /// f(t, y, ydot), counted; nonzero when f failed (a recoverable error for CPODES).
+    int tryEvaluate(double t, const double* y, double* ydot) { return calc(t, y, ydot); }
     /// f(t, y, ydot); throws SimulationError naming t if f fails.
     void evaluate(double t, const double* y, double* ydot) {
         if (calc(t, y, ydot) != 0) throw SimulationError("t = " + formatNumber(t) + " s: " + lastError_);
@@ -166,13 +172,163 @@ private:
     std::string lastError_, solverMessage_;
 };
 
+// Newton's systems (I - gamma J) x = b of an arrow-structured J (OdeArrow), for CPODES' Krylov solver:
+// setup() builds J by CPODES' difference quotients (when CPODES asks for a fresh one) and factors
+// P = I - gamma J as block LUs and the coupled states' Schur complement; solve() applies P^-1 and
+// multiply() J: with the same J in both, GMRES converges in one iteration.
+class ArrowSolver {
+public:
+    ArrowSolver(const OdeArrow& f, RhsContext& context, int n) : context_(context), nc_(f.numCoupled), n_(n) {
+        first_ = f.first;
+        size_ = f.size;
+        const int nb = int(first_.size());
+        Jcc_.setZero(nc_, nc_);
+        Jcb_.resize(nb);
+        Jbc_.resize(nb);
+        Jbb_.resize(nb);
+        lu_.resize(nb);
+        DinvAbc_.resize(nb);
+        for (int b = 0; b < nb; ++b) {
+            Jcb_[b].setZero(nc_, size_[b]);
+            Jbc_[b].setZero(size_[b], nc_);
+            Jbb_[b].setZero(size_[b], size_[b]);
+        }
+        yWork_.resize(n);
+        fWork_.resize(n);
+        owner_.assign(n, -1);
+        for (int b = 0; b < nb; ++b)
+            for (int i = first_[b]; i < first_[b] + size_[b]; ++i) owner_[i] = b;
+    }
+    void setCpodes(void* mem) { mem_ = mem; }
+
+    static int setupCallback(double t, cpodes::NVector y, cpodes::NVector fy, cpodes::booleantype jok,
+                             cpodes::booleantype* jcurPtr, double gamma, void* data, cpodes::NVector,
+                             cpodes::NVector, cpodes::NVector) {
+        auto* self = static_cast<ArrowSolver*>(data);
+        if (!jok) {
+            const int r = self->calcJacobian(t, cpodes::ArrayVector::updData(y), cpodes::ArrayVector::updData(fy));
+            if (r != 0) return r;
+            *jcurPtr = 1;
+        } else {
+            *jcurPtr = 0;
+        }
+        return self->factor(gamma) ? 0 : 1;   // singular: recoverable (CPODES cuts the step)
+    }
+    static int solveCallback(double, cpodes::NVector, cpodes::NVector, cpodes::NVector b, cpodes::NVector x, double,
+                             double, int, void* data, cpodes::NVector) {
+        static_cast<ArrowSolver*>(data)->solve(cpodes::ArrayVector::updData(b), cpodes::ArrayVector::updData(x));
+        return 0;
+    }
+    static int multiplyCallback(double, cpodes::NVector, cpodes::NVector, cpodes::NVector v, cpodes::NVector Jv,
+                                void* data, cpodes::NVector) {
+        static_cast<ArrowSolver*>(data)->multiply(cpodes::ArrayVector::updData(v), cpodes::ArrayVector::updData(Jv));
+        return 0;
+    }
+
+private:
+    // CPODES' dense difference quotients (cpDlsDenseDQJacExpl): column j from f(y + inc e_j), inc =
+    // max(sqrt(uround) |y_j|, minInc / ewt_j), minInc from the step and the weighted norm of f.
+    int calcJacobian(double t, const double* y, const double* fy) {
+        std::vector<double> ewt(n_);
+        cpodes::ArrayVector ewtv(n_, ewt.data());
+        cpodes::CPodeGetErrWeights(mem_, &ewtv);
+        double h = 0;
+        cpodes::CPodeGetCurrentStep(mem_, &h);
+        double fnorm = 0;
+        for (int i = 0; i < n_; ++i) fnorm += (fy[i] * ewt[i]) * (fy[i] * ewt[i]);
+        fnorm = std::sqrt(fnorm / n_);
+        const double uround = DBL_EPSILON, srur = std::sqrt(uround);
+        const double minInc = fnorm != 0 ? 1000 * std::abs(h) * uround * n_ * fnorm : 1.0;
+        std::copy(y, y + n_, yWork_.begin());
+        for (int j = 0; j < n_; ++j) {
+            const double yj = yWork_[j];
+            const double inc = std::max(srur * std::abs(yj), minInc / ewt[j]);
+            yWork_[j] = yj + inc;
+            const int r = context_.tryEvaluate(t, yWork_.data(), fWork_.data());
+            yWork_[j] = yj;
+            if (r != 0) return r;
+            const double invInc = 1 / inc;
+            const int bj = owner_[j];
+            // Rows of the coupled states, then of the block(s) the column may reach.
+            for (int i = 0; i < nc_; ++i) {
+                const double d = (fWork_[i] - fy[i]) * invInc;
+                if (bj < 0) Jcc_(i, j) = d;
+                else Jcb_[bj](i, j - first_[bj]) = d;
+            }
+            if (bj < 0) {
+                for (std::size_t b = 0; b < first_.size(); ++b)
+                    for (int i = 0; i < size_[b]; ++i)
+                        Jbc_[b](i, j) = (fWork_[first_[b] + i] - fy[first_[b] + i]) * invInc;
+            } else {
+                for (int i = 0; i < size_[bj]; ++i)
+                    Jbb_[bj](i, j - first_[bj]) = (fWork_[first_[bj] + i] - fy[first_[bj] + i]) * invInc;
+            }
+        }
+        return 0;
+    }
+    bool factor(double gamma) {
+        Eigen::MatrixXd S = Eigen::MatrixXd::Identity(nc_, nc_) - gamma * Jcc_;
+        for (std::size_t b = 0; b < first_.size(); ++b) {
+            const Eigen::MatrixXd D = Eigen::MatrixXd::Identity(size_[b], size_[b]) - gamma * Jbb_[b];
+            lu_[b].compute(D);
+            if (!(std::abs(lu_[b].determinant()) > 0)) return false;
+            DinvAbc_[b] = lu_[b].solve(-gamma * Jbc_[b]);
+            S -= (-gamma * Jcb_[b]) * DinvAbc_[b];
+        }
+        gamma_ = gamma;
+        if (nc_ > 0) {
+            schur_.compute(S);
+            if (!(std::abs(schur_.determinant()) > 0)) return false;
+        }
+        return true;
+    }
+    // x = P^-1 b: x_c = S^-1 (b_c - sum A_cb D^-1 b_b), x_b = D^-1 b_b - D^-1 A_bc x_c.
+    void solve(const double* b, double* x) {
+        Eigen::VectorXd rhs = Eigen::Map<const Eigen::VectorXd>(b, nc_);
+        std::vector<Eigen::VectorXd> Dinvb(first_.size());
+        for (std::size_t k = 0; k < first_.size(); ++k) {
+            Dinvb[k] = lu_[k].solve(Eigen::Map<const Eigen::VectorXd>(b + first_[k], size_[k]));
+            rhs -= (-gamma_ * Jcb_[k]) * Dinvb[k];
+        }
+        Eigen::VectorXd xc = nc_ > 0 ? Eigen::VectorXd(schur_.solve(rhs)) : Eigen::VectorXd();
+        for (int i = 0; i < nc_; ++i) x[i] = xc[i];
+        for (std::size_t k = 0; k < first_.size(); ++k) {
+            Eigen::Map<Eigen::VectorXd> xb(x + first_[k], size_[k]);
+            xb = Dinvb[k];
+            if (nc_ > 0) xb -= DinvAbc_[k] * xc;
+        }
+    }
+    void multiply(const double* v, double* Jv) {
+        const Eigen::Map<const Eigen::VectorXd> vc(v, nc_);
+        Eigen::Map<Eigen::VectorXd> Jvc(Jv, nc_);
+        Jvc = Jcc_ * vc;
+        for (std::size_t k = 0; k < first_.size(); ++k) {
+            const Eigen::Map<const Eigen::VectorXd> vb(v + first_[k], size_[k]);
+            Jvc += Jcb_[k] * vb;
+            Eigen::Map<Eigen::VectorXd> Jvb(Jv + first_[k], size_[k]);
+            Jvb = Jbb_[k] * vb + Jbc_[k] * vc;
+        }
+    }
+
+    RhsContext& context_;
+    void* mem_ = nullptr;
+    int nc_, n_;
+    std::vector<int> first_, size_, owner_;
+    Eigen::MatrixXd Jcc_;
+    std::vector<Eigen::MatrixXd> Jcb_, Jbc_, Jbb_, DinvAbc_;
+    std::vector<Eigen::PartialPivLU<Eigen::MatrixXd>> lu_;
+    Eigen::PartialPivLU<Eigen::MatrixXd> schur_;
+    double gamma_ = 0;
+    std::vector<double> yWork_, fWork_;
+};
+
 // One CPODES run (a segment between breakpoints), configured as Simbody's CPodesIntegrator configures
 // its CPodes: BDF, Newton, dense LAPACK Jacobian by CPODES' difference quotients (or, with a half
 // bandwidth >= 0, a LAPACK band Jacobian by CPODES' grouped difference quotients).
 class Cpodes {
 public:
     Cpodes(RhsContext& context, double t0, std::vector<double>& y0, std::vector<double>& yp0, double relTol,
-           double absTol, const IntegrationSettings& settings, int halfBandwidth)
+           double absTol, const IntegrationSettings& settings, int halfBandwidth, ArrowSolver* arrow = nullptr)
         : mem_(cpodes::CPodeCreate(cpodes::CP_EXPL, cpodes::CP_BDF, cpodes::CP_NEWTON)), absTol_(absTol) {
         if (!mem_) throw std::bad_alloc();
         try {
@@ -183,7 +339,19 @@ public:
                   "CPodeInit", t0);
             check(cpodes::CPodeSetErrHandlerFn(mem_, &RhsContext::handleError, &context), "CPodeSetErrHandlerFn",
                   t0);
-            if (halfBandwidth < 0)
+            if (arrow) {
+                krylov_ = true;
+                arrow->setCpodes(mem_);
+                check(cpodes::CPSpgmr(mem_, cpodes::PREC_LEFT, 5), "CPSpgmr", t0);
+                check(cpodes::CPSpilsSetPreconditioner(
+                          mem_, reinterpret_cast<void*>(cpodes::CPSpilsPrecSetupExplFn(&ArrowSolver::setupCallback)),
+                          reinterpret_cast<void*>(cpodes::CPSpilsPrecSolveExplFn(&ArrowSolver::solveCallback)), arrow),
+                      "CPSpilsSetPreconditioner", t0);
+                check(cpodes::CPSpilsSetJacTimesVecFn(
+                          mem_, reinterpret_cast<void*>(cpodes::CPSpilsJacTimesVecExplFn(&ArrowSolver::multiplyCallback)),
+                          arrow),
+                      "CPSpilsSetJacTimesVecFn", t0);
+            } else if (halfBandwidth < 0)
                 check(cpodes::CPLapackDense(mem_, n), "CPLapackDense", t0);
             else
                 check(cpodes::CPLapackBand(mem_, n, halfBandwidth, halfBandwidth), "CPLapackBand", t0);
@@ -214,6 +382,16 @@ public:
         cpodes::CPodeGetNumSteps(mem_, &steps);
         return int(steps);
     }
+    int getNumNewtonIterations() const {
+        long iterations = 0;
+        cpodes::CPodeGetNumNonlinSolvIters(mem_, &iterations);
+        return int(iterations);
+    }
+    int getNumKrylovIterations() const {
+        long iterations = 0;
+        if (krylov_) cpodes::CPSpilsGetNumLinIters(mem_, &iterations);
+        return int(iterations);
+    }
 
 private:
     static void check(int flag, const char* call, double t) {
@@ -223,6 +401,7 @@ private:
     }
     void* mem_;
     double absTol_;
+    bool krylov_ = false;
 };
 
 // The N_Vector layout declared in cpodes_c.h, checked once against the loaded library.
@@ -236,7 +415,8 @@ void checkCpodesLayout() {
 // integrateSampled for f, whose blocks (if any) are `blocks`.
 IntegrationStats integrate(const OdeRhs& f, const OdeBlocks* blocks, double t0, std::vector<double>& y,
                            double duration, double sampleRate, const std::vector<double>& breakpoints,
-                           const IntegrationSettings& settings, const OdeVisitor& sample, const OdeVisitor& check) {
+                           const IntegrationSettings& settings, const OdeVisitor& sample, const OdeVisitor& check,
+                           const OdeArrow* arrowShape = nullptr) {
     settings.validate();
     checkField("duration", duration, Bound::nonNegative("s"));
     checkField("sample_rate", sampleRate, Bound::positive("Hz"));
@@ -245,6 +425,8 @@ IntegrationStats integrate(const OdeRhs& f, const OdeBlocks* blocks, double t0, 
     detail::SampledRun run(t0, duration, sampleRate, breakpoints, n);
     IntegrationStats stats;
     RhsContext context(f, blocks, n);
+    std::unique_ptr<ArrowSolver> arrow;
+    if (arrowShape) arrow = std::make_unique<ArrowSolver>(*arrowShape, context, n);
 
     if (check) check(t0, y.data());
     checkFinite(t0, y.data(), n);
@@ -258,7 +440,7 @@ IntegrationStats integrate(const OdeRhs& f, const OdeBlocks* blocks, double t0, 
     for (double segmentEnd : run.getSegmentEnds()) {
         context.evaluate(t, yv.data(), ydot.data());
         run.restart(t, yv.data(), ydot.data());
-        Cpodes cpodes(context, t, yv, ydot, relTol, absTol, settings, halfBandwidth);
+        Cpodes cpodes(context, t, yv, ydot, relTol, absTol, settings, halfBandwidth, arrow.get());
         ++stats.restarts;
         while (t < segmentEnd - run.getEpsilon()) {
             checkInterruption();  // a long trial stops within a step of Ctrl-C
@@ -290,6 +472,8 @@ IntegrationStats integrate(const OdeRhs& f, const OdeBlocks* blocks, double t0, 
             run.advance(t, yv.data(), ydot.data(), run.isBreakpoint(t, segmentEnd), sample);
         }
         stats.steps += cpodes.getNumSteps();
+        stats.newtonIterations += cpodes.getNumNewtonIterations();
+        stats.krylovIterations += cpodes.getNumKrylovIterations();
     }
     stats.restarts -= 1;
     stats.realizations = context.getNumEvaluations();
@@ -331,6 +515,24 @@ IntegrationStats integrateSampled(const OdeBlocks& f, double t0, std::vector<dou
         for (std::size_t b = 0; b < numBlocks; ++b) f.calcBlock(int(b), t, yIn, ydot);
     };
     return integrate(whole, &f, t0, y, duration, sampleRate, breakpoints, settings, sample, check);
+}
+
+IntegrationStats integrateSampled(const OdeArrow& f, double t0, std::vector<double>& y, double duration,
+                                  double sampleRate, const std::vector<double>& breakpoints,
+                                  const IntegrationSettings& settings, const OdeVisitor& sample,
+                                  const OdeVisitor& check) {
+    if (!f.f || f.first.size() != f.size.size() || f.numCoupled < 0)
+        throw std::invalid_argument("integrateSampled: an arrow needs f, a first state and a size per block");
+    int next = f.numCoupled;
+    for (std::size_t b = 0; b < f.first.size(); ++b) {
+        if (f.first[b] != next || f.size[b] <= 0)
+            throw std::invalid_argument("integrateSampled: arrow block " + std::to_string(b) +
+                                        " does not follow the coupled states and the blocks before it");
+        next += f.size[b];
+    }
+    if (next != int(y.size()))
+        throw std::invalid_argument("integrateSampled: the arrow's states do not cover y");
+    return integrate(f.f, nullptr, t0, y, duration, sampleRate, breakpoints, settings, sample, check, &f);
 }
 
 }  // namespace armsim

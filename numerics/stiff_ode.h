@@ -42,6 +42,9 @@ struct IntegrationStats {
     int restarts = 0;           ///< restarts at input discontinuities (breakpoints)
     int realizations = 0;       ///< right-hand-side evaluations (Simbody realizations or f calls), Jacobians included
     int partialEvaluations = 0; ///< of those, calls of a block-structured f that evaluated one block or none
+    int newtonIterations = 0;   ///< Newton iterations (one linear solve each)
+    int krylovIterations = 0;   ///< OdeArrow: Krylov iterations of those solves (1 each when the
+                                ///< preconditioner is the exact inverse); 0 for the direct solvers
 };
 
 /// f(t, y, ydot): writes dy/dt. May throw SimulationError for a state outside the model: the solver
@@ -81,6 +84,28 @@ struct OdeBlocks {
 /// difference-quotient Jacobian) evaluates those blocks and copies the others' derivatives, which are
 /// bit-for-bit what a full evaluation would give. std::invalid_argument if the blocks do not partition y.
 IntegrationStats integrateSampled(const OdeBlocks& f, double t0, std::vector<double>& y, double duration,
+                                  double sampleRate, const std::vector<double>& breakpoints,
+                                  const IntegrationSettings& settings, const OdeVisitor& sample,
+                                  const OdeVisitor& check = {});
+
+/// y' = f(t, y) whose Jacobian is an arrow: the first numCoupled states (a free joint's q and u) may
+/// drive every derivative, while block b, states [first[b], first[b] + size[b]) (one muscle), drives
+/// only its own derivatives and the coupled states' (blocks follow the coupled states and partition
+/// the rest of y). Newton's systems are then solved by block LU factorisations and the Schur
+/// complement of the coupled states: cost linear in the blocks (CPODES' Krylov solver with that
+/// factorisation as an exact preconditioner and the stored Jacobian as its operator, so it converges
+/// in one iteration). The Jacobian is still built by CPODES' difference quotients, one f call per
+/// state: f should make a call that moves one block's states cheap (the caller's concern). Steps
+/// differ from the dense solve's by rounding and by when the Jacobian is refreshed.
+struct OdeArrow {
+    OdeRhs f;
+    int numCoupled = 0;
+    std::vector<int> first, size;
+};
+
+/// integrateSampled for an arrow-structured f; std::invalid_argument if the blocks do not follow the
+/// coupled states and partition the rest of y.
+IntegrationStats integrateSampled(const OdeArrow& f, double t0, std::vector<double>& y, double duration,
                                   double sampleRate, const std::vector<double>& breakpoints,
                                   const IntegrationSettings& settings, const OdeVisitor& sample,
                                   const OdeVisitor& check = {});

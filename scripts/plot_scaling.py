@@ -19,7 +19,7 @@ SERIES = {  # benchmark name prefix and its trailing arguments -> label
     ("BM_LockedMvcNMuscles", "1/1000"): "locked MVC 3.5 s, banded Newton, 1000 Hz table",
     ("BM_LockedMvcNMuscles", "1/100"): "locked MVC 3.5 s, banded Newton, 100 Hz table",
     ("BM_LockedMvcNMuscles", "0/1000"): "locked MVC 3.5 s, dense Newton (before)",
-    ("BM_FreeMovementNMuscles", "0"): "free movement 1 s, muscle blocks (dense LU)",
+    ("BM_FreeMovementNMuscles", "0"): "free movement 1 s, muscle blocks, arrow solve",
     ("BM_FreeMovementNMuscles", "1"): "free movement 1 s, whole System (before)",
 }
 
