@@ -114,18 +114,24 @@ void BM_HillTwinMvcTrial(benchmark::State& state, const char* model) {
 BENCHMARK_CAPTURE(BM_HillTwinMvcTrial, thelen2003, "thelen2003")->Arg(1000)->Arg(100)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_HillTwinMvcTrial, degroote2016, "degroote2016")->Arg(1000)->Arg(100)->Unit(benchmark::kMillisecond);
 
+// The thesis arm with N copies of its straight biceps (m1 .. mN).
+ArmSetup copiesOfTheThesisBiceps(int n) {
+    ArmSetup setup = subject();
+    const MuscleSpec one = setup.muscles[0];
+    setup.muscles.clear();
+    for (int i = 0; i < n; ++i) {
+        setup.muscles.push_back(one);
+        setup.muscles.back().params.name = "m" + std::to_string(i + 1);
+    }
+    return setup;
+}
+
 // Issue 30: the locked MVC (0.5 s rest + 3 s hold, 1000 Hz) of N copies of the thesis's straight biceps;
 // arg 0 = N, arg 1 = 1 for the banded Newton solve (the default), 0 for the dense one, arg 2 = sample
 // rate [Hz] (at 1000 Hz the table of every muscle's states dominates from 64 muscles on; 100 Hz shows
 // the integration). Goals: time(64) / time(8) <= 10; 256 muscles <= 1 s.
 void BM_LockedMvcNMuscles(benchmark::State& state) {
-    ArmSetup setup = subject();
-    const MuscleSpec one = setup.muscles[0];
-    setup.muscles.clear();
-    for (int i = 0; i < int(state.range(0)); ++i) {
-        setup.muscles.push_back(one);
-        setup.muscles.back().params.name = "m" + std::to_string(i + 1);
-    }
+    const ArmSetup setup = copiesOfTheThesisBiceps(int(state.range(0)));
     IsometricTrialSettings s;
     s.bandedNewton = state.range(1) != 0;
     s.sampleRate = double(state.range(2));
@@ -143,13 +149,7 @@ BENCHMARK(BM_LockedMvcNMuscles)
 // thesis's straight biceps; arg 0 = N, arg 1 = 0 for FreeMovementSolver::MuscleBlocks, 1 for the whole
 // System. The arm reaches the flexion stop sooner with more muscles: compare time per step.
 void BM_FreeMovementNMuscles(benchmark::State& state) {
-    ArmSetup setup = subject();
-    const MuscleSpec one = setup.muscles[0];
-    setup.muscles.clear();
-    for (int i = 0; i < int(state.range(0)); ++i) {
-        setup.muscles.push_back(one);
-        setup.muscles.back().params.name = "m" + std::to_string(i + 1);
-    }
+    const ArmSetup setup = copiesOfTheThesisBiceps(int(state.range(0)));
     FreeMovementSettings s;
     s.duration = 1.0;
     s.sampleRate = 100;
