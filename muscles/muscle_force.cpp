@@ -23,18 +23,29 @@ public:
     void realizeTopology(State& s) const override {
         const Vector zInit(muscle_->getNumStates(), 0.0);
         firstZ_ = s.allocateZ(forces_, zInit);
+        geometryIndex_ = s.allocateLazyCacheEntry(forces_, Stage::Position, new Value<PathGeometry>());
     }
 
-    double pathLength(const State& s) const { return path_.calcLength(s); }
+    // The path at the state's positions, computed once per realization (the derivatives and the
+    // force both need it).
+    const PathGeometry& cachedGeometry(const State& s) const {
+        if (!s.isCacheValueRealized(forces_, geometryIndex_)) {
+            Value<PathGeometry>::updDowncast(s.updCacheEntry(forces_, geometryIndex_)) =
+                path_.calcGeometry(s, name(), false);
+            s.markCacheValueRealized(forces_, geometryIndex_);
+        }
+        return Value<PathGeometry>::downcast(s.getCacheEntry(forces_, geometryIndex_));
+    }
+    double pathLength(const State& s) const { return path_.isStraight() ? path_.calcLength(s) : cachedGeometry(s).length; }
     PathGeometry geometry(const State& s, bool withPolyline = false) const {
-        return path_.calcGeometry(s, name(), withPolyline);
+        return withPolyline ? path_.calcGeometry(s, name(), true) : cachedGeometry(s);
     }
     const double* z(const State& s) const { return &s.getZ(forces_)[firstZ_]; }
 
     void realizeDynamics(const State& s) const override {
         Vector& zdot = s.updZDot(forces_);
         if (muscle_->usesPathVelocity()) {
-            const PathGeometry g = geometry(s);
+            const PathGeometry& g = cachedGeometry(s);
             muscle_->calcMovingStateDerivative(g.length, path_.calcLengtheningSpeed(s, g), activation_.getValue(s.getTime()),
                                                z(s), &zdot[firstZ_]);
         } else {
@@ -43,7 +54,7 @@ public:
     }
 
     void calcForce(const State& s, Vector_<SpatialVec>& bodyForces, Vector_<Vec3>&, Vector&) const override {
-        const PathGeometry g = geometry(s);
+        const PathGeometry& g = cachedGeometry(s);
         MusclePath::applyTension(g, muscle_->calcForce(g.length, z(s)), bodyForces);
     }
 
@@ -63,6 +74,7 @@ public:
     MusclePath path_;
     ActivationProfile activation_;
     mutable ZIndex firstZ_;  // topology-stage cache
+    mutable CacheEntryIndex geometryIndex_;
 };
 
 MuscleForce::MuscleForce(GeneralForceSubsystem& forces, std::shared_ptr<const MuscleModel> muscle,

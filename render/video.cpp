@@ -284,7 +284,7 @@ void VideoSettings::validate() const {
 // Frames are encoded on a worker thread so that rendering the next frame overlaps encoding this
 // one; the queue is bounded so a slow encoder throttles the producer.
 struct VideoWriter::Impl {
-    static constexpr size_t kMaxQueued = 3;
+    static constexpr size_t kMaxQueued = 1;   // frames waiting: each is 2.7 MB at 1280 x 720
 
     std::unique_ptr<Encoder> encoder;
     std::string path, temporary;

@@ -24,7 +24,7 @@ struct VideoSettings {
 
 /// Writes BGR frames to a video file through FFmpeg's libraries (x264 on one thread, no lookahead). Encoding runs on a
 /// worker thread owned by the writer, so rendering the next frame overlaps encoding this one: write()
-/// copies the frame into a queue of at most 3 frames and blocks while it is full. Use one writer from
+/// copies the frame into a queue of at most 1 frame and blocks while it is full. Use one writer from
 /// one thread at a time.
 class VideoWriter {
 public:
