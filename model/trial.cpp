@@ -37,6 +37,21 @@ std::vector<const ActivationProfile*> getActivationProfiles(const MuscleArm& mod
     return profiles;
 }
 
+// Where each muscle's states sit in y = [q u z] (their first index); std::logic_error naming `caller`
+// when some z belongs to no muscle (the trials' ODEs hold q, u and the muscles' states only).
+std::vector<int> findMuscleStates(const MuscleArm& model, const State& state, const char* caller) {
+    const int nqu = state.getNQ() + state.getNU();
+    std::vector<int> first;
+    int numMuscleStates = 0;
+    for (int i = 0; i < model.getNumMuscles(); ++i) {
+        first.push_back(nqu + model.getMuscleForce(i).getFirstStateIndex(state));
+        numMuscleStates += model.getMuscle(i).getNumStates();
+    }
+    if (numMuscleStates != state.getNZ())
+        throw std::logic_error(std::string(caller) + ": the arm has z states that belong to no muscle");
+    return first;
+}
+
 void appendMuscleForces(std::vector<double>& row, const std::vector<const ActivationProfile*>& activations,
                         const std::vector<double>& forces, double t) {
     if (forces.size() == 1) return;
@@ -209,16 +224,8 @@ IsometricTrialResult runIsometricTrial(const ArmSetup& setup, const IsometricTri
     std::vector<const MuscleModel*> muscles;
     for (int i = 0; i < n; ++i) muscles.push_back(&model.getMuscle(i));
     const std::vector<const ActivationProfile*> activations = getActivationProfiles(model);
-    // Where each muscle's states sit in y = [q u z].
     const int nqu = state.getNQ() + state.getNU();
-    std::vector<int> firstState(n);
-    int numMuscleStates = 0;
-    for (int i = 0; i < n; ++i) {
-        firstState[i] = nqu + model.getMuscleForce(i).getFirstStateIndex(state);
-        numMuscleStates += muscles[i]->getNumStates();
-    }
-    if (numMuscleStates != state.getNZ())
-        throw std::logic_error("runIsometricTrial: the arm has z states that belong to no muscle");
+    const std::vector<int> firstState = findMuscleStates(model, state, "runIsometricTrial");
     std::vector<double> forces(n), row;
 
     const bool primaryVelocityIsState = muscles[primary]->hasFascicleVelocityState();
@@ -356,24 +363,19 @@ public:
     CoupledMuscleOde(const MuscleArm& model, const State& initial, bool checkPartial)
         : model_(model), system_(model.getSystem()), state_(initial), n_(model.getNumMuscles()),
           checkPartial_(checkPartial) {
-        const int nqu = state_.getNQ() + state_.getNU();
         nq_ = state_.getNQ();
+        nqu_ = nq_ + state_.getNU();
         ny_ = state_.getNY();
         elbowU_ = nq_ + int(model.getArm().getForearm().getFirstUIndex(state_));
-        int numMuscleStates = 0;
-        for (int i = 0; i < n_; ++i) {
-            muscles_.push_back(&model.getMuscle(i));
-            first_.push_back(nqu + model.getMuscleForce(i).getFirstStateIndex(state_));
-            numMuscleStates += muscles_.back()->getNumStates();
-        }
-        // What the one-muscle evaluation assumes: every z belongs to a muscle, the elbow is the only
-        // free mobility (the radius, if any, locked: its acceleration is 0 and the elbow's is its
-        // generalized force over M_ee).
+        first_ = findMuscleStates(model, state_, "FreeMovementSolver::MuscleBlocks");
+        for (int i = 0; i < n_; ++i) muscles_.push_back(&model.getMuscle(i));
+        // What the one-muscle evaluation assumes besides: the elbow is the only free mobility (the
+        // radius, if any, locked: its acceleration is 0 and the elbow's is its generalized force over M_ee).
         const ArmModel& arm = model.getArm();
-        if (numMuscleStates != state_.getNZ() || state_.getNU() != (arm.hasForearmRotation() ? 2 : 1) ||
+        if (state_.getNU() != (arm.hasForearmRotation() ? 2 : 1) ||
             (arm.hasForearmRotation() && !arm.getRadius().isLocked(state_)))
-            throw std::logic_error("FreeMovementSolver::MuscleBlocks: the arm has states other than q, u and the "
-                                   "muscles', or a free mobility besides the elbow; use SimbodySystem");
+            throw std::logic_error("FreeMovementSolver::MuscleBlocks: the arm has a free mobility besides the elbow; "
+                                   "use SimbodySystem");
         activations_ = getActivationProfiles(model);
         base_.resize(ny_);
         baseYdot_.resize(ny_);
@@ -385,21 +387,35 @@ public:
 
     int getNumPartialEvaluations() const { return partial_; }
 
+    /// Newton's systems as an arrow: [q u], then each muscle's states, in state order.
+    OdeArrow makeArrow() {
+        OdeArrow arrow;
+        arrow.f = [this](double t, const double* y, double* ydot) { (*this)(t, y, ydot); };
+        arrow.numCoupled = nqu_;
+        std::vector<std::pair<int, int>> blocks;
+        for (int i = 0; i < n_; ++i) blocks.emplace_back(first_[i], muscles_[i]->getNumStates());
+        std::sort(blocks.begin(), blocks.end());
+        for (const auto& [first, size] : blocks) {
+            arrow.first.push_back(first);
+            arrow.size.push_back(size);
+        }
+        return arrow;
+    }
+
     void operator()(double t, const double* y, double* ydot) {
         if (haveBase_ && t == baseTime_) {
-            const bool jointMoved = !std::equal(y, y + nq_ + state_.getNU(), base_.data());
-            std::vector<int>& moved = moved_;
-            moved.clear();
+            const bool jointMoved = !std::equal(y, y + nqu_, base_.data());
+            moved_.clear();
             for (int i = 0; i < n_; ++i) {
                 const int a = first_[i], b = a + muscles_[i]->getNumStates();
-                if (!std::equal(y + a, y + b, base_.data() + a)) moved.push_back(i);
+                if (!std::equal(y + a, y + b, base_.data() + a)) moved_.push_back(i);
             }
-            if (!jointMoved && !moved.empty()) {
-                evaluateMuscles(t, y, ydot, moved);
+            if (!jointMoved && !moved_.empty()) {
+                evaluateMuscles(t, y, ydot, moved_);
                 if (checkPartial_) checkPartial(t, y, ydot);
                 return;
             }
-            if (jointMoved && moved.empty()) {   // a joint column: the base stays
+            if (jointMoved && moved_.empty()) {   // a joint column: the base stays
                 realize(t, y, ydot);
                 return;
             }
@@ -472,7 +488,7 @@ private:
     const MuscleArm& model_;
     const MultibodySystem& system_;
     State state_;
-    int n_, nq_ = 0, ny_ = 0, elbowU_ = 0;
+    int n_, nq_ = 0, nqu_ = 0, ny_ = 0, elbowU_ = 0;
     bool checkPartial_;
     std::vector<const MuscleModel*> muscles_;
     std::vector<int> first_;
@@ -502,21 +518,8 @@ IntegrationStats integrateCoupledMuscles(const MuscleArm& model, State& state, d
         system.realize(out, Stage::Time);
         return out;
     };
-    // Newton's systems as an arrow: [q u], then each muscle's states (in state order).
-    OdeArrow arrow;
-    arrow.f = [&](double t, const double* yIn, double* ydot) { f(t, yIn, ydot); };
-    arrow.numCoupled = state.getNQ() + state.getNU();
-    std::vector<std::pair<int, int>> blocks;
-    for (int i = 0; i < model.getNumMuscles(); ++i)
-        blocks.emplace_back(arrow.numCoupled + model.getMuscleForce(i).getFirstStateIndex(state),
-                            model.getMuscle(i).getNumStates());
-    std::sort(blocks.begin(), blocks.end());
-    for (const auto& [first, size] : blocks) {
-        arrow.first.push_back(first);
-        arrow.size.push_back(size);
-    }
     IntegrationStats st = integrateSampled(
-        arrow, state.getTime(), y, duration, sampleRate, breakpoints, integration,
+        f.makeArrow(), state.getTime(), y, duration, sampleRate, breakpoints, integration,
         [&](double t, const double* yIn) { sample(toState(t, yIn)); },
         [&](double t, const double* yIn) { model.checkMuscleStates(toState(t, yIn)); });
     st.partialEvaluations = f.getNumPartialEvaluations();

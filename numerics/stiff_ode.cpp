@@ -188,6 +188,7 @@ public:
         Jbb_.resize(nb);
         lu_.resize(nb);
         DinvAbc_.resize(nb);
+        DinvB_.resize(nb);
         for (int b = 0; b < nb; ++b) {
             Jcb_[b].setZero(nc_, size_[b]);
             Jbc_[b].setZero(size_[b], nc_);
@@ -195,6 +196,7 @@ public:
         }
         yWork_.resize(n);
         fWork_.resize(n);
+        ewt_.resize(n);
         owner_.assign(n, -1);
         for (int b = 0; b < nb; ++b)
             for (int i = first_[b]; i < first_[b] + size_[b]; ++i) owner_[i] = b;
@@ -229,7 +231,7 @@ private:
     // CPODES' dense difference quotients (cpDlsDenseDQJacExpl): column j from f(y + inc e_j), inc =
     // max(sqrt(uround) |y_j|, minInc / ewt_j), minInc from the step and the weighted norm of f.
     int calcJacobian(double t, const double* y, const double* fy) {
-        std::vector<double> ewt(n_);
+        std::vector<double>& ewt = ewt_;
         cpodes::ArrayVector ewtv(n_, ewt.data());
         cpodes::CPodeGetErrWeights(mem_, &ewtv);
         double h = 0;
@@ -284,17 +286,16 @@ private:
     }
     // x = P^-1 b: x_c = S^-1 (b_c - sum A_cb D^-1 b_b), x_b = D^-1 b_b - D^-1 A_bc x_c.
     void solve(const double* b, double* x) {
-        Eigen::VectorXd rhs = Eigen::Map<const Eigen::VectorXd>(b, nc_);
-        std::vector<Eigen::VectorXd> Dinvb(first_.size());
+        rhsC_ = Eigen::Map<const Eigen::VectorXd>(b, nc_);
         for (std::size_t k = 0; k < first_.size(); ++k) {
-            Dinvb[k] = lu_[k].solve(Eigen::Map<const Eigen::VectorXd>(b + first_[k], size_[k]));
-            rhs -= (-gamma_ * Jcb_[k]) * Dinvb[k];
+            DinvB_[k] = lu_[k].solve(Eigen::Map<const Eigen::VectorXd>(b + first_[k], size_[k]));
+            rhsC_ -= (-gamma_ * Jcb_[k]) * DinvB_[k];
         }
-        Eigen::VectorXd xc = nc_ > 0 ? Eigen::VectorXd(schur_.solve(rhs)) : Eigen::VectorXd();
-        for (int i = 0; i < nc_; ++i) x[i] = xc[i];
+        Eigen::Map<Eigen::VectorXd> xc(x, nc_);
+        if (nc_ > 0) xc = schur_.solve(rhsC_);
         for (std::size_t k = 0; k < first_.size(); ++k) {
             Eigen::Map<Eigen::VectorXd> xb(x + first_[k], size_[k]);
-            xb = Dinvb[k];
+            xb = DinvB_[k];
             if (nc_ > 0) xb -= DinvAbc_[k] * xc;
         }
     }
@@ -315,11 +316,14 @@ private:
     int nc_, n_;
     std::vector<int> first_, size_, owner_;
     Eigen::MatrixXd Jcc_;
-    std::vector<Eigen::MatrixXd> Jcb_, Jbc_, Jbb_, DinvAbc_;
+    std::vector<Eigen::MatrixXd> Jcb_, Jbc_, Jbb_;
+    std::vector<Eigen::MatrixXd> DinvAbc_;   // of the last factor(): D^-1 (-gamma Jbc)
+    double gamma_ = 0;                       // and its gamma
     std::vector<Eigen::PartialPivLU<Eigen::MatrixXd>> lu_;
     Eigen::PartialPivLU<Eigen::MatrixXd> schur_;
-    double gamma_ = 0;
-    std::vector<double> yWork_, fWork_;
+    std::vector<Eigen::VectorXd> DinvB_;   // solve()'s workspace
+    Eigen::VectorXd rhsC_;
+    std::vector<double> yWork_, fWork_, ewt_;
 };
 
 // One CPODES run (a segment between breakpoints), configured as Simbody's CPodesIntegrator configures
