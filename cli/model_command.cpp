@@ -153,10 +153,15 @@ void addModelCommands(CLI::App& app) {
             if (!targets->empty()) {
                 const std::vector<AnatomyTarget> t = loadAnatomyTargets(*targets);
                 std::printf("fitting model %s to %s (specific tension, volume and fascicle length per group, "
-                            "tendon length per muscle; priors: model/anatomy_calibration.h)\n",
+                            "tendon and fascicle length per muscle; priors: model/anatomy_calibration.h)\n",
                             setup.name.c_str(), targets->c_str());
                 std::fflush(stdout);
-                const AnatomyCalibrationResult r = calibrateToAnatomy(setup, t);
+                AnatomyCalibrationOptions options;
+                options.progress = [](int stage, int numStages, int passed, int total) {
+                    std::printf("  stage %d of %d: %d of %d targets pass\n", stage, numStages, passed, total);
+                    std::fflush(stdout);
+                };
+                const AnatomyCalibrationResult r = calibrateToAnatomy(setup, t, options);
                 auto passed = [](const std::vector<TargetScore>& s) {
                     int n = 0;
                     for (const TargetScore& x : s) n += x.pass;

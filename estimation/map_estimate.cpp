@@ -2,6 +2,7 @@
 
 #include "basics/errors.h"
 #include "estimation/ceres_logging.h"
+#include "estimation/numeric_diff.h"
 
 #include <ceres/ceres.h>
 #include <Eigen/Cholesky>
@@ -100,9 +101,7 @@ MapResult calcMapEstimate(const MapProblem& problem) {
     MapCost functor{&problem, Eigen::Map<const Eigen::VectorXd>(problem.priorMean.data(), n), llt.matrixL()};
     MapResult result;
     result.x = problem.start.empty() ? problem.priorMean : problem.start;
-    auto* cost = new ceres::DynamicNumericDiffCostFunction<MapCost, ceres::CENTRAL>(new MapCost(functor));
-    cost->AddParameterBlock(n);
-    cost->SetNumResiduals(problem.numResiduals + n);
+    auto* cost = new SteppingNumericDiffCost<MapCost>(new MapCost(functor), n, problem.numResiduals + n);
     ceres::Problem pr;
     pr.AddResidualBlock(cost, nullptr, result.x.data());
     std::vector<int> fixed;

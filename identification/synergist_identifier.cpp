@@ -679,6 +679,7 @@ MuscleEstimate identifySynergistAware(const Population& prior, const std::vector
 
     MuscleEstimate est;
     est.method = !channels.empty() ? "channels" : measured ? "synergist-va" : "synergist";
+    est.predictedTorque.assign(data.size(), NAN);   // whole even when the fit fails
     std::tie(est.noiseLevel, est.noiseDegreesOfFreedom) = estimateNoiseLevel(data);
     if (std::isfinite(options.noiseLevel)) {
         checkField("noise level", options.noiseLevel, Bound{0, 0.5, true, true, "relative sd"});
@@ -731,7 +732,10 @@ MuscleEstimate identifySynergistAware(const Population& prior, const std::vector
     est.converged = m.converged;
     est.message = m.message;
     est.iterations = m.iterations;
-    if (m.failed) return est;  // no estimate: mass and tendon length stay NaN
+    if (m.failed) {  // no estimate: mass and tendon length stay NaN
+        est.converged = false;
+        return est;
+    }
 
     const ArmSetup& base = prior.base;
     const MuscleParameters& b = base.muscles[base.primary].params;

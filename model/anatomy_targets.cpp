@@ -46,6 +46,19 @@ double findOptimumAngle(const SteadyMvcCurve& c, int m) {
     return NAN;
 }
 
+// Where the fibre length would cross 1 beyond the range, from the slope over the last 10 deg at the end
+// nearest to 1 (for a fit to steer by when there is no crossing); NaN for a flat curve.
+double extrapolateOptimumAngle(const SteadyMvcCurve& c, int m) {
+    const std::size_t n = c.flexionDeg.size();
+    if (n < 2) return NAN;
+    const bool first = std::abs(c.points[0][m].fibreLength - 1) < std::abs(c.points[n - 1][m].fibreLength - 1);
+    std::size_t a = first ? 0 : n - 1, b = a;
+    while (std::abs(c.flexionDeg[b] - c.flexionDeg[a]) < 10 && (first ? b + 1 < n : b > 0)) b += first ? 1 : -1;
+    const double slope = (c.points[b][m].fibreLength - c.points[a][m].fibreLength) / (c.flexionDeg[b] - c.flexionDeg[a]);
+    if (!(std::abs(slope) > 0)) return NAN;
+    return c.flexionDeg[a] + (1 - c.points[a][m].fibreLength) / slope;
+}
+
 // A forearm target the model can score: it rotates, and the target's posture is within its range.
 bool isScoredForearmTarget(const ArmSetup& setup, const AnatomyTarget& t) {
     const ArmParameters::ForearmRotation& rot = setup.arm.forearmRotation;
@@ -172,11 +185,12 @@ std::vector<TargetScore> scoreAnatomy(const ArmSetup& setup, const std::vector<A
             sharedMuscles.push_back(i);
 
     std::vector<TargetScore> out;
-    auto add = [&](const AnatomyTarget& t, const std::string& muscle, double value) {
+    auto add = [&](const AnatomyTarget& t, const std::string& muscle, double value, double fitValue = NAN) {
         TargetScore s;
         s.target = t;
         s.muscle = muscle;
         s.value = value;
+        s.fitValue = std::isfinite(value) ? value : fitValue;
         s.pass = std::isfinite(value) && value >= t.lower - t.tolerance && value <= t.upper + t.tolerance;
         out.push_back(s);
     };
@@ -210,7 +224,8 @@ std::vector<TargetScore> scoreAnatomy(const ArmSetup& setup, const std::vector<A
             for (int m : covered) add(t, setup.muscles[m].params.name, geometry.momentArm[indexOf(t.flexionDeg)][m]);
             break;
         case TargetKind::OptimumAngle:
-            for (int m : covered) add(t, setup.muscles[m].params.name, findOptimumAngle(full, m));
+            for (int m : covered)
+                add(t, setup.muscles[m].params.name, findOptimumAngle(full, m), extrapolateOptimumAngle(full, m));
             break;
         case TargetKind::Volume: {
             double v = 0;

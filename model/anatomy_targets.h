@@ -58,6 +58,7 @@ struct TargetScore {
     AnatomyTarget target;
     std::string muscle;           ///< the model muscle (or family) scored
     double value = 0.0 / 0.0;     ///< model value, SI; NaN when the model has none (e.g. no optimum in range)
+    double fitValue = 0.0 / 0.0;  ///< value, or where the model's trend puts it beyond the range (what a fit steers by)
     bool pass = false;            ///< value within [lower - tolerance, upper + tolerance]
 };
 

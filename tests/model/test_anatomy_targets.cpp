@@ -159,3 +159,16 @@ TEST(AnatomyTargets, TwinMomentArmsAreInThePublishedBands) {
     }
     EXPECT_EQ(muscles, 7);   // both biceps heads, BRA, BRD and the three triceps heads are scored
 }
+
+// The twin as calibrated meets every goal of the target file (issue 28): MVC vs angle and posture,
+// Holzbaur's 90-deg values, volumes within 1.5x, shares, optimum angles, forearm torques. The test
+// fails when a change to the muscle model, the paths or the calibration lines moves any target out.
+TEST(AnatomyTargets, TwinMeetsEveryTargetOfTheFile) {
+    const ArmSetup twin = loadModel("twin");
+    const std::vector<TargetScore> scores = scoreAnatomy(twin, loadDefaultAnatomyTargets());
+    ASSERT_GT(scores.size(), 100u);   // moment arms, MVCs, volumes, shares, optimum angles, forearm
+    for (const TargetScore& s : scores)
+        EXPECT_TRUE(s.pass) << getTargetKindName(s.target.kind) << " " << s.muscle << " " << describeTargetCondition(s.target) << " at " << s.target.flexionDeg
+                            << " deg: " << s.value << " outside [" << s.target.lower << ", " << s.target.upper
+                            << "] +/- " << s.target.tolerance << " (" << s.target.where << ")";
+}
