@@ -60,11 +60,11 @@ void runIdentifyTorque(const IdentifyTorqueOptions& o) {
     std::printf("%-13s %9s %21s %9s %21s %10s %12s %6s %8s\n", "method", "M (g)", "95 % interval", "L0T (cm)",
                 "95 % interval", "rms (N m)", "chi2 / dof", "p", "verdict");
     for (const MuscleEstimate& e : estimates) {
-        if (!std::isfinite(e.mass)) {
+        const TorqueResidualCheck c = checkTorqueResiduals(data, e, noise);
+        if (!std::isfinite(e.mass) || c.n == 0) {
             std::printf("%-13s no estimate: %s\n", e.method.c_str(), e.message.c_str());
             continue;
         }
-        const TorqueResidualCheck c = checkTorqueResiduals(data, e, noise);
         std::printf("%-13s %9.1f   [%7.1f, %7.1f] %9.2f   [%7.2f, %7.2f] %10.2f %6.1f / %-4d %6.3f %8s%s\n",
                     e.method.c_str(), 1000 * e.mass, 1000 * e.massLower, 1000 * e.massUpper, 100 * e.tendonLength,
                     100 * e.tendonLower, 100 * e.tendonUpper, c.rms, c.chiSquare, c.dof, c.p,

@@ -153,7 +153,12 @@ TorqueResidualCheck checkTorqueResiduals(const std::vector<TorqueObservation>& d
         chi += std::pow(residual / sd, 2);
         ++c.n;
     }
-    c.rms = std::sqrt(sum / std::max(c.n, 1));
+    if (c.n == 0) {   // no prediction (a failed fit): no check, not a perfect one
+        c.rms = c.chiSquare = c.p = NAN;
+        c.dof = 0;
+        return c;
+    }
+    c.rms = std::sqrt(sum / c.n);
     c.chiSquare = chi;
     c.dof = std::max(1, c.n - (e.method == "thesis" ? e.numParameters : 0));
     c.p = calcChiSquareSurvival(c.chiSquare, c.dof);

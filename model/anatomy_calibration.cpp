@@ -29,6 +29,7 @@ void AnatomyCalibrationOptions::validate() const {
     };
     range("volume bounds", volumeMin, volumeMax);
     range("fascicle bounds", fascicleMin, fascicleMax);
+    range("muscle fascicle bounds", muscleFascicleMin, muscleFascicleMax);
     range("tendon bounds", tendonMin, tendonMax);
     range("specific tension bounds", specificTensionMin, specificTensionMax);
 }
@@ -69,7 +70,8 @@ double calcGoalResidual(const TargetScore& s, double stage) {
     const double passHalf = 0.5 * (t.upper - t.lower) + t.tolerance;
     const double margin = std::min(std::max(kGoalMarginOfTolerance * t.tolerance, kGoalMarginOfValue * std::abs(centre)),
                                    0.5 * passHalf);
-    const double unit = t.tolerance > 0 ? t.tolerance : kValueUnit * std::abs(centre);
+    double unit = t.tolerance > 0 ? t.tolerance : kValueUnit * std::abs(centre);
+    if (!(unit > 0)) unit = passHalf;   // a band about 0 without tolerance (a point band needs one: the loader)
     const double d = s.fitValue - centre;
     const double excess = std::max(0.0, std::abs(d) - (passHalf - margin));
     return w * std::copysign(excess, d) / (stage * unit);
@@ -172,7 +174,10 @@ AnatomyCalibrationResult calibrateToAnatomy(const ArmSetup& setup, const std::ve
     stages.insert(stages.end(), options.goalStages.begin(), options.goalStages.end());
     ceres::Solver::Summary summary;
     int iterations = 0;
-    for (double stage : stages) {   // each stage starts where the last ended
+    bool allConverged = true;
+    std::string stageReports;
+    for (std::size_t k = 0; k < stages.size(); ++k) {   // each stage starts where the last ended
+        const double stage = stages[k];
         problem.stage = stage;
         auto* cost = new SteppingNumericDiffCost<AnatomyProblem>(new AnatomyProblem(problem), n, problem.numResiduals);
         ceres::Problem pr;
@@ -188,7 +193,7 @@ AnatomyCalibrationResult calibrateToAnatomy(const ArmSetup& setup, const std::ve
         }
         for (int m = 0; m < setup.getNumMuscles(); ++m) {
             bound(problem.getTendonIndex(m), options.tendonMin, options.tendonMax);
-            bound(problem.getFascicleIndex(m), options.fascicleMin, options.fascicleMax);
+            bound(problem.getFascicleIndex(m), options.muscleFascicleMin, options.muscleFascicleMax);
         }
         ceres::Solver::Options so;
         so.max_num_iterations = options.maxIterations;
@@ -196,6 +201,10 @@ AnatomyCalibrationResult calibrateToAnatomy(const ArmSetup& setup, const std::ve
         so.parameter_tolerance = 1e-8;
         ceres::Solve(so, &pr, &summary);
         iterations += int(summary.iterations.size());
+        allConverged = allConverged && summary.termination_type == ceres::CONVERGENCE;
+        if (summary.termination_type != ceres::CONVERGENCE)
+            stageReports += "; stage " + std::to_string(k + 1) + " of " + std::to_string(stages.size()) + ": " +
+                            ceres::TerminationTypeToString(summary.termination_type);
         if (summary.termination_type == ceres::FAILURE)
             throw SimulationError("anatomy calibration of model '" + setup.name + "' failed: " + summary.message +
                                   " (a muscle has no steady state at the start or within the bounds)");
@@ -203,7 +212,7 @@ AnatomyCalibrationResult calibrateToAnatomy(const ArmSetup& setup, const std::ve
             int passed = 0;
             const std::vector<TargetScore> now = scoreAnatomy(applyCalibration(setup, problem.calcCalibration(x.data())), fitted, sweep);
             for (const TargetScore& t : now) passed += t.pass;
-            options.progress(int(&stage - stages.data()) + 1, int(stages.size()), passed, int(now.size()));
+            options.progress(int(k) + 1, int(stages.size()), passed, int(now.size()));
         }
     }
 
@@ -213,8 +222,8 @@ AnatomyCalibrationResult calibrateToAnatomy(const ArmSetup& setup, const std::ve
     result.after = scoreAnatomy(applyCalibration(setup, result.muscles), fitted, sweep);
     result.cost = summary.final_cost;
     result.iterations = iterations;
-    result.converged = summary.termination_type == ceres::CONVERGENCE;
-    result.report = summary.BriefReport();
+    result.converged = allConverged;
+    result.report = summary.BriefReport() + stageReports;
     return result;
 }
 

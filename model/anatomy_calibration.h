@@ -41,7 +41,8 @@ struct AnatomyCalibrationOptions {
     double muscleFascicleLengthSd = 0.10;   ///< f_m per muscle about its group's f: Murray et al. 2000 / arm26 per muscle, 0.82-1.15
     std::vector<double> goalStages = {1, 0.3, 0.1};   ///< goal residual units, tightened in turn (none: the bands' shape alone)
     double volumeMin = 0.4, volumeMax = 2.5;
-    double fascicleMin = 0.7, fascicleMax = 1.5;
+    double fascicleMin = 0.7, fascicleMax = 1.5;            ///< the group's f
+    double muscleFascicleMin = 0.8, muscleFascicleMax = 1.25;   ///< a muscle's own f_m (so f f_m spans 0.56-1.88)
     double tendonMin = 0.5, tendonMax = 1.5;
     double specificTensionMin = 0.3, specificTensionMax = 4.0;
     int maxIterations = 200;     ///< per stage

@@ -47,7 +47,8 @@ double findOptimumAngle(const SteadyMvcCurve& c, int m) {
 }
 
 // Where the fibre length would cross 1 beyond the range, from the slope over the last 10 deg at the end
-// nearest to 1 (for a fit to steer by when there is no crossing); NaN for a flat curve.
+// nearest to 1 (for a fit to steer by when there is no crossing), at most kMaxExtrapolationDeg beyond;
+// NaN for a flat curve or one whose trend there points back into the range.
 double extrapolateOptimumAngle(const SteadyMvcCurve& c, int m) {
     const std::size_t n = c.flexionDeg.size();
     if (n < 2) return NAN;
@@ -56,7 +57,10 @@ double extrapolateOptimumAngle(const SteadyMvcCurve& c, int m) {
     while (std::abs(c.flexionDeg[b] - c.flexionDeg[a]) < 10 && (first ? b + 1 < n : b > 0)) b += first ? 1 : -1;
     const double slope = (c.points[b][m].fibreLength - c.points[a][m].fibreLength) / (c.flexionDeg[b] - c.flexionDeg[a]);
     if (!(std::abs(slope) > 0)) return NAN;
-    return c.flexionDeg[a] + (1 - c.points[a][m].fibreLength) / slope;
+    constexpr double kMaxExtrapolationDeg = 90;
+    const double beyond = (1 - c.points[a][m].fibreLength) / slope;   // deg from the end angle
+    if (first ? beyond > 0 : beyond < 0) return NAN;                   // the trend crosses inside: not monotonic
+    return c.flexionDeg[a] + std::clamp(beyond, -kMaxExtrapolationDeg, kMaxExtrapolationDeg);
 }
 
 // A forearm target the model can score: it rotates, and the target's posture is within its range.
@@ -121,6 +125,9 @@ std::vector<AnatomyTarget> loadAnatomyTargets(const std::string& path) {
             throw InputError(n.where("upper") + ": field 'upper' = " + formatNumber(t.upper / u.toSi) + " " +
                              u.file + ": expected >= lower = " + formatNumber(t.lower / u.toSi) + " " + u.file);
         t.tolerance = n.getNumber("tolerance", Bound::closed(0, 1e5, u.file), 0.0) * u.toSi;
+        if (t.lower == t.upper && t.tolerance == 0)
+            throw InputError(n.where("upper") + ": a point value (lower = upper = " + formatNumber(t.upper / u.toSi) +
+                             " " + u.file + ") needs a tolerance > 0: expected a band or a tolerance");
         t.weight = n.getNumber("weight", Bound::closed(0, 1e3), 1.0);
         t.source = n.getString("source");
         n.finish();

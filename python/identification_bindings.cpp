@@ -392,7 +392,8 @@ py::list identifyTorquePy(const py::object& data, const py::object& population, 
         check["chi_square"] = c.chiSquare;
         check["degrees_of_freedom"] = c.dof;
         check["p_value"] = c.p;
-        check["consistent_with_noise"] = c.p >= 0.05;
+        if (c.n > 0) check["consistent_with_noise"] = c.p >= 0.05;
+        else check["consistent_with_noise"] = py::none();   // no prediction: the fit failed
         d["residual_check"] = check;
         l.append(d);
     }

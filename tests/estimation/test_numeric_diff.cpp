@@ -69,3 +69,23 @@ TEST(SteppingNumericDiff, FallsBackToOneSidedDifferencesAtTheDomainsEdge) {
     parameters[0] = outside;
     EXPECT_FALSE(stepping.Evaluate(parameters, r, jacobians));
 }
+
+// Both probes of a coordinate without a value: no Jacobian (a failure, not a made-up column).
+TEST(SteppingNumericDiff, FailsWhereBothProbesHaveNoValue) {
+    struct Point {   // a value only on the line x1 = 0.5
+        bool operator()(double const* const* p, double* r) const {
+            if (p[0][1] != 0.5) return false;
+            r[0] = p[0][0];
+            return true;
+        }
+    };
+    const SteppingNumericDiffCost<Point> stepping(new Point, 2, 1);
+    const double x[2] = {1.0, 0.5};
+    double r[1], J[2];
+    const double* parameters[1] = {x};
+    double* jacobians[1] = {J};
+    EXPECT_FALSE(stepping.Evaluate(parameters, r, jacobians));
+    double* noJacobian[1] = {nullptr};   // the value alone is there
+    EXPECT_TRUE(stepping.Evaluate(parameters, r, noJacobian));
+    EXPECT_EQ(r[0], 1.0);
+}

@@ -141,6 +141,20 @@ TEST(TorqueIdentification, RunsThesisOnlyWithMvcsAtTwoAnglesAndChecksResidualsIn
     EXPECT_NEAR(c.chiSquare, chi, kChiTol * chi);
     EXPECT_EQ(c.p, calcChiSquareSurvival(c.chiSquare, c.dof));
     EXPECT_EQ(checkTorqueResiduals(data, all[1], noise).dof, int(data.size()));  // MAP fits: no subtraction
+    // Every method gives an estimate on these data (synergist-va's fit once stopped where a finite-difference
+    // probe had no steady state), with a prediction per trial.
+    for (const MuscleEstimate& e : all) {
+        EXPECT_TRUE(std::isfinite(e.mass)) << e.method << ": " << e.message;
+        EXPECT_EQ(e.predictedTorque.size(), data.size()) << e.method;
+    }
+    // A failed fit (no predictions) has no residual check, not a perfect one.
+    MuscleEstimate failed;
+    failed.method = "synergist";
+    failed.predictedTorque.assign(data.size(), NAN);
+    const TorqueResidualCheck none = checkTorqueResiduals(data, failed, noise);
+    EXPECT_EQ(none.n, 0);
+    EXPECT_TRUE(std::isnan(none.p));
+    EXPECT_TRUE(std::isnan(none.rms));
 
     // one angle only: the thesis method is skipped and says why
     std::vector<TorqueObservation> oneAngle;

@@ -43,6 +43,13 @@ TEST(AnatomyTargets, LoaderNamesFileLineFieldAndValue) {
     }
     EXPECT_THROW(loadAnatomyTargets(writeTargets("  - {kind: moment, muscle: BRA, flexion_deg: 90, lower: 1, upper: 2, source: x}\n")), InputError);
     EXPECT_THROW(loadAnatomyTargets(writeTargets("  - {kind: volume, muscle: BRA, lower: 1, upper: 2, sourse: x}\n")), InputError);
+    try {   // a point without tolerance: only the value itself would pass, and a fit has no unit for it
+        loadAnatomyTargets(writeTargets("  - {kind: share, muscle: BIC, flexion_deg: 90, lower: 0.3, upper: 0.3, source: x}\n"));
+        FAIL() << "point band without tolerance accepted";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("targets.yaml:2"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("needs a tolerance"), std::string::npos) << e.what();
+    }
     EXPECT_NO_THROW(loadDefaultAnatomyTargets());
 }
 
