@@ -72,7 +72,10 @@ void runDesign(const DesignOptions& o) {
     s.jobs = o.jobs;
     s.freeSlowFraction = o.freeSlowFraction;
     s.budgetMinutes = o.budget;
-    s.validate();
+    runNamingOptions({{"angles", "--angles"}, {"levels", "--levels"}, {"postures", "--postures"},
+                      {"repetitions", "--repetitions"}, {"trials", "--trials"}, {"draws", "--draws"},
+                      {"activation_sd", "--activation-sd"}, {"jobs", "--jobs"}, {"budget", "--budget"}},
+                     [&] { s.validate(); });
     std::printf("experiment design for the synergist-aware identifier: population '%s', budget %d trials in blocks "
                 "of %d, angles %s deg, extension MVCs %s, submaximal EMG-feedback levels %s, VA %s; %d prior draws\n",
                 population.name.c_str(), s.trials, s.repetitions, formatList(o.angles).c_str(), s.extension ? "allowed" : "not allowed",

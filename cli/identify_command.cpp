@@ -2,6 +2,7 @@
 // with the steady or the faithful forward model; armsim validate: the identifiers against ground truth
 // on synthetic MVC data; and the main-job step that identifies the thesis's and our own MVC data.
 #include "basics/quick_run.h"
+#include "basics/bound.h"
 #include "basics/errors.h"
 #include "basics/files.h"
 #include "basics/format.h"
@@ -450,6 +451,9 @@ void addValidateCommand(CLI::App& app) {
                 if (c->count(option))
                     throw InputError(std::string(option) + " applies to --truth thesis only (--truth elbow runs the "
                                      "thesis, synergist and synergist-va identifiers on --subjects drawn subjects)");
+        runNamingOptions({{"angles", "--angles"}}, [&] {   // before any work, in the option's words
+            for (double a : o->angles) checkField("angles", a, Bound::closed(0, 180, "deg, 0 = extended"));
+        });
         runValidate(*o);
     });
 }

@@ -277,7 +277,8 @@ IsometricTrialResult runIsometricTrial(const ArmSetup& setup, const IsometricTri
             f.first.push_back(firstState[i]);
             f.size.push_back(muscles[i]->getNumStates());
         }
-        f.banded = settings.bandedNewton && n > 1;
+        const bool analytic = settings.bandedNewton && settings.analyticJacobian;
+        f.banded = settings.bandedNewton && (n > 1 || analytic);
         f.calcBlock = [&](int b, double t, const double* yIn, double* ydot) {
             if (b == 0) {
                 std::fill(ydot, ydot + nqu, 0.0);
@@ -287,6 +288,12 @@ IsometricTrialResult runIsometricTrial(const ArmSetup& setup, const IsometricTri
             muscles[i]->calcStateDerivative(P[i], activations[i]->getValue(t), yIn + firstState[i],
                                             ydot + firstState[i]);
         };
+        if (analytic)
+            f.calcBlockJacobian = [&](int b, double t, const double* yIn, double* J) {
+                if (b == 0) return true;   // q' = u' = 0: the zero block
+                const int i = b - 1;
+                return muscles[i]->calcStateJacobian(P[i], activations[i]->getValue(t), yIn + firstState[i], J);
+            };
         sum.stats = integrateSampled(
             f, state.getTime(), y, settings.getDuration(), settings.sampleRate, profile.getBreakpoints(),
             settings.integration, [&](double t, const double* yIn) { sample(t, yIn, nullptr); },

@@ -72,6 +72,11 @@ struct IsometricTrialSettings {
     /// LockedOde with several muscles: Newton's systems as a band matrix (the muscles' states are
     /// independent blocks; numerics/stiff_ode.h), cost linear in the muscles. false: the dense solve.
     bool bandedNewton = true;
+    /// With bandedNewton: Newton's matrices from the muscle models' analytic Jacobians
+    /// (MuscleModel::calcStateJacobian; a model without one is differenced) instead of CPODES'
+    /// difference quotients. Off by default: it takes 7-15 % more steps and is 6-12 % slower
+    /// (docs/benchmarks.md, the motor units' rise/fall switch at fint = feff, which the quotients smooth).
+    bool analyticJacobian = false;
     IntegrationSettings integration;
 
     /// Throws InputError naming the field unless every value is in range (angle inside the arm's

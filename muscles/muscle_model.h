@@ -77,6 +77,13 @@ public:
         (void)pathVelocity;
         calcStateDerivative(pathLength, U, y, ydot, outputs);
     }
+    /// d(dy/dt)/dy at path P, input U for state y, row-major (jacobian[i * n + j] = d ydot_i / d y_j, n =
+    /// getNumStates()); one-sided where the derivative has a branch (the value's). false: the model has
+    /// no analytic Jacobian and callers take difference quotients (the default).
+    virtual bool calcStateJacobian(double pathLength, double U, const double* y, double* jacobian) const {
+        (void)pathLength, (void)U, (void)y, (void)jacobian;
+        return false;
+    }
     /// Throws SimulationError naming the time t, the muscle and the state unless y is finite and inside
     /// the model's validity range (call at step boundaries).
     virtual void checkStates(double t, const double* y) const = 0;

@@ -355,6 +355,145 @@ void VirtualMuscle::calcStateDerivative(double P, double U, const double* y, dou
     }
 }
 
+namespace {
+
+double calcSigmoid(double x) { return x >= 0 ? 1.0 / (1.0 + std::exp(-x)) : std::exp(x) / (1.0 + std::exp(x)); }
+
+// d FL / dL.
+double calcForceLengthSlope(const FibreType& t, double L) {
+    const double g = (std::pow(L, t.beta) - 1.0) / t.omega;
+    if (g == 0) return 0.0;
+    const double a = std::abs(g);
+    return -calcForceLength(t, L) * t.rho * std::pow(a, t.rho - 1.0) * (g > 0 ? 1.0 : -1.0) * t.beta *
+           std::pow(L, t.beta - 1.0) / t.omega;
+}
+
+// d FV / dV and d FV / dL (the branch of the value at V).
+void calcForceVelocitySlopes(const FibreType& t, double V, double L, double& dV, double& dL) {
+    if (V <= 0) {
+        const double num = t.Vmax - V, den = t.Vmax + (t.cV0 + t.cV1 * L) * V;
+        dV = (-den - num * (t.cV0 + t.cV1 * L)) / (den * den);
+        dL = -num * t.cV1 * V / (den * den);
+        return;
+    }
+    const double a = t.aV0 + t.aV1 * L + t.aV2 * L * L, num = t.bV - a * V, den = t.bV + V;
+    dV = (-a * den - num) / (den * den);
+    dL = -(t.aV1 + 2.0 * t.aV2 * L) * V / den;
+}
+
+}  // namespace
+
+bool VirtualMuscle::calcStateJacobian(double P, double U, const double* y, double* J) const {
+    const auto& c = params_.coefficients;
+    const int n = numStates_;
+    std::fill(J, J + std::size_t(n) * std::size_t(n), 0.0);
+    auto at = [&](int i, int j) -> double& { return J[std::size_t(i) * std::size_t(n) + std::size_t(j)]; };
+    const double L = y[kL], V = y[kV];
+    const double Ls = std::max(L, kLFloor), dLs = L > kLFloor ? 1.0 : 0.0;
+    const double L0 = params_.optimalFascicleLength;
+    const double LT = (P - L0 * L) / params_.optimalTendonLength;
+    const double dFse = c.cT * calcSigmoid((LT - c.LrT) / c.kT) * (-L0 / params_.optimalTendonLength);   // d/dL
+    const double e2 = c.c2 * (std::exp(c.k2 * (L - c.Lr2)) - 1.0);
+    const double fpe2 = std::min(0.0, e2), dFpe2 = e2 < 0 ? c.c2 * c.k2 * std::exp(c.k2 * (L - c.Lr2)) : 0.0;
+
+    // Per fibre type: active = FL FV + Fpe2 and its slopes; nf; Y; sum of Af x fraction and its slopes.
+    struct Type {
+        double active = 0, dActiveL = 0, dActiveV = 0, nf = 0, dNfL = 0, Y = 1;
+        int yieldIndex = -1;
+        double sum = 0, dSumL = 0, dSumY = 0;
+    };
+    auto makeType = [&](const FibreType& t, int yieldIndex) {
+        Type k;
+        const double fl = calcForceLength(t, L), fv = calcForceVelocity(t, V, L);
+        double dFvV = 0, dFvL = 0;
+        calcForceVelocitySlopes(t, V, L, dFvV, dFvL);
+        k.active = fl * fv + fpe2;
+        k.dActiveL = calcForceLengthSlope(t, L) * fv + fl * dFvL + dFpe2;
+        k.dActiveV = fl * dFvV;
+        const double nfRaw = calcNf(t, Ls);
+        k.nf = std::max(nfRaw, kNfFloor);
+        k.dNfL = nfRaw > kNfFloor ? -t.nf1 / (Ls * Ls) * dLs : 0.0;
+        k.yieldIndex = yieldIndex;
+        if (yieldIndex >= 0) {
+            k.Y = y[yieldIndex];
+            at(yieldIndex, yieldIndex) = -1.0 / t.TY;
+            const double e = std::exp(-std::abs(V) / t.VY);
+            at(yieldIndex, kV) = -t.cY * e * (V > 0 ? 1.0 : V < 0 ? -1.0 : 0.0) / (t.VY * t.TY);
+        }
+        return k;
+    };
+    Type slow = makeType(params_.slow, yieldSlow_), fast = makeType(params_.fast, yieldFast_);
+
+    // Row V collects d fce / d(unit states) as it goes: fce = stretch + sum_s active_s + sum_f active_f.
+    const double K = F0_ / (getNodeMass() * L0);
+    std::vector<double> dFce(std::size_t(n), 0.0);
+    for (int u = 0; u < getNumUnits(); ++u) {
+        const MotorUnit& mu = units_[u];
+        const FibreType& t = mu.slow ? params_.slow : params_.fast;
+        Type& k = mu.slow ? slow : fast;
+        const double fenv = calcEnvelopeFrequency(c, mu.threshold, U);
+        const int fi = getFintIndex(u), fe = getFeffIndex(u), si = sagIndex_[u];
+        const double fint = y[fi], feff = y[fe], S = si >= 0 ? y[si] : 1.0;
+        const double x = k.Y * S * feff;
+        const double Af = calcActivationFrequency(t, x, k.nf);
+        // Af = 1 - exp(-w), w = (x / (af nf))^nf: dAf/dx = exp(-w) w nf / x, dAf/dnf = exp(-w) w (ln z - 1).
+        double dAfX = 0, dAfNf = 0;
+        if (x > 0) {
+            const double z = x / (t.af * k.nf), w = std::pow(z, k.nf), e = std::exp(-w);
+            dAfX = e * w * k.nf / x;
+            dAfNf = e * w * (std::log(z) - 1.0);
+        }
+        const double dAfL = dAfNf * k.dNfL, dAfFeff = dAfX * k.Y * S, dAfS = dAfX * k.Y * feff, dAfY = dAfX * S * feff;
+        // Tf and its slopes (the branch of the value: rise while fint >= feff).
+        double Tf, dTfL = 0, dTfFeff = 0, dTfS = 0, dTfY = 0;
+        if (fint >= feff) {
+            Tf = t.Tf1 * L * L + t.Tf2 * fenv;
+            dTfL = 2.0 * t.Tf1 * L;
+        } else {
+            Tf = (t.Tf3 + t.Tf4 * Af) / Ls;
+            dTfL = t.Tf4 * dAfL / Ls - (t.Tf3 + t.Tf4 * Af) * dLs / (Ls * Ls);
+            dTfFeff = t.Tf4 * dAfFeff / Ls;
+            dTfS = t.Tf4 * dAfS / Ls;
+            dTfY = t.Tf4 * dAfY / Ls;
+        }
+        const double a = fenv - fint, b = fint - feff, Tf2 = Tf * Tf;
+        at(fi, fi) = -1.0 / Tf;
+        at(fi, kL) = -a / Tf2 * dTfL;
+        at(fi, fe) = -a / Tf2 * dTfFeff;
+        at(fe, fi) = 1.0 / Tf;
+        at(fe, fe) = -1.0 / Tf - b / Tf2 * dTfFeff;
+        at(fe, kL) = -b / Tf2 * dTfL;
+        if (si >= 0) {
+            at(fi, si) = -a / Tf2 * dTfS;
+            at(fe, si) = -b / Tf2 * dTfS;
+            at(si, si) = -1.0 / t.TS;
+        }
+        if (k.yieldIndex >= 0) {
+            at(fi, k.yieldIndex) = -a / Tf2 * dTfY;
+            at(fe, k.yieldIndex) = -b / Tf2 * dTfY;
+        }
+        k.sum += Af * mu.fraction;
+        k.dSumL += dAfL * mu.fraction;
+        k.dSumY += dAfY * mu.fraction;
+        dFce[std::size_t(fe)] += dAfFeff * mu.fraction * k.active;
+        if (si >= 0) dFce[std::size_t(si)] += dAfS * mu.fraction * k.active;
+    }
+    const double fceRaw = calcPassiveStretch(c, L, V, Lmax_) + slow.sum * slow.active + fast.sum * fast.active;
+    at(kL, kV) = 1.0;
+    if (fceRaw < 0) {   // fce = 0: only the tendon moves the node
+        at(kV, kL) = K * dFse;
+        return true;
+    }
+    dFce[kL] = c.c1 * calcSigmoid((L / Lmax_ - c.Lr1) / c.k1) / Lmax_ + slow.dSumL * slow.active + slow.sum * slow.dActiveL +
+               fast.dSumL * fast.active + fast.sum * fast.dActiveL;
+    dFce[kV] = c.eta + slow.sum * slow.dActiveV + fast.sum * fast.dActiveV;
+    if (slow.yieldIndex >= 0) dFce[std::size_t(slow.yieldIndex)] += slow.dSumY * slow.active;
+    if (fast.yieldIndex >= 0) dFce[std::size_t(fast.yieldIndex)] += fast.dSumY * fast.active;
+    for (int j = 0; j < n; ++j) at(kV, j) = -K * dFce[std::size_t(j)];
+    at(kV, kL) += K * dFse;
+    return true;
+}
+
 void VirtualMuscle::checkStates(double t, const double* y) const {
     for (int i = 0; i < numStates_; ++i)
         if (!std::isfinite(y[i])) {

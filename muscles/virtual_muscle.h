@@ -222,6 +222,8 @@ public:
     /// dy/dt at path P, activation U. Optionally fills outputs.
     void calcStateDerivative(double pathLength, double U, const double* y, double* ydot,
                              MuscleOutputs* outputs = nullptr) const override;
+    /// d(dy/dt)/dy, analytic (checked against difference quotients in tests/muscles).
+    bool calcStateJacobian(double pathLength, double U, const double* y, double* jacobian) const override;
     /// Throws SimulationError naming the time t, the muscle and the state unless every entry of y is
     /// finite and 0 < L < getNfLimit() (the model's validity range; step boundaries).
     void checkStates(double t, const double* y) const override;

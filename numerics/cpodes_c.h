@@ -60,6 +60,15 @@ struct SerialContent {
     double* data;
 };
 
+/// struct _DlsMat (sundials_direct.h): a band matrix's entry (i, j) is cols[j][i - j + s_mu].
+struct DlsMatBase {
+    int type, M, N, ldim, mu, ml, s_mu;
+    double* data;
+    int ldata;
+    double** cols;
+};
+using DlsMat = DlsMatBase*;
+
 // cpodes.h
 constexpr int CP_BDF = 2, CP_NEWTON = 2, CP_EXPL = 1, CP_SS = 1, CP_ONE_STEP = 2;
 constexpr int CP_SUCCESS = 0, CP_TOO_CLOSE = -27;
@@ -78,6 +87,10 @@ int CPodeSetMaxStep(void* cpode_mem, double hmax);
 int CPodeSetNonlinConvCoef(void* cpode_mem, double nlscoef);
 int CPLapackDense(void* cpode_mem, int N);
 int CPLapackBand(void* cpode_mem, int N, int mupper, int mlower);
+/// jac: with CPLapackBand a CPDlsBandJacExplFn, int(int N, int mupper, int mlower, double t, NVector y,
+/// NVector fy, DlsMat J, void* jac_data, NVector tmp1, NVector tmp2, NVector tmp3); with CPLapackDense a
+/// CPDlsDenseJacExplFn, the same without mupper and mlower.
+int CPDlsSetJacFn(void* cpode_mem, void* jac, void* jac_data);
 int CPode(void* cpode_mem, double tout, double* tret, NVector yout, NVector ypout, int mode);
 int CPodeGetDky(void* cpode_mem, double t, int k, NVector dky);
 int CPodeGetNumSteps(void* cpode_mem, long* nsteps);

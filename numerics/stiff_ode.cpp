@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cfloat>
 #include <cmath>
+#include <limits>
 #include <cstring>
 #include <memory>
 #include <stdexcept>
@@ -112,6 +113,20 @@ public:
     void evaluate(double t, const double* y, double* ydot) {
         if (calc(t, y, ydot) != 0) throw SimulationError("t = " + formatNumber(t) + " s: " + lastError_);
     }
+    /// CPDlsBandJacExplFn: each block's Jacobian from calcBlockJacobian (or its difference quotients).
+    static int calcBandJacobian(int n, int, int, double t, cpodes::NVector y, cpodes::NVector fy, cpodes::DlsMat J,
+                                void* context, cpodes::NVector, cpodes::NVector, cpodes::NVector) {
+        return static_cast<RhsContext*>(context)->fillJacobian(n, t, cpodes::ArrayVector::updData(y),
+                                                               cpodes::ArrayVector::updData(fy), J, true);
+    }
+    /// CPDlsDenseJacExplFn: the same into a dense matrix (a band as wide as the system).
+    static int calcDenseJacobian(int n, double t, cpodes::NVector y, cpodes::NVector fy, cpodes::DlsMat J,
+                                 void* context, cpodes::NVector, cpodes::NVector, cpodes::NVector) {
+        return static_cast<RhsContext*>(context)->fillJacobian(n, t, cpodes::ArrayVector::updData(y),
+                                                               cpodes::ArrayVector::updData(fy), J, false);
+    }
+    int getNumJacobians() const { return jacobians_; }
+    bool hasBlockJacobian() const { return blocks_ && blocks_->banded && blocks_->calcBlockJacobian; }
     static int calcRhs(double t, cpodes::NVector y, cpodes::NVector ydot, void* context) {
         return static_cast<RhsContext*>(context)->calc(t, cpodes::ArrayVector::updData(y),
                                                        cpodes::ArrayVector::updData(ydot));
@@ -124,6 +139,40 @@ public:
     }
 
 private:
+    int fillJacobian(int n, double t, const double* y, const double* fy, cpodes::DlsMat J, bool band) {
+        ++jacobians_;
+        try {
+            std::fill(J->data, J->data + std::size_t(J->ldim) * std::size_t(n), 0.0);
+            const int offset = band ? J->s_mu : 0;   // entry (i, j): cols[j][i - j + s_mu] or cols[j][i]
+            for (int b = 0; b < int(blocks_->first.size()); ++b) {
+                const int first = blocks_->first[b], m = blocks_->size[b];
+                blockJ_.assign(std::size_t(m) * std::size_t(m), 0.0);
+                if (!blocks_->calcBlockJacobian(b, t, y, blockJ_.data())) differenceBlock(b, t, y, fy);
+                for (int i = 0; i < m; ++i)
+                    for (int j = 0; j < m; ++j)
+                        J->cols[first + j][band ? i - j + offset : first + i] =
+                            blockJ_[std::size_t(i) * std::size_t(m) + std::size_t(j)];
+            }
+        } catch (const std::exception& e) {
+            lastError_ = e.what();
+            return 1;   // recoverable: CPODES retries with a smaller step
+        }
+        return 0;
+    }
+    // Forward difference quotients of block b into blockJ_ (a model without an analytic Jacobian).
+    void differenceBlock(int b, double t, const double* y, const double* fy) {
+        const int first = blocks_->first[b], m = blocks_->size[b];
+        work_.assign(y, y + baseY_.size());
+        workDot_.assign(fy, fy + baseY_.size());
+        for (int j = 0; j < m; ++j) {
+            const double yj = y[first + j], h = std::sqrt(std::numeric_limits<double>::epsilon()) * std::max(1.0, std::abs(yj));
+            work_[std::size_t(first + j)] = yj + h;
+            blocks_->calcBlock(b, t, work_.data(), workDot_.data());
+            for (int i = 0; i < m; ++i)
+                blockJ_[std::size_t(i) * std::size_t(m) + std::size_t(j)] = (workDot_[std::size_t(first + i)] - fy[first + i]) / h;
+            work_[std::size_t(first + j)] = yj;
+        }
+    }
     int calc(double t, const double* y, double* ydot) {
         ++count_;
         try {
@@ -164,7 +213,8 @@ private:
     }
     const OdeRhs& f_;
     const OdeBlocks* blocks_;
-    int count_ = 0, partial_ = 0;
+    int count_ = 0, partial_ = 0, jacobians_ = 0;
+    std::vector<double> blockJ_, work_, workDot_;
     bool hasBase_ = false;
     double baseT_ = 0;
     std::vector<double> baseY_, baseYdot_;  // the last full evaluation
@@ -355,10 +405,17 @@ public:
                           mem_, reinterpret_cast<void*>(cpodes::CPSpilsJacTimesVecExplFn(&ArrowSolver::multiplyCallback)),
                           arrow),
                       "CPSpilsSetJacTimesVecFn", t0);
-            } else if (halfBandwidth < 0)
+            } else if (halfBandwidth < 0) {
                 check(cpodes::CPLapackDense(mem_, n), "CPLapackDense", t0);
-            else
+                if (context.hasBlockJacobian())
+                    check(cpodes::CPDlsSetJacFn(mem_, reinterpret_cast<void*>(&RhsContext::calcDenseJacobian), &context),
+                          "CPDlsSetJacFn", t0);
+            } else {
                 check(cpodes::CPLapackBand(mem_, n, halfBandwidth, halfBandwidth), "CPLapackBand", t0);
+                if (context.hasBlockJacobian())
+                    check(cpodes::CPDlsSetJacFn(mem_, reinterpret_cast<void*>(&RhsContext::calcBandJacobian), &context),
+                          "CPDlsSetJacFn", t0);
+            }
             check(cpodes::CPodeSetNonlinConvCoef(mem_, 0.01), "CPodeSetNonlinConvCoef", t0);
             check(cpodes::CPodeSetMinStep(mem_, IntegrationSettings::kMinStepSize), "CPodeSetMinStep", t0);
             if (settings.maxStepSize > 0)
@@ -439,6 +496,7 @@ IntegrationStats integrate(const OdeRhs& f, const OdeBlocks* blocks, double t0, 
     const double relTol = settings.accuracy, absTol = settings.accuracy / 10;  // CPodesIntegrator's choice
     int halfBandwidth = -1;  // dense
     if (blocks && blocks->banded) halfBandwidth = *std::max_element(blocks->size.begin(), blocks->size.end()) - 1;
+    if (2 * halfBandwidth + 1 >= n) halfBandwidth = -1;   // a band as wide as y: the dense solve (LAPACK's band storage would be larger)
     double t = t0;
     std::vector<double> yv = y, ydot(n), yout(n), ypout(n);
     for (double segmentEnd : run.getSegmentEnds()) {
@@ -482,6 +540,7 @@ IntegrationStats integrate(const OdeRhs& f, const OdeBlocks* blocks, double t0, 
     stats.restarts -= 1;
     stats.realizations = context.getNumEvaluations();
     stats.partialEvaluations = context.getNumPartialEvaluations();
+    stats.jacobians = context.getNumJacobians();
     y = yv;
     return stats;
 }

@@ -45,6 +45,7 @@ struct IntegrationStats {
     int newtonIterations = 0;   ///< Newton iterations (one linear solve each)
     int krylovIterations = 0;   ///< OdeArrow: Krylov iterations of those solves (1 each when the
                                 ///< preconditioner is the exact inverse); 0 for the direct solvers
+    int jacobians = 0;          ///< OdeBlocks::calcBlockJacobian: Newton matrices built from it
 };
 
 /// f(t, y, ydot): writes dy/dt. May throw SimulationError for a state outside the model: the solver
@@ -76,6 +77,10 @@ struct OdeBlocks {
     /// y's size. Steps and samples then differ from the dense solve's by rounding only; false keeps the
     /// dense solve, bit for bit the OdeRhs path.
     bool banded = false;
+    /// Optional, with banded: block b's Jacobian d(ydot_b)/d(y_b) at (t, y), row-major size x size, in
+    /// place of CPODES' difference quotients (no f calls for Newton's matrices); return false to have
+    /// that block differenced (forward, step sqrt(eps) max(1, |y_j|)) instead.
+    std::function<bool(int block, double t, const double* y, double* jacobian)> calcBlockJacobian;
 };
 
 /// integrateSampled for a block-structured f, with the same steps and samples as for the equivalent

@@ -42,6 +42,7 @@ void measureIsometricTrial(benchmark::State& state, const ArmSetup& setup, Isome
     state.counters["steps"] = stats.steps;
     state.counters["rhs"] = stats.realizations;  // right-hand sides, finite-difference Jacobians included
     state.counters["partial"] = stats.partialEvaluations;  // of those, one muscle (a Jacobian column)
+    state.counters["jac"] = stats.jacobians;                 // Newton matrices from analytic Jacobians
 }
 
 void BM_IsometricMvcTrial(benchmark::State& state) {
@@ -97,6 +98,24 @@ void BM_TwinMvcTrial(benchmark::State& state) {
     measureIsometricTrial(state, twin, s);
 }
 BENCHMARK(BM_TwinMvcTrial)->Arg(1000)->Arg(100)->Unit(benchmark::kMillisecond);
+
+// Issue 30: a 3 s MVC at 1000 Hz with Newton's matrices from the muscles' analytic Jacobians (arg 1,
+// the default) or CPODES' difference quotients (arg 0): the thesis arm, the elbow, the twin.
+void BM_MvcJacobian(benchmark::State& state, const char* model) {
+    static const ArmSetup thesis = loadShippedModel("thesis"), elbowModel = loadShippedModel("elbow"),
+                          twin = loadShippedModel("twin");
+    const ArmSetup& setup = std::string(model) == "thesis" ? thesis : std::string(model) == "elbow" ? elbowModel : twin;
+    IsometricTrialSettings s;
+    if (setup.getNumMuscles() > 1) {
+        s.activation = setup.effort.voluntaryActivation;
+        s.antagonistActivation = setup.effort.coContraction;
+    }
+    s.analyticJacobian = state.range(1) != 0;
+    measureIsometricTrial(state, setup, s);
+}
+BENCHMARK_CAPTURE(BM_MvcJacobian, thesis, "thesis")->Args({1000, 0})->Args({1000, 1})->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_MvcJacobian, elbow, "elbow")->Args({1000, 0})->Args({1000, 1})->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_MvcJacobian, twin, "twin")->Args({1000, 0})->Args({1000, 1})->Unit(benchmark::kMillisecond);
 
 // Issue 29: the same trial on the twin with Hill-type muscles (2 states per muscle against Virtual
 // Muscle's 14-20).

@@ -172,3 +172,57 @@ TEST(VirtualMuscle, ThesisCompositionAnchorAtActivationNinetyPercent) {
     const VirtualMuscle m(bicepsLongHead());
     EXPECT_NEAR(m.calcSteadyState(0.375, 0.9).force, 346.128, kRelTol * 346.128);
 }
+
+// The analytic Jacobian d(dy/dt)/dy against central difference quotients of calcStateDerivative, at
+// seeded states of both fibre types' units (rising and falling Tf branches, sag, yield, shortening and
+// lengthening), away from the branch points (fint = feff, feff = 0.1, V = 0) by more than the step.
+TEST(VirtualMuscle, AnalyticJacobianEqualsDifferenceQuotients) {
+    constexpr double kStep = 1e-7;          // relative to max(1, |y_j|)
+    constexpr double kTol = 2e-5;           // of the row's largest entry: central differences, step 1e-7
+    MuscleParameters p = bicepsLongHead();
+    const VirtualMuscle m(p);
+    const int n = m.getNumStates();
+    const double P = 0.9 * m.getMaxPathLength();
+    std::uint32_t seed = 12345;
+    auto uniform = [&](double lo, double hi) {   // LCG: portable and seeded
+        seed = seed * 1664525u + 1013904223u;
+        return lo + (hi - lo) * (seed >> 8) / double(1u << 24);
+    };
+    int checkedStates = 0, nonzero = 0;
+    for (int trial = 0; trial < 12; ++trial) {
+        const double U = trial % 3 == 0 ? 0.3 : trial % 3 == 1 ? 0.7 : 0.98;
+        std::vector<double> y = m.calcSteadyState(P, U).states;
+        ASSERT_EQ(int(y.size()), n);
+        y[VirtualMuscle::kL] = uniform(0.75, 1.2);
+        y[VirtualMuscle::kV] = (trial % 2 ? 1 : -1) * uniform(0.05, 0.6);
+        for (int u = 0; u < m.getNumUnits(); ++u) {
+            const double feff = uniform(0.2, 1.6);
+            y[m.getFeffIndex(u)] = feff;
+            y[m.getFintIndex(u)] = feff * (trial % 4 < 2 ? uniform(1.05, 1.4) : uniform(0.6, 0.95));   // both Tf branches
+            if (m.getSagIndex(u) >= 0) y[m.getSagIndex(u)] = uniform(0.75, 1.0);
+        }
+        for (bool slow : {true, false})
+            if (m.getYieldIndex(slow) >= 0) y[m.getYieldIndex(slow)] = uniform(0.8, 1.0);
+        std::vector<double> J(std::size_t(n * n)), plus(n), minus(n);
+        ASSERT_TRUE(m.calcStateJacobian(P, U, y.data(), J.data()));
+        for (int j = 0; j < n; ++j) {
+            const double h = kStep * std::max(1.0, std::abs(y[j]));
+            std::vector<double> a = y, b = y;
+            a[j] += h;
+            b[j] -= h;
+            m.calcStateDerivative(P, U, a.data(), plus.data());
+            m.calcStateDerivative(P, U, b.data(), minus.data());
+            for (int i = 0; i < n; ++i) {
+                double rowMax = 1e-12;
+                for (int k = 0; k < n; ++k) rowMax = std::max(rowMax, std::abs(J[std::size_t(i * n + k)]));
+                const double fd = (plus[i] - minus[i]) / (2 * h);
+                EXPECT_NEAR(J[std::size_t(i * n + j)], fd, kTol * rowMax)
+                    << "d " << m.getStateNames()[i] << " / d " << m.getStateNames()[j] << " at trial " << trial;
+                nonzero += J[std::size_t(i * n + j)] != 0;
+            }
+        }
+        ++checkedStates;
+    }
+    EXPECT_EQ(checkedStates, 12);
+    EXPECT_GT(nonzero, 12 * 3 * n);   // not an empty matrix: every unit couples to L, V and its own states
+}
