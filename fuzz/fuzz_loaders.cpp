@@ -1,6 +1,6 @@
 // libFuzzer target for armsim's file loaders (issue 15). One binary, the loader chosen by the
 // ARMSIM_FUZZ_LOADER environment variable (muscle, arm, model, osim, protocol, torque_protocol, population,
-// study, force_csv, torque_csv, channel_csv, sto, trace, study_journal, forward_setup). Each input is written to a scratch file and loaded; a loader
+// study, force_csv, torque_csv, channel_csv, sto, trace, study_journal, forward_setup, anatomy_targets). Each input is written to a scratch file and loaded; a loader
 // may reject it only with InputError (bad input) or SimulationError (a model it cannot solve). Any
 // other exception, a crash, a hang or a sanitizer report is a finding.
 #include "basics/errors.h"
@@ -12,6 +12,7 @@
 #include "experiments/torque_protocol.h"
 #include "identification/observations.h"
 #include "studies/study.h"
+#include "model/anatomy_targets.h"
 #include "model/arm_parameters.h"
 #include "model/model_file.h"
 #include "model/osim_file.h"
@@ -40,6 +41,7 @@ const std::map<std::string, std::pair<std::string, Loader>>& getLoaders() {
         {"arm", {".yaml", [](const std::string& p) { loadArmParameters(p); }}},
         {"model", {".yaml", [](const std::string& p) { loadModel(p); }}},
         {"osim", {".osim", [](const std::string& p) { readOsimFile(p); }}},
+        {"anatomy_targets", {".yaml", [](const std::string& p) { loadAnatomyTargets(p); }}},
         {"forward_setup", {".xml", [](const std::string& p) { readOsimForwardSetup(p); }}},
         {"protocol", {".yaml", [](const std::string& p) { loadProtocolSubject(readProtocol(p)); }}},
         {"torque_protocol", {".yaml", [](const std::string& p) { readTorqueProtocol(p); }}},
