@@ -424,9 +424,9 @@ bool VirtualMuscle::calcStateJacobian(double P, double U, const double* y, doubl
     };
     Type slow = makeType(params_.slow, yieldSlow_), fast = makeType(params_.fast, yieldFast_);
 
-    // Row V collects d fce / d(unit states) as it goes: fce = stretch + sum_s active_s + sum_f active_f.
+    // Row V = K (dFse - dFce) collects -K d fce / d(unit states) as it goes: fce = stretch + sum_s
+    // active_s + sum_f active_f (each unit's feff and sag are columns of their own).
     const double K = F0_ / (getNodeMass() * L0);
-    std::vector<double> dFce(std::size_t(n), 0.0);
     for (int u = 0; u < getNumUnits(); ++u) {
         const MotorUnit& mu = units_[u];
         const FibreType& t = mu.slow ? params_.slow : params_.fast;
@@ -475,22 +475,22 @@ bool VirtualMuscle::calcStateJacobian(double P, double U, const double* y, doubl
         k.sum += Af * mu.fraction;
         k.dSumL += dAfL * mu.fraction;
         k.dSumY += dAfY * mu.fraction;
-        dFce[std::size_t(fe)] += dAfFeff * mu.fraction * k.active;
-        if (si >= 0) dFce[std::size_t(si)] += dAfS * mu.fraction * k.active;
+        at(kV, fe) = -K * (dAfFeff * mu.fraction * k.active);
+        if (si >= 0) at(kV, si) = -K * (dAfS * mu.fraction * k.active);
     }
     const double fceRaw = calcPassiveStretch(c, L, V, Lmax_) + slow.sum * slow.active + fast.sum * fast.active;
     at(kL, kV) = 1.0;
     if (fceRaw < 0) {   // fce = 0: only the tendon moves the node
+        std::fill(&at(kV, 0), &at(kV, 0) + n, 0.0);
         at(kV, kL) = K * dFse;
         return true;
     }
-    dFce[kL] = c.c1 * calcSigmoid((L / Lmax_ - c.Lr1) / c.k1) / Lmax_ + slow.dSumL * slow.active + slow.sum * slow.dActiveL +
-               fast.dSumL * fast.active + fast.sum * fast.dActiveL;
-    dFce[kV] = c.eta + slow.sum * slow.dActiveV + fast.sum * fast.dActiveV;
-    if (slow.yieldIndex >= 0) dFce[std::size_t(slow.yieldIndex)] += slow.dSumY * slow.active;
-    if (fast.yieldIndex >= 0) dFce[std::size_t(fast.yieldIndex)] += fast.dSumY * fast.active;
-    for (int j = 0; j < n; ++j) at(kV, j) = -K * dFce[std::size_t(j)];
-    at(kV, kL) += K * dFse;
+    const double dFceL = c.c1 * calcSigmoid((L / Lmax_ - c.Lr1) / c.k1) / Lmax_ + slow.dSumL * slow.active +
+                         slow.sum * slow.dActiveL + fast.dSumL * fast.active + fast.sum * fast.dActiveL;
+    at(kV, kL) = -K * dFceL + K * dFse;
+    at(kV, kV) = -K * (c.eta + slow.sum * slow.dActiveV + fast.sum * fast.dActiveV);
+    if (slow.yieldIndex >= 0) at(kV, slow.yieldIndex) = -K * (slow.dSumY * slow.active);
+    if (fast.yieldIndex >= 0) at(kV, fast.yieldIndex) = -K * (fast.dSumY * fast.active);
     return true;
 }
 

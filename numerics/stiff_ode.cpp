@@ -144,10 +144,18 @@ private:
         try {
             std::fill(J->data, J->data + std::size_t(J->ldim) * std::size_t(n), 0.0);
             const int offset = band ? J->s_mu : 0;   // entry (i, j): cols[j][i - j + s_mu] or cols[j][i]
+            bool haveWork = false;   // differenceBlock's copies of y and fy, made once
             for (int b = 0; b < int(blocks_->first.size()); ++b) {
                 const int first = blocks_->first[b], m = blocks_->size[b];
                 blockJ_.assign(std::size_t(m) * std::size_t(m), 0.0);
-                if (!blocks_->calcBlockJacobian(b, t, y, blockJ_.data())) differenceBlock(b, t, y, fy);
+                if (!blocks_->calcBlockJacobian(b, t, y, blockJ_.data())) {
+                    if (!haveWork) {
+                        work_.assign(y, y + n);
+                        workDot_.assign(fy, fy + n);
+                        haveWork = true;
+                    }
+                    differenceBlock(b, t, fy);
+                }
                 for (int i = 0; i < m; ++i)
                     for (int j = 0; j < m; ++j)
                         J->cols[first + j][band ? i - j + offset : first + i] =
@@ -159,13 +167,13 @@ private:
         }
         return 0;
     }
-    // Forward difference quotients of block b into blockJ_ (a model without an analytic Jacobian).
-    void differenceBlock(int b, double t, const double* y, const double* fy) {
+    // Forward difference quotients of block b into blockJ_ (a model without an analytic Jacobian), from
+    // work_ = y and workDot_ = fy outside the block (calcBlock writes block b's entries only; work_ is
+    // restored after each column).
+    void differenceBlock(int b, double t, const double* fy) {
         const int first = blocks_->first[b], m = blocks_->size[b];
-        work_.assign(y, y + baseY_.size());
-        workDot_.assign(fy, fy + baseY_.size());
         for (int j = 0; j < m; ++j) {
-            const double yj = y[first + j], h = std::sqrt(std::numeric_limits<double>::epsilon()) * std::max(1.0, std::abs(yj));
+            const double yj = work_[std::size_t(first + j)], h = std::sqrt(std::numeric_limits<double>::epsilon()) * std::max(1.0, std::abs(yj));
             work_[std::size_t(first + j)] = yj + h;
             blocks_->calcBlock(b, t, work_.data(), workDot_.data());
             for (int i = 0; i < m; ++i)
