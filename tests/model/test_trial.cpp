@@ -484,6 +484,30 @@ TEST(IsometricTrial, HillTypeTwinLockedOdeMatchesSimbodyAndTheSteadyCurve) {
     }
 }
 
+// Issue 30: Newton's matrices from analytic Jacobians where a model has none (the Hill-type muscles:
+// MuscleModel::calcStateJacobian returns false) fall back to each block's difference quotients; the
+// trial agrees with CPODES' own quotients to 1e-6 and the fallback was used.
+TEST(IsometricTrial, BlocksWithoutAnAnalyticJacobianAreDifferenced) {
+    constexpr double kRelTol = 1e-6;
+    constexpr double kAccuracy = 1e-8;
+    ArmSetup twin = loadModel("twin");
+    setMuscleModel(twin, "thelen2003");
+    IsometricTrialSettings s = mvcAt(90);
+    s.activation = 0.9;
+    s.antagonistActivation = 0.05;
+    s.holdDuration = 0.5;
+    s.averagingWindow = 0.2;
+    s.integration.accuracy = kAccuracy;
+    s.analyticJacobian = true;
+    const IsometricTrialResult fallback = runIsometricTrial(twin, s);
+    s.analyticJacobian = false;
+    const IsometricTrialResult quotients = runIsometricTrial(twin, s);
+    EXPECT_GT(fallback.summary.stats.jacobians, 0);
+    EXPECT_EQ(quotients.summary.stats.jacobians, 0);
+    std::string column;
+    EXPECT_LE(calcMaxColumnDifference(fallback.series, quotients.series, &column), kRelTol) << column;
+}
+
 // Issue 29: free movement with Hill-type muscles (their path moves): the fascicle velocity each model
 // reports equals the time derivative of the fascicle length it reports (central differences of the
 // samples). For De Groote the length comes from the tendon-force state, whose derivative uses the
