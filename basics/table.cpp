@@ -43,6 +43,13 @@ void Table::appendRow(const std::vector<double>& row) {
     ++numRows_;
 }
 
+void Table::truncateRows(int n) {
+    if (n < 0 || n > numRows_) throw std::invalid_argument("truncateRows: " + std::to_string(n) + " of " + std::to_string(numRows_) + " rows");
+    data_.resize(std::size_t(n) * names_.size());
+    if (int(lines_.size()) > n) lines_.resize(n);
+    numRows_ = n;
+}
+
 std::vector<double> Table::getRow(int i) const {
     const auto first = data_.begin() + std::ptrdiff_t(i) * std::ptrdiff_t(names_.size());
     return std::vector<double>(first, first + std::ptrdiff_t(names_.size()));

@@ -27,6 +27,8 @@ public:
     void appendRow(const std::vector<double>& row);
     /// Makes room for n rows in all (no reallocation while appending up to n).
     void reserveRows(int n) { data_.reserve(std::size_t(n) * names_.size()); }
+    /// Keeps the first n rows (n <= getNumRows()): undoes appends that must not stay.
+    void truncateRows(int n);
     std::vector<double> getRow(int i) const;
     double get(int row, int column) const { return data_[std::size_t(row) * names_.size() + column]; }
     double get(int row, const std::string& column) const { return get(row, findColumn(column)); }

@@ -35,6 +35,8 @@ public:
 
     int getNumMuscles() const { return int(forces_.size()); }
     const MuscleForce& getMuscleForce(int i) const { return forces_.at(i); }
+    /// For replacing muscle i's activation profile (MuscleForce::setActivationProfile).
+    MuscleForce& updMuscleForce(int i) { return forces_.at(i); }
     const MuscleModel& getMuscle(int i) const { return forces_.at(i).getMuscle(); }
     const std::string& getMuscleName(int i) const { return setup_.muscles.at(i).params.name; }
     /// The primary muscle (the thesis's biceps).

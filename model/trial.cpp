@@ -507,8 +507,8 @@ private:
     int partial_ = 0;
 };
 
-// Integrates the free arm from state (on return: the end state) with CoupledMuscleOde; sample gets a
-// State realized to Stage::Time at every sample time.
+}  // namespace
+
 IntegrationStats integrateCoupledMuscles(const MuscleArm& model, State& state, double duration, double sampleRate,
                                          const std::vector<double>& breakpoints, const IntegrationSettings& integration,
                                          bool checkPartial, const std::function<void(const State&)>& sample) {
@@ -534,7 +534,6 @@ IntegrationStats integrateCoupledMuscles(const MuscleArm& model, State& state, d
     return st;
 }
 
-}  // namespace
 
 Table runFreeMovement(const ArmSetup& setup, const FreeMovementSettings& settings, IntegrationStats* stats) {
     settings.validate(setup.arm);

@@ -200,6 +200,14 @@ struct FreeMovementSettings {
 /// muscles, then the muscle states.
 Table runFreeMovement(const ArmSetup& setup, const FreeMovementSettings& settings, IntegrationStats* stats = nullptr);
 
+/// Integrates a free arm (FreeMovementSolver::MuscleBlocks) from `state` for `duration` seconds; on return
+/// `state` is the end state (realized to Stage::Time). sample gets a State realized to Stage::Time at
+/// state.getTime() + k / sampleRate, the start included. checkPartial: as
+/// FreeMovementSettings::checkPartialEvaluations.
+IntegrationStats integrateCoupledMuscles(const MuscleArm& model, SimTK::State& state, double duration, double sampleRate,
+                                         const std::vector<double>& breakpoints, const IntegrationSettings& integration,
+                                         bool checkPartial, const std::function<void(const SimTK::State&)>& sample);
+
 /// Reads trial settings from a YAML mapping (keys: elbow_angle_deg, activation, rest, rise, hold,
 /// sample_rate, accuracy, averaging_window); unknown keys are errors naming file and line.
 IsometricTrialSettings readIsometricTrialSettings(const ParamNode& node, const ArmParameters& arm);

@@ -18,6 +18,7 @@ public:
     const MuscleModel& muscle() const { return *muscle_; }
     const MusclePath& path() const { return path_; }
     const ActivationProfile& activation() const { return activation_; }
+    void setActivation(ActivationProfile a) { activation_ = std::move(a); }
     const std::string& name() const { return muscle_->getName(); }
 
     void realizeTopology(State& s) const override {
@@ -97,6 +98,9 @@ const MuscleForce::Impl& MuscleForce::getImpl() const {
 const MuscleModel& MuscleForce::getMuscle() const { return getImpl().muscle(); }
 const MusclePath& MuscleForce::getPath() const { return getImpl().path(); }
 const ActivationProfile& MuscleForce::getActivationProfile() const { return getImpl().activation(); }
+void MuscleForce::setActivationProfile(ActivationProfile activation) {
+    dynamic_cast<Impl&>(updImplementation()).setActivation(std::move(activation));
+}
 
 double MuscleForce::getPathLength(const State& s) const { return getImpl().pathLength(s); }
 

@@ -35,6 +35,9 @@ public:
     const MuscleModel& getMuscle() const;
     const MusclePath& getPath() const;
     const ActivationProfile& getActivationProfile() const;
+    /// Replaces U(t). The derivatives of states realized at Stage::Dynamics or above are stale afterwards:
+    /// a caller invalidates them (State::invalidateAllCacheAtOrAbove(Stage::Dynamics)).
+    void setActivationProfile(ActivationProfile activation);
 
     /// Path length P [m] (Stage::Position).
     double getPathLength(const SimTK::State& s) const;

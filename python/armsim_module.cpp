@@ -386,4 +386,5 @@ PYBIND11_MODULE(_armsim, mod) {
         "Resumes from the folder's journal like the command. Releases the GIL; Ctrl-C raises KeyboardInterrupt.");
 
     addIdentificationBindings(mod);
+    addSimulationBindings(mod);
 }

@@ -113,5 +113,7 @@ auto runInterruptible(F&& f) -> decltype(f()) {
 /// Adds identify, identify_torque, read_torque_data, validate, validate_elbow, design_protocol and
 /// run_protocol (python/identification_bindings.cpp).
 void addIdentificationBindings(py::module_& module);
+/// Adds Simulation (python/simulation_bindings.cpp).
+void addSimulationBindings(py::module_& module);
 
 }  // namespace armsim::python

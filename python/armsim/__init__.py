@@ -1,8 +1,8 @@
 """armsim: a musculoskeletal arm simulator with Virtual Muscle force elements.
 
-Models, steady states, muscle and arm trials, protocols, identification with its reports,
-validation, experiment design, population studies and rendering on the C++ core, with numpy arrays
-out. Units are SI; keyword names are those of the YAML files, and for the command's options their long
+Models, steady states, muscle and arm trials, simulations stepped on request (Simulation), protocols,
+identification with its reports, validation, experiment design, population studies and rendering on
+the C++ core, with numpy arrays out. Units are SI; keyword names are those of the YAML files, and for the command's options their long
 names with underscores (--max-iterations: max_iterations; --speed is playback_speed). Errors carry
 the command line's messages: ValueError for bad input, FileNotFoundError for a missing file,
 RuntimeError for a simulation that cannot go on. Long calls release the GIL, so threads can run
@@ -12,6 +12,7 @@ assets folder: ARMSIM_ASSETS if set, else the installed one (cmake --install) or
     import armsim
     model = armsim.Model.load("twin")
     series, summary = armsim.arm_trial(model, angle_deg=90, activation=1.0)
+    sim = armsim.Simulation(model, angle_deg=120, excitation={"BRA": 0.3}); sim.advance_to(0.5)
     report = armsim.identify(armsim.Model.load("thesis"), "measured/thesis_measured.csv")
     armsim.render_video(model, series, "mvc.mp4")
 """
@@ -34,7 +35,7 @@ def _use_installed_assets():
 _use_installed_assets()
 
 from ._armsim import (Model, arm_trial, design_protocol, forward, identify, identify_torque, muscle_trial,
-                      read_torque_data, run_protocol, run_study, steady_state, validate, validate_elbow, __version__)
+                      read_torque_data, run_protocol, run_study, Simulation, steady_state, validate, validate_elbow, __version__)
 
 
 def render_video(model, series, path, fps=30.0, width=1280, height=720, playback_speed=1.0, overlay=True,
@@ -60,4 +61,4 @@ def render_frame(model, series, time, width=640, height=360, overlay=True, super
 
 
 __all__ = ["__version__", "Model", "arm_trial", "design_protocol", "forward", "identify", "identify_torque", "muscle_trial", "read_torque_data", "render_frame",
-           "render_video", "run_protocol", "run_study", "steady_state", "validate", "validate_elbow"]
+           "render_video", "run_protocol", "run_study", "Simulation", "steady_state", "validate", "validate_elbow"]

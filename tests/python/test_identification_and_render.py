@@ -256,7 +256,29 @@ def _stub_functions():
             for node in ast.parse(f.read()).body:
                 if isinstance(node, ast.FunctionDef):
                     funcs[node.name] = [a.arg for a in node.args.args]
+                elif isinstance(node, ast.ClassDef):   # Class.member: its methods and properties
+                    for member in node.body:
+                        if isinstance(member, ast.FunctionDef):
+                            funcs[node.name + "." + member.name] = [a.arg for a in member.args.args + member.args.kwonlyargs]
     return funcs
+
+
+def test_type_stubs_name_every_public_member_of_the_classes():
+    """Every public method and property of Model and Simulation is in the stubs (with the method's
+    argument names as pybind11 reports them)."""
+    import re
+    stubs = _stub_functions()
+    for cls in (armsim.Model, armsim.Simulation):
+        for name, member in vars(cls).items():
+            if name.startswith("_"):
+                continue
+            key = cls.__name__ + "." + name
+            assert key in stubs, key
+            doc = getattr(member, "__doc__", "") or ""
+            if callable(member) and doc.startswith(name + "("):
+                signature = doc.splitlines()[0]
+                names = re.findall(r"(\w+): ", signature[signature.index("(") + 1:signature.rindex(")")])
+                assert stubs[key] == names, (key, stubs[key], names)
 
 
 def test_type_stubs_name_every_public_function_with_its_arguments():
@@ -266,7 +288,7 @@ def test_type_stubs_name_every_public_function_with_its_arguments():
     import re
     stubs = _stub_functions()
     for name in armsim.__all__:
-        if name in ("Model", "__version__"):   # a class and a string, not functions
+        if name in ("Model", "Simulation", "__version__"):   # classes and a string, not functions
             continue
         f = getattr(armsim, name)
         assert name in stubs, name

@@ -21,6 +21,10 @@ CALLS = {
     "run_study": "armsim.run_study(os.path.join(work, 'study.yaml'), threads=2, out=os.path.join(work, 'study_out'))",
     "render_video": "armsim.render_video(thesis, series, os.path.join(work, 'v.mp4'), width=320, height=240)",
     "design_protocol": "armsim.design_protocol(draws=100000)",
+    # a forced oscillation keeps the steps short for 10^4 s of simulated time
+    "simulation_advance_to": "import numpy as np; t = np.linspace(0, 1e4, 10**6); "
+                             "armsim.Simulation(thesis, rate_hz=1, excitation={'time_s': t, 'biceps': "
+                             "0.5 + 0.4 * np.sin(20 * t)}).advance_to(1e4)",
 }
 
 STUDY = """kind: study
