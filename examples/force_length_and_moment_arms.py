@@ -28,7 +28,7 @@ def main():
     fig, ax = plt.subplots(figsize=(7, 4.5))
     rows = []
     for u in (1.0, 0.5, 0.2):
-        force = [armsim.steady_state(thesis, float(x), u)["force"] for x in paths]
+        force = [armsim.steady_state(thesis, float(x), u)["force_N"] for x in paths]
         rows.append(force)
         ax.plot(100 * paths, force, label=f"U = {u:g}")
     ax.set(xlabel="path length P (cm)", ylabel="steady force Fse (N)",

@@ -41,7 +41,7 @@ def identify_forces(path, model_name, out):
     fitted = model.with_muscle(mass=m, optimal_tendon_length=l0t)
     obs = r["observations"]
     paths = np.linspace(0.8 * obs["path_m"].min(), min(1.05 * obs["path_m"].max(), fitted.parameters()["max_path_length"]), 80)
-    curve = [armsim.steady_state(fitted, float(p), 1.0)["force"] for p in paths]
+    curve = [armsim.steady_state(fitted, float(p), 1.0)["force_N"] for p in paths]
     fig, (left, right) = plt.subplots(1, 2, figsize=(11, 4.3))
     left.plot(100 * obs["path_m"], obs["measured_N"], "ko", label="measured")
     left.plot(100 * paths, curve, "-", label=f"steady model, M {1000 * m:.1f} g, L0T {100 * l0t:.2f} cm")
@@ -60,16 +60,16 @@ def identify_torque(path, out):
     fig, ax = plt.subplots(figsize=(7, 4.5))
     rows = []
     for e in estimates:
-        print(f"{e['method']:13s} M = {1000 * e['mass']:.1f} g [{1000 * e['mass_interval'][0]:.1f}, "
-              f"{1000 * e['mass_interval'][1]:.1f}], L0T = {100 * e['tendon_length']:.2f} cm, "
+        print(f"{e['method']:13s} M = {1000 * e['mass_kg']:.1f} g [{1000 * e['mass_interval_kg'][0]:.1f}, "
+              f"{1000 * e['mass_interval_kg'][1]:.1f}], L0T = {100 * e['tendon_length_m']:.2f} cm, "
               f"residuals p = {e['residual_check']['p_value']:.3f}")
-        rows.append([e["method"], e["mass"], *e["mass_interval"], e["tendon_length"], *e["tendon_interval"],
-                     e["rms_residual"]])
+        rows.append([e["method"], e["mass_kg"], *e["mass_interval_kg"], e["tendon_length_m"], *e["tendon_interval_m"],
+                     e.get("rms_residual_Nm", e.get("rms_residual_N"))])
     table = armsim.read_torque_data(path)
     ax.plot(table["flexion_deg"], table["torque_Nm"], "ko", label="measured")
     for e in estimates:
-        k = np.isfinite(e["predicted_torque"])
-        ax.plot(table["flexion_deg"][k], e["predicted_torque"][k], "x", label=e["method"])
+        k = np.isfinite(e["predicted_torque_Nm"])
+        ax.plot(table["flexion_deg"][k], e["predicted_torque_Nm"][k], "x", label=e["method"])
     ax.set(xlabel="elbow flexion (deg, 0 = extended)", ylabel="tared torque (N m)", title="torque data and fits")
     ax.legend()
     fig.tight_layout()

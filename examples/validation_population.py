@@ -34,11 +34,11 @@ def main():
     method = np.array(rows["method"])
     fig, ax = plt.subplots(figsize=(6.5, 6))
     for name, marker in zip(methods, "o^s"):
-        k = (method == name) & np.isfinite(rows["mass"])
-        true, est = 1000 * rows["true_mass"][k], 1000 * rows["mass"][k]
-        err = np.vstack([est - 1000 * rows["mass_lower"][k], 1000 * rows["mass_upper"][k] - est])
+        k = (method == name) & np.isfinite(rows["mass_kg"])
+        true, est = 1000 * rows["true_mass_kg"][k], 1000 * rows["mass_kg"][k]
+        err = np.vstack([est - 1000 * rows["mass_lower_kg"][k], 1000 * rows["mass_upper_kg"][k] - est])
         ax.errorbar(true, est, yerr=err, fmt=marker, capsize=2, label=name, alpha=0.8)
-    lo, hi = 1000 * rows["true_mass"].min(), 1000 * rows["true_mass"].max()
+    lo, hi = 1000 * rows["true_mass_kg"].min(), 1000 * rows["true_mass_kg"].max()
     ax.plot([lo, hi], [lo, hi], "k--", lw=1, label="identity")
     ax.set(xlabel="true biceps long-head mass (g)", ylabel="identified mass (g)",
            title=f"{args.subjects} virtual subjects, 2 % noise, 95 % intervals")

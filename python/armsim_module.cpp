@@ -228,14 +228,14 @@ PYBIND11_MODULE(_armsim, mod) {
             const SteadyState s = vm->calcSteadyState(pathLength, activation);
             if (!s.converged) throw SimulationError("steady state at path " + formatNumber(pathLength) + " m: " + s.message);
             py::dict d;
-            d["force"] = s.force;
-            d["fascicle_length"] = s.fascicleLength;
+            d["force_N"] = s.force;
+            d["fascicle_length_m"] = s.fascicleLength;
             d["normalized_fascicle_length"] = s.L;
             return d;
         },
         py::arg("model"), py::arg("path_length"), py::arg("activation") = 1.0, py::arg("muscle") = py::none(),
         "The steady isometric state of one muscle (default the primary) at path length P [m] and activation\n"
-        "U in [0, 1]: dict of force [N] (Fse = Fce), fascicle_length [m], normalized_fascicle_length.");
+        "U in [0, 1]: dict of force_N (Fse = Fce), fascicle_length_m, normalized_fascicle_length.");
 
     mod.def(
         "muscle_trial",
@@ -326,13 +326,13 @@ PYBIND11_MODULE(_armsim, mod) {
                 r = runIsometricTrial(m.setup, s);
             });
             py::dict summary;
-            summary["mean_force"] = r.summary.meanForce;
-            summary["mean_muscle_torque"] = r.summary.meanMuscleTorque;
-            summary["mean_forearm_torque"] = r.summary.meanForearmTorque;   // 0 without a forearm rotation
-            summary["mean_strap_force"] = r.summary.meanStrapForce;
-            summary["path_length"] = r.summary.pathLength;
-            summary["moment_arm"] = r.summary.momentArm;
-            summary["mean_forces"] = r.summary.meanForces;
+            summary["mean_force_N"] = r.summary.meanForce;
+            summary["mean_muscle_torque_Nm"] = r.summary.meanMuscleTorque;
+            summary["mean_forearm_torque_Nm"] = r.summary.meanForearmTorque;   // 0 without a forearm rotation
+            summary["mean_strap_force_N"] = r.summary.meanStrapForce;
+            summary["path_length_m"] = r.summary.pathLength;
+            summary["moment_arm_m"] = r.summary.momentArm;
+            summary["mean_forces_N"] = r.summary.meanForces;
             summary["saturated"] = r.summary.saturated;
             return py::make_tuple(toDict(std::move(r.series)), summary);
         },
@@ -348,7 +348,9 @@ PYBIND11_MODULE(_armsim, mod) {
         "antagonist_activation. Returns (series, summary): series a dict of float64 arrays (time_s,\n"
         "activation, elbow_angle_deg, muscle_force_N, holding_torque_Nm, muscle_torque_Nm, strap_force_N,\n"
         "per-muscle force_<muscle>_N with several muscles, states); summary the means over the last\n"
-        "averaging_window [s] (None: 1 s, or the whole hold when shorter). Releases the GIL; Ctrl-C raises KeyboardInterrupt.");
+        "averaging_window [s] (None: 1 s, or the whole hold when shorter): mean_force_N (primary muscle),\n"
+        "mean_muscle_torque_Nm, mean_forearm_torque_Nm, mean_strap_force_N, path_length_m, moment_arm_m,\n"
+        "mean_forces_N (per muscle), saturated. Releases the GIL; Ctrl-C raises KeyboardInterrupt.");
 
     mod.def(
         "run_study",
@@ -371,7 +373,7 @@ PYBIND11_MODULE(_armsim, mod) {
             d["resumed"] = r.resumed;
             d["failed"] = r.failed;
             d["not_converged"] = r.notConverged;
-            d["wall_time"] = r.wallTime;
+            d["wall_time_s"] = r.wallTime;
             d["journal_dropped"] = r.journalDrops.size();
             d["journal_summary"] = r.journalSummary;
             d["files"] = r.files;
@@ -380,7 +382,7 @@ PYBIND11_MODULE(_armsim, mod) {
         py::arg("study_file"), py::arg("threads") = 0, py::arg("out") = "", py::arg("restart") = false,
         "Runs a population study file (as `armsim study`, on threads: 1 .. 1024, or 0 for every CPU this\n"
         "process may use) and returns what it did: output\n"
-        "folder, total, computed, resumed, failed and not_converged task counts, wall_time [s], files,\n"
+        "folder, total, computed, resumed, failed and not_converged task counts, wall_time_s, files,\n"
         "journal_dropped (journal lines the run could not use; their cells were computed again) and\n"
         "journal_summary (what they were; also in the folder's journal_repairs.log).\n"
         "Resumes from the folder's journal like the command. Releases the GIL; Ctrl-C raises KeyboardInterrupt.");

@@ -161,7 +161,7 @@ py::dict toDict(const std::vector<TorqueObservation>& data) {
 
 /// Channel data as columns with channel_data.csv's names (formatChannelData with the truth).
 py::dict toDict(const std::vector<ChannelObservation>& data) {
-    py::list channel, muscle;
+    py::list channel, muscle, unit;
     std::vector<double> flexion, effort, level, repetition, value, sd, clean;
     for (const ChannelObservation& o : data) {
         channel.append(o.channel);
@@ -173,6 +173,7 @@ py::dict toDict(const std::vector<ChannelObservation>& data) {
         value.push_back(o.value);
         sd.push_back(o.sd);
         clean.push_back(o.cleanValue);
+        unit.append(o.channel == "volume" ? "m^3" : o.channel == "emg" ? "1" : "m");
     }
     py::dict d;
     d["channel"] = channel;
@@ -184,6 +185,7 @@ py::dict toDict(const std::vector<ChannelObservation>& data) {
     d["value"] = toArray(value);
     d["sd"] = toArray(sd);
     d["clean_value"] = toArray(clean);
+    d["unit"] = unit;   // of value, sd and clean_value: each channel has its own
     return d;
 }
 
@@ -192,10 +194,10 @@ py::dict toDict(const MuscleEstimate& e) {
     d["method"] = e.method;
     d["converged"] = e.converged;
     d["message"] = e.message;
-    d["mass"] = e.mass;
-    d["tendon_length"] = e.tendonLength;
-    d["mass_interval"] = py::make_tuple(e.massLower, e.massUpper);
-    d["tendon_interval"] = py::make_tuple(e.tendonLower, e.tendonUpper);
+    d["mass_kg"] = e.mass;
+    d["tendon_length_m"] = e.tendonLength;
+    d["mass_interval_kg"] = py::make_tuple(e.massLower, e.massUpper);
+    d["tendon_interval_m"] = py::make_tuple(e.tendonLower, e.tendonUpper);
     d["noise_level"] = e.noiseLevel;
     d["noise_degrees_of_freedom"] = e.noiseDegreesOfFreedom;
     py::dict nuisance;
@@ -203,13 +205,13 @@ py::dict toDict(const MuscleEstimate& e) {
         nuisance[py::str(e.nuisanceNames[k])] = e.nuisance[k];
     d["nuisance"] = nuisance;
     d["mass_tendon_correlation"] = e.massTendonCorrelation;
-    d["rms_residual"] = e.rmsResidual;
-    d["predicted_torque"] = toArray(e.predictedTorque);
+    d[e.method == "thesis" ? "rms_residual_N" : "rms_residual_Nm"] = e.rmsResidual;   // thesis: of the force
+    d["predicted_torque_Nm"] = toArray(e.predictedTorque);
     d["parameters"] = e.numParameters;
     d["iterations"] = e.iterations;
-    d["max_force"] = e.maxForce;
-    d["max_force_interval"] = py::make_tuple(e.maxForceLower, e.maxForceUpper);
-    d["specific_tension"] = e.specificTension;
+    d["max_force_N"] = e.maxForce;
+    d["max_force_interval_N"] = py::make_tuple(e.maxForceLower, e.maxForceUpper);
+    d["specific_tension_N_per_m2"] = e.specificTension;
     py::list fits;
     for (const ChannelFit& f : e.channelFits) {
         py::dict c;
@@ -275,13 +277,13 @@ py::dict toDict(const ProtocolPrediction& p) {
     d["draws_used"] = p.drawsUsed;
     d["criterion"] = p.criterion;
     d["mass_sd"] = p.massSd;
-    d["tendon_sd"] = p.tendonSd;
+    d["tendon_sd_m"] = p.tendonSd;
     d["flexor_strength_sd"] = p.flexorStrengthSd;
     d["prior_mass_sd"] = p.priorMassSd;
-    d["prior_tendon_sd"] = p.priorTendonSd;
+    d["prior_tendon_sd_m"] = p.priorTendonSd;
     d["prior_flexor_strength_sd"] = p.priorFlexorStrengthSd;
     d["mass_sd_considered"] = p.massSdConsidered;     // with what the fit shares (the intervals' widening)
-    d["tendon_sd_considered"] = p.tendonSdConsidered;
+    d["tendon_sd_considered_m"] = p.tendonSdConsidered;
     d["max_force_sd"] = p.maxForceSd;                 // of ln F0
     d["prior_max_force_sd"] = p.priorMaxForceSd;
     d["max_force_sd_considered"] = p.maxForceSdConsidered;
@@ -291,14 +293,15 @@ py::dict toDict(const ProtocolPrediction& p) {
     return d;
 }
 
-py::dict toDict(const QuadraticFit& q) {
+// A force's quadratic fit against x: the elbow angle [deg] (overAngle) or the path length [m].
+py::dict toDict(const QuadraticFit& q, bool overAngle) {
     py::dict d;
     d["coefficients"] = toArray(q.fit.coefficients);
     d["r_squared"] = q.fit.rSquared;
-    d["rms_residual"] = q.fit.rmsResidual;
+    d["rms_residual_N"] = q.fit.rmsResidual;
     d["has_maximum"] = q.hasMaximum;
-    d["peak_x"] = q.peakX;
-    d["peak_y"] = q.peakY;
+    d[overAngle ? "peak_angle_deg" : "peak_path_length_m"] = q.peakX;
+    d["peak_force_N"] = q.peakY;
     return d;
 }
 
@@ -388,7 +391,7 @@ py::list identifyTorquePy(const py::object& data, const py::object& population, 
         const TorqueResidualCheck c = checkTorqueResiduals(obs, e, noise);
         py::dict check;
         check["noise_level"] = noise;
-        check["rms"] = c.rms;
+        check["rms_Nm"] = c.rms;
         check["chi_square"] = c.chiSquare;
         check["degrees_of_freedom"] = c.dof;
         check["p_value"] = c.p;
@@ -422,18 +425,18 @@ py::dict validatePy(const Model& m, int seeds, unsigned seed, const std::vector<
         c.add("truth", r.truth);
         c.add("noise", r.noise);
         c.add("method", r.method);
-        c.add("true_mass", r.trueMass);
-        c.add("true_tendon_length", r.trueTendonLength);
-        c.add("mass", r.mass);
-        c.add("tendon_length", r.tendonLength);
+        c.add("true_mass_kg", r.trueMass);
+        c.add("true_tendon_length_m", r.trueTendonLength);
+        c.add("mass_kg", r.mass);
+        c.add("tendon_length_m", r.tendonLength);
         c.add("mass_error", r.massError);
-        c.add("tendon_length_error", r.tendonLengthError);
+        c.add("tendon_length_error_m", r.tendonLengthError);
         c.add("mass_covered", r.massCovered);
         c.add("tendon_length_covered", r.tendonLengthCovered);
         c.add("stop_reason", r.stopReason);
         c.add("iterations", r.iterations);
         c.add("evaluations", r.evaluations);
-        c.add("wall_time", r.wallTime);
+        c.add("wall_time_s", r.wallTime);
     }
     return c.finish();
 }
@@ -474,17 +477,17 @@ py::tuple validateElbowPy(const py::object& population, int subjects, unsigned s
         c.add("subject", r.subject);
         c.add("noise", r.noise);
         c.add("method", r.method);
-        c.add("true_mass", r.trueMass);
-        c.add("true_tendon_length", r.trueTendonLength);
-        c.add("mass", r.estimate.mass);
-        c.add("tendon_length", r.estimate.tendonLength);
-        c.add("mass_lower", r.estimate.massLower);
-        c.add("mass_upper", r.estimate.massUpper);
-        c.add("tendon_lower", r.estimate.tendonLower);
-        c.add("tendon_upper", r.estimate.tendonUpper);
+        c.add("true_mass_kg", r.trueMass);
+        c.add("true_tendon_length_m", r.trueTendonLength);
+        c.add("mass_kg", r.estimate.mass);
+        c.add("tendon_length_m", r.estimate.tendonLength);
+        c.add("mass_lower_kg", r.estimate.massLower);
+        c.add("mass_upper_kg", r.estimate.massUpper);
+        c.add("tendon_lower_m", r.estimate.tendonLower);
+        c.add("tendon_upper_m", r.estimate.tendonUpper);
         c.add("converged", r.estimate.converged);
         c.add("mass_error", r.massError);
-        c.add("tendon_error", r.tendonError);
+        c.add("tendon_error_m", r.tendonError);
         c.add("mass_covered", r.massCovered);
         c.add("tendon_covered", r.tendonCovered);
         c.add("voluntary_activation", r.voluntaryActivation);
@@ -502,12 +505,12 @@ py::tuple validateElbowPy(const py::object& population, int subjects, unsigned s
         d["converged"] = x.converged;
         d["mass_bias"] = x.massBias;
         d["mass_rmse"] = x.massRmse;
-        d["tendon_bias"] = x.tendonBias;
-        d["tendon_rmse"] = x.tendonRmse;
+        d["tendon_bias_m"] = x.tendonBias;
+        d["tendon_rmse_m"] = x.tendonRmse;
         d["mass_coverage"] = x.massCoverage;
         d["tendon_coverage"] = x.tendonCoverage;
         d["mass_interval_width"] = x.massIntervalWidth;
-        d["tendon_interval_width"] = x.tendonIntervalWidth;
+        d["tendon_interval_width_m"] = x.tendonIntervalWidth;
         summary.append(d);
     }
     return py::make_tuple(c.finish(), summary);
@@ -593,7 +596,8 @@ py::dict runProtocolPy(const py::object& file, const py::object& outArgument, in
     d["trial_ids"] = r.trialIds;
     d["summary"] = toDict(std::move(r.summary));
     py::dict fits;
-    for (const auto& [key, q] : r.quadraticFits) fits[py::str(key)] = toDict(q);
+    for (const auto& [key, q] : r.quadraticFits)   // mvc: over the angle; force_length: over the path
+        fits[py::str(key)] = toDict(q, protocol.kind == ProtocolKind::Mvc);
     d["fits"] = fits;
     if (r.emgToActivation) {
         py::dict e;
@@ -646,15 +650,15 @@ every elbow method, as `armsim identify-torque`: 'thesis' (flexion MVCs at >= 2 
 'synergist' (MAP over the whole elbow, the population as prior), given a measured voluntary
 activation 'synergist-va', and given channel data (`channels`: a channel CSV path, docs/channels.md:
 ultrasound fascicle length and volume, EMG, upper-arm length) 'channels', which also reports
-max_force (F0) with its interval, the specific_tension the mass assumes and channel_fits (a
+max_force_N (F0) with its interval, the specific_tension_N_per_m2 the mass assumes and channel_fits (a
 chi-square check per channel naming its worst measurement).
 
 data: a torque CSV path or a dict of columns (flexion_deg [deg, 0 = extended], torque_Nm, optional
 effort 1/-1, level, repetition; e.g. run_protocol(...)['data']).  population: prior population file
 (default assets/subjects/default_population.yaml).  noise_level: relative sd of one trial's torque
-(default: estimated from the repetitions).  Returns one dict per method: mass [kg], tendon_length
-[m], 95 % mass_interval and tendon_interval, nuisance estimates, predicted_torque, and
-residual_check (chi-square against the noise level). A method that cannot run on these data (the
+(default: estimated from the repetitions).  Returns one dict per method: mass_kg, tendon_length_m,
+95 % mass_interval_kg and tendon_interval_m, nuisance estimates, rms_residual_Nm (thesis: rms_residual_N,
+of the force), predicted_torque_Nm, and residual_check (rms_Nm, chi-square against the noise level). A method that cannot run on these data (the
 thesis method without flexion MVCs at two angles) is left out with a UserWarning saying why.
 Releases the GIL; Ctrl-C raises KeyboardInterrupt.)");
 
@@ -674,9 +678,9 @@ synthetic data, are NaN: the reader ignores them): pass it to identify_torque. V
 `armsim validate --truth thesis`): the thesis's truth and `seeds` random ones, each at every noise
 level (relative force sd, a fraction: 0.02 = 2 %), identified by every method (default lm and the
 two-output learning family) with the `forward` model (corrected | faithful | steady).
-Returns the rows as columns: truth, noise, method, true_mass, true_tendon_length, mass, tendon_length,
-mass_error, tendon_length_error, mass_covered, tendon_length_covered (1/0, -1 without an interval),
-stop_reason, iterations, evaluations, wall_time [s].)");
+Returns the rows as columns: truth, noise, method, true_mass_kg, true_tendon_length_m, mass_kg,
+tendon_length_m, mass_error (relative), tendon_length_error_m, mass_covered, tendon_length_covered (1/0, -1
+without an interval), stop_reason, iterations, evaluations, wall_time_s.)");
 
     mod.def("validate_elbow", &validateElbowPy, "population"_a = py::none(), "subjects"_a = 200, "seed"_a = 1u,
             "noise"_a = py::none(), "activation_sd"_a = 0.02, "angles"_a = py::none(), "repetitions"_a = py::none(),
@@ -689,11 +693,12 @@ or out of family from `truth_population` with `prior` as the identifiers' prior 
 MVC torque data synthesized per noise level (fractions; default the population's), identified by
 the thesis, synergist and (activation_sd > 0) synergist-va methods. The protocol: flexion MVCs at
 `angles` [deg flexion, default 135, 120, 90, 60, 30] x repetitions, or a torque protocol file.
-Returns (rows, summary): rows as columns (subject, noise, method, true_mass, true_tendon_length,
-mass, tendon_length, mass_lower, mass_upper, tendon_lower, tendon_upper, converged, mass_error,
-tendon_error, mass_covered, tendon_covered, and the nuisance truths voluntary_activation,
-co_contraction, strength_level, biceps_short_scale, synergist_scale); summary one dict per method
-and noise (bias, RMSE, coverage, interval widths). Releases the GIL; Ctrl-C raises KeyboardInterrupt.)");
+Returns (rows, summary): rows as columns (subject, noise, method, true_mass_kg, true_tendon_length_m,
+mass_kg, tendon_length_m, mass_lower_kg, mass_upper_kg, tendon_lower_m, tendon_upper_m, converged,
+mass_error (relative), tendon_error_m, mass_covered, tendon_covered, and the nuisance truths
+voluntary_activation, co_contraction, strength_level, biceps_short_scale, synergist_scale); summary
+one dict per method and noise (mass_bias, mass_rmse relative; tendon_bias_m, tendon_rmse_m;
+coverages; mass_interval_width relative, tendon_interval_width_m). Releases the GIL; Ctrl-C raises KeyboardInterrupt.)");
 
     mod.def("design_protocol", &designPy, "population"_a = py::none(),
             "angles"_a = std::vector<double>{15, 30, 45, 60, 75, 90, 105, 120, 135}, "levels"_a = py::none(),
@@ -717,7 +722,8 @@ reference (the thesis's five angles) uncertainty, and the greedy steps. Releases
 protocols: written whole and replacing an earlier run; torque protocols: torque_data.csv,
 protocol.yaml and torque_angle.png written into it); None computes only.
 Arm protocols (mvc, submaximal, force_length, composition) return trials and summary (dicts of
-float64 arrays: per trial and per condition), fits (quadratic force-angle fits), emg_to_activation,
+float64 arrays: per trial and per condition), fits (quadratic fits of a force: mvc over the angle, with
+peak_angle_deg; force_length over the path, with peak_path_length_m; peak_force_N), emg_to_activation,
 muscle_sweep, composition, files. Torque protocols (kind: torque) return data: the tared torque per
 trial with the torque data file's columns, ready for identify_torque. Releases the GIL; Ctrl-C raises KeyboardInterrupt.)");
 }

@@ -182,7 +182,7 @@ void addSimulationBindings(py::module_& mod) {
         "        sim.set_excitation({'BRA': 0.3 + 0.01 * (sim.state['elbow_angle_deg'] - 90)})\n"
         "    samples = sim.samples()      # dict of arrays, pandas.DataFrame(samples) works\n\n"
         "Free (the elbow moves under its muscles, gravity and a hand load) or locked (held at angle_deg; the\n"
-        "lock's torque is recorded). Samples are taken every 1/rate_hz s of simulated time from the start,\n"
+        "lock's torque is recorded). Samples are taken every 1/rate s of simulated time from the start,\n"
         "however advance_to cuts the time.")
         .def(py::init([](const Model& m, bool locked, double angleDeg, double velocityDegps,
                          std::optional<double> rotationDeg, double handLoadKg, const py::object& excitation,
@@ -209,14 +209,15 @@ void addSimulationBindings(py::module_& mod) {
                  return ps;
              }),
              py::arg("model"), py::arg("locked") = false, py::arg("angle_deg") = 90.0, py::arg("velocity_degps") = 0.0,
-             py::arg("rotation_deg") = py::none(), py::arg("hand_load_kg") = 0.0, py::arg("excitation") = py::none(),
-             py::arg("rate_hz") = 1000.0, py::arg("start") = "steady", py::arg("accuracy") = py::none(),
+             py::arg("rotation_deg") = py::none(), py::arg("hand_load") = 0.0, py::arg("excitation") = py::none(),
+             py::arg("rate") = 1000.0, py::arg("start") = "steady", py::arg("accuracy") = py::none(),
              "model: an armsim.Model. locked: hold the elbow at angle_deg (included angle, deg; 180 = extended).\n"
              "velocity_degps: dtheta/dt at the start (+ = extending; free only). rotation_deg: forearm rotation the\n"
-             "radius is held at (+ = supination; None: the model's posture). hand_load_kg: a mass in the hand.\n"
+             "radius is held at (+ = supination; None: the model's posture). hand_load: a mass in the hand [kg].\n"
+             "rate: samples per second of simulated time [Hz].\n"
              "excitation U in [0, 1] per muscle: None (0), a number (every muscle), one number per muscle, a dict\n"
              "{muscle: number}, a dict of arrays {'time_s': t, muscle: u, ...} (linear between rows), a callable\n"
-             "f(t) returning any of the constant forms (sampled every 1/rate_hz, linear between), or a controls\n"
+             "f(t) returning any of the constant forms (sampled every 1/rate, linear between), or a controls\n"
              "file (.sto/.mot as OpenSim writes them, or .csv with time_s); muscles not named get 0.\n"
              "start: 'steady' (each muscle at its steady state for U(0)) or 'initial' (the spec-5 state).\n"
              "accuracy: the integrator's relative accuracy (None: the trials' default).")

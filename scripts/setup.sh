@@ -26,6 +26,8 @@ test_packages=(
   clang libclang-rt-14-dev
   slurm-wlm munge
   chromium
+  python3-nbclient python3-ipykernel jupyter-nbconvert   # the notebooks, executed by ctest
+  python3-pandas                                         # optional for users; its tests run when present
 )
 [ $with_tests -eq 1 ] && packages+=("${test_packages[@]}")
 

@@ -31,10 +31,10 @@ class Model:
 class Simulation:
     """A model's arm advanced on request (free or locked elbow), its state read and written between calls."""
     def __init__(self, model: Model, locked: bool = False, angle_deg: float = 90.0, velocity_degps: float = 0.0,
-                 rotation_deg: Optional[float] = None, hand_load_kg: float = 0.0,
+                 rotation_deg: Optional[float] = None, hand_load: float = 0.0,
                  excitation: Union[None, float, Sequence[float], Mapping[str, Any], Callable[[float], Any], str,
                                    "os.PathLike[str]"] = None,
-                 rate_hz: float = 1000.0, start: str = "steady", accuracy: Optional[float] = None) -> None: ...
+                 rate: float = 1000.0, start: str = "steady", accuracy: Optional[float] = None) -> None: ...
     @property
     def muscles(self) -> List[str]: ...
     @property

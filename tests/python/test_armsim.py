@@ -28,14 +28,14 @@ def test_with_muscle_changes_one_parameter_and_keeps_the_original(thesis):
     assert heavier.parameters()["optimal_tendon_length"] == 0.25
     assert thesis.parameters()["mass"] == 0.33599
     # force scales with mass at a fixed normalised state: F0 is proportional to M
-    f = armsim.steady_state(thesis, 0.40, 1.0)["force"]
-    assert armsim.steady_state(thesis.with_muscle(mass=0.67198), 0.40 + 0.0, 1.0)["force"] > f
+    f = armsim.steady_state(thesis, 0.40, 1.0)["force_N"]
+    assert armsim.steady_state(thesis.with_muscle(mass=0.67198), 0.40 + 0.0, 1.0)["force_N"] > f
 
 
 def test_steady_state_equals_the_cpp_api(thesis, reference):
     s = armsim.steady_state(thesis, 0.40, 1.0)
-    assert s["force"] == pytest.approx(reference["steady_force"], rel=REL_TOL)
-    assert s["fascicle_length"] == pytest.approx(0.16 * s["normalized_fascicle_length"], rel=1e-14)
+    assert s["force_N"] == pytest.approx(reference["steady_force"], rel=REL_TOL)
+    assert s["fascicle_length_m"] == pytest.approx(0.16 * s["normalized_fascicle_length"], rel=1e-14)
 
 
 def test_muscle_trial_samples_equal_the_cpp_api(thesis, reference):
@@ -58,9 +58,9 @@ def test_arm_trial_equals_the_cpp_api(elbow, reference):
     n = len(series["time_s"])
     assert n == int(round((0.5 + 1.0) * 200)) + 1
     assert all(a.dtype == np.float64 and a.shape == (n,) for a in series.values())
-    assert len(summary["mean_forces"]) == 7
+    assert len(summary["mean_forces_N"]) == 7
     np.testing.assert_allclose(series["muscle_torque_Nm"][::20], reference["arm_trial_torque"], rtol=REL_TOL, atol=0)
-    assert summary["mean_muscle_torque"] == pytest.approx(reference["arm_trial_mean_torque"], rel=REL_TOL)
+    assert summary["mean_muscle_torque_Nm"] == pytest.approx(reference["arm_trial_mean_torque"], rel=REL_TOL)
 
 
 def test_run_study_writes_the_commands_files(tmp_path):
@@ -105,7 +105,7 @@ def test_a_trial_releases_the_gil(elbow):
 def test_docstrings_name_units_and_arguments():
     for f in (armsim.steady_state, armsim.muscle_trial, armsim.arm_trial, armsim.run_study, armsim.Model.load):
         assert f.__doc__ and len(f.__doc__) > 80
-    assert "path_length" in armsim.steady_state.__doc__ and "[N]" in armsim.steady_state.__doc__
+    assert "path_length" in armsim.steady_state.__doc__ and "force_N" in armsim.steady_state.__doc__
 
 
 def test_version_is_the_projects():
@@ -120,15 +120,15 @@ def test_arm_trial_takes_a_forearm_posture_and_a_short_hold(elbow):
     _, neutral = armsim.arm_trial(twin, rotation_deg=0.0, **kw)
     _, default = armsim.arm_trial(twin, **kw)                      # the twin's posture is neutral
     _, pronated = armsim.arm_trial(twin, rotation_deg=-90.0, **kw)
-    assert default["mean_muscle_torque"] == neutral["mean_muscle_torque"]
-    assert pronated["mean_muscle_torque"] < 0.99 * neutral["mean_muscle_torque"]
+    assert default["mean_muscle_torque_Nm"] == neutral["mean_muscle_torque_Nm"]
+    assert pronated["mean_muscle_torque_Nm"] < 0.99 * neutral["mean_muscle_torque_Nm"]
     with pytest.raises(ValueError, match="forearm_rotation_deg"):
         armsim.arm_trial(elbow, rotation_deg=-90.0, **kw)          # the elbow's forearm does not rotate
     # the second axis: a flexion effort's biceps supinates, a supination effort more, a pronation effort pronates
     series, sup = armsim.arm_trial(twin, effort="supination", rotation_deg=-60.0, **kw)
     _, pro = armsim.arm_trial(twin, effort="pronation", rotation_deg=30.0, **kw)
-    assert 0 < neutral["mean_forearm_torque"] < sup["mean_forearm_torque"]
-    assert pro["mean_forearm_torque"] < 0
+    assert 0 < neutral["mean_forearm_torque_Nm"] < sup["mean_forearm_torque_Nm"]
+    assert pro["mean_forearm_torque_Nm"] < 0
     assert series["forearm_torque_Nm"][-1] > 0
     with pytest.raises(ValueError, match="no forearm rotation"):
         armsim.arm_trial(elbow, effort="supination", **kw)
@@ -145,7 +145,7 @@ def test_model_pickles_as_what_made_it_for_process_pools(elbow):
         assert back.parameters(muscle) == changed.parameters(muscle)
     assert back.parameters("BIClong")["mass"] == 0.31 and back.parameters("BRA")["slow_units"] == 40
     kw = dict(angle_deg=90.0, hold=0.5, rest=0.2, rate=200.0)
-    assert armsim.arm_trial(back, **kw)[1]["mean_muscle_torque"] == armsim.arm_trial(changed, **kw)[1]["mean_muscle_torque"]
+    assert armsim.arm_trial(back, **kw)[1]["mean_muscle_torque_Nm"] == armsim.arm_trial(changed, **kw)[1]["mean_muscle_torque_Nm"]
     path = pathlib.Path(__file__).resolve().parents[2] / "assets" / "models" / "thesis.yaml"
     with concurrent.futures.ProcessPoolExecutor(max_workers=2) as pool:
         masses = list(pool.map(_primary_mass, [changed, armsim.Model.load(path)]))
@@ -181,11 +181,11 @@ def test_with_muscle_model_swaps_the_equations_and_keeps_f0(thesis):
     for name in ("thelen2003", "degroote2016"):
         hill = thesis.with_muscle_model(name)
         s = armsim.steady_state(hill, P, 1.0)
-        assert s["force"] == pytest.approx(F0, rel=0.02)
+        assert s["force_N"] == pytest.approx(F0, rel=0.02)
         assert s["normalized_fascicle_length"] == pytest.approx(1.0, abs=0.03)
-        assert abs(s["force"] - vm["force"]) > 1.0  # other equations
+        assert abs(s["force_N"] - vm["force_N"]) > 1.0  # other equations
         t = armsim.muscle_trial(hill, path_length=P, activation=1.0, duration=1.0, rate=10)
-        assert t["force_N"][-1] == pytest.approx(s["force"], rel=1e-4)  # integration ends at the steady state
+        assert t["force_N"][-1] == pytest.approx(s["force_N"], rel=1e-4)  # integration ends at the steady state
     slow = thesis.with_muscle_model("thelen2003", activation_time_constant=0.05)
     fast = thesis.with_muscle_model("thelen2003")
     rise = lambda m: armsim.muscle_trial(m, path_length=P, activation=1.0, duration=0.02, rate=1000)["force_N"][-1]
@@ -220,3 +220,62 @@ def test_forward_runs_an_osim_model_as_the_command_does(tmp_path):
     with pytest.raises(ValueError) as e:
         armsim.forward("arm26", {"time": np.array([0.0, 1.0]), "BIC": np.array([0.1, 0.1])}, final_time=0.1)
     assert "column 'BIC' names no muscle" in str(e.value)
+
+
+# The key-naming rule (README, Python): a returned key or column holding a quantity with a unit ends in
+# that unit; the dimensionless ones below have none. Model.parameters() and identify's "estimate" keep
+# the model files' parameter names (what with_muscle takes); a channel's value carries its unit beside it.
+UNIT_SUFFIXES = ("_N", "_Nm", "_m", "_mm", "_m3", "_kg", "_s", "_Hz", "_deg", "_degps", "_mps", "_pct",
+                 "_N_per_m2", "_kg_per_m3")
+DIMENSIONLESS = {
+    "activation", "saturated", "normalized_fascicle_length", "active_fraction", "method", "converged", "message",
+    "noise", "noise_level", "noise_degrees_of_freedom", "nuisance", "mass_tendon_correlation", "parameters",
+    "iterations", "channel_fits", "channel", "n", "chi_square", "p_value", "consistent_with_noise", "worst",
+    "worst_residual_sd", "residual_check", "degrees_of_freedom", "subject", "mass_error", "mass_covered",
+    "tendon_covered", "voluntary_activation", "co_contraction", "strength_level", "biceps_short_scale",
+    "synergist_scale", "mass_bias", "mass_rmse", "mass_coverage", "tendon_coverage", "mass_interval_width",
+    "subjects", "effort", "level", "repetition", "muscle", "value", "sd", "clean_value", "unit",
+    "output", "total", "computed", "resumed", "failed", "not_converged",
+    "journal_dropped", "journal_summary", "files", "muscle_states", "truth", "stop_reason", "evaluations",
+    "tendon_length_covered", "mass_sd", "mass_sd_considered", "prior_mass_sd", "flexor_strength_sd",
+    "prior_flexor_strength_sd", "max_force_sd", "prior_max_force_sd", "max_force_sd_considered", "parameter_names",
+    "mass_correlation", "posterior_sd", "name", "trials", "draws_used", "criterion", "conditions", "protocol_yaml",
+    "predicted", "reference", "steps", "repetitions",
+}   # mass_sd and max_force_sd: of ln M and ln F0; posterior_sd: per parameter_names entry; *_scale: ratios
+
+
+def _keys(obj, prefix=""):
+    if isinstance(obj, dict):
+        for k, v in obj.items():
+            yield prefix + str(k), str(k)
+            yield from _keys(v, prefix + str(k) + ".")
+    elif isinstance(obj, (list, tuple)):
+        for v in obj:
+            yield from _keys(v, prefix)
+
+
+def test_returned_keys_carry_their_units(thesis, elbow, tmp_path):
+    twin = armsim.Model.load("twin")
+    sim = armsim.Simulation(twin, excitation=0.1)
+    sim.advance_to(0.01)
+    results = {
+        "steady_state": armsim.steady_state(thesis, 0.37),
+        "muscle_trial": armsim.muscle_trial(thesis, duration=0.01),
+        "arm_trial": armsim.arm_trial(twin, hold=0.2),
+        "geometry": elbow.geometry([90]),
+        "Simulation.samples": sim.samples(),
+        "Simulation.state": sim.state,
+        "identify_torque": armsim.identify_torque("measured/thesis_mvc_torque.csv", activation=0.95),
+        "validate_elbow": armsim.validate_elbow(subjects=1, noise=[0.02], jobs=1),
+        "validate": armsim.validate(thesis, noise=[0.02], methods=["lm"], jobs=1),
+        "design_protocol": armsim.design_protocol(draws=2, trials=3, jobs=1),
+    }
+    bad = []
+    for name, result in results.items():
+        for path, key in _keys(result):
+            if (key.startswith(("state_", "excitation_", "active_fraction_", "activation_")) or key.endswith("_scale")
+                    or key in DIMENSIONLESS):
+                continue
+            if not key.endswith(UNIT_SUFFIXES):
+                bad.append(f"{name}: {path}")
+    assert not bad, "keys without a unit: " + ", ".join(sorted(set(bad)))

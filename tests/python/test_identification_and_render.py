@@ -61,22 +61,22 @@ def test_identify_reads_a_csv_and_writes_the_commands_report_files(thesis, tmp_p
 def test_identify_torque_runs_every_method_and_equals_the_cpp_api(reference):
     estimates = armsim.identify_torque("measured/thesis_mvc_torque.csv", activation=0.95)
     assert [e["method"] for e in estimates] == ["thesis", "synergist", "synergist-va"]
-    np.testing.assert_allclose([e["mass"] for e in estimates], reference["identify_torque_masses"], rtol=REL_TOL)
+    np.testing.assert_allclose([e["mass_kg"] for e in estimates], reference["identify_torque_masses"], rtol=REL_TOL)
     for e in estimates:
-        lo, hi = e["mass_interval"]
-        assert lo <= e["mass"] <= hi
+        lo, hi = e["mass_interval_kg"]
+        assert lo <= e["mass_kg"] <= hi
         assert 0 <= e["residual_check"]["p_value"] <= 1
     assert "activation" in " ".join(estimates[1]["nuisance"])
 
 
 def test_validate_elbow_equals_the_cpp_api(reference):
     rows, summary = armsim.validate_elbow(subjects=2, noise=[0.02])
-    np.testing.assert_allclose(rows["mass"], reference["validate_elbow_masses"], rtol=REL_TOL)
+    np.testing.assert_allclose(rows["mass_kg"], reference["validate_elbow_masses"], rtol=REL_TOL)
     # Out of family: the stronger mismatch population as truth, the default as prior: the same people 1.26x heavier.
     strong, _ = armsim.validate_elbow(subjects=2, noise=[0.02], truth_population="subjects/mismatch/stronger.yaml")
-    np.testing.assert_allclose(strong["true_mass"], 1.26 * np.asarray(rows["true_mass"]), rtol=1e-12)
+    np.testing.assert_allclose(strong["true_mass_kg"], 1.26 * np.asarray(rows["true_mass_kg"]), rtol=1e-12)
     assert rows["method"][:3] == ["thesis", "synergist", "synergist-va"]
-    assert rows["true_mass"].dtype == np.float64 and rows["true_mass"].shape == (6,)
+    assert rows["true_mass_kg"].dtype == np.float64 and rows["true_mass_kg"].shape == (6,)
     assert {s["method"] for s in summary} == {"thesis", "synergist", "synergist-va"}
 
 
@@ -103,7 +103,7 @@ def test_design_across_channels_with_postures_reads_both_axes():
     assert "forearm_torque: true" in d["protocol_yaml"]
     assert "volume_scan" in d["protocol_yaml"] or "anthropometry: true" in d["protocol_yaml"]
     p = d["predicted"]
-    assert np.isfinite(p["tendon_sd_considered"]) and np.isfinite(p["mass_sd_considered"])
+    assert np.isfinite(p["tendon_sd_considered_m"]) and np.isfinite(p["mass_sd_considered"])
     with pytest.raises(ValueError, match="criterion"):
         armsim.design_protocol(draws=4, criterion="best")
 
@@ -115,7 +115,7 @@ def test_run_protocol_torque_equals_the_cpp_api_and_feeds_identify_torque(refere
     from_dict = armsim.identify_torque(run["data"])
     from_file = armsim.identify_torque(str(tmp_path / "run" / "torque_data.csv"))
     # the file holds the same numbers to 17 digits: the same estimates
-    assert [e["mass"] for e in from_dict] == pytest.approx([e["mass"] for e in from_file], rel=1e-12)
+    assert [e["mass_kg"] for e in from_dict] == pytest.approx([e["mass_kg"] for e in from_file], rel=1e-12)
 
 
 def test_forearm_postures_reach_python_and_feed_identify_torque(tmp_path):
@@ -126,11 +126,11 @@ def test_forearm_postures_reach_python_and_feed_identify_torque(tmp_path):
     prior = "subjects/default_population.yaml"
     from_dict = armsim.identify_torque(run["data"], population=prior)
     from_file = armsim.identify_torque(str(tmp_path / "run" / "torque_data.csv"), population=prior)
-    assert [e["mass"] for e in from_dict] == pytest.approx([e["mass"] for e in from_file], rel=1e-12)
+    assert [e["mass_kg"] for e in from_dict] == pytest.approx([e["mass_kg"] for e in from_file], rel=1e-12)
     # dropping the postures changes the synergist fit: the posture is read, not ignored
     neutral = {k: np.asarray(v)[np.isnan(rot)] for k, v in run["data"].items()}
     alone = armsim.identify_torque(neutral, population=prior)
-    assert alone[1]["mass"] != pytest.approx(from_dict[1]["mass"], rel=1e-6)
+    assert alone[1]["mass_kg"] != pytest.approx(from_dict[1]["mass_kg"], rel=1e-6)
 
 
 def test_run_protocol_mvc_then_identify_recovers_the_subject(thesis):
@@ -333,9 +333,9 @@ def test_recommended_protocol_channels_feed_identify_torque(tmp_path):
                                        channels=str(tmp_path / "run" / "channel_data.csv"), activation=0.93)
     fit = [e for e in estimates if e["method"] == "channels"]
     assert len(fit) == 1 and fit[0]["converged"]
-    lo, hi = fit[0]["max_force_interval"]
-    assert lo < fit[0]["max_force"] < hi
+    lo, hi = fit[0]["max_force_interval_N"]
+    assert lo < fit[0]["max_force_N"] < hi
     assert [f["channel"] for f in fit[0]["channel_fits"]][:2] == ["torque", "fascicle_length"]
     # the channels narrow the mass interval of the same torques
-    width = {e["method"]: e["mass_interval"][1] - e["mass_interval"][0] for e in estimates}
+    width = {e["method"]: e["mass_interval_kg"][1] - e["mass_interval_kg"][0] for e in estimates}
     assert width["channels"] < 0.8 * width["synergist-va"]

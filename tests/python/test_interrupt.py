@@ -23,7 +23,7 @@ CALLS = {
     "design_protocol": "armsim.design_protocol(draws=100000)",
     # a forced oscillation keeps the steps short for 10^4 s of simulated time
     "simulation_advance_to": "import numpy as np; t = np.linspace(0, 1e4, 10**6); "
-                             "armsim.Simulation(thesis, rate_hz=1, excitation={'time_s': t, 'biceps': "
+                             "armsim.Simulation(thesis, rate=1, excitation={'time_s': t, 'biceps': "
                              "0.5 + 0.4 * np.sin(20 * t)}).advance_to(1e4)",
 }
 
