@@ -97,6 +97,18 @@ void startStream(const std::string& tmp, int width, int height, PlplotErrors& er
     for (int i = 0; i < 10; ++i) plscol0(i, kPalette[i][0], kPalette[i][1], kPalette[i][2]);
 }
 
+// Two series draw the same curve: the same kind and the same points, y within tol (a small part of the
+// plot's y range: closer curves cannot be told apart at any resolution).
+bool isSameCurve(const PlotSeries& a, const PlotSeries& b, double tol) {
+    if (a.markers != b.markers || a.x.size() != b.x.size() || a.y.size() != b.y.size() || a.x.empty()) return false;
+    for (std::size_t i = 0; i < a.x.size(); ++i) {
+        if (a.x[i] != b.x[i]) return false;
+        const bool fa = std::isfinite(a.y[i]), fb = std::isfinite(b.y[i]);
+        if (fa != fb || (fa && std::abs(a.y[i] - b.y[i]) > tol)) return false;
+    }
+    return true;
+}
+
 }  // namespace
 
 bool isWholePng(const std::string& path) {
@@ -152,50 +164,128 @@ void writePlotPng(const std::string& path, const PlotSpec& spec) {
         plinit();
         plcol0(1);
         plschr(0, 1.1);
-        plenv(x0, x1, y0, y1, 0, spec.logY ? 20 : 2);  // 2: grid lines; 20: log y with grid
-        pllab(spec.xLabel.c_str(), spec.yLabel.c_str(), spec.title.c_str());
+        // Identical curves hide each other: a series equal to an earlier one is dashed and its legend
+        // says which it equals.
+        // A colour used again by another curve (more curves than the palette has colours) changes the dashes.
+        const std::size_t ns = spec.series.size();
+        const double sameTol = 1e-4 * (spec.logY ? 0.0 : (dataY1 - dataY0));
+        std::vector<int> sameAs(ns, -1);
+        for (std::size_t i = 1; i < ns; ++i)
+            for (std::size_t j = 0; j < i && sameAs[i] < 0; ++j)
+                if (sameAs[j] < 0 && isSameCurve(spec.series[i], spec.series[j], sameTol)) sameAs[i] = int(j);
+        std::vector<PLINT> styles(ns, 1);
+        {
+            std::vector<int> uses(8, 0);
+            const PLINT reuseStyles[] = {1, 4, 5, 8};
+            for (std::size_t i = 0; i < ns; ++i) {
+                if (sameAs[i] >= 0) {
+                    styles[i] = 3;   // dashed over the curve it repeats
+                    continue;
+                }
+                if (spec.series[i].markers) continue;
+                const int c = spec.series[i].color % 8;
+                styles[i] = reuseStyles[std::min(uses[c], 3)];
+                ++uses[c];
+            }
+        }
+        std::vector<std::string> labels;
+        std::size_t longest = 0;
+        for (std::size_t i = 0; i < ns; ++i) {
+            std::string text = spec.series[i].label;
+            if (!text.empty() && sameAs[i] >= 0)
+                text += " (= " + (spec.series[sameAs[i]].label.empty() ? std::string("another") : spec.series[sameAs[i]].label) + ")";
+            labels.push_back(text);
+            longest = std::max(longest, text.size());
+        }
+        // The legend stands right of the data, outside the axes: the viewport (plenv's standard one) is
+        // narrowed by the legend's width, estimated from its longest text (drawn smaller if it is long).
+        pladv(0);
+        plvsta();
+        PLFLT vx0, vx1, vy0, vy1, defaultHeight, charHeight, px0, px1, py0, py1;
+        plgvpd(&vx0, &vx1, &vy0, &vy1);
+        plgchr(&defaultHeight, &charHeight);   // mm
+        plgspa(&px0, &px1, &py0, &py1);         // mm
+        const double pageMm = px1 - px0;
+        constexpr double kCharWidth = 0.70;     // glyph advance / character height (cairo's sans font, measured)
+        double legendScale = 1.0, legendMm = 0.0;
+        if (longest > 0) {
+            const double maxMm = 0.38 * pageMm;
+            legendScale = std::min(1.0, std::max(0.55, (maxMm / charHeight - 4.0) / (kCharWidth * double(longest))));
+            legendMm = charHeight * (4.0 + legendScale * kCharWidth * double(longest));
+        }
+        const double plotRight = longest > 0 ? std::min(vx1, 0.985 - legendMm / pageMm) : vx1;
+        plvpor(vx0, plotRight, vy0, vy1);
+        plwind(x0, x1, y0, y1);
+        plcol0(1);
+        plbox("bcgnst", 0, 0, spec.logY ? "bcgnstlv" : "bcgnstv", 0, 0);
+        plvpor(vx0, vx1, vy0, vy1);   // title and x label centred on the page, not on the narrowed axes
+        plwind(x0, x1, y0, y1);
+        plmtex("t", 2.0, 0.5, 0.5, spec.title.c_str());
+        plmtex("b", 3.2, 0.5, 0.5, spec.xLabel.c_str());
+        plvpor(vx0, plotRight, vy0, vy1);
+        plwind(x0, x1, y0, y1);
+        plmtex("l", 5.0, 0.5, 0.5, spec.yLabel.c_str());
 
         std::vector<PLINT> opts, colors, lineStyles, markerColors;
         std::vector<PLFLT> widths, scales;
         std::vector<PLINT> markerCounts;
         std::vector<const char*> texts, symbols;
-        for (const auto& s : spec.series) {
+        for (std::size_t i = 0; i < ns; ++i) {
+            const PlotSeries& s = spec.series[i];
             const int color = 2 + (s.color % 8);
+            const PLINT style = styles[i];
+            const char* symbol = sameAs[i] >= 0 ? "#(727)" : "#(728)";   // open circle for a repeat
             std::vector<PLFLT> xs, ys;
-            for (std::size_t i = 0; i < s.x.size(); ++i)
-                if (std::isfinite(s.x[i]) && std::isfinite(s.y[i]) && (!spec.logY || s.y[i] > 0)) {
-                    xs.push_back(s.x[i]);
-                    ys.push_back(spec.logY ? std::log10(s.y[i]) : s.y[i]);
+            for (std::size_t k = 0; k < s.x.size(); ++k)
+                if (std::isfinite(s.x[k]) && std::isfinite(s.y[k]) && (!spec.logY || s.y[k] > 0)) {
+                    xs.push_back(s.x[k]);
+                    ys.push_back(spec.logY ? std::log10(s.y[k]) : s.y[k]);
                 }
             plcol0(color);
             plwidth(2.0);
-            if (s.markers) plstring(PLINT(xs.size()), xs.data(), ys.data(), "#(728)");
+            pllsty(style);
+            if (s.markers) plstring(PLINT(xs.size()), xs.data(), ys.data(), symbol);
             else if (xs.size() > 1) plline(PLINT(xs.size()), xs.data(), ys.data());
-            if (s.label.empty()) continue;
+            pllsty(1);
+            if (labels[i].empty()) continue;
             opts.push_back(s.markers ? PL_LEGEND_SYMBOL : PL_LEGEND_LINE);
             colors.push_back(color);
-            lineStyles.push_back(1);
+            lineStyles.push_back(style);
             widths.push_back(2.0);
             markerColors.push_back(color);
             scales.push_back(1.0);
             markerCounts.push_back(1);
-            texts.push_back(s.label.c_str());
-            symbols.push_back("#(728)");
+            texts.push_back(labels[i].c_str());
+            symbols.push_back(symbol);
         }
         if (!texts.empty()) {
-            plcol0(1);
-            PLFLT legendWidth, legendHeight;
-            std::vector<PLINT> textColors(texts.size(), 1), zeros(texts.size(), 0);
-            std::vector<PLFLT> zerosF(texts.size(), 0.0);
-            const bool top = spec.legend == PlotSpec::Legend::TopLeft || spec.legend == PlotSpec::Legend::TopRight;
-            const bool left = spec.legend == PlotSpec::Legend::TopLeft || spec.legend == PlotSpec::Legend::BottomLeft;
-            const PLINT position = PL_POSITION_INSIDE | (top ? PL_POSITION_TOP : PL_POSITION_BOTTOM) |
-                                   (left ? PL_POSITION_LEFT : PL_POSITION_RIGHT);
-            pllegend(&legendWidth, &legendHeight, PL_LEGEND_BACKGROUND | PL_LEGEND_BOUNDING_BOX, position, 0.02, 0.02,
-                     0.1, 0, 1, 1, 0, 0, PLINT(texts.size()), opts.data(), 1.0, 1.0, 2.0, 1.0,
-                     textColors.data(), texts.data(), zeros.data(), zeros.data(), zerosF.data(), zerosF.data(),
-                     colors.data(), lineStyles.data(), widths.data(), markerColors.data(), scales.data(),
-                     markerCounts.data(), symbols.data());
+            // Hand-drawn (pllegend sizes its text with metrics the cairo driver does not use): a line or a
+            // marker and the text per entry, top down, in a viewport right of the axes.
+            plvpor(plotRight + 0.01, 0.995, vy0, vy1);
+            plwind(0, 1, 0, 1);
+            const double boxMm = (0.995 - plotRight - 0.01) * pageMm;
+            const double rowMm = 1.9 * charHeight * std::max(0.75, legendScale);
+            const double heightMm = (vy1 - vy0) * (py1 - py0);
+            const double row = rowMm / heightMm, symbolEnd = 2.6 * charHeight / boxMm, textAt = 3.2 * charHeight / boxMm;
+            plschr(0, 1.1 * legendScale);
+            for (std::size_t i = 0; i < texts.size(); ++i) {
+                const PLFLT y = 1.0 - (double(i) + 0.6) * row;
+                if (y < 0) break;   // more entries than fit: the rest are left out
+                plcol0(colors[i]);
+                plwidth(2.0);
+                if (opts[i] == PL_LEGEND_SYMBOL) {
+                    const PLFLT sx = 0.5 * symbolEnd, sy = y;
+                    plstring(1, &sx, &sy, symbols[i]);
+                } else {
+                    const PLFLT lx[2] = {0.2 * symbolEnd, symbolEnd}, ly[2] = {y, y};
+                    pllsty(lineStyles[i]);
+                    plline(2, lx, ly);
+                    pllsty(1);
+                }
+                plcol0(1);
+                plptex(textAt, y, 1.0, 0.0, 0.0, texts[i]);
+            }
+            plschr(0, 1.1);
         }
         plend1();
         errors.throwIfAny(tmp, path, spec.title);

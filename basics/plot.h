@@ -15,14 +15,14 @@ struct PlotSeries {
     int color = 0;               ///< palette index 0..7 (blue, red, green, orange, purple, grey, cyan, black)
 };
 
-/// A 2-D line plot.
+/// A 2-D line plot. The legend (the labelled series) stands right of the axes, outside the data; a series
+/// that draws the same curve as an earlier one is dashed (open markers) and its label says which it equals.
 struct PlotSpec {
     std::string title;
     std::string xLabel, yLabel;  ///< axis labels with units, e.g. "path length (cm)"
     std::vector<PlotSeries> series;
     int width = 1000, height = 700;   ///< pixels
     bool logY = false;               ///< logarithmic y axis (convergence plots); y must be > 0
-    enum class Legend { TopLeft, TopRight, BottomLeft, BottomRight } legend = Legend::TopLeft;
     /// Axis limits; NaN = from the data with a margin.
     double xMin = 0.0 / 0.0, xMax = 0.0 / 0.0, yMin = 0.0 / 0.0, yMax = 0.0 / 0.0;
 };

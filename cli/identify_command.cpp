@@ -570,7 +570,6 @@ void runOutOfFamilyPersonStep(const MainJobContext& ctx) {
     std::printf("%-13s %22.1f %22.2f %22.0f\n", "truth", 1000 * t.trueMass, 100 * t.trueTendonLength, t.trueMaxForce);
     PlotSpec plot;
     plot.title = "One person out of family: biceps long-head mass per method";
-    plot.legend = PlotSpec::Legend::TopRight;
     plot.xLabel = "method (1 thesis, 2 synergist, 3 synergist-va, 4 channels)";
     plot.yLabel = "mass (g)";
     PlotSeries estimate{"estimate", {}, {}, true, 0}, interval{"95 % interval ends", {}, {}, true, 5};

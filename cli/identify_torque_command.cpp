@@ -115,7 +115,6 @@ void runIdentifyTorque(const IdentifyTorqueOptions& o) {
     plot.title = "Torque data and each method's fit";
     plot.xLabel = "elbow flexion (deg, 0 = extended)";
     plot.yLabel = "tared torque (N m, + = flexion)";
-    plot.legend = PlotSpec::Legend::TopRight;  // flexion torque falls toward full flexion: that corner is free
     PlotSeries measured{"measured", {}, {}, true, 7};
     for (const TorqueObservation& d : data)  // the flexion axis of flexion and extension efforts (what is fitted)
         if (!isForearmEffort(d.effort)) measured.x.push_back(d.flexionDeg), measured.y.push_back(d.torque);

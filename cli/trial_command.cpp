@@ -240,7 +240,7 @@ void runSubjectMvcAngles(const MainJobContext& ctx) {
                  ", co-contraction " + formatNumber(setup.effort.coContraction) + ")";
     spec.xLabel = "elbow angle (deg, thesis convention: 180 = extended)";
     spec.yLabel = "force (N)";
-    PlotSeries estimated{"thesis estimate: tared torque / " + biceps + " moment arm", {}, {}, false, 1};
+    PlotSeries estimated{"thesis estimate of " + biceps + " (torque / moment arm)", {}, {}, false, 1};
     std::vector<PlotSeries> forces;
     for (int i = 0; i < n; ++i)
         if (setup.muscles[i].group == MuscleGroup::Flexor)
@@ -273,9 +273,7 @@ void runSubjectMvcAngles(const MainJobContext& ctx) {
     spec.series = forces;
     spec.series.push_back(bothHeads);
     spec.series.push_back(estimated);
-    spec.legend = PlotSpec::Legend::TopLeft;
     spec.yMin = 0;
-    spec.yMax = 2.4 * *std::max_element(estimated.y.begin(), estimated.y.end());  // room for the legend
     t.writeCsv(ctx.outDir + "/mvc_angles_twin.csv");
     writePlotPng(ctx.outDir + "/mvc_angles_twin.png", spec);
     std::printf("  the estimate credits the biceps with the brachialis' and brachioradialis' torque, less the\n"

@@ -33,9 +33,9 @@ def main():
         ax.plot(100 * paths, force, label=f"U = {u:g}")
     ax.set(xlabel="path length P (cm)", ylabel="steady force Fse (N)",
            title=f"{p['name']}: steady isometric force (M = {1000 * p['mass']:.0f} g)")
-    ax.legend()
+    ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1))
     fig.tight_layout()
-    fig.savefig(os.path.join(args.out, "force_length.png"), dpi=120)
+    fig.savefig(os.path.join(args.out, "force_length.png"), dpi=120, bbox_inches="tight")
     np.savetxt(os.path.join(args.out, "force_length.csv"), np.column_stack([paths, *rows]), delimiter=",",
                header="path_length_m,force_U1_N,force_U05_N,force_U02_N", comments="")
 
@@ -43,13 +43,13 @@ def main():
     angles = np.arange(10.0, 141.0, 5.0)
     g = elbow.geometry(list(angles))
     fig, ax = plt.subplots(figsize=(7, 4.5))
-    for i, name in enumerate(elbow.muscles):
-        ax.plot(angles, 100 * g["moment_arm_m"][:, i], label=name)
+    for i, name in enumerate(elbow.muscles):   # heads on one path share a curve: dashes tell them apart
+        ax.plot(angles, 100 * g["moment_arm_m"][:, i], label=name, linestyle=["-", "--", ":"][i % 3])
     ax.axhline(0, color="grey", lw=0.8)
     ax.set(xlabel="elbow flexion (deg)", ylabel="moment arm (cm), + flexes", title="Elbow model: moment arms")
-    ax.legend(ncol=2, fontsize=8)
+    ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1), fontsize=8)
     fig.tight_layout()
-    fig.savefig(os.path.join(args.out, "moment_arms.png"), dpi=120)
+    fig.savefig(os.path.join(args.out, "moment_arms.png"), dpi=120, bbox_inches="tight")
     np.savetxt(os.path.join(args.out, "moment_arms.csv"), np.column_stack([angles, g["moment_arm_m"]]), delimiter=",",
                header="flexion_deg," + ",".join(f"{m}_m" for m in elbow.muscles), comments="")
     peak = paths[int(np.argmax(rows[0]))]

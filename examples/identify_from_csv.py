@@ -46,12 +46,12 @@ def identify_forces(path, model_name, out):
     left.plot(100 * obs["path_m"], obs["measured_N"], "ko", label="measured")
     left.plot(100 * paths, curve, "-", label=f"steady model, M {1000 * m:.1f} g, L0T {100 * l0t:.2f} cm")
     left.set(xlabel="path length (cm)", ylabel="force (N)", title="data and the identified muscle at U = 1")
-    left.legend(fontsize=8)
+    left.legend(loc="upper center", bbox_to_anchor=(0.5, -0.15), fontsize=8)  # below: the right panel is beside it
     h = r["history"]
     right.semilogy(h["iteration"], np.maximum(np.sqrt(2 * h["cost_N2"]), 1e-12), "o-")
     right.set(xlabel="iteration", ylabel="residual norm (N)", title=f"{r['method']}: {r['stop_reason']}")
     fig.tight_layout()
-    fig.savefig(os.path.join(out, "identify_fit.png"), dpi=120)
+    fig.savefig(os.path.join(out, "identify_fit.png"), dpi=120, bbox_inches="tight")
     return [["lm", m, *r["parameters"][0]["interval"], l0t, *r["parameters"][1]["interval"], r["rms_residual_N"]]]
 
 
@@ -71,9 +71,9 @@ def identify_torque(path, out):
         k = np.isfinite(e["predicted_torque_Nm"])
         ax.plot(table["flexion_deg"][k], e["predicted_torque_Nm"][k], "x", label=e["method"])
     ax.set(xlabel="elbow flexion (deg, 0 = extended)", ylabel="tared torque (N m)", title="torque data and fits")
-    ax.legend()
+    ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1))
     fig.tight_layout()
-    fig.savefig(os.path.join(out, "identify_fit.png"), dpi=120)
+    fig.savefig(os.path.join(out, "identify_fit.png"), dpi=120, bbox_inches="tight")
     return rows
 
 

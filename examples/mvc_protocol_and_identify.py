@@ -63,12 +63,12 @@ def main():
         right.semilogy(h["iteration"], np.maximum(np.sqrt(2 * h["cost_N2"]), 1e-12), "o-", label=forward)
     left.set(xlabel="included elbow angle (deg, 180 = extended)", ylabel="biceps force (N)",
              title="MVC protocol, five angles x three")
-    left.legend(fontsize=8)
+    left.legend(loc="upper center", bbox_to_anchor=(0.5, -0.15), fontsize=8)  # below: the right panel is beside it
     right.set(xlabel="iteration (corrected: faithful corrections)", ylabel="residual norm (N)",
               title="convergence")
-    right.legend()
+    right.legend(loc="upper left", bbox_to_anchor=(1.01, 1))
     fig.tight_layout()
-    fig.savefig(os.path.join(args.out, "mvc_identification.png"), dpi=120)
+    fig.savefig(os.path.join(args.out, "mvc_identification.png"), dpi=120, bbox_inches="tight")
     print(f"wrote {args.out}/mvc_identification.png, mvc_identification.csv")
 
 

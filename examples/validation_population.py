@@ -33,18 +33,23 @@ def main():
     methods = list(dict.fromkeys(rows["method"]))
     method = np.array(rows["method"])
     fig, ax = plt.subplots(figsize=(6.5, 6))
+    converged = np.asarray(rows["converged"], dtype=bool)
     for name, marker in zip(methods, "o^s"):
-        k = (method == name) & np.isfinite(rows["mass_kg"])
+        k = (method == name) & np.isfinite(rows["mass_kg"]) & converged
         true, est = 1000 * rows["true_mass_kg"][k], 1000 * rows["mass_kg"][k]
         err = np.vstack([est - 1000 * rows["mass_lower_kg"][k], 1000 * rows["mass_upper_kg"][k] - est])
         ax.errorbar(true, est, yerr=err, fmt=marker, capsize=2, label=name, alpha=0.8)
+    failed = (~converged) & np.isfinite(rows["mass_kg"])   # fits that did not converge: marked, not mixed in
+    if failed.any():
+        ax.plot(1000 * rows["true_mass_kg"][failed], 1000 * rows["mass_kg"][failed], "x", color="grey",
+                label=f"not converged ({failed.sum()})")
     lo, hi = 1000 * rows["true_mass_kg"].min(), 1000 * rows["true_mass_kg"].max()
     ax.plot([lo, hi], [lo, hi], "k--", lw=1, label="identity")
     ax.set(xlabel="true biceps long-head mass (g)", ylabel="identified mass (g)",
            title=f"{args.subjects} virtual subjects, 2 % noise, 95 % intervals")
-    ax.legend()
+    ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1))   # outside the data
     fig.tight_layout()
-    fig.savefig(os.path.join(args.out, "validation_scatter.png"), dpi=120)
+    fig.savefig(os.path.join(args.out, "validation_scatter.png"), dpi=120, bbox_inches="tight")
 
     with open(os.path.join(args.out, "validation_rows.csv"), "w", newline="") as f:
         w = csv.writer(f)

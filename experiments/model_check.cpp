@@ -79,24 +79,18 @@ ModelCheckResult writeModelCheck(const ArmSetup& setup, const std::vector<Anatom
     arms.title = "Moment arms; markers: published band +/- tolerance";
     arms.xLabel = "elbow flexion (deg)";
     arms.yLabel = "moment arm (mm), + = flexor";
-    arms.legend = PlotSpec::Legend::TopLeft;  // above the curves: the y range is raised to leave it room
     for (int m = 0; m < setup.getNumMuscles(); ++m) {
         PlotSeries c{setup.muscles[m].params.name, angles, {}, false, m % 8};
         for (std::size_t a = 0; a < angles.size(); ++a) c.y.push_back(1000 * g.momentArm[a][m]);
         arms.series.push_back(c);
         addBands(arms, r.scores, TargetKind::MomentArm, setup.muscles[m].params.name, MuscleGroup::Flexor, 1000, m % 8, "");
     }
-    double top = 0;
-    for (const PlotSeries& c : arms.series)
-        for (double y : c.y) top = std::max(top, y);
-    arms.yMax = 2 * top;
     folder.writeWith("check_moment_arms.png", [&](const std::string& p) { writePlotPng(p, arms); });
 
     PlotSpec mvc;
     mvc.title = "Steady MVC torque; markers: published band +/- tolerance";
     mvc.xLabel = "elbow flexion (deg)";
     mvc.yLabel = "net torque magnitude (N m)";
-    mvc.legend = PlotSpec::Legend::TopLeft;  // above the data: the y range is raised below to leave it room
     const MuscleGroup groups[2] = {MuscleGroup::Flexor, MuscleGroup::Extensor};
     for (int k = 0; k < 2; ++k) {
         const SteadyMvcCurve c = calcSteadyMvcCurve(setup.muscles, g, groups[k], setup.effort);
@@ -105,10 +99,6 @@ ModelCheckResult writeModelCheck(const ArmSetup& setup, const std::vector<Anatom
         mvc.series.push_back(s);
         addBands(mvc, r.scores, TargetKind::Mvc, "", groups[k], 1, k, k == 0 ? "flexion band" : "extension band");
     }
-    double highest = 0;
-    for (const PlotSeries& c : mvc.series)
-        for (double y : c.y) highest = std::max(highest, y);
-    mvc.yMax = 1.5 * highest;
     folder.writeWith("check_mvc.png", [&](const std::string& p) { writePlotPng(p, mvc); });
     r.files.push_back(path("check_moment_arms.png"));
     r.files.push_back(path("check_mvc.png"));

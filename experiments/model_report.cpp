@@ -133,15 +133,6 @@ void addMomentArmSeries(PlotSpec& plot, const ArmSetup& setup, const Table& t, c
     }
 }
 
-// y range over every series and 0, with the upper half left free for a legend above the curves.
-void setRangeWithLegendRoom(PlotSpec& plot) {
-    double lo = 0, hi = 0;
-    for (const PlotSeries& ps : plot.series)
-        for (double v : ps.y) lo = std::min(lo, v), hi = std::max(hi, v);
-    plot.yMin = lo - 0.05 * (hi - lo);
-    plot.yMax = hi + 1.0 * (hi - lo);
-}
-
 }  // namespace
 
 Table calcForearmMomentArmTable(const ArmSetup& setup, double flexionDeg, double stepDeg) {
@@ -237,7 +228,6 @@ ModelReportFiles writeModelReport(const ArmSetup& setup, const std::string& outD
     armPlot.title = "Moment arms, model " + setup.name + " (virtual work); markers: published ranges";
     armPlot.xLabel = "flexion angle (deg, 0 = extended)";
     armPlot.yLabel = "moment arm (cm, + = flexion)";
-    armPlot.legend = PlotSpec::Legend::TopLeft;
     addMomentArmSeries(armPlot, setup, arms, "flexion_deg", "moment_arm_", false);
     PlotSeries refs;
     refs.label = "published min/max";
@@ -253,7 +243,6 @@ ModelReportFiles writeModelReport(const ArmSetup& setup, const std::string& outD
         }
     }
     if (!refs.x.empty()) armPlot.series.push_back(refs);
-    setRangeWithLegendRoom(armPlot);
     folder.writeWith("moment_arms.png", [&](const std::string& p) { writePlotPng(p, armPlot); });
     out.files.push_back(path("moment_arms.png"));
 
@@ -266,9 +255,7 @@ ModelReportFiles writeModelReport(const ArmSetup& setup, const std::string& outD
         plot.title = "Forearm-rotation moment arms at 90 deg flexion, model " + setup.name + " (virtual work)";
         plot.xLabel = "forearm rotation (deg, - pronated, + supinated)";
         plot.yLabel = "moment arm (cm, + = supination)";
-        plot.legend = PlotSpec::Legend::TopLeft;
         addMomentArmSeries(plot, setup, fa, "rotation_deg", "forearm_moment_arm_", true);  // those that rotate it
-        setRangeWithLegendRoom(plot);
         folder.writeWith("forearm_moment_arms.png", [&](const std::string& p) { writePlotPng(p, plot); });
         out.files.push_back(path("forearm_moment_arms.png"));
     }
@@ -317,11 +304,7 @@ ModelReportFiles writeModelReport(const ArmSetup& setup, const std::string& outD
                 pub.y.push_back(sign * v);
             }
         if (!pub.x.empty()) plot.series.push_back(pub);
-        double top = 0;
-        for (const PlotSeries& ps : plot.series)
-            for (double v : ps.y) top = std::max(top, v);
         plot.yMin = 0;
-        if (top > 0) plot.yMax = 1.7 * top;  // room for the legend above the curves (none: a model without the group)
         folder.writeWith("mvc_" + name + ".png", [&](const std::string& p) { writePlotPng(p, plot); });
         out.files.push_back(path("mvc_" + name + ".png"));
     }

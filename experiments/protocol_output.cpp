@@ -65,7 +65,6 @@ void plotMvc(OutputFolder& dir, const Table& trials, const Table& summary, const
     };
     addFit("muscle_force", "fit, peak", 0);
     addFit("force_fixed_ratio", "fit, peak", 1);
-    spec.legend = PlotSpec::Legend::BottomRight;
     spec.yMin = 0;
     dir.writeWith("force_angle.png", [&](const std::string& p) { writePlotPng(p, spec); });
 
@@ -81,7 +80,6 @@ void plotMvc(OutputFolder& dir, const Table& trials, const Table& summary, const
         active.y.push_back(summary.get(i, "active_force_N_mean"));
     }
     fl.series = {truth, active};
-    fl.legend = PlotSpec::Legend::BottomRight;
     dir.writeWith("force_length.png", [&](const std::string& p) { writePlotPng(p, fl); });
 }
 

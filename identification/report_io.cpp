@@ -125,7 +125,6 @@ void writeConvergencePlot(const std::string& path, const IdentificationReport& r
     spec.xLabel = "iteration";
     spec.yLabel = "residual norm ||r|| (N)";
     spec.logY = true;
-    spec.legend = PlotSpec::Legend::TopRight;
     PlotSeries s;
     s.label = "||model - measured||";
     for (std::size_t i = 0; i < r.history.size(); ++i) {

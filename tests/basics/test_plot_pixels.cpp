@@ -67,3 +67,71 @@ TEST(PlotPixels, EveryHeatMapCellHasTheColourOfItsValue) {
     EXPECT_THROW(writeHeatMapPng((dir / "bad.png").string(), bad), std::invalid_argument);
     fs::remove_all(dir);
 }
+
+namespace {
+
+bool isBlue(const cv::Vec3b& c) { return c[0] > 140 && c[2] < 110; }            // B, G, R
+bool isRed(const cv::Vec3b& c) { return c[2] > 150 && c[0] < 110 && c[1] < 110; }
+
+// The columns of the longest run of `colour` pixels in any row: a horizontal data line.
+std::pair<int, int> findLongestRun(const cv::Mat& png, bool (*colour)(const cv::Vec3b&)) {
+    std::pair<int, int> best{0, -1};
+    for (int r = 0; r < png.rows; ++r)
+        for (int c = 0; c < png.cols;) {
+            int e = c;
+            while (e < png.cols && colour(png.at<cv::Vec3b>(r, e))) ++e;
+            if (e - c > best.second - best.first) best = {c, e - 1};
+            c = e + 1;
+        }
+    return best;
+}
+
+cv::Mat drawLines(const PlotSpec& spec, const std::string& path) {
+    writePlotPng(path, spec);
+    return cv::imread(path, cv::IMREAD_COLOR);
+}
+
+}  // namespace
+
+// The legend stands right of the data: the legend's blue sample line lies right of the whole blue data
+// line, which spans the x range (the legend used to sit inside a corner of the axes, over the data).
+TEST(PlotPixels, TheLegendStandsRightOfTheData) {
+    const fs::path dir = fs::temp_directory_path() / ("armsim_plot_legend_" + std::to_string(::getpid()));
+    fs::create_directories(dir);
+    PlotSpec spec;
+    spec.title = "legend outside";
+    spec.series = {{"a level line with a long label", {0, 10}, {1, 1}, false, 0},
+                   {"another", {0, 10}, {0, 0}, false, 1}};
+    const cv::Mat png = drawLines(spec, (dir / "legend.png").string());
+    ASSERT_FALSE(png.empty());
+    const auto [first, last] = findLongestRun(png, isBlue);
+    ASSERT_GT(last - first, spec.width / 3);   // the data line
+    int legendBlue = 0;
+    for (int r = 0; r < png.rows; ++r)
+        for (int c = last + 5; c < png.cols; ++c) legendBlue += isBlue(png.at<cv::Vec3b>(r, c));
+    EXPECT_GT(legendBlue, 10);   // the legend's sample, right of the data
+    fs::remove_all(dir);
+}
+
+// Two series on the same points: the later one is dashed, so the earlier shows between its dashes (a
+// solid line over it hid it: blue pixels on the line were under 5 % of red ones).
+TEST(PlotPixels, IdenticalCurvesStayVisible) {
+    const fs::path dir = fs::temp_directory_path() / ("armsim_plot_same_" + std::to_string(::getpid()));
+    fs::create_directories(dir);
+    PlotSpec spec;
+    spec.title = "two heads on one path";
+    spec.series = {{"first", {0, 5, 10}, {0, 3, 1}, false, 0}, {"second", {0, 5, 10}, {0, 3, 1}, false, 1}};
+    const cv::Mat png = drawLines(spec, (dir / "same.png").string());
+    ASSERT_FALSE(png.empty());
+    const int plotRight = int(0.55 * spec.width);   // the data; the legend is right of it
+    int blue = 0, red = 0;
+    for (int r = 0; r < png.rows; ++r)
+        for (int c = 0; c < plotRight; ++c) {
+            const cv::Vec3b p = png.at<cv::Vec3b>(r, c);
+            blue += isBlue(p);
+            red += isRed(p);
+        }
+    EXPECT_GT(red, 200);
+    EXPECT_GT(blue, red / 5) << "blue " << blue << ", red " << red;
+    fs::remove_all(dir);
+}
