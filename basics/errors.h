@@ -41,6 +41,10 @@ private:
     std::string detail_;
 };
 
+/// A field path as a message names it: "a.b" as 'a.b'; a list entry by its key and 1-based place, so
+/// "conditions[1].flexion_deg" is 'flexion_deg' (conditions, entry 2) and "angles[0]" is 'angles' (entry 1).
+std::string describeField(const std::string& path);
+
 /// Records that signal `sig` asked the process to stop (async-signal-safe: sets an atomic).
 void requestInterruption(int sig);
 /// The signal that asked to stop, 0 if none.

@@ -97,7 +97,7 @@ std::string ParamNode::findFile(const std::string& key, const std::string& what,
     if (doesPathExist(file)) return file;
     if (!fallbackDirectory.empty() && doesPathExist(fallbackDirectory + "/" + file))
         return fallbackDirectory + "/" + file;
-    throw InputError(where(key) + ": field '" + path(key) + "' = '" + file + "': no such " + what +
+    throw InputError(where(key) + ": field " + describeField(path(key)) + " = '" + file + "': no such " + what +
                      " (relative paths are taken from the file's directory" +
                      (fallbackDirectory.empty() ? std::string() : " or " + fallbackDirectory) + ")");
 }
@@ -121,14 +121,14 @@ bool ParamNode::has(const std::string& key) const { return bool(node()[key]); }
 
 YAML::Node ParamNode::requireKey(const std::string& key) const {
     YAML::Node n = node()[key];
-    if (!n) throw InputError(where() + ": missing required field '" + path(key) + "'");
+    if (!n) throw InputError(where() + ": missing required field " + describeField(path(key)));
     impl_->used->insert(key);
     return n;
 }
 
 ParamNode ParamNode::child(const std::string& key) const {
     YAML::Node n = requireKey(key);
-    if (!n.IsMap()) throw InputError(where(key) + ": field '" + path(key) + "' must be a mapping");
+    if (!n.IsMap()) throw InputError(where(key) + ": field " + describeField(path(key)) + " must be a mapping");
     auto impl = std::make_shared<Impl>();
     impl->source = impl_->source;
     impl->prefix = path(key);
@@ -138,13 +138,13 @@ ParamNode ParamNode::child(const std::string& key) const {
 
 std::vector<ParamNode> ParamNode::children(const std::string& key) const {
     YAML::Node n = requireKey(key);
-    if (!n.IsSequence()) throw InputError(where(key) + ": field '" + path(key) + "' must be a list");
+    if (!n.IsSequence()) throw InputError(where(key) + ": field " + describeField(path(key)) + " must be a list");
     std::vector<ParamNode> out;
     for (std::size_t i = 0; i < n.size(); ++i) {
         const std::string item = path(key) + "[" + std::to_string(i) + "]";
         if (!n[i].IsMap())
-            throw InputError(impl_->source + ":" + std::to_string(n[i].Mark().line + 1) + ": field '" + item +
-                             "' must be a mapping");
+            throw InputError(impl_->source + ":" + std::to_string(n[i].Mark().line + 1) + ": field " + describeField(item) +
+                             " must be a mapping");
         auto impl = std::make_shared<Impl>();
         impl->source = impl_->source;
         impl->prefix = item;
@@ -160,11 +160,11 @@ bool ParamNode::isMapping(const std::string& key) const {
 }
 
 static double toNumber(const YAML::Node& n, const std::string& where, const std::string& field) {
-    if (!n.IsScalar()) throw InputError(where + ": field '" + field + "' must be a number");
+    if (!n.IsScalar()) throw InputError(where + ": field " + describeField(field) + " must be a number");
     try {
         return n.as<double>();
     } catch (const YAML::Exception&) {
-        throw InputError(where + ": field '" + field + "' = '" + n.Scalar() + "': expected a number");
+        throw InputError(where + ": field " + describeField(field) + " = '" + n.Scalar() + "': expected a number");
     }
 }
 
@@ -185,7 +185,7 @@ double ParamNode::getNumber(const std::string& key, const Bound& bound, double d
 int ParamNode::getInt(const std::string& key, int lo, int hi) const {
     double v = getNumber(key, Bound::closed(lo, hi));
     if (v != std::floor(v))
-        throw InputError(where(key) + ": field '" + path(key) + "' = " + formatNumber(v) +
+        throw InputError(where(key) + ": field " + describeField(path(key)) + " = " + formatNumber(v) +
                          ": expected a whole number");
     return int(v);
 }
@@ -200,14 +200,14 @@ bool ParamNode::getBool(const std::string& key, bool defaultValue) const {
     try {
         return n.as<bool>();
     } catch (const YAML::Exception&) {
-        throw InputError(where(key) + ": field '" + path(key) + "' = '" + n.Scalar() +
+        throw InputError(where(key) + ": field " + describeField(path(key)) + " = '" + n.Scalar() +
                          "': expected true or false");
     }
 }
 
 std::string ParamNode::getString(const std::string& key) const {
     YAML::Node n = requireKey(key);
-    if (!n.IsScalar()) throw InputError(where(key) + ": field '" + path(key) + "' must be a string");
+    if (!n.IsScalar()) throw InputError(where(key) + ": field " + describeField(path(key)) + " must be a string");
     return n.Scalar();
 }
 
@@ -222,13 +222,13 @@ std::string ParamNode::getChoice(const std::string& key, const std::vector<std::
         if (a == v) return v;
     std::string list;
     for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
-    throw InputError(where(key) + ": field '" + path(key) + "' = '" + v + "': expected one of " + list);
+    throw InputError(where(key) + ": field " + describeField(path(key)) + " = '" + v + "': expected one of " + list);
 }
 
 std::vector<double> ParamNode::getNumbers(const std::string& key, const Bound& bound) const {
     YAML::Node n = requireKey(key);
     if (!n.IsSequence())
-        throw InputError(where(key) + ": field '" + path(key) + "' must be a list of numbers");
+        throw InputError(where(key) + ": field " + describeField(path(key)) + " must be a list of numbers");
     std::vector<double> out;
     for (std::size_t i = 0; i < n.size(); ++i) {
         const std::string field = path(key) + "[" + std::to_string(i) + "]";
@@ -246,12 +246,12 @@ std::vector<double> ParamNode::getNumbers(const std::string& key, const Bound& b
 
 std::vector<std::string> ParamNode::getStrings(const std::string& key) const {
     YAML::Node n = requireKey(key);
-    if (!n.IsSequence()) throw InputError(where(key) + ": field '" + path(key) + "' must be a list of strings");
+    if (!n.IsSequence()) throw InputError(where(key) + ": field " + describeField(path(key)) + " must be a list of strings");
     std::vector<std::string> out;
     for (std::size_t i = 0; i < n.size(); ++i) {
         if (!n[i].IsScalar() || n[i].Scalar().empty())
-            throw InputError(impl_->source + ":" + std::to_string(n[i].Mark().line + 1) + ": field '" + path(key) +
-                             "[" + std::to_string(i) + "]' must be a non-empty string");
+            throw InputError(impl_->source + ":" + std::to_string(n[i].Mark().line + 1) + ": field " +
+                             describeField(path(key) + "[" + std::to_string(i) + "]") + " must be a non-empty string");
         out.push_back(n[i].Scalar());
     }
     return out;
@@ -268,7 +268,7 @@ void ParamNode::finish() const {
         const std::string key = it->first.as<std::string>();
         if (!impl_->used->count(key))
             throw InputError(impl_->source + ":" + std::to_string(it->first.Mark().line + 1) +
-                             ": unknown field '" + path(key) + "' (misspelt, or not a field here)");
+                             ": unknown field " + describeField(path(key)) + " (misspelt, or not a field here)");
     }
 }
 
@@ -293,7 +293,7 @@ void ParamNode::throwLocated(const FieldError& e) const {
             }
         if (!found) break;
     }
-    throw InputError(impl_->source + ":" + std::to_string(line + 1) + ": field '" + path(field) + "' " +
+    throw InputError(impl_->source + ":" + std::to_string(line + 1) + ": field " + describeField(path(field)) + " " +
                      e.getDetail());
 }
 

@@ -366,12 +366,15 @@ void runValidate(const ValidateOptions& o) {
     s.seeds = o.seeds;
     s.seed = o.seed;
     s.noiseLevels.clear();
-    for (double pct : o.noise) s.noiseLevels.push_back(pct / 100.0);
+    for (double pct : o.noise) {   // in the unit typed (percent), before it becomes a fraction
+        checkField("--noise", pct, {0, 50, false, true, "%, relative force sd"});
+        s.noiseLevels.push_back(pct / 100.0);
+    }
     for (const std::string& m : o.methods) s.methods.push_back(parseMethodName(m));
     s.model = parseValidationModelName(o.model);
     s.estimate = parseForceEstimateName(o.estimate);
     s.jobs = o.jobs;
-    s.validate(setup.arm);
+    runNamingOptions({{"seeds", "--seeds"}, {"jobs", "--jobs"}}, [&] { s.validate(setup.arm); });
     std::printf("validation: data from the faithful model (thesis protocol, 1000 Hz, %s estimate) at %zu angles, "
                 "identified with the %s model, start 330 g / 22 cm\n",
                 o.estimate.c_str(), s.anglesDeg.size(), o.model.c_str());

@@ -94,6 +94,8 @@ void addModelCommands(CLI::App& app) {
                       "an OpenSim model's coordinate to sweep (default: its only moving one)");
         c->callback([=] {
             checkOutputFolder("--out", *out);
+            if (!(*step > 0 && *step <= 90))   // before any folder is made
+                throw InputError("--step = " + formatNumber(*step) + " deg: expected in (0, 90] (the angle step)");
             // An OpenSim model: a file ending .osim, or a shipped name with only an .osim file.
             const bool isOsim = (name->size() > 5 && name->compare(name->size() - 5, 5, ".osim") == 0) ||
                                 (name->find('/') == std::string::npos &&

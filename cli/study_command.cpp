@@ -85,6 +85,9 @@ void runStudyCommand(const StudyOptions& o) {
         if (!done) return;                  // a worker rank: rank 0 reports
     } else {
         const Study study = readStudy(o.file);
+        if (!isQuiet())   // the size before the work: a study of millions of tasks says so at once
+            std::fprintf(stderr, "study '%s': %s, about %.3g GB of journal and results\n", study.name.c_str(),
+                         study.describeSize().c_str(), double(study.getNumTasks()) * kStudyBytesPerTask / 1e9);
         done.emplace(study, runStudy(study, run));
     }
     const Study& study = done->first;

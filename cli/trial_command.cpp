@@ -81,6 +81,9 @@ void runTrialCommand(const TrialOptions& o) {
         iso.averagingWindow = std::min(iso.averagingWindow, o.hold);
         iso.sampleRate = o.rate;
         iso.integration.accuracy = o.accuracy;
+        runNamingOptions({{"elbow_angle_deg", "--angle"}, {"activation", "--activation"}, {"rest", "--rest"},
+                          {"rise", "--rise"}, {"hold", "--hold"}, {"sample_rate", "--rate"}, {"accuracy", "--accuracy"}},
+                         [&] { iso.validate(setup.arm); });   // in the options' words, before any work
     } else {
         free.initialAngle = degToRad(o.initialAngleDeg);
         free.initialVelocity = degToRad(o.initialVelocityDegps);
@@ -97,6 +100,10 @@ void runTrialCommand(const TrialOptions& o) {
         free.handLoad = o.load;
         free.sampleRate = o.rate;
         free.integration.accuracy = o.accuracy;
+        runNamingOptions({{"initial_angle_deg", "--initial-angle"}, {"initial_velocity_degps", "--initial-velocity"},
+                          {"duration", "--duration"}, {"hand_load", "--load"}, {"sample_rate", "--rate"},
+                          {"accuracy", "--accuracy"}},
+                         [&] { free.validate(setup.arm); });
     }
 
     PlotSpec spec;

@@ -132,7 +132,7 @@ Population loadPopulation(const std::string& path) {
         p.validate();
     } catch (const FieldError& e) {
         const std::string key = e.getField().substr(0, e.getField().find('.'));  // the top-level key
-        throw InputError((root.has(key) ? root.where(key) : path) + ": field '" + e.getField() + "' " + e.getDetail());
+        throw InputError((root.has(key) ? root.where(key) : path) + ": field " + describeField(e.getField()) + " " + e.getDetail());
     }
     return p;
 }

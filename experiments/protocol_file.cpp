@@ -26,14 +26,14 @@ std::vector<double> readRange(const ParamNode& parent, const std::string& key, c
     const double step = r.getNumber("step", Bound::positive(bound.unit));
     r.finish();
     if (to < from)
-        throw InputError(r.where("to") + ": field '" + r.path("to") + "' is below 'from': expected from <= to");
+        throw InputError(r.where("to") + ": field " + describeField(r.path("to")) + " is below 'from': expected from <= to");
     std::vector<double> v;
     for (int k = 0;; ++k) {
         const double x = from + k * step;
         if (x > to + 1e-9 * std::max(1.0, std::abs(to))) break;
         v.push_back(std::min(x, to));
         if (v.size() > 10000)
-            throw InputError(r.where("step") + ": field '" + r.path("step") + "' gives more than 10000 values");
+            throw InputError(r.where("step") + ": field " + describeField(r.path("step")) + " gives more than 10000 values");
     }
     return v;
 }
@@ -41,7 +41,7 @@ std::vector<double> readRange(const ParamNode& parent, const std::string& key, c
 std::vector<double> requireNonEmpty(const ParamNode& n, const std::string& key, std::vector<double> v,
                                     const char* what) {
     if (v.empty())
-        throw InputError(n.where(key) + ": field '" + n.path(key) + "' is empty: expected at least one " + what);
+        throw InputError(n.where(key) + ": field " + describeField(n.path(key)) + " is empty: expected at least one " + what);
     return v;
 }
 

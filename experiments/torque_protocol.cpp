@@ -68,7 +68,7 @@ bool TorqueProtocol::hasChannels() const {
 }
 
 void TorqueProtocol::validate() const {
-    if (conditions.empty()) throw FieldError("conditions", "no conditions: expected at least one");
+    if (conditions.empty()) throw FieldError("conditions", "is empty: expected at least one condition");
     std::set<ConditionKey> seen;
     for (std::size_t k = 0; k < conditions.size(); ++k) {
         const TorqueCondition& c = conditions[k];
@@ -194,12 +194,12 @@ TorqueProtocol readTorqueProtocol(const std::string& path) {
                 if (name == "ultrasound") tc.ultrasound = true;
                 else if (name == "emg") tc.emg = true;
                 else if (name != "torque")
-                    throw InputError(c.where("channels") + ": field '" + c.path("channels") + "' = '" + name +
+                    throw InputError(c.where("channels") + ": field " + describeField(c.path("channels")) + " = '" + name +
                                      "': expected torque, ultrasound or emg");
             }
             if (std::find(channels.begin(), channels.end(), "torque") == channels.end())
-                throw InputError(c.where("channels") + ": field '" + c.path("channels") +
-                                 "' leaves out torque: expected every effort to be read by the transducer (list torque)");
+                throw InputError(c.where("channels") + ": field " + describeField(c.path("channels")) +
+                                 " leaves out torque: expected every effort to be read by the transducer (list torque)");
         }
         c.finish();
         p.conditions.push_back(tc);

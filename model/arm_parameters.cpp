@@ -132,7 +132,7 @@ bool readArmParameters(const ParamNode& root, ArmParameters& p, bool requireBice
         auto vec3 = [&](const char* key) {
             const std::vector<double> v = r.getNumbers(key, any);
             if (v.size() != 3)
-                throw InputError(r.where(key) + ": field '" + r.path(key) + "' has " + std::to_string(v.size()) +
+                throw InputError(r.where(key) + ": field " + describeField(r.path(key)) + " has " + std::to_string(v.size()) +
                                  " numbers: expected 3 (x, y, z in the forearm frame)");
             return std::array<double, 3>{v[0], v[1], v[2]};
         };

@@ -149,7 +149,7 @@ MuscleModelChoice readMuscleModelChoice(const ParamNode& n, const std::string& i
         try {
             return findMuscleModelType(name);
         } catch (const InputError& e) {
-            throw InputError(node.where(key) + ": field '" + node.path(key) + "' = '" + name + "': " +
+            throw InputError(node.where(key) + ": field " + describeField(node.path(key)) + " = '" + name + "': " +
                              std::string(e.what()).substr(std::string(e.what()).find("expected")));
         }
     };
@@ -166,7 +166,7 @@ MuscleModelChoice readMuscleModelChoice(const ParamNode& n, const std::string& i
         if (std::find(type.coefficientKeys.begin(), type.coefficientKeys.end(), key) == type.coefficientKeys.end()) {
             std::string keys;
             for (const std::string& k : type.coefficientKeys) keys += (keys.empty() ? "" : ", ") + k;
-            throw InputError(m.where(key) + ": field '" + m.path(key) + "': muscle model " + type.name +
+            throw InputError(m.where(key) + ": field " + describeField(m.path(key)) + ": muscle model " + type.name +
                              " has no such coefficient (expected " + (keys.empty() ? "none" : "one of " + keys) + ")");
         }
         c.coefficients[key] = m.getNumber(key, Bound::any());
@@ -189,7 +189,7 @@ std::map<std::string, double> loadMuscleModelCoefficients(const MuscleModelType&
 std::array<double, 3> readVec3(const ParamNode& n, const std::string& key, const Bound& bound) {
     const std::vector<double> v = n.getNumbers(key, bound);
     if (v.size() != 3)
-        throw InputError(n.where(key) + ": field '" + n.path(key) + "' has " + std::to_string(v.size()) +
+        throw InputError(n.where(key) + ": field " + describeField(n.path(key)) + " has " + std::to_string(v.size()) +
                          " numbers: expected 3 (x, y, z in the body frame, m)");
     return {v[0], v[1], v[2]};
 }
@@ -207,8 +207,8 @@ PathElementSpec readPoint(const ParamNode& n, const std::string& label, bool via
     if (via && n.has("active_rotation_deg")) {
         const std::vector<double> r = n.getNumbers("active_rotation_deg", Bound::closed(-180, 180, "deg"));
         if (r.size() != 2 || !(r[0] < r[1]))
-            throw InputError(n.where("active_rotation_deg") + ": field '" + n.path("active_rotation_deg") +
-                             "' = " + formatList(r) + ": expected [min, max] with min < max (forearm rotation, deg)");
+            throw InputError(n.where("active_rotation_deg") + ": field " + describeField(n.path("active_rotation_deg")) +
+                             " = " + formatList(r) + ": expected [min, max] with min < max (forearm rotation, deg)");
         e.activeRotationDeg = {r[0], r[1]};
     }
     n.finish();
@@ -230,15 +230,15 @@ PathElementSpec readViaElement(const ParamNode& n, int index) {
     if (cylinder) {
         e.axis = readVec3(s, "axis", Bound::closed(-1e3, 1e3));
         if (std::hypot(e.axis[0], e.axis[1], e.axis[2]) < 1e-9)
-            throw InputError(s.where("axis") + ": field '" + s.path("axis") + "' is the zero vector: expected a direction");
+            throw InputError(s.where("axis") + ": field " + describeField(s.path("axis")) + " is the zero vector: expected a direction");
     }
     s.finish();
     if (n.has("side")) e.side = readVec3(n, "side", Bound::closed(-1e3, 1e3));
     if (n.has("winds")) {
         e.winds = n.getBool("winds", false);
         if (e.winds && !n.has("side"))
-            throw InputError(n.where("winds") + ": field '" + n.path("winds") +
-                             "' = true needs a 'side': the path winds round that side of the surface");
+            throw InputError(n.where("winds") + ": field " + describeField(n.path("winds")) +
+                             " = true needs a 'side': the path winds round that side of the surface");
     }
     e.label = std::string(cylinder ? "cylinder " : "sphere ") + std::to_string(index + 1);
     n.finish();
@@ -261,7 +261,7 @@ MuscleSpec readMuscle(const ParamNode& n, const MuscleDefaults& defaults, const 
     }
     const std::string name = n.getString("name");
     if (!std::regex_match(name, std::regex("[A-Za-z][A-Za-z0-9_]*")))
-        throw InputError(n.where("name") + ": field '" + n.path("name") + "' = '" + name +
+        throw InputError(n.where("name") + ": field " + describeField(n.path("name")) + " = '" + name +
                          "': expected a name of letters, digits and _ (it names CSV columns)");
     m.source = n.getString("source", "");
     const std::string group = n.getChoice("group", {"flexor", "extensor", "forearm"}, "flexor");
@@ -497,7 +497,7 @@ ArmSetup loadModelFile(const std::string& file) {
                 try {
                     out.push_back(s.findMuscle(name));
                 } catch (const InputError& e) {
-                    throw InputError(roles.where(key) + ": field '" + roles.path(key) + "': " + e.what());
+                    throw InputError(roles.where(key) + ": field " + describeField(roles.path(key)) + ": " + e.what());
                 }
             }
             return out;

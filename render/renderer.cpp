@@ -183,7 +183,7 @@ RenderSettings readRenderSettings(const ParamNode& node) {
         if (!n.has(key)) return def;
         const std::vector<double> v = n.getNumbers(key, bound);
         if (v.size() != 3)
-            throw InputError(n.where(key) + ": field '" + n.path(key) + "' has " + std::to_string(v.size()) +
+            throw InputError(n.where(key) + ": field " + describeField(n.path(key)) + " has " + std::to_string(v.size()) +
                              " numbers: expected 3");
         return Vec3(v[0], v[1], v[2]);
     };

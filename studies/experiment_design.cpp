@@ -438,7 +438,7 @@ ProtocolPrediction predictProtocol(const Population& prior, const TorqueProtocol
         try {
             prior.base.findMuscle(protocol.volumeScan[k]);
         } catch (const InputError& e) {
-            throw InputError("protocol '" + protocol.name + "': measurements.volume_scan[" + std::to_string(k) + "]: " + e.what());
+            throw InputError("protocol '" + protocol.name + "': " + describeField("measurements.volume_scan[" + std::to_string(k) + "]") + ": " + e.what());
         }
     }
     for (const TorqueCondition& c : protocol.conditions)

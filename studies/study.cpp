@@ -83,7 +83,7 @@ std::string resolveStudyFile(const ParamNode& n, const std::string& field, const
         if (isRegularFile(beside.string())) return beside.string();
     }
     if (isRegularFile(p.string())) return p.string();
-    throw InputError(n.where(field) + ": field '" + field + "' = '" + value + "': no such " + what +
+    throw InputError(n.where(field) + ": field " + describeField(field) + " = '" + value + "': no such " + what +
                      " (looked beside the study file and in the working directory)");
 }
 
@@ -113,8 +113,8 @@ void Study::validate() const {
         if (truths[i].label.empty()) throw FieldError(field + ".label", "is empty: expected a name");
         for (std::size_t j = 0; j < i; ++j)
             if (truths[j].label == truths[i].label)
-                throw FieldError(field + ".label", "= '" + truths[i].label + "': also truths[" + std::to_string(j) +
-                                                       "]'s label: expected unique labels (set `label:`)");
+                throw FieldError(field + ".label", "= '" + truths[i].label + "': also the label of entry " + std::to_string(j + 1) +
+                                                       ": expected unique labels (set `label:`)");
     }
     checkField("subjects", subjects, Bound::closed(1, 1e7));
     if (protocols.empty()) throw FieldError("protocols", "is empty: expected at least one protocol");
@@ -128,7 +128,7 @@ void Study::validate() const {
             if (protocols[j].protocol.name == protocols[i].protocol.name)
                 throw FieldError("protocols[" + std::to_string(i) + "]",
                                  "= '" + protocols[i].reference + "': its name '" + protocols[i].protocol.name +
-                                     "' is also protocols[" + std::to_string(j) + "]'s: expected unique protocol names");
+                                     "' is also that of entry " + std::to_string(j + 1) + ": expected unique protocol names");
     }
     // Names go into CSV cells, journal lines and plot legends: no control characters (they would not
     // round-trip) and UTF-8 (PLplot cannot draw other bytes). The message shows bytes as \xNN.
@@ -155,8 +155,8 @@ void Study::validate() const {
         if (methods[i].label.empty()) throw FieldError(f + ".label", "is empty: expected a name");
         for (std::size_t j = 0; j < i; ++j)
             if (methods[j].label == methods[i].label)
-                throw FieldError(f + ".label", "= '" + methods[i].label + "': also methods[" + std::to_string(j) +
-                                                   "]'s label: expected unique labels");
+                throw FieldError(f + ".label", "= '" + methods[i].label + "': also the label of entry " + std::to_string(j + 1) +
+                                                   ": expected unique labels");
         // channels: 0 leaves voluntary activation unmeasured; synergist-va needs a measurement.
         checkField(f + ".activation_sd", methods[i].options.activationSd,
                    Bound{0, 0.5, methods[i].kind != "channels", false});
@@ -215,7 +215,7 @@ Study readStudy(const std::string& path) {
         p.reference = protocols[i];
         if (p.reference != "thesis")
             p.protocol = readTorqueProtocol(
-                resolveStudyFile(n, "protocols", p.reference, ("protocol file (protocols[" + std::to_string(i) + "])").c_str()));
+                resolveStudyFile(n, "protocols", p.reference, ("protocol file (" + describeField("protocols[" + std::to_string(i) + "]") + ")").c_str()));
         s.protocols.push_back(p);
     }
     s.noiseLevels = n.has("noise_levels") ? n.getNumbers("noise_levels", Bound{0, 0.5, false, true, "relative sd"})
@@ -724,6 +724,37 @@ std::string formatStudySummaryCsv(const std::vector<StudySummaryRow>& rows) {
         csv.addRow(row);
     }
     return csv.getText();
+}
+
+}  // namespace armsim
+
+namespace armsim {
+
+std::string Study::describeSize() const {
+    auto count = [](std::size_t n, const char* one, const char* many) {
+        return std::to_string(n) + " " + (n == 1 ? one : many);
+    };
+    return std::to_string(getNumTasks()) + " tasks (" +
+           (truths.size() > 1 ? count(truths.size(), "truth", "truths") + " x " : std::string()) +
+           count(std::size_t(subjects), "subject", "subjects") + " x " + count(protocols.size(), "protocol", "protocols") +
+           " x " + count(noiseLevels.size(), "noise level", "noise levels") + " x " +
+           count(methods.size(), "method", "methods") + ")";
+}
+
+void checkStudyFitsOnDisk(const Study& study, long tasksToCompute, const std::string& outputFolder) {
+    namespace fs = std::filesystem;
+    fs::path at = fs::absolute(outputFolder.empty() ? "." : outputFolder);
+    std::error_code ec;
+    while (!fs::exists(at, ec) && at.has_parent_path() && at != at.parent_path()) at = at.parent_path();
+    const fs::space_info space = fs::space(at, ec);
+    if (ec) return;   // a file system that does not say: nothing to check against
+    const double need = double(tasksToCompute) * kStudyBytesPerTask;
+    if (need > double(space.available))
+        throw InputError("study '" + study.name + "': " + study.describeSize() + ", " + std::to_string(tasksToCompute) +
+                         " to compute, need about " + fmt::format("{:.3g}", need / 1e9) + " GB for the journal and " +
+                         "results (" + fmt::format("{:.0f}", kStudyBytesPerTask) + " B a task); " + at.string() +
+                         " has " + fmt::format("{:.3g}", double(space.available) / 1e9) +
+                         " GB free: expected a smaller study (subjects, noise levels, methods) or more space");
 }
 
 }  // namespace armsim

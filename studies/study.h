@@ -75,6 +75,8 @@ struct Study {
     long getNumGroups() const { return long(truths.size()) * long(subjects) * long(protocols.size()); }
     int getCellsPerGroup() const { return int(noiseLevels.size() * methods.size()); }
     long getNumTasks() const { return getNumGroups() * getCellsPerGroup(); }
+    /// "N tasks (T truths x S subjects x P protocols x L noise levels x M methods)": the study's size.
+    std::string describeSize() const;
     /// FieldError naming the field for an empty list, a duplicate label or a value out of range.
     void validate() const;
 };
@@ -90,6 +92,15 @@ std::string calcStudyFingerprint(const Study& study);
 
 /// One cell. Tasks are numbered truth- then subject-major:
 /// (((truth x S + subject) x P + protocol) x N + noise) x K + method.
+/// Disk a task takes in a study folder: its journal line (~470 B measured on a thesis-method study), its
+/// results.csv row (~450 B) and the task-order sort's scratch copy (~470 B), rounded up [B].
+constexpr double kStudyBytesPerTask = 1500;
+
+/// Refuses (InputError naming the study's size, the need and the space) a run whose `tasksToCompute`
+/// would need more disk than the file system holding `outputFolder` has free; a folder that does not
+/// exist yet is measured at its nearest existing parent.
+void checkStudyFitsOnDisk(const Study& study, long tasksToCompute, const std::string& outputFolder);
+
 struct StudyTask {
     long index = 0;
     int truth = 0, subject = 0, protocol = 0, noise = 0, method = 0;

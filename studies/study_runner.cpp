@@ -706,6 +706,9 @@ StudyOutcome runStudy(const Study& study, const StudyRunOptions& options, StudyC
                          ": expected I/N with 0 <= I < N");
     if (sharded && (options.merge || link))
         throw InputError("study: a shard (--shard) runs on its own threads: not with --merge or MPI ranks");
+    // A new folder is checked before it is made (nothing left behind); an existing one for what it lacks, below.
+    const bool existed = std::filesystem::exists(outcome.output);
+    if (!options.merge && !existed) checkStudyFitsOnDisk(study, study.getNumTasks() / std::max(1, options.shards), outcome.output);
     StudyFolder folder(outcome.output, fingerprint, study, options.restart, options.shard, options.shards);
     outcome.journalDrops = folder.getDropped();
     outcome.journalSummary = folder.getDroppedSummary();
@@ -723,6 +726,7 @@ StudyOutcome runStudy(const Study& study, const StudyRunOptions& options, StudyC
     WorkQueue pending(study, folder, sharded ? options.shard : 0, sharded ? options.shards : 1);
     outcome.total = pending.getNumCells();
     outcome.resumed = outcome.total - pending.getNumMissing();
+    if (!options.merge && existed) checkStudyFitsOnDisk(study, pending.getNumMissing(), outcome.output);
     if (options.merge && pending.getNumMissing() > 0)
         throw InputError("study output '" + outcome.output + "': --merge: " + std::to_string(pending.getNumMissing()) +
                          " of " + std::to_string(outcome.total) + " cells are in no journal (a shard failed or has not " +

@@ -144,3 +144,22 @@ TEST(Files, AtomicWriteReplacesWholeAndReadsBack) {
     EXPECT_TRUE(has(messageOf([&] { writeFileAtomically("/proc/armsim_cannot", "x"); }), "/proc/armsim_cannot"));
     fs::remove_all(dir);
 }
+
+// A list entry is named by the key the user typed and its place counted from 1, not by an internal
+// 0-based path (issue 34: 'conditions[1].flexion_deg' for the second condition).
+TEST(ParamNode, ListEntriesAreNamedByTheirKeyAndPlaceFromOne) {
+    EXPECT_EQ(describeField("hold"), "'hold'");
+    EXPECT_EQ(describeField("trial.hold"), "'trial.hold'");
+    EXPECT_EQ(describeField("conditions[1].flexion_deg"), "'flexion_deg' (conditions, entry 2)");
+    EXPECT_EQ(describeField("angles[0]"), "'angles' (entry 1)");
+    EXPECT_EQ(describeField("a[2].b[0].c"), "'c' (a[3].b, entry 1)");
+    const ParamNode n = ParamNode::loadString("conditions:\n  - {level: 0.5}\n  - {level: 7}\n", "p.yaml");
+    const std::string m = messageOf([&] {
+        for (const ParamNode& c : n.children("conditions")) c.getNumber("level", Bound::closed(0, 1));
+    });
+    EXPECT_NE(m.find("p.yaml:3: field 'level' (conditions, entry 2) = 7"), std::string::npos) << m;
+    const std::string list = messageOf([&] {
+        ParamNode::loadString("angles: [30, 400]\n", "q.yaml").getNumbers("angles", Bound::closed(0, 180));
+    });
+    EXPECT_NE(list.find("q.yaml:1: field 'angles' (entry 2) = 400"), std::string::npos) << list;
+}

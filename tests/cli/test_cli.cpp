@@ -157,7 +157,7 @@ TEST(Cli, TrialWritesTheSeriesAndRejectsBadSettings) {
 
     r = runArmsim("trial --angle 30 --out " + (d / "bad.csv").string());
     EXPECT_EQ(r.exitCode, 2);
-    EXPECT_NE(r.output.find("elbow_angle_deg"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("--angle = 30"), std::string::npos) << r.output;   // the option typed
     EXPECT_NE(r.output.find("[40, 180]"), std::string::npos) << r.output;
     r = runArmsim("trial --hold -1 --out " + (d / "bad.csv").string());
     EXPECT_EQ(r.exitCode, 2);
@@ -278,7 +278,7 @@ TEST(Cli, ModelShowWritesTablesAndPlots) {
 
     const CommandResult bad = runArmsim("model show --model elbow --step 0 --out " + d.string());
     EXPECT_NE(bad.exitCode, 0);
-    EXPECT_NE(bad.output.find("angle step = 0"), std::string::npos) << bad.output;
+    EXPECT_NE(bad.output.find("--step = 0 deg: expected in (0, 90]"), std::string::npos) << bad.output;
 }
 
 // A protocol without maximal efforts leaves synergist-va without its twitch-interpolation measurement:
@@ -526,6 +526,8 @@ TEST(Cli, AFullDiskLeavesNoPartialOutput) {
     } unmount{small};
     std::ofstream(d / "tiny.yaml") << "kind: study\nname: tiny\nsubjects: 2\nprotocols: [thesis]\nnoise_levels: [0.02]\n"
                                       "methods:\n  - {method: thesis}\n";
+    std::ofstream(d / "hundred.yaml") << "kind: study\nname: hundred\nsubjects: 100\nprotocols: [thesis]\n"
+                                         "noise_levels: [0.02]\nmethods:\n  - {method: thesis}\n";
     const struct {
         std::string args, expect;
         std::vector<std::string> left;  // what may stay in small/ afterwards
@@ -536,6 +538,9 @@ TEST(Cli, AFullDiskLeavesNoPartialOutput) {
         {"study " + (d / "tiny.yaml").string() + " --out " + (small / "st").string(), "disk full",
          {"st", "st/.lock", "st/journal.log"}},
         {"run --out " + (small / "run").string(), "disk full", {}},
+        // 100 tasks x 1500 B > 48 KiB: refused before the folder is made, with the study's size
+        {"study " + (d / "hundred.yaml").string() + " --out " + (small / "sh").string(),
+         "100 tasks (100 subjects x 1 protocol x 1 noise level x 1 method), 100 to compute, need about", {}},
     };
     for (const auto& c : cases) {
         const CommandResult r = runArmsim(c.args);

@@ -82,7 +82,7 @@ TEST(Channels, BadProtocolChannelsNameFileLineAndValue) {
         readTorqueProtocol(writeTemp("armsim_ch_bad4.yaml", "name: x\nkind: torque\nmeasurements: {volume_scan: [BIClong, BIClong]}\n"
                                                             "conditions:\n  - {flexion_deg: 90}\n"));
     });
-    EXPECT_NE(e.find("volume_scan[1]"), std::string::npos) << e;
+    EXPECT_NE(e.find("'measurements.volume_scan' (entry 2)"), std::string::npos) << e;
     EXPECT_NE(e.find("listed twice"), std::string::npos) << e;
     {  // EMG on a model that names no surface_emg muscles
         VirtualSubject bare = drawSubject(population(), 1, 0);

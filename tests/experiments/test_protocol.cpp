@@ -152,7 +152,7 @@ TEST(ProtocolFile, MalformedFilesNameFileLineAndKey) {
     text = replaced(kSmallMvc, "[80, 100, 120]", "[80,\n    185]");
     e = protocolError(d, text);
     EXPECT_NE(e.find("bad.yaml:" + std::to_string(lineOf(text, "185"))), std::string::npos) << e;
-    EXPECT_NE(e.find("conditions.elbow_angles_deg[1]' = 185"), std::string::npos) << e;
+    EXPECT_NE(e.find("conditions.elbow_angles_deg' (entry 2) = 185"), std::string::npos) << e;
 
     text = replaced(kSmallMvc, "[80, 100, 120]", "[]");
     e = protocolError(d, text);

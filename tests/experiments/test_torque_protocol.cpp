@@ -84,7 +84,7 @@ TEST(TorqueProtocol, ForearmPosturesReadBackAndKeepConditionsApart) {
                                      "  - {flexion_deg: 90, rotation_deg: 90, channels: [torque, ultrasound]}\n"));
     });
     EXPECT_NE(e.find("armsim_bad_posture.yaml"), std::string::npos) << e;
-    EXPECT_NE(e.find("conditions[0].channels"), std::string::npos) << e;
+    EXPECT_NE(e.find("'channels' (conditions, entry 1)"), std::string::npos) << e;
     EXPECT_NE(errorOf([&] { readTorqueData(writeTemp("armsim_bad_posture.csv", "flexion_deg,torque_Nm,rotation_deg\n90,50,200\n")); })
                   .find("'rotation_deg' = 200"), std::string::npos);
 }

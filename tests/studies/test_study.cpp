@@ -308,19 +308,19 @@ TEST(Study, ReadsAStudyFileAndNamesTheFileLineAndFieldOfEveryError) {
         {good + "subject: 3\n", "subject"},                                       // unknown key
         {"kind: study\nsubjects: 0\nprotocols: [thesis]\nmethods:\n  - {method: thesis}\n", "subjects"},
         {"kind: study\nsubjects: 2\nprotocols: [missing.yaml]\nmethods:\n  - {method: thesis}\n", "missing.yaml"},
-        {"kind: study\nsubjects: 2\nprotocols: [thesis]\nmethods:\n  - {method: lm}\n", "methods[0].method"},
+        {"kind: study\nsubjects: 2\nprotocols: [thesis]\nmethods:\n  - {method: lm}\n", "'method' (methods, entry 1)"},
         {"kind: study\nsubjects: 2\nprotocols: [thesis]\nmethods:\n  - {method: thesis}\n  - {method: thesis}\n",
          "expected unique labels"},
         {"kind: study\nsubjects: 2\nprotocols: [thesis]\nnoise_levels: [0.7]\nmethods:\n  - {method: thesis}\n",
-         "noise_levels[0]"},
+         "'noise_levels' (entry 1)"},
         {"kind: study\nsubjects: 2\nprotocols: [thesis, thesis]\nmethods:\n  - {method: thesis}\n",
          "expected unique protocol names"},
         {"kind: study\nsubjects: 2\nprotocols: []\nmethods:\n  - {method: thesis}\n", "protocols"},
         {"kind: study\nsubjects: 2\nprotocols: [thesis]\nmethods:\n  - {method: thesis, label: \"a\\tb\"}\n",
-         "methods[0].label"},
+         "'label' (methods, entry 1)"},
         // Latin-1 bytes (a file not saved as UTF-8): PLplot would print "malformed" and draw nothing.
         {"kind: study\nsubjects: 2\nprotocols: [thesis]\nmethods:\n  - {method: thesis, label: caf\xe9}\n",
-         "field 'methods[0].label' = 'caf\\xe9': not UTF-8 text"},
+         "field 'label' (methods, entry 1) = 'caf\\xe9': not UTF-8 text"},
         {"kind: study\nname: r\xe9sum\xe9\nsubjects: 2\nprotocols: [thesis]\nmethods:\n  - {method: thesis}\n",
          "field 'name' = 'r\\xe9sum\\xe9': not UTF-8 text"},
         // Several truths (issue 31): a prior, unique labels, known keys, one way of naming the truth.
@@ -328,7 +328,7 @@ TEST(Study, ReadsAStudyFileAndNamesTheFileLineAndFieldOfEveryError) {
          "needs 'prior'"},
         {"kind: study\nsubjects: 2\nprior: default\ntruths:\n  - {population: default}\n  - {population: default}\n"
          "protocols: [thesis]\nmethods:\n  - {method: thesis}\n",
-         "truths[1].label' = 'default': also truths[0]'s label"},
+         "'label' (truths, entry 2) = 'default': also the label of entry 1"},
         {"kind: study\nsubjects: 2\nprior: default\ntruths:\n  - {population: default, lable: x}\n"
          "protocols: [thesis]\nmethods:\n  - {method: thesis}\n",
          "lable"},
