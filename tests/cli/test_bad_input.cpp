@@ -4,6 +4,7 @@
 // written: the case's output folder does not exist afterwards.
 #include "tests/support/run_armsim.h"
 #include "tests/support/temp_files.h"
+#include "basics/bound.h"
 #include "basics/files.h"
 #include "muscles/muscle_file.h"
 
@@ -391,6 +392,52 @@ TEST(BadInputCatalogue, HasAtLeastOneHundredFiftyCasesOverEveryCommand) {
         bool found = false;
         for (const BadInput& c : all) found = found || c.args.rfind(command, 0) == 0;
         EXPECT_TRUE(found) << command;
+    }
+}
+
+}  // namespace
+
+namespace {
+
+// Issue 34: one bound per quantity (basics/bound.h) holds on the command line and in the files alike. Each
+// entry of the table is tried just outside its bound through an option and through a file; both must
+// refuse with the table's own description of the bound. (tests/python/test_armsim.py does the same for
+// the Python module.)
+TEST(BoundsTable, EveryEntryPointRefusesOutsideTheSameBound) {
+    const std::string assets = armsim::getAssetDirectory();
+    const std::string arm = armsim::readFileText(assets + "/arm/default_male.yaml");
+    const std::string muscle = replaceAll(armsim::readFileText(assets + "/muscles/biceps_long_head.yaml"),
+                                          "fibre_types: ", "fibre_types: " + assets + "/muscles/");
+    struct Entry {
+        const char* name;
+        armsim::Bound bound;
+        std::string option;                       ///< a command with the option just outside the bound
+        std::pair<std::string, std::string> file; ///< (file name, text) with the field just outside
+        std::string fileCommand;                  ///< the command reading it (IN: the file's folder)
+    };
+    const std::vector<Entry> table = {
+        {"hand load", armsim::bounds::kHandLoad, "trial --type free --load 60 --out OUT/f.csv",
+         {"a.yaml", replaceAll(arm, "hand_load: 0", "hand_load: 60")}, "trial --arm IN/a.yaml --hold 0.2 --out OUT/t.csv"},
+        {"muscle mass", armsim::bounds::kMuscleMass, "muscle steady --mass 11",
+         {"m.yaml", replaceAll(muscle, "mass: 0.33599", "mass: 11")}, "muscle steady --muscle IN/m.yaml"},
+        {"tendon length", armsim::bounds::kTendonLength, "muscle steady --tendon-length 3",
+         {"m.yaml", replaceAll(muscle, "optimal_tendon_length: 0.245", "optimal_tendon_length: 3")},
+         "muscle steady --muscle IN/m.yaml"},
+        {"motor units", armsim::bounds::kMotorUnits, "muscle steady --slow-units 1001",
+         {"m.yaml", replaceAll(muscle, "slow: 3", "slow: 1001")}, "muscle steady --muscle IN/m.yaml"},
+    };
+    for (const Entry& e : table) {
+        const fs::path d = armsim::testing::makeFreshDir("bounds_table", replaceAll(e.name, " ", "_"));
+        fs::create_directories(d / "in");
+        ASSERT_TRUE(e.file.second != arm && e.file.second != muscle) << e.name << ": the field to change was not found";
+        std::ofstream(d / "in" / e.file.first) << e.file.second;
+        for (const std::string& args : {e.option, e.fileCommand}) {
+            const CommandResult r = runArmsim(replaceAll(replaceAll(args, "IN", (d / "in").string()), "OUT", (d / "out").string()));
+            EXPECT_EQ(r.exitCode, 2) << e.name << ": " << args << "\n" << r.output;
+            EXPECT_NE(r.output.find(e.bound.describe()), std::string::npos)
+                << e.name << ": " << args << " should name the bound '" << e.bound.describe() << "'\n" << r.output;
+        }
+        fs::remove_all(d);
     }
 }
 

@@ -279,3 +279,14 @@ def test_returned_keys_carry_their_units(thesis, elbow, tmp_path):
             if not key.endswith(UNIT_SUFFIXES):
                 bad.append(f"{name}: {path}")
     assert not bad, "keys without a unit: " + ", ".join(sorted(set(bad)))
+
+
+def test_the_bounds_table_holds_in_python_as_on_the_command_line(thesis):
+    """basics/bound.h's table, through the module: the same bounds and words as the command line and the files
+    (tests/cli/test_bad_input.cpp, BoundsTable)."""
+    for kw, bound in ((dict(mass=11.0), "(0, 10] (kg)"), (dict(optimal_tendon_length=3.0), "(0, 2] (m)"),
+                      (dict(slow_units=1001), "[0, 1000]")):
+        with pytest.raises(ValueError, match=re.escape(bound)):
+            thesis.with_muscle(**kw)
+    with pytest.raises(ValueError, match=re.escape("[0, 50] (kg)")):
+        armsim.Simulation(thesis, hand_load=60)
