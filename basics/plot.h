@@ -2,6 +2,8 @@
 // PLplot's cairo driver. Framework-free apart from PLplot; safe to call from several threads (serialised).
 #pragma once
 
+#include "basics/numbers.h"
+
 #include <string>
 #include <vector>
 
@@ -24,7 +26,7 @@ struct PlotSpec {
     int width = 1000, height = 700;   ///< pixels
     bool logY = false;               ///< logarithmic y axis (convergence plots); y must be > 0
     /// Axis limits; NaN = from the data with a margin.
-    double xMin = 0.0 / 0.0, xMax = 0.0 / 0.0, yMin = 0.0 / 0.0, yMax = 0.0 / 0.0;
+    double xMin = kNaN, xMax = kNaN, yMin = kNaN, yMax = kNaN;
 };
 
 /// Writes the plot as a PNG file, whole or not at all (temporary + rename). Throws InputError naming

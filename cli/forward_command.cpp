@@ -1,6 +1,7 @@
 // armsim forward: OpenSim's Forward tool on an .osim model (model/osim_forward.h): excitations from a
 // controls file, states written as OpenSim writes them. Parses and calls; no science here.
 #include "basics/errors.h"
+#include "basics/numbers.h"
 #include "basics/files.h"
 #include "basics/format.h"
 #include "basics/output_folder.h"
@@ -21,9 +22,9 @@ struct ForwardOptions {
     std::string setup;          ///< a Forward tool setup file (positional)
     std::string model;          ///< .osim file or a shipped model's name (arm26)
     std::string controls, initialStates;
-    double initialTime = 0.0 / 0.0, finalTime = 0.0 / 0.0;
+    double initialTime = kNaN, finalTime = kNaN;
     double rate = 200;
-    double accuracy = 0.0 / 0.0;  ///< NaN: the setup's tolerance, else 1e-5
+    double accuracy = kNaN;  ///< NaN: the setup's tolerance, else 1e-5
     std::string muscleModel;
     std::string out;
 };

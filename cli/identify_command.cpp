@@ -302,7 +302,7 @@ void runElbowValidate(const ValidateOptions& o) {
     if (!o.protocol.empty()) {
         s.protocol = readTorqueProtocol(o.protocol);
     } else {
-        std::vector<double> angles = {135, 120, 90, 60, 30};
+        std::vector<double> angles = getThesisMvcFlexionDeg();
         if (!o.angles.empty()) angles = o.angles;
         s.protocol.conditions = TorqueProtocol::makeFlexionMvcs(angles, o.repetitions);
     }

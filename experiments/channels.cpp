@@ -1,4 +1,5 @@
 #include "experiments/channels.h"
+#include "basics/numbers.h"
 
 #include "basics/bound.h"
 #include "basics/csv.h"
@@ -186,7 +187,7 @@ std::vector<ChannelObservation> readChannelData(const std::string& path) {
             fail("channel", "'" + o.channel + "'", "fascicle_length, volume, emg or upper_arm_length");
         o.muscle = text("muscle");
         if (o.muscle.empty() && o.channel != "upper_arm_length") fail("muscle", "''", "the muscle's name in the model");
-        o.flexionDeg = number("flexion_deg", 0.0 / 0.0);
+        o.flexionDeg = number("flexion_deg", kNaN);
         const bool atAngle = o.channel == "fascicle_length" || o.channel == "emg";
         if (atAngle && !(o.flexionDeg >= 0 && o.flexionDeg <= 180))
             fail("flexion_deg", formatNumber(o.flexionDeg), "in [0, 180] (0 = extended) for " + o.channel);
@@ -199,12 +200,12 @@ std::vector<ChannelObservation> readChannelData(const std::string& path) {
         const double rep = number("repetition", 0);
         if (rep != std::floor(rep) || rep < 0 || rep > 1e6) fail("repetition", formatNumber(rep), "an integer >= 0");
         o.repetition = int(rep);
-        o.value = number("value", 0.0 / 0.0);
+        o.value = number("value", kNaN);
         if (!std::isfinite(o.value) || (o.channel != "emg" && o.value <= 0))
             fail("value", formatNumber(o.value), o.channel == "emg" ? "a finite number" : "> 0 (SI units)");
-        o.sd = number("sd", 0.0 / 0.0);
+        o.sd = number("sd", kNaN);
         if (!(o.sd > 0)) fail("sd", formatNumber(o.sd), "> 0 (the measurement's sd, units of value)");
-        o.cleanValue = number("clean_value", 0.0 / 0.0);
+        o.cleanValue = number("clean_value", kNaN);
         o.source = path;
         data.push_back(o);
     }

@@ -1,5 +1,5 @@
 // The channels a lab records besides joint torque, each with its measurement model, synthesized on
-// virtual subjects and read from a lab's CSV (issue 31):
+// virtual subjects and read from a lab's CSV:
 // - fascicle_length: B-mode ultrasound of the primary muscle's fascicle length [m], imaged at rest
 //   (level 0) just before an effort and at the effort's plateau; relative error sd_f (the fascicle
 //   runs beyond the probe and is extrapolated).
@@ -15,6 +15,8 @@
 // Every error is multiplicative (or additive for anthropometry) and Gaussian, drawn per measurement.
 #pragma once
 
+#include "basics/numbers.h"
+
 #include "experiments/torque_protocol.h"
 
 #include <string>
@@ -26,13 +28,13 @@ namespace armsim {
 struct ChannelObservation {
     std::string channel;        ///< fascicle_length, volume, emg or upper_arm_length
     std::string muscle;         ///< the muscle measured (empty for upper_arm_length)
-    double flexionDeg = 0.0 / 0.0;  ///< elbow flexion during the measurement [deg] (NaN: volume, anthropometry)
+    double flexionDeg = kNaN;  ///< elbow flexion during the measurement [deg] (NaN: volume, anthropometry)
     Effort effort = Effort::Flexion;  ///< the effort it was recorded in (flexion or extension)
     double level = 0;           ///< the effort's drive [1]; 0: relaxed (fascicle at rest)
     int repetition = 0;
     double value = 0;           ///< the measurement [m, m^3 or 1]
     double sd = 0;              ///< its measurement sd, same units [> 0]
-    double cleanValue = 0.0 / 0.0;  ///< before measurement error (truth; synthetic data)
+    double cleanValue = kNaN;  ///< before measurement error (truth; synthetic data)
     int line = 0;               ///< line in the file it was read from (0: synthesized)
     std::string source;         ///< the file it was read from ("" : synthesized)
 };

@@ -1,4 +1,4 @@
-// Populations of virtual subjects (issue 11): a YAML file gives the distributions around a base model
+// Populations of virtual subjects: a YAML file gives the distributions around a base model
 // (strength, tendon and fascicle lengths, fibre composition, effort, transducer noise); drawSubject
 // makes person `index` of a seeded population, reproducibly from (seed, index) alone.
 //

@@ -1,4 +1,4 @@
-// Torque protocols (issue 11): isometric efforts of a (virtual) subject at elbow angles, read by a
+// Torque protocols: isometric efforts of a (virtual) subject at elbow angles, read by a
 // tared joint-torque transducer. A condition is one effort kind at one angle: a flexion or an extension
 // effort, or on a model with a forearm rotation a supination or a pronation effort, maximal (level 1)
 // or held at a fraction of the agonists' MVC EMG by EMG feedback (level < 1), repeated. A two-axis
@@ -15,7 +15,10 @@
 // cell's error scales with its load, cross-talk between the axes included.
 #pragma once
 
+#include "basics/numbers.h"
+
 #include "experiments/population.h"
+#include "model/geometry.h"
 
 #include <cmath>
 #include <string>
@@ -39,7 +42,7 @@ struct TorqueCondition {
     bool emg = false;
     /// Forearm posture [deg], + = supination (rotation_deg; a model with a forearm rotation only);
     /// NaN = the model's posture. Ultrasound and EMG are read at the model's posture only.
-    double rotationDeg = 0.0 / 0.0;
+    double rotationDeg = kNaN;
 };
 
 /// Measurement error of the channels besides torque (experiments/channels.h). Defaults and their
@@ -61,7 +64,7 @@ struct TorqueProtocol {
     std::string name = "thesis_mvc";
     std::string description;
     /// Default: the thesis's five flexion MVCs (45..150 deg included = 135..30 deg flexion) x 3.
-    std::vector<TorqueCondition> conditions = makeFlexionMvcs({135, 120, 90, 60, 30}, 3);
+    std::vector<TorqueCondition> conditions = makeFlexionMvcs(getThesisMvcFlexionDeg(), 3);
     double restDuration = 0.5;       ///< [s] relaxed, transducer tared at its start
     double holdDuration = 3.0;       ///< [s] effort (thesis: 3 s)
     double averagingWindow = 1.0;    ///< [s] end of the hold averaged (thesis: last second)
@@ -122,11 +125,11 @@ struct TorqueObservation {
     double antagonistActivation = NAN;  ///< the antagonists' activation (truth) [1]
     double restFascicleLength = NAN;    ///< the primary's fascicle at rest before the effort (truth) [m]
     double fascicleLength = NAN;        ///< the primary's fascicle at the plateau, window mean (truth) [m]
-    double rotationDeg = 0.0 / 0.0;  ///< forearm posture [deg], + = supination; NaN = the model's posture
+    double rotationDeg = kNaN;  ///< forearm posture [deg], + = supination; NaN = the model's posture
     /// Tared torque about the forearm axis, + = supination [N m] (with transducer noise); NaN: not read.
-    double forearmTorque = 0.0 / 0.0;
-    double cleanForearmTorque = 0.0 / 0.0;  ///< the same before transducer noise (truth) [N m]
-    double forearmNoiseDraw = 0.0 / 0.0;    ///< its standard normal noise draw
+    double forearmTorque = kNaN;
+    double cleanForearmTorque = kNaN;  ///< the same before transducer noise (truth) [N m]
+    double forearmNoiseDraw = kNaN;    ///< its standard normal noise draw
     int line = 0;              ///< line in the file it was read from (0: synthesized)
     /// The reading about the effort's own axis: torque for flexion and extension, forearmTorque for
     /// supination and pronation [N m].

@@ -70,6 +70,8 @@
 // fails stops the ILC variants as "not-converged" with the reason. Never a silent wrong answer.
 #pragma once
 
+#include "basics/numbers.h"
+
 #include "identification/force_model.h"
 #include "identification/observations.h"
 #include "identification/unknowns.h"
@@ -121,11 +123,11 @@ struct IdentificationOptions {
     double probeStep = 0.01;         ///< secant ILC: initial one-at-a-time trials change x_j by this * scale_j
     int stallIterations = 50;        ///< ILC "no-progress" after this many iterations without a lower cost
     Derivatives derivatives = Derivatives::Central;   ///< lm
-    double differenceStep = 0.0 / 0.0;      ///< lm: central-difference step [scaled]; NaN: ForceModel::getDifferenceStep()
-    double parameterTolerance = 0.0 / 0.0;  ///< lm: Ceres parameter_tolerance; NaN: ForceModel::getParameterTolerance()
+    double differenceStep = kNaN;      ///< lm: central-difference step [scaled]; NaN: ForceModel::getDifferenceStep()
+    double parameterTolerance = kNaN;  ///< lm: Ceres parameter_tolerance; NaN: ForceModel::getParameterTolerance()
     NoiseModel noise = NoiseModel::Absolute;  ///< lm: residual weighting
-    double forceSd = 0.0 / 0.0;      ///< lm, absolute noise: known force sd [N]; NaN: estimate from residuals (n > p)
-    double relativeForceSd = 0.0 / 0.0;  ///< lm, relative noise: known sd / force [1]; NaN: estimate (n > p)
+    double forceSd = kNaN;      ///< lm, absolute noise: known force sd [N]; NaN: estimate from residuals (n > p)
+    double relativeForceSd = kNaN;  ///< lm, relative noise: known sd / force [1]; NaN: estimate (n > p)
     double confidenceLevel = 0.95;   ///< lm: two-sided interval level
     int starts = 1;                  ///< lm: number of starts (>= 1)
     unsigned seed = 1;               ///< lm: seed of the multi-start generator
@@ -149,9 +151,9 @@ struct ParameterEstimate {
     double start = 0;                 ///< start value [unit]
     double lower = 0, upper = 0;      ///< bounds [unit]
     bool atBound = false;             ///< within the unknown's tolerance of a bound
-    double standardError = 0.0 / 0.0; ///< [unit] (lm; NaN: unavailable)
-    double ciLower = 0.0 / 0.0;       ///< interval at IdentificationOptions::confidenceLevel [unit]
-    double ciUpper = 0.0 / 0.0;
+    double standardError = kNaN; ///< [unit] (lm; NaN: unavailable)
+    double ciLower = kNaN;       ///< interval at IdentificationOptions::confidenceLevel [unit]
+    double ciUpper = kNaN;
 };
 
 /// State after one solver iteration (iteration 0 = the start).
@@ -170,7 +172,7 @@ struct ModelCheck {
     std::string note;                ///< the model and its settings in words (e.g. FaithfulForceModel::describe()); empty: the name
     std::vector<double> forces;      ///< model forces at the estimate [N] (NaN where it failed)
     std::vector<double> residuals;   ///< model - measured [N]
-    double rmsResidual = 0.0 / 0.0;  ///< [N]
+    double rmsResidual = kNaN;  ///< [N]
     std::string failure;             ///< why the model failed (empty: it ran)
 };
 
@@ -195,8 +197,8 @@ struct IdentificationReport {
     bool hasUncertainty = false;
     std::string uncertaintyNote;          ///< why intervals are missing, or how they were made
     int degreesOfFreedom = 0;             ///< n - p
-    double residualSd = 0.0 / 0.0;        ///< s: sqrt(SSR / (n - p)) or the given sd [N; 1 for relative noise]
-    double intervalQuantile = 0.0 / 0.0;  ///< t or z quantile used for the intervals
+    double residualSd = kNaN;        ///< s: sqrt(SSR / (n - p)) or the given sd [N; 1 for relative noise]
+    double intervalQuantile = kNaN;  ///< t or z quantile used for the intervals
     std::vector<std::vector<double>> covariance;   ///< p x p [unit_i unit_j]
     std::vector<std::vector<double>> correlation;  ///< p x p [1]
     std::vector<double> startCosts;       ///< lm multi-start: final cost of every start [N^2]
@@ -233,7 +235,7 @@ struct CorrectionOptions {
     int maxCorrections = 10;    ///< expensive-model evaluations at most
     /// Stop when no unknown moves by more than this * its scale between corrections; NaN: the
     /// expensive model's getParameterTolerance() (below it the corrections only chase its noise).
-    double tolerance = 0.0 / 0.0;
+    double tolerance = kNaN;
 };
 
 /// Output correction (defect correction, a form of space mapping): identifies with the cheap model

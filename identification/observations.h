@@ -2,6 +2,8 @@
 // read from CSV and validated once. Framework-free.
 #pragma once
 
+#include "basics/numbers.h"
+
 #include <functional>
 #include <string>
 #include <vector>
@@ -15,7 +17,7 @@ struct Observation {
     double pathLength = 0;   ///< musculotendon path length P [m]
     double activation = 1;   ///< neural activation U [1], 0..1 (MVC data: 1)
     double force = 0;        ///< measured muscle force [N]
-    double angle = 0.0 / 0.0;  ///< included elbow angle theta [rad] when the file gave one, else NaN
+    double angle = kNaN;  ///< included elbow angle theta [rad] when the file gave one, else NaN
     int trial = 0;           ///< trial number (CSV column `trial`; 0 when absent)
     int subject = 0;         ///< subject number (CSV column `subject`; 0 when absent)
     int line = 0;            ///< line in the source file (0: not read from a file)

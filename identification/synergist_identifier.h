@@ -17,6 +17,8 @@
 // supinator) then get a mass scale each.
 #pragma once
 
+#include "basics/numbers.h"
+
 #include "experiments/channels.h"
 #include "identification/torque_estimate.h"
 #include "model/mvc_curve.h"
@@ -39,14 +41,14 @@ struct SynergistOptions {
     // Every extensor shares s_e.
     /// The subject's voluntary activation measured by twitch interpolation (superimposed stimulation
     /// during the MVCs) [1]; NaN: not measured. Adds the residual (VA - measured) / activationSd.
-    double measuredActivation = 0.0 / 0.0;
+    double measuredActivation = kNaN;
     double activationSd = 0.02;  ///< sd of that measurement [1] (an assumption, see measureVoluntaryActivation)
     /// Free the flexors' slow-fibre fractions (one shift for the biceps heads, one for the synergists;
     /// prior sd the population's): submaximal efforts depend on them.
     bool freeSlowFraction = false;
     /// Relative sd of one trial's torque [1]; NaN: estimated from the repetitions (pooled over the
     /// conditions), or the population's transducer noise when nothing is repeated.
-    double noiseLevel = 0.0 / 0.0;
+    double noiseLevel = kNaN;
     /// Measurements besides torque (experiments/channels.h), each a residual (model - value) / sd.
     std::vector<ChannelObservation> channels;
     double emgCrosstalk = 0.10;  ///< c of the EMG measurement model (ChannelNoise::emgCrosstalk) [1]
@@ -195,7 +197,7 @@ private:
     /// Frees the rotators' scales within the mass scales' bounds (the data read the forearm axis).
     void freeRotatorMass();
     /// Index of the pose (flexion, forearm rotation; NaN = the model's posture, kept as +inf), added if new.
-    int findPose(double flexionDeg, std::vector<std::pair<double, double>>& poses, double rotationDeg = 0.0 / 0.0);
+    int findPose(double flexionDeg, std::vector<std::pair<double, double>>& poses, double rotationDeg = kNaN);
     std::vector<double> priorMean_, lower_, upper_;
     std::vector<std::vector<double>> priorCovariance_;
     // What calcConsideredCovariance needs of the model alone, computed once at construction

@@ -13,8 +13,6 @@ namespace armsim {
 
 namespace {
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-
 ObservationSet onlyPath(const ObservationSet& set, double path) {
     ObservationSet out;
     out.source = set.source;

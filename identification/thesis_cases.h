@@ -1,6 +1,8 @@
 // The thesis's identification cases rerun with armsim's model: ours vs the thesis's numbers.
 #pragma once
 
+#include "basics/numbers.h"
+
 #include "identification/identifier.h"
 
 #include <string>
@@ -21,7 +23,7 @@ struct ThesisComparisonRow {
     std::string quantity;   ///< "M", "L0T", "Y1 (40 cm)", "iterations", ...
     std::string unit;       ///< "kg", "m", "N" or "" (count)
     double ours = 0;
-    double thesis = 0.0 / 0.0;
+    double thesis = kNaN;
 };
 
 /// A rerun case: its report and its rows.

@@ -2,6 +2,8 @@
 // the nuisance parameters: the result every torque-data identifier returns.
 #pragma once
 
+#include "basics/numbers.h"
+
 #include <string>
 #include <vector>
 
@@ -11,10 +13,10 @@ namespace armsim {
 struct ChannelFit {
     std::string channel;           ///< torque, fascicle_length, volume, emg, upper_arm_length, activation
     int n = 0;                     ///< measurements
-    double chiSquare = 0.0 / 0.0;
-    double p = 0.0 / 0.0;          ///< chi-square tail probability with n degrees of freedom; < 0.05: misfit
+    double chiSquare = kNaN;
+    double p = kNaN;          ///< chi-square tail probability with n degrees of freedom; < 0.05: misfit
     std::string worst;             ///< the measurement with the largest |residual| / sd, described
-    double worstResidual = 0.0 / 0.0;  ///< its (model - value) / sd
+    double worstResidual = kNaN;  ///< its (model - value) / sd
 };
 
 /// An identifier's estimate of the primary muscle (the biceps long head).
@@ -22,23 +24,23 @@ struct MuscleEstimate {
     std::string method;                  ///< "thesis", "synergist" or "synergist-va"
     bool converged = false;
     std::string message;                 ///< solver summary or why it failed
-    double mass = 0.0 / 0.0;             ///< M [kg]
-    double tendonLength = 0.0 / 0.0;     ///< L0T [m]
-    double massLower = 0.0 / 0.0, massUpper = 0.0 / 0.0;        ///< 95 % interval [kg]
-    double tendonLower = 0.0 / 0.0, tendonUpper = 0.0 / 0.0;    ///< 95 % interval [m]
-    double noiseLevel = 0.0 / 0.0;       ///< relative torque sd used to weight the data [1]
+    double mass = kNaN;             ///< M [kg]
+    double tendonLength = kNaN;     ///< L0T [m]
+    double massLower = kNaN, massUpper = kNaN;        ///< 95 % interval [kg]
+    double tendonLower = kNaN, tendonUpper = kNaN;    ///< 95 % interval [m]
+    double noiseLevel = kNaN;       ///< relative torque sd used to weight the data [1]
     int noiseDegreesOfFreedom = 0;       ///< of that sd's estimate (repetitions); 0: taken as known
     std::vector<std::string> nuisanceNames;    ///< synergist: activation, co-contraction, length and mass scales
     std::vector<double> nuisance;              ///< their estimates
-    double massTendonCorrelation = 0.0 / 0.0;  ///< posterior correlation of ln M and ln L0T
-    double rmsResidual = 0.0 / 0.0;            ///< of the torque [N m] (thesis: of the force [N])
+    double massTendonCorrelation = kNaN;  ///< posterior correlation of ln M and ln L0T
+    double rmsResidual = kNaN;            ///< of the torque [N m] (thesis: of the force [N])
     /// Per observation: the torque the method predicts at the estimate [N m] (thesis: the fitted biceps
     /// force x the biceps moment arm, flexion MVCs only; NaN elsewhere).
     std::vector<double> predictedTorque;
     /// F0 = sigma M / (rho L0) of the primary muscle [N] with its 95 % interval, and the specific tension
     /// sigma the mass assumes [N/m^2] (NaN for methods that do not estimate them).
-    double maxForce = 0.0 / 0.0, maxForceLower = 0.0 / 0.0, maxForceUpper = 0.0 / 0.0;
-    double specificTension = 0.0 / 0.0;
+    double maxForce = kNaN, maxForceLower = kNaN, maxForceUpper = kNaN;
+    double specificTension = kNaN;
     /// Per channel (torque first), the fit at the estimate (synergist kinds only).
     std::vector<ChannelFit> channelFits;
     int numParameters = 0;                     ///< free parameters of the fit

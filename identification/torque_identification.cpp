@@ -1,4 +1,5 @@
 #include "identification/torque_identification.h"
+#include "basics/numbers.h"
 
 #include "basics/bound.h"
 #include "basics/csv.h"
@@ -24,7 +25,7 @@ MuscleEstimate identifyElbowMethod(const ElbowMethod& method, const Population& 
         e = identifyThesisMethod(population.base, data);
     } else if (method.kind == "synergist") {
         SynergistOptions o = method.options;
-        o.measuredActivation = 0.0 / 0.0;
+        o.measuredActivation = kNaN;
         e = identifySynergistAware(population, data, o);
     } else if (method.kind == "synergist-va") {
         SynergistOptions o = method.options;
@@ -39,7 +40,7 @@ MuscleEstimate identifyElbowMethod(const ElbowMethod& method, const Population& 
         checkField("activation_sd", o.activationSd, Bound{0, 0.5, false, false});
         o.measuredActivation = o.activationSd > 0
                                    ? measureVoluntaryActivation(data, o.activationSd, seed + 7919u * unsigned(subject))
-                                   : 0.0 / 0.0;
+                                   : kNaN;
         o.channels = channels;
         e = identifySynergistAware(population, data, o);
     } else {

@@ -2,6 +2,8 @@
 // studies): the identifiers by name, the set run on a lab's data, residual checks and the CSV tables.
 #pragma once
 
+#include "basics/numbers.h"
+
 #include "identification/synergist_identifier.h"
 #include "identification/thesis_method.h"
 
@@ -12,8 +14,8 @@ namespace armsim {
 
 /// Which identifiers identifyTorqueData runs on one person's torque data (as `armsim identify-torque`).
 struct TorqueIdentificationOptions {
-    double noiseLevel = 0.0 / 0.0;   ///< relative sd of one trial's torque [1]; NaN: estimated from repetitions
-    double activation = 0.0 / 0.0;   ///< measured voluntary activation [1]; NaN: not measured (no synergist-va)
+    double noiseLevel = kNaN;   ///< relative sd of one trial's torque [1]; NaN: estimated from repetitions
+    double activation = kNaN;   ///< measured voluntary activation [1]; NaN: not measured (no synergist-va)
     double activationSd = 0.02;      ///< sd of that measurement [1]
     bool freeSlowFraction = false;   ///< the synergist kinds free the flexors' slow-fibre fractions
     /// Channels besides torque (experiments/channels.h); non-empty: also the "channels" fit.
@@ -36,10 +38,10 @@ std::vector<MuscleEstimate> identifyTorqueData(const Population& prior, const st
 /// the degrees of freedom; the MAP fits' are not (their prior keeps the effective count lower: a
 /// conservative test for them).
 struct TorqueResidualCheck {
-    double rms = 0.0 / 0.0;      ///< of predicted - measured [N m], over the observations it predicts
-    double chiSquare = 0.0 / 0.0;
+    double rms = kNaN;      ///< of predicted - measured [N m], over the observations it predicts
+    double chiSquare = kNaN;
     int n = 0, dof = 0;
-    double p = 0.0 / 0.0;        ///< chi-square tail probability; >= 0.05: consistent with the noise
+    double p = kNaN;        ///< chi-square tail probability; >= 0.05: consistent with the noise
 };
 TorqueResidualCheck checkTorqueResiduals(const std::vector<TorqueObservation>& data, const MuscleEstimate& estimate,
                                          double noiseLevel);

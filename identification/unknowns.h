@@ -2,6 +2,8 @@
 // scales and learning-gain defaults, and the mapping parameter vector <-> MuscleParameters.
 #pragma once
 
+#include "basics/numbers.h"
+
 #include "muscles/virtual_muscle.h"
 
 #include <string>
@@ -37,10 +39,10 @@ struct Unknown {
     ParameterId id = ParameterId::Mass;
     double lower = 0;           ///< lower bound [unit]
     double upper = 0;           ///< upper bound [unit]
-    double start = 0.0 / 0.0;   ///< start value [unit]; NaN: the base muscle's value
-    double scale = 0.0 / 0.0;   ///< solver scale [unit] (inside solvers x / scale is order 1); NaN: |start|
+    double start = kNaN;   ///< start value [unit]; NaN: the base muscle's value
+    double scale = kNaN;   ///< solver scale [unit] (inside solvers x / scale is order 1); NaN: |start|
     double tolerance = 0;       ///< resolution [unit]: false-position bracket width, smallest useful step
-    double gain = 0.0 / 0.0;    ///< ILC learning gain [unit/N] (ilc-standard, ilc-constant); NaN: none
+    double gain = kNaN;    ///< ILC learning gain [unit/N] (ilc-standard, ilc-constant); NaN: none
     double gainMin = 0;         ///< smallest |gain element| [unit/N] (bounded ILC variants)
     double gainMax = 1.0 / 0.0; ///< largest |gain element| [unit/N] (bounded ILC variants)
 };

@@ -4,6 +4,8 @@
 // to anatomy fits.
 #pragma once
 
+#include "basics/numbers.h"
+
 #include "model/model_file.h"
 #include "model/mvc_curve.h"
 
@@ -36,7 +38,7 @@ struct AnatomyTarget {
     MuscleGroup direction = MuscleGroup::Flexor;   ///< mvc: flexion or extension effort
     Effort forearmEffort = Effort::Supination;   ///< forearm_mvc: supination or pronation
     double rotationDeg = 0;       ///< forearm posture [deg] (forearm_mvc, posture_ratio; + = supinated)
-    double flexionDeg = 0.0 / 0.0;///< angle [deg] (moment_arm, mvc, share); NaN for volume, optimum_angle
+    double flexionDeg = kNaN;///< angle [deg] (moment_arm, mvc, share); NaN for volume, optimum_angle
     double lower = 0, upper = 0;  ///< published band, SI (m, N m, m^3, 1, deg)
     double tolerance = 0;         ///< added on both sides of the band before judging (SI, as the band)
     double weight = 1;            ///< in a calibration's objective [1]
@@ -57,8 +59,8 @@ std::vector<AnatomyTarget> loadDefaultAnatomyTargets();
 struct TargetScore {
     AnatomyTarget target;
     std::string muscle;           ///< the model muscle (or family) scored
-    double value = 0.0 / 0.0;     ///< model value, SI; NaN when the model has none (e.g. no optimum in range)
-    double fitValue = 0.0 / 0.0;  ///< value, or where the model's trend puts it beyond the range (what a fit steers by)
+    double value = kNaN;     ///< model value, SI; NaN when the model has none (e.g. no optimum in range)
+    double fitValue = kNaN;  ///< value, or where the model's trend puts it beyond the range (what a fit steers by)
     bool pass = false;            ///< value within [lower - tolerance, upper + tolerance]
 };
 

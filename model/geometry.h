@@ -14,10 +14,19 @@
 
 #include "basics/angles.h"
 
+#include <vector>
+
 namespace armsim {
 
 /// The thesis's MVC elbow angles theta [deg] (6.1.2; assets/protocols/mvc_force_angle.yaml).
 inline constexpr double kThesisMvcAnglesDeg[] = {45, 60, 90, 120, 150};
+/// The same five angles as elbow flexion [deg, 0 = extended], most flexed first (135 .. 30): the
+/// torque protocols' and the elbow validation's default, derived from kThesisMvcAnglesDeg.
+inline std::vector<double> getThesisMvcFlexionDeg() {
+    std::vector<double> flexion;
+    for (double theta : kThesisMvcAnglesDeg) flexion.push_back(180.0 - theta);
+    return flexion;
+}
 /// Flexion angle q (pin coordinate, 0 = extended) from the included elbow angle theta [rad].
 constexpr double flexionFromElbowAngle(double theta) { return kPi - theta; }
 /// Included elbow angle theta (pi = extended) from the flexion angle q [rad].

@@ -46,6 +46,8 @@
 //                                         OpenSim tendon: 3.3 %).
 #pragma once
 
+#include "basics/numbers.h"
+
 #include "model/arm_parameters.h"
 #include "muscles/muscle_models.h"
 #include "muscles/virtual_muscle.h"
@@ -108,7 +110,7 @@ struct PathElementSpec {
     bool winds = false;                 ///< with a side: may wind round by more than half a turn (muscle_path.h)
     /// A via point used only while the forearm rotation is in [min, max] (OpenSim's conditional path
     /// point; `active_rotation_deg: [min, max]`, + = supination) [deg]; both NaN = always.
-    std::array<double, 2> activeRotationDeg{0.0 / 0.0, 0.0 / 0.0};
+    std::array<double, 2> activeRotationDeg{kNaN, kNaN};
     bool isConditional() const { return activeRotationDeg[0] == activeRotationDeg[0]; }
     std::string label;                  ///< "origin", "via 1", "cylinder 2", "insertion"
 };

@@ -2,6 +2,8 @@
 // integration): what `armsim model show` plots and what the elbow calibration fits.
 #pragma once
 
+#include "basics/numbers.h"
+
 #include "model/model_file.h"
 
 #include <string>
@@ -47,7 +49,7 @@ struct MvcGeometry {
 /// posture; ignored without a forearm rotation). Throws InputError for an angle outside the elbow's or
 /// the rotation's range.
 MvcGeometry calcMvcGeometry(const ArmSetup& setup, const std::vector<double>& flexionDeg,
-                            double rotationDeg = 0.0 / 0.0);
+                            double rotationDeg = kNaN);
 
 /// Scratch (data, not model) of the curve functions below for fits that call them many times: the
 /// last steady state of every (angle, muscle) with what it was solved for. A call reuses a state when the
@@ -109,6 +111,6 @@ SteadyMvcCurve calcSteadyMvcCurve(const ArmSetup& setup, MuscleGroup effort, con
 /// The same for an effort (a rotation effort's agonists by their forearm moment arm) in forearm posture
 /// rotationDeg (NaN: the model's).
 SteadyMvcCurve calcSteadyMvcCurve(const ArmSetup& setup, Effort effort, const SubjectEffort& subject,
-                                  const std::vector<double>& flexionDeg, double rotationDeg = 0.0 / 0.0);
+                                  const std::vector<double>& flexionDeg, double rotationDeg = kNaN);
 
 }  // namespace armsim

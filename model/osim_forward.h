@@ -9,6 +9,8 @@
 // `normalized_tendon_force`). Also reads a Forward tool setup file (<ForwardTool>).
 #pragma once
 
+#include "basics/numbers.h"
+
 #include "basics/storage_file.h"
 #include "model/osim_file.h"
 #include "numerics/stiff_ode.h"
@@ -32,7 +34,7 @@ std::string findOsimModelFile(const std::string& nameOrFile, const std::string& 
 
 /// What to run.
 struct OsimForwardSettings {
-    double initialTime = 0.0 / 0.0;   ///< [s]; NaN: the controls' first time
+    double initialTime = kNaN;   ///< [s]; NaN: the controls' first time
     double finalTime = 1.0;           ///< [s]
     double sampleRate = 200;          ///< rows of the states table per second [Hz]
     std::string muscleModel;          ///< "" = each muscle's file type (model/osim_arm.h)

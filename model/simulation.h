@@ -3,6 +3,8 @@
 // read and written between steps, and samples recorded on a fixed grid.
 #pragma once
 
+#include "basics/numbers.h"
+
 #include "basics/angles.h"
 #include "basics/table.h"
 #include "model/muscle_arm.h"
@@ -21,7 +23,7 @@ struct SimulationSettings {
     double elbowVelocity = 0.0;            ///< dtheta/dt at the start, + = extending [rad/s]; 0 when locked
     /// Forearm rotation the radius is locked at [deg], + = supination; NaN = the model's posture. Only for
     /// a model with a forearm rotation (InputError otherwise).
-    double forearmRotationDeg = 0.0 / 0.0;
+    double forearmRotationDeg = kNaN;
     double handLoad = 0.0;                 ///< mass held in the hand [kg]
     double sampleRate = 1000.0;            ///< samples per second of simulated time [Hz]
     /// true: every muscle starts at its steady isometric state for U(0) at its initial path (V = 0);

@@ -21,8 +21,8 @@ struct MvcTorqueTarget {
 };
 
 /// Target for the elbow's flexion MVC: peak 80 N m at 95 deg flexion (centre of the accepted 70-90 N m
-/// at 80-110 deg; Holzbaur et al. 2007 J Biomech 40:2442: 79.5 +/- 8.1 N m at 90 deg, as issue 10
-/// quotes it), falling as a parabola on each side to 55 % of the peak at 20 and 130 deg (the accepted floor is
+/// at 80-110 deg; Holzbaur et al. 2007 J Biomech 40:2442: 79.5 +/- 8.1 N m at 90 deg),
+/// falling as a parabola on each side to 55 % of the peak at 20 and 130 deg (the accepted floor is
 /// 45 %; the thesis's bell-shaped force-angle curve stays above 75 % of its peak between 30 and 135 deg).
 /// Sampled every 10 deg from 20 to 130 deg.
 MvcTorqueTarget getElbowFlexionTarget();

@@ -4,6 +4,8 @@
 // Simbody System, so trials run in parallel threads and give the same numbers as a sequential run.
 #pragma once
 
+#include "basics/numbers.h"
+
 #include "basics/angles.h"
 #include "basics/table.h"
 #include "model/muscle_arm.h"
@@ -56,7 +58,7 @@ struct IsometricTrialSettings {
     double elbowAngle = degToRad(90);  ///< theta, included angle [rad]
     /// Forearm rotation the radius is locked at [deg], + = supination; NaN = the model's posture. Only
     /// for a model with a forearm rotation (InputError otherwise).
-    double forearmRotationDeg = 0.0 / 0.0;
+    double forearmRotationDeg = kNaN;
     double activation = 1.0;       ///< target U of the agonists during the hold [1]
     /// What the subject does: a flexion or an extension effort, or (a model with a forearm rotation) a
     /// supination or a pronation effort, whose agonists turn the forearm that way in the pose.

@@ -1,4 +1,4 @@
-// The Python module armsim._armsim (issue 12): models, steady states, muscle and arm trials and
+// The Python module armsim._armsim: models, steady states, muscle and arm trials and
 // population studies on the C++ libraries, numpy arrays out. SI units and the YAML files' names;
 // errors keep the C++ messages (InputError -> ValueError, a missing file -> FileNotFoundError,
 // SimulationError -> RuntimeError). Long calls release the GIL.

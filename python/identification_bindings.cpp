@@ -12,6 +12,7 @@
 #include "identification/forward_choice.h"
 #include "identification/report_io.h"
 #include "studies/validation.h"
+#include "model/geometry.h"
 #include "python/module_support.h"
 
 #include <cmath>
@@ -465,7 +466,7 @@ py::tuple validateElbowPy(const py::object& population, int subjects, unsigned s
     } else {
         checkField("repetitions", repetitions.value_or(3), Bound::closed(1, 100));
         s.protocol.conditions =
-            TorqueProtocol::makeFlexionMvcs(angles.value_or(std::vector<double>{135, 120, 90, 60, 30}), repetitions.value_or(3));
+            TorqueProtocol::makeFlexionMvcs(angles.value_or(getThesisMvcFlexionDeg()), repetitions.value_or(3));
         s.protocol.validate();
     }
     std::vector<ElbowValidationRow> rows;

@@ -1,4 +1,5 @@
 #include "studies/experiment_design.h"
+#include "basics/numbers.h"
 
 #include "basics/bound.h"
 #include "basics/csv.h"
@@ -19,8 +20,8 @@ namespace armsim {
 
 namespace {
 
-constexpr double kMassGoal = 0.10;     // issue 11: mass RMSE <= 10 %
-constexpr double kTendonGoal = 0.010;  // issue 11: tendon-length RMSE <= 1 cm [m]
+constexpr double kMassGoal = 0.10;     // the design goal: mass RMSE <= 10 %
+constexpr double kTendonGoal = 0.010;  // the design goal: tendon-length RMSE <= 1 cm [m]
 constexpr double kStep = 1e-4;         // central-difference step in x (ln scales and activations)
 constexpr unsigned kMaxRedraws = 100;  // prior draws tried again for one without a steady state
 
@@ -367,7 +368,7 @@ std::vector<TorqueCondition> makeCandidates(const DesignSettings& settings) {
             }
     }
     if (!settings.postures.empty()) {
-        std::vector<double> postures = {0.0 / 0.0};
+        std::vector<double> postures = {kNaN};
         postures.insert(postures.end(), settings.postures.begin(), settings.postures.end());
         for (Effort effort : {Effort::Supination, Effort::Pronation})
             for (double r : postures)
@@ -451,11 +452,11 @@ ProtocolPrediction predictProtocol(const Population& prior, const TorqueProtocol
             counts.push_back(c.repetitions);
         }
     for (const std::string& m : protocol.volumeScan) {
-        rows.push_back(makeRow("volume", m, 0.0 / 0.0, Effort::Flexion, 0));
+        rows.push_back(makeRow("volume", m, kNaN, Effort::Flexion, 0));
         counts.push_back(1);
     }
     if (protocol.anthropometry) {
-        rows.push_back(makeRow("upper_arm_length", "", 0.0 / 0.0, Effort::Flexion, 0));
+        rows.push_back(makeRow("upper_arm_length", "", kNaN, Effort::Flexion, 0));
         counts.push_back(1);
     }
     const bool forearm = protocol.readsForearmTorque();
@@ -512,10 +513,10 @@ DesignResult designChannelProtocol(const Population& prior, const DesignSettings
     for (int m : base.surfaceEmg)
         if (base.muscles[m].group == MuscleGroup::Flexor) {
             volumeRows.push_back({base.muscles[m].params.name, nc + int(rows.size())});
-            rows.push_back(makeRow("volume", base.muscles[m].params.name, 0.0 / 0.0, Effort::Flexion, 0));
+            rows.push_back(makeRow("volume", base.muscles[m].params.name, kNaN, Effort::Flexion, 0));
         }
     const int armRow = nc + int(rows.size());
-    rows.push_back(makeRow("upper_arm_length", "", 0.0 / 0.0, Effort::Flexion, 0));
+    rows.push_back(makeRow("upper_arm_length", "", kNaN, Effort::Flexion, 0));
     const ChannelNoise noise = reference.channelNoise;
     const int total = 2 * settings.draws + 1;
     Sensitivities s = calcSensitivities(prior, result.candidates, settings, [&](int done, int) {
@@ -573,7 +574,7 @@ DesignResult designChannelProtocol(const Population& prior, const DesignSettings
                 consider(ch, cost.ultrasoundAngle, "ultrasound", result.candidates[c]);
             }
         }
-        const TorqueCondition none{0.0 / 0.0, Effort::Flexion, 0, 0};
+        const TorqueCondition none{kNaN, Effort::Flexion, 0, 0};
         bool emgPossible = false;
         for (int c = 0; c < nc; ++c) emgPossible = emgPossible || (chosen.torque[c] > 0 && takesChannels(result.candidates[c]));
         if (!chosen.emg && emgPossible) {

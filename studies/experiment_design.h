@@ -1,4 +1,4 @@
-// Bayesian experiment design for the synergist-aware identifier (issue 11, `armsim design`).
+// Bayesian experiment design for the synergist-aware identifier (`armsim design`).
 //
 // A protocol's expected posterior uncertainty is computed with the Laplace approximation the identifier
 // itself reports: for a parameter vector x, the posterior covariance is
@@ -10,7 +10,7 @@
 // interpolation. The expectation is over `draws` parameter vectors drawn from the identifier's prior
 // (Gaussian, clipped to its bounds, seeded).
 //
-// Criterion (minimised): mean over draws of var(ln M) / g_M^2 + var(ln L0T) / g_T^2 with the issue's
+// Criterion (minimised): mean over draws of var(ln M) / g_M^2 + var(ln L0T) / g_T^2 with the design's
 // goals g_M = 10 % (mass RMSE) and g_T = 1 cm / L0T (tendon RMSE): each width counts relative to its goal.
 // The variances are the identifier's error covariance with the consider parameters (what its fit shares
 // or holds and the population varies: SynergistModel::calcConsideredCovariance) unless
@@ -19,6 +19,8 @@
 // most, until the trial budget is spent or no block lowers it (information adds over trials, so this is the usual greedy
 // approximation to the optimal exact design); a condition picked twice gets twice the repetitions.
 #pragma once
+
+#include "basics/numbers.h"
 
 #include "identification/torque_identification.h"
 
@@ -77,25 +79,25 @@ struct ProtocolPrediction {
     std::string name;
     int trials = 0;
     int drawsUsed = 0;                   ///< prior draws with a steady state at every condition
-    double criterion = 0.0 / 0.0;        ///< as minimised (1 = both widths at their goals) [1]
-    double massSd = 0.0 / 0.0;           ///< RMS over draws of the posterior sd of ln M [1] (~ relative sd of M)
-    double tendonSd = 0.0 / 0.0;         ///< RMS over draws of the posterior sd of L0T [m]
+    double criterion = kNaN;        ///< as minimised (1 = both widths at their goals) [1]
+    double massSd = kNaN;           ///< RMS over draws of the posterior sd of ln M [1] (~ relative sd of M)
+    double tendonSd = kNaN;         ///< RMS over draws of the posterior sd of L0T [m]
     /// RMS posterior sd of the mean of the flexors' ln mass scales (total flexor strength) [1]: small
     /// when the data pin the flexors' sum while massSd stays near the per-muscle prior sd (the split).
-    double flexorStrengthSd = 0.0 / 0.0;
-    double priorFlexorStrengthSd = 0.0 / 0.0;  ///< its prior sd [1]
-    double priorMassSd = 0.0 / 0.0;      ///< the prior's sd of ln M [1]
-    double priorTendonSd = 0.0 / 0.0;    ///< the prior's sd of L0T [m]
+    double flexorStrengthSd = kNaN;
+    double priorFlexorStrengthSd = kNaN;  ///< its prior sd [1]
+    double priorMassSd = kNaN;      ///< the prior's sd of ln M [1]
+    double priorTendonSd = kNaN;    ///< the prior's sd of L0T [m]
     /// massSd and tendonSd with what the fit shares or holds and the truth varies (the identifier's
     /// consider parameters, SynergistModel::calcConsideredCovariance): the widths its intervals report
     /// [1], [m]. NaN where not computed (the greedy search's trial designs).
-    double massSdConsidered = 0.0 / 0.0;
-    double tendonSdConsidered = 0.0 / 0.0;
+    double massSdConsidered = kNaN;
+    double tendonSdConsidered = kNaN;
     /// RMS over draws of the posterior sd of the primary's ln F0 (= ln sigma + ln M - ln L0 + const) [1],
     /// its prior sd, and the same with the consider parameters (NaN where not computed).
-    double maxForceSd = 0.0 / 0.0;
-    double priorMaxForceSd = 0.0 / 0.0;
-    double maxForceSdConsidered = 0.0 / 0.0;
+    double maxForceSd = kNaN;
+    double priorMaxForceSd = kNaN;
+    double maxForceSdConsidered = kNaN;
     std::vector<std::string> parameterNames;
     /// Mean over draws of the posterior correlation of ln M with each parameter.
     std::vector<double> massCorrelation;
@@ -108,7 +110,7 @@ struct DesignStep {
     TorqueCondition condition;           ///< with repetitions = the block (0 for an item of no condition)
     double criterion = 0;                ///< after the pick
     std::string item = "torque";         ///< torque, ultrasound, emg, volume MUSCLE, anthropometry
-    double minutes = 0.0 / 0.0;          ///< its lab minutes (designs across channels)
+    double minutes = kNaN;          ///< its lab minutes (designs across channels)
 };
 
 struct DesignResult {

@@ -1,4 +1,5 @@
 #include "studies/study.h"
+#include "basics/numbers.h"
 
 #include "basics/format.h"
 #include "basics/csv.h"
@@ -36,7 +37,7 @@ std::string toHex(std::uint64_t v) { return fmt::format("{:016x}", v); }
 
 bool parseDouble(const std::string& s, double& v) {
     if (s.empty()) {
-        v = 0.0 / 0.0;
+        v = kNaN;
         return true;
     }
     const char* b = s.data();
@@ -367,7 +368,7 @@ std::vector<StudyResult> runStudyGroup(const Study& study, long group, const std
             r.row.method = m.label;
             r.row.estimate = e;
             r.row.trueMass = r.row.trueTendonLength = r.row.trueMaxForce = r.row.voluntaryActivation =
-                r.row.coContraction = r.row.strengthLevel = 0.0 / 0.0;
+                r.row.coContraction = r.row.strengthLevel = kNaN;
         }
         r.identificationTime = std::chrono::duration<double>(Clock::now() - t1).count();
         out.push_back(std::move(r));
@@ -688,7 +689,7 @@ void StudySummaryAccumulator::add(const StudyResult& r) {
         if (r.status == "skipped") return;
         if (r.status != "failed") return p.stats.add(r.row);
         ElbowValidationRow row = r.row;
-        row.massError = row.tendonError = row.maxForceError = 0.0 / 0.0;
+        row.massError = row.tendonError = row.maxForceError = kNaN;
         return p.stats.add(row);
     }
 }

@@ -1,4 +1,4 @@
-// Population studies (issue 13): Monte Carlo over virtual subjects. A study file names the truth (a
+// Population studies: Monte Carlo over virtual subjects. A study file names the truth (a
 // population of virtual subjects around a model: `population:`, or `truth:` with `prior:`, the
 // population the identifiers assume, for a study out of family; or several truths, `truths:` with
 // `prior:`, each drawn and identified against the same prior), the protocols, the identifiers with their options,

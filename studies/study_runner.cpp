@@ -1,6 +1,7 @@
 // The study's machinery: the output folder (lock, journal, final files), the worker threads of one
 // process, the coordinator (rank 0) and the worker-rank loop. The numbers come from runStudyGroup.
 #include "basics/bound.h"
+#include "basics/numbers.h"
 #include "basics/errors.h"
 #include "basics/files.h"
 #include "basics/output_folder.h"
@@ -525,7 +526,7 @@ void writeTruthHeatMap(const std::string& path, const std::string& title, const 
         spec.y.push_back(double(j));
         spec.yNames.push_back(study.truths[nt - 1 - j].label);
     }
-    spec.z.assign(columns.size() * nt, 0.0 / 0.0);
+    spec.z.assign(columns.size() * nt, kNaN);
     bool any = false;
     for (const StudySummaryRow& r : summary) {
         const std::size_t i = std::size_t(std::find(columns.begin(), columns.end(), columnOf(r)) - columns.begin());
@@ -760,7 +761,7 @@ StudyOutcome runStudy(const Study& study, const StudyRunOptions& options, StudyC
         progress.elapsed = std::chrono::duration<double>(Clock::now() - start).count();
         const long computed = progress.done - progress.resumed;
         progress.rate = progress.elapsed > 0 ? double(computed) / progress.elapsed : 0;
-        progress.remaining = computed > 0 ? double(progress.total - progress.done) / progress.rate : 0.0 / 0.0;
+        progress.remaining = computed > 0 ? double(progress.total - progress.done) / progress.rate : kNaN;
         options.progress(progress);
     };
 

@@ -1,4 +1,5 @@
 #include "studies/torque_validation.h"
+#include "basics/numbers.h"
 
 #include "basics/bound.h"
 #include "basics/csv.h"
@@ -197,7 +198,7 @@ std::vector<ElbowValidationSummary> ElbowValidationAccumulator::getSummaries() c
         s.noise = c.noise;
         s.subjects = c.subjects;
         s.converged = c.converged;
-        s.massBias = s.massRmse = s.tendonBias = s.tendonRmse = 0.0 / 0.0;  // no estimate
+        s.massBias = s.massRmse = s.tendonBias = s.tendonRmse = kNaN;  // no estimate
         if (c.n > 0) {
             s.massBias = c.mb / c.n, s.massRmse = std::sqrt(c.mm / c.n);
             s.tendonBias = c.tb / c.n, s.tendonRmse = std::sqrt(c.tm / c.n);

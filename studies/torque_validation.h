@@ -2,6 +2,8 @@
 // its data synthesized through a protocol, identified with every method, truth beside estimate.
 #pragma once
 
+#include "basics/numbers.h"
+
 #include "identification/torque_identification.h"
 
 #include <functional>
@@ -18,18 +20,18 @@ struct ElbowValidationRow {
     double trueMass = 0, trueTendonLength = 0;   ///< the subject's primary muscle [kg], [m]
     double trueMaxForce = 0;                     ///< its F0 = sigma M / (rho L0) [N]
     MuscleEstimate estimate;
-    double massError = 0.0 / 0.0;      ///< estimate / truth - 1 [1]
-    double tendonError = 0.0 / 0.0;    ///< estimate - truth [m]
+    double massError = kNaN;      ///< estimate / truth - 1 [1]
+    double tendonError = kNaN;    ///< estimate - truth [m]
     int massCovered = -1;              ///< 1/0: truth inside/outside the interval; -1: no interval
     int tendonCovered = -1;
-    double maxForceError = 0.0 / 0.0;  ///< F0 estimate / truth - 1 (methods that estimate F0) [1]
+    double maxForceError = kNaN;  ///< F0 estimate / truth - 1 (methods that estimate F0) [1]
     int maxForceCovered = -1;
     /// The prior's check (ChannelFit "prior"): its chi-square tail probability; NaN without one.
-    double priorCheckP = 0.0 / 0.0;
+    double priorCheckP = kNaN;
     // Nuisance truths, for error-vs-nuisance plots.
     double voluntaryActivation = 0, coContraction = 0, strengthLevel = 0;
-    double bicepsShortScale = 0.0 / 0.0;  ///< second biceps head's mass scale / primary's [1]
-    double synergistScale = 0.0 / 0.0;    ///< mean mass scale of the synergists / primary's [1]
+    double bicepsShortScale = kNaN;  ///< second biceps head's mass scale / primary's [1]
+    double synergistScale = kNaN;    ///< mean mass scale of the synergists / primary's [1]
 };
 
 /// A validation row: the subject's truth beside the estimate.
@@ -43,19 +45,19 @@ struct ElbowValidationSummary {
     int subjects = 0, converged = 0;
     double massBias = 0, massRmse = 0;        ///< relative [1]; NaN when no subject has an estimate
     double tendonBias = 0, tendonRmse = 0;    ///< [m]
-    double maxForceBias = 0.0 / 0.0, maxForceRmse = 0.0 / 0.0;  ///< relative [1]; NaN without F0 estimates
-    double maxForceCoverage = 0.0 / 0.0;
-    double massCoverage = 0.0 / 0.0, tendonCoverage = 0.0 / 0.0;  ///< fraction of subjects [1]
-    double massIntervalWidth = 0.0 / 0.0;     ///< mean 95 % interval width / estimate [1]
-    double tendonIntervalWidth = 0.0 / 0.0;   ///< mean 95 % interval width [m]
+    double maxForceBias = kNaN, maxForceRmse = kNaN;  ///< relative [1]; NaN without F0 estimates
+    double maxForceCoverage = kNaN;
+    double massCoverage = kNaN, tendonCoverage = kNaN;  ///< fraction of subjects [1]
+    double massIntervalWidth = kNaN;     ///< mean 95 % interval width / estimate [1]
+    double tendonIntervalWidth = kNaN;   ///< mean 95 % interval width [m]
     /// Standard errors over the subjects (NaN with fewer than 2): of the bias (the mean), of the RMSE
     /// (delta method) and of the coverage (binomial); a 95 % interval is about +/- 2 of them.
-    double massBiasSe = 0.0 / 0.0, massRmseSe = 0.0 / 0.0, massCoverageSe = 0.0 / 0.0;
-    double tendonBiasSe = 0.0 / 0.0, tendonRmseSe = 0.0 / 0.0, tendonCoverageSe = 0.0 / 0.0;
+    double massBiasSe = kNaN, massRmseSe = kNaN, massCoverageSe = kNaN;
+    double tendonBiasSe = kNaN, tendonRmseSe = kNaN, tendonCoverageSe = kNaN;
     /// Of the estimates with a prior check: the fraction it flags (p < 0.05; about 0.05 when the person
     /// is one of the prior's population) and the mass and L0T coverage of those it passes [1].
-    double priorFlagged = 0.0 / 0.0;
-    double massCoveragePassed = 0.0 / 0.0, tendonCoveragePassed = 0.0 / 0.0;
+    double priorFlagged = kNaN;
+    double massCoveragePassed = kNaN, tendonCoveragePassed = kNaN;
 };
 
 /// Settings of runElbowValidation.

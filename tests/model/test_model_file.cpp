@@ -452,7 +452,7 @@ TEST(ModelFile, SpecificTensionAndVolumeSetF0AndMass) {
     // Bounds in files as on the command line: F0 up to 1e5 N, mass up to 10 kg (the volume's 10 L).
     msg = messageOf(writeTemp("f0_huge.yaml", "name: sigma\narm: arm/default_male.yaml\nmuscles:\n" +
                                                   muscle("m", "    max_isometric_force: 1e9\n")));
-    EXPECT_NE(msg.find("max_isometric_force' = 1e+09: expected in (0, 1e+05] (N)"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("max_isometric_force' (muscles, entry 1) = 1e+09: expected in (0, 1e+05] (N)"), std::string::npos) << msg;
     msg = messageOf(writeTemp("mass_huge.yaml", "name: sigma\narm: arm/default_male.yaml\nmuscles:\n" +
                                                     muscle("m", "    mass: 50\n")));
     EXPECT_NE(msg.find("mass"), std::string::npos) << msg;

@@ -1,5 +1,6 @@
 // Trials on the biceps arm: isometric (locked elbow, transducer, tare) and free movement.
 #include "basics/param_node.h"
+#include "basics/numbers.h"
 #include "model/geometry.h"
 #include "model/model_file.h"
 #include "model/mvc_curve.h"
@@ -313,7 +314,7 @@ TEST(IsometricTrial, ForearmTorqueIsTheRadiusLocksTorque) {
         double deg, rotationDeg;
         Effort effort;
     };
-    for (const Case& c : {Case{90, 0.0 / 0.0, Effort::Flexion}, Case{90, -60, Effort::Supination},
+    for (const Case& c : {Case{90, kNaN, Effort::Flexion}, Case{90, -60, Effort::Supination},
                           Case{60, 30, Effort::Pronation}}) {
         IsometricTrialSettings s = mvcAt(c.deg);
         s.forearmRotationDeg = c.rotationDeg;
