@@ -162,6 +162,24 @@ std::vector<ActivationProfile> IsometricTrialSettings::calcActivationProfiles(co
     return profiles;
 }
 
+TransducerAtAngle::TransducerAtAngle(const ArmParameters& arm, double elbowAngle, double momentArm)
+    : range_(arm.transducerRange), strapDistance_(arm.strapDistance), momentArm_(momentArm),
+      fixedRatioPerNewton_(calcBicepsForceFixedRatio(1.0, elbowAngle, kPi / 2)) {
+    calcBicepsForceFromTorque(0.0, momentArm);   // checks the moment arm
+}
+
+TransducerReading TransducerAtAngle::read(double strapForce, double muscleForce) const {
+    TransducerReading r;
+    r.saturated = std::abs(strapForce) > range_;
+    r.strapForce = r.saturated ? std::copysign(range_, strapForce) : strapForce;
+    r.forceMomentArm = r.strapForce * strapDistance_ / momentArm_;
+    r.forceFixedRatio = r.strapForce * fixedRatioPerNewton_;
+    const double F = muscleForce;
+    r.errorMomentArmPct = F > 0 ? 100 * (r.forceMomentArm - F) / F : NAN;
+    r.errorFixedRatioPct = F > 0 ? 100 * (r.forceFixedRatio - F) / F : NAN;
+    return r;
+}
+
 TransducerReading calcTransducerReading(const ArmParameters& arm, double strapForce, double elbowAngle,
                                         double momentArm, double muscleForce) {
     TransducerReading r;
@@ -229,6 +247,7 @@ IsometricTrialResult runIsometricTrial(const ArmSetup& setup, const IsometricTri
     std::vector<double> forces(n), row;
 
     const bool primaryVelocityIsState = muscles[primary]->hasFascicleVelocityState();
+    const TransducerAtAngle transducer(ap, settings.elbowAngle, h);
     // One sample from y = [q u z]; s is the realized-per-sample reference's State (else null).
     auto sample = [&](double t, const double* y, const State* s) {
         double torque, forearmTorque = 0;
@@ -248,8 +267,7 @@ IsometricTrialResult runIsometricTrial(const ArmSetup& setup, const IsometricTri
         }
         const double F = forces[primary];
         const double muscleTorque = sum.tareTorque - torque;  // tared, + = flexion
-        const TransducerReading r =
-            calcTransducerReading(ap, muscleTorque / ap.strapDistance, settings.elbowAngle, h, F);
+        const TransducerReading r = transducer.read(muscleTorque / ap.strapDistance, F);
         sum.saturated = sum.saturated || r.saturated;
         const double* yp = y + firstState[primary];
         const double Pp = sum.pathLengths[primary];

@@ -151,6 +151,18 @@ struct TransducerReading {
 TransducerReading calcTransducerReading(const ArmParameters& arm, double strapForce, double elbowAngle,
                                         double momentArm, double muscleForce);
 
+/// calcTransducerReading at one elbow angle and moment arm, with the angle's constants checked and
+/// computed once (a locked trial reads the transducer at every sample: per sample only products).
+class TransducerAtAngle {
+public:
+    /// Throws InputError (as calcTransducerReading) for an angle outside (0, 180) deg or a moment arm <= 0.
+    TransducerAtAngle(const ArmParameters& arm, double elbowAngle, double momentArm);
+    TransducerReading read(double strapForce, double muscleForce) const;
+
+private:
+    double range_, strapDistance_, momentArm_, fixedRatioPerNewton_;
+};
+
 /// Runs several isometric trials on `jobs` threads (one System per trial). Results are in input
 /// order and identical to a sequential run. progress(done, total) is called from the caller's thread.
 std::vector<IsometricTrialResult> runIsometricTrials(const ArmSetup& setup,

@@ -118,6 +118,20 @@ TEST(Transducer, ReadingClipsAtTheRangeAndEstimatesTheForce) {
     EXPECT_TRUE(over.saturated);
     EXPECT_EQ(over.strapForce, -a.transducerRange);
     EXPECT_TRUE(std::isnan(calcTransducerReading(a, strap, theta, h, 0).errorMomentArmPct));
+
+    // The per-angle form a locked trial uses reads the same, to rounding, at every angle and force.
+    for (double deg : {30.0, 90.0, 150.0})
+        for (double s : {-2 * a.transducerRange, 0.0, strap, 3 * strap}) {
+            const TransducerReading x = TransducerAtAngle(a, degToRad(deg), h).read(s, F);
+            const TransducerReading y = calcTransducerReading(a, s, degToRad(deg), h, F);
+            EXPECT_EQ(x.saturated, y.saturated);
+            EXPECT_EQ(x.strapForce, y.strapForce);
+            EXPECT_EQ(x.forceMomentArm, y.forceMomentArm);
+            EXPECT_NEAR(x.forceFixedRatio, y.forceFixedRatio, kTol * std::abs(y.forceFixedRatio));
+            EXPECT_NEAR(x.errorFixedRatioPct, y.errorFixedRatioPct, kTol * 100);
+        }
+    EXPECT_THROW(TransducerAtAngle(a, degToRad(90), 0.0), InputError);
+    EXPECT_THROW(TransducerAtAngle(a, degToRad(180), h), InputError);
 }
 
 TEST(IsometricTrial, ParallelAndSequentialRunsGiveIdenticalNumbers) {
