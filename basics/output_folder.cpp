@@ -79,6 +79,11 @@ OutputFolder::OutputFolder(const std::string& outDir, Mode mode, std::string mar
     // needed); a new folder or a whole run is staged beside the target and renamed into place.
     const bool inside = mode_ == Mode::AddFiles && fs::is_directory(target_, ec);
     const fs::path parent = inside ? target_ : target_.has_parent_path() ? target_.parent_path() : fs::path(".");
+    // Folders made here for the staging folder are removed again if the output never appears.
+    for (fs::path p = parent; !p.empty() && !fs::exists(p, ec); p = p.parent_path()) {
+        madeParents_.push_back(p);
+        if (p == p.parent_path()) break;
+    }
     fs::create_directories(parent, ec);
     const std::string stem = inside ? ".armsim" : "." + target_.filename().string();
     removeStaleLeftovers(parent, stem);
@@ -96,7 +101,10 @@ OutputFolder::OutputFolder(const std::string& outDir, Mode mode, std::string mar
 OutputFolder::~OutputFolder() {
     if (temp_.empty()) return;
     std::error_code ec;
-    if (!committed_) fs::remove_all(temp_, ec);
+    if (!committed_) {
+        fs::remove_all(temp_, ec);
+        for (const fs::path& p : madeParents_) fs::remove(p, ec);   // innermost first; only while empty
+    }
     std::lock_guard<std::mutex> lock(liveMutex);
     liveStaging.erase(temp_.string());
 }
@@ -281,10 +289,38 @@ OutputFiles::~OutputFiles() {
     for (const Entry& e : entries_) fs::remove(e.staging, ec);
 }
 
+namespace {
+
+// The same file: one path's file system object is the other's (links, ".."), or both name one path.
+bool isSameFile(const std::string& a, const std::string& b) {
+    std::error_code ec;
+    if (fs::exists(a, ec) && fs::exists(b, ec)) return fs::equivalent(a, b, ec);
+    return fs::absolute(a, ec).lexically_normal() == fs::absolute(b, ec).lexically_normal();
+}
+
+}  // namespace
+
+void OutputFiles::checkNotInput(const std::string& option, const std::string& path) const {
+    for (const Entry& in : inputs_)
+        if (isSameFile(in.target, path))
+            throw InputError(option + " '" + path + "' is the file " + in.option +
+                             " reads: expected a path of its own (the input would be overwritten)");
+}
+
+void OutputFiles::addInput(const std::string& option, const std::string& path) {
+    if (path.empty()) return;
+    for (const Entry& out : entries_)
+        if (isSameFile(out.target, path))
+            throw InputError(out.option + " '" + out.target + "' is the file " + option +
+                             " reads: expected a path of its own (the input would be overwritten)");
+    inputs_.push_back({option, path, ""});
+}
+
 std::string OutputFiles::add(const std::string& option, const std::string& path, bool required) {
     if (path.empty() && required) throw InputError(option + " is empty: expected a file path");
     if (path.empty()) return "";
     if (committed_) throw std::logic_error("OutputFiles::add after commit");
+    checkNotInput(option, path);
     const fs::path target = fs::path(path).lexically_normal();
     std::error_code ec;
     const fs::path absolute = fs::absolute(target, ec).lexically_normal();

@@ -68,6 +68,7 @@ public:
 
 private:
     void removeStaleLeftovers(const std::filesystem::path& parent, const std::string& stem) const;
+    std::vector<std::filesystem::path> madeParents_;   ///< folders the constructor made, innermost first
     void checkReplaceable() const;
     void commitInto();
 
@@ -97,6 +98,9 @@ public:
     /// naming both options when two give the same file, and naming the option when a folder is in the
     /// way or its folder cannot be made.
     std::string add(const std::string& option, const std::string& path, bool required = false);
+    /// Declares a file the command reads (given with `option`): an output on the same file is refused
+    /// (InputError naming both options), before or after this call. An empty path is ignored.
+    void addInput(const std::string& option, const std::string& path);
     /// Runs writer(staging) for a path add() returned; an InputError it throws is reported naming the
     /// option and the file as typed instead of any staging file.
     void writeWith(const std::string& staging, const std::function<void(const std::string& path)>& writer);
@@ -108,7 +112,8 @@ private:
     struct Entry {
         std::string option, target, staging;
     };
-    std::vector<Entry> entries_;
+    std::vector<Entry> entries_, inputs_;
+    void checkNotInput(const std::string& option, const std::string& path) const;
     bool committed_ = false;
 };
 

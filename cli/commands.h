@@ -4,6 +4,7 @@
 // turns into a message and an exit code.
 #pragma once
 
+#include "basics/output_folder.h"
 #include "model/model_file.h"
 #include "muscles/virtual_muscle.h"
 
@@ -34,6 +35,8 @@ struct MuscleOptions {
     std::optional<double> maxPathLength;   ///< override P_max [m]
     std::string muscleModel;               ///< --muscle-model: every muscle's model ("" = the model file's)
     void add(CLI::App& app);
+    /// Declares the files these options read (--muscle, --arm, a --model file) as `files`' inputs.
+    void declareInputs(OutputFiles& files) const;
     /// Adds --muscle-model (only to commands that honour it).
     void addMuscleModel(CLI::App& app);
     /// The model with the overrides applied, validated (errors name the option and value).

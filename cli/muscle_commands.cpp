@@ -3,6 +3,7 @@
 #include "basics/output_folder.h"
 #include "basics/plot.h"
 #include "cli/commands.h"
+#include "basics/files.h"
 #include "model/arm_parameters.h"
 #include "model/muscle_arm.h"
 #include "muscles/muscle_file.h"
@@ -14,6 +15,12 @@
 #include <memory>
 
 namespace armsim::cli {
+
+void MuscleOptions::declareInputs(OutputFiles& files) const {
+    files.addInput("--muscle", file);
+    files.addInput("--arm", armFile);
+    if (isRegularFile(model)) files.addInput("--model", model);
+}
 
 void MuscleOptions::add(CLI::App& app) {
     app.add_option("--model", model, "model: a name under assets/models/ (thesis, elbow) or a model file")
@@ -161,6 +168,7 @@ void addMuscleCommands(CLI::App& app) {
                                  " path lengths: expected at most 1000001");
             if (!(*to >= *from)) throw InputError("--to must not be below --from");
             OutputFiles files;  // both appear at the end, or neither
+            opts->declareInputs(files);
             const std::string csvPath = files.add("--out", *out, true), plotPath = files.add("--plot", *plot);
             const std::shared_ptr<const MuscleModel> built = opts->build();
             const MuscleModel& m = *built;
@@ -224,6 +232,8 @@ void addMuscleCommands(CLI::App& app) {
             checkField("--onset", *onset, Bound::nonNegative("s"));
             checkField("--rise", *rise, Bound::nonNegative("s"));
             OutputFiles files;  // both appear at the end, or neither
+            opts->declareInputs(files);
+            files.addInput("--activation-trace", *trace);
             const std::string csvPath = files.add("--out", *out, true), plotPath = files.add("--plot", *plot);
             const std::shared_ptr<const MuscleModel> built = opts->build();
             const MuscleModel& m = *built;

@@ -167,6 +167,7 @@ void addRegisteredCommands(CLI::App& app) {
         // Every step writes into a staging folder; the results join --out together at the end, or (an
         // error, an interruption) none of them does and the staging folder is removed.
         checkOutputFolder("--out", ctx->outDir);
+        ctx->muscle.loadSetup();   // the model and its options checked before any step prints or writes
         OutputFolder folder(ctx->outDir, OutputFolder::Mode::AddFiles, "manifest.json");  // protocol runs whole
         MainJobContext staged = *ctx;
         staged.outDir = folder.getStagingPath();

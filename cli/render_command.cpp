@@ -76,6 +76,8 @@ void runRenderCommand(const RenderOptions& o) {
         options.insert({{"width", "--width"}, {"height", "--height"}, {"supersample", "--supersample"}});
     runNamingOptions(options, [&] { getRenderPlugin("render").validate(v); });  // before the table is read
     OutputFiles files;  // the video and the still appear together at the end, or neither
+    o.muscle.declareInputs(files);
+    files.addInput("the trial-table argument", o.table);
     v.videoPath = files.add("--out", o.out);
     v.stillPath = files.add("--still", o.still);
 

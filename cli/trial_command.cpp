@@ -55,6 +55,8 @@ int renderVideo(const TrialOptions& o, const std::string& path, const ArmSetup& 
 void runTrialCommand(const TrialOptions& o) {
     // Every output checked and staged before the trial; all appear together at the end, or none.
     OutputFiles files;
+    o.muscle.declareInputs(files);
+    files.addInput("--settings", o.settingsFile);
     const std::string csvPath = files.add("--out", o.out, true), plotPath = files.add("--plot", o.plot),
                       videoPath = files.add("--video", o.video);
 #ifdef ARMSIM_WITH_RENDER
