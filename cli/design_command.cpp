@@ -153,11 +153,13 @@ void runDesign(const DesignOptions& o) {
     if (!channels)  // the reference's lab minutes are not on this axis with channels
         plot.series.push_back({"thesis five angles", {double(reference.trials)}, {reference.criterion}, true, 1});
     out.writeWith("design_criterion.png", [&](const std::string& p) { writePlotPng(p, plot); });
-    out.commit();
-    std::printf("wrote %s, %s/design_predictions.csv, design_steps.csv, design_criterion.png\n", protocolPath.c_str(),
-                o.out.c_str());
-
-    if (o.validateSubjects <= 0) return;
+    // The design's files and its validation appear together at the end, or (an error, a stop) neither.
+    auto commitDesign = [&] {
+        out.commit();
+        std::printf("wrote %s, %s/design_predictions.csv, design_steps.csv, design_criterion.png%s\n",
+                    protocolPath.c_str(), o.out.c_str(), o.validateSubjects > 0 ? ", design_validation.csv" : "");
+    };
+    if (o.validateSubjects <= 0) return commitDesign();
     std::printf("validation of both protocols on %d subjects (seed %u):\n", o.validateSubjects, o.seed);
     CsvText csv({"protocol", "method", "subjects", "converged", "mass_bias_pct", "mass_rmse_pct", "mass_coverage",
                  "mass_interval_width_pct", "tendon_bias_mm", "tendon_rmse_mm", "tendon_coverage",
@@ -197,10 +199,8 @@ void runDesign(const DesignOptions& o) {
     std::printf("  (predicted: %s; the RMSE is the obtained counterpart of the predicted sd)\n",
                 channels ? "the thesis protocol's for synergist-va, the design's for the channels fit"
                          : o.activationSd > 0 ? "synergist-va" : "synergist-aware");
-    OutputFolder validation(o.out, OutputFolder::Mode::AddFiles);
-    validation.write("design_validation.csv", csv.getText());
-    validation.commit();
-    std::printf("wrote %s/design_validation.csv\n", o.out.c_str());
+    out.write("design_validation.csv", csv.getText());
+    commitDesign();
 }
 
 void addDesignCommand(CLI::App& app) {
@@ -228,7 +228,7 @@ void addDesignCommand(CLI::App& app) {
         ->check(CLI::Range(1.0, 10000.0));
     c->add_flag("--free-slow-fraction", o->freeSlowFraction,
                 "the identifier frees the flexors' slow-fibre fractions (biceps heads, synergists)");
-    c->add_option("--trials", o->trials, "budget: total trials")->capture_default_str()->check(CLI::Range(1, 10000));
+    c->add_option("--trials", o->trials, "budget: total trials (at most 100)")->capture_default_str();
     c->add_option("--repetitions", o->repetitions, "trials per picked condition (>= 2 lets the identifier estimate its noise)")
         ->capture_default_str()
         ->check(CLI::Range(1, 100));

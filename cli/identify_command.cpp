@@ -157,6 +157,13 @@ void runIdentify(const IdentifyOptions& o) {
         Unknown& u = findUnknown("--bounds", name);
         u.lower = parseNumber("--bounds " + name + " lower", range.substr(0, colon));
         u.upper = parseNumber("--bounds " + name + " upper", range.substr(colon + 1));
+        // Inside what the parameter may be anywhere else (--mass, a muscle file): basics/bound.h.
+        const Bound* physical = u.id == ParameterId::Mass ? &bounds::kMuscleMass
+                              : u.id == ParameterId::OptimalTendonLength ? &bounds::kTendonLength : nullptr;
+        if (physical) {
+            checkField("--bounds " + name + " lower", u.lower, *physical);
+            checkField("--bounds " + name + " upper", u.upper, *physical);
+        }
     }
     for (const std::string& s : o.starts) {
         const auto [name, value] = splitAssignment("--start", s);
@@ -174,10 +181,27 @@ void runIdentify(const IdentifyOptions& o) {
     io.forceTolerance = o.tolerance;
 
     IdentificationReport r;
-    runNamingOptions({{"options.max_iterations", "--max-iterations"}, {"options.force_tolerance", "--tolerance"},
-                      {"options.force_sd", "--force-sd"}, {"options.relative_force_sd", "--force-sd"},
-                      {"options.starts", "--multistart"}},
-                     [&] { r = runIdentification(pr, io, setup.arm, o.model); });
+    try {
+        runNamingOptions({{"options.max_iterations", "--max-iterations"}, {"options.force_tolerance", "--tolerance"},
+                          {"options.force_sd", "--force-sd"}, {"options.relative_force_sd", "--force-sd"},
+                          {"options.starts", "--multistart"}, {"protocol.sample_rate", "--rate"},
+                          {"protocol.hold", "--hold"}},
+                         [&] { r = runIdentification(pr, io, setup.arm, o.model); });
+    } catch (const FieldError& e) {   // an unknown's field, in the options' words: unknowns.<name>.<what>
+        const std::string& f = e.getField();
+        const auto dot = f.rfind('.');
+        if (f.rfind("unknowns.", 0) != 0 || dot == std::string::npos || dot < 9) throw;
+        const std::string name = f.substr(9, dot - 9), what = f.substr(dot + 1);
+        const bool started = std::any_of(o.starts.begin(), o.starts.end(), [&](const std::string& x) {
+            return x.rfind(name + "=", 0) == 0;
+        });
+        if (what == "lower" || what == "upper") throw InputError("--bounds " + name + " " + what + " " + e.getDetail());
+        if (what == "start")
+            throw InputError((started ? "--start " + name : "the default start of " + name + " (give --start " + name +
+                                                                "=VALUE inside --bounds)") + " " + e.getDetail());
+        if (what == "id") throw InputError("--free " + e.getDetail());
+        throw;
+    }
     std::printf("%s", formatReport(r).c_str());
     for (const std::string& p : writeReportFiles(r, o.out)) std::printf("wrote %s\n", p.c_str());
 }
@@ -209,10 +233,18 @@ void addIdentifyCommand(CLI::App& app) {
     c->add_option("--max-iterations", o->maxIterations, "solver iterations")->capture_default_str();
     c->add_option("--tolerance", o->tolerance, "force tolerance [N] (forces reproduced)")->capture_default_str();
     c->add_option("--subject", o->subject, "keep only this subject's rows (-1: all)")->capture_default_str();
-    c->add_flag("--thesis-cases", o->thesisCases, "rerun the thesis's cases (4.5.1, Tables 7.1-7.3) beside its numbers");
+    c->add_flag("--thesis-cases", o->thesisCases, "rerun the thesis's cases (4.5.1, Tables 7.1-7.3) beside its numbers")
+        ->excludes(c->get_option("data"));
     o->muscle.add(*c);
     c->add_option("--out", o->out, "output directory (report JSON, history CSV, convergence PNG)")->capture_default_str();
-    c->callback([o] { runIdentify(*o); });
+    c->callback([o, c] {
+        // The faithful model's options would be ignored by the steady model.
+        for (const char* option : {"--estimate", "--hold", "--rate", "--no-warm-start"})
+            if (o->model.model == "steady" && c->count(option))
+                throw InputError(std::string(option) + " is an option of the faithful forward model: with --forward "
+                                 "steady (the default) it would be ignored; add --forward faithful or corrected");
+        runIdentify(*o);
+    });
 }
 
 // ---- validate -----------------------------------------------------------------------------------
@@ -457,6 +489,10 @@ void addValidateCommand(CLI::App& app) {
         runNamingOptions({{"angles", "--angles"}}, [&] {   // before any work, in the option's words
             for (double a : o->angles) checkField("angles", a, Bound::closed(0, 180, "deg, 0 = extended"));
         });
+        for (std::size_t i = 0; i < o->methods.size(); ++i)   // a method twice would run and be written twice
+            for (std::size_t j = 0; j < i; ++j)
+                if (o->methods[i] == o->methods[j])
+                    throw InputError("--methods '" + o->methods[i] + "' is listed twice: expected each method once");
         runValidate(*o);
     });
 }

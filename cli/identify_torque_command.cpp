@@ -152,12 +152,14 @@ void addIdentifyTorqueCommand(CLI::App& app) {
                                        : "voluntary activation " + text + ": expected in (0, 1] (a fraction of full drive)";
             },
             "(0, 1]"));
-    c->add_option("--activation-sd", o->activationSd, "sd of that measurement")->capture_default_str()->check(CLI::Range(1e-4, 0.5));
+    c->add_option("--activation-sd", o->activationSd, "sd of that measurement")->capture_default_str()->check(CLI::Range(1e-4, 0.5))
+        ->needs("--activation");
     c->add_option("--channels", o->channels,
                   "channel CSV (docs/channels.md: ultrasound fascicle length and volume, EMG, upper-arm length): adds "
                   "the channels fit");
     c->add_option("--emg-crosstalk", o->emgCrosstalk, "crosstalk c of the EMG measurement model")
-        ->capture_default_str()->check(CLI::Range(0.0, 0.5));
+        ->capture_default_str()->check(CLI::Range(0.0, 0.5))
+        ->needs("--channels");
     c->add_flag("--free-slow-fraction", o->freeSlowFraction, "the synergist fits free the flexors' slow-fibre fractions");
     c->add_option("--out", o->out, "output directory")->capture_default_str();
     c->callback([o] { runIdentifyTorque(*o); });

@@ -220,7 +220,8 @@ void addMuscleCommands(CLI::App& app) {
         c->add_option("--onset", *onset, "activation onset time [s] (0 before it)")->capture_default_str();
         c->add_option("--rise", *rise, "rise time of the activation ramp [s] (0 = step)")->capture_default_str();
         c->add_option("--activation-trace", *trace,
-                      "CSV with columns time_s,activation: a sampled U(t) instead of --activation/--onset");
+                      "CSV with columns time_s,activation: a sampled U(t) instead of --activation/--onset")
+            ->excludes("--activation")->excludes("--onset")->excludes("--rise");
         c->add_option("--duration", settings->duration, "simulated time [s]")->capture_default_str();
         c->add_option("--rate", settings->sampleRate, "output samples per second [Hz]")->capture_default_str();
         c->add_option("--accuracy", settings->integration.accuracy, "integrator relative accuracy")->capture_default_str();
@@ -231,6 +232,14 @@ void addMuscleCommands(CLI::App& app) {
             checkActivation(*U);
             checkField("--onset", *onset, Bound::nonNegative("s"));
             checkField("--rise", *rise, Bound::nonNegative("s"));
+            if (trace->empty() && *U > 0 && !(*onset < settings->duration))
+                throw InputError("--onset " + formatNumber(*onset) + " s is not before the end of the trial (--duration " +
+                                 formatNumber(settings->duration) + " s): expected an onset before the end (the "
+                                 "activation would never start)");
+            runNamingOptions({{"duration", "--duration"}, {"sample_rate", "--rate"}, {"accuracy", "--accuracy"}},
+                             [&] { settings->integration.validate(); checkField("duration", settings->duration,
+                                                                               Bound::positive("s"));
+                                   checkField("sample_rate", settings->sampleRate, Bound::positive("Hz")); });
             OutputFiles files;  // both appear at the end, or neither
             opts->declareInputs(files);
             files.addInput("--activation-trace", *trace);

@@ -174,7 +174,24 @@ void addTrialCommand(CLI::App& app) {
     c->add_option("--out", o->out, "CSV output")->capture_default_str();
     c->add_option("--plot", o->plot, "PNG plot (optional)");
     c->add_option("--video", o->video, "video of the trial (.mp4, H.264), rendered from the written table (optional)");
-    c->callback([o] { runTrialCommand(*o); });
+    // Options that would be ignored are refused: the settings file gives the whole trial, and each
+    // trial type takes its own options.
+    const std::vector<std::string> trialOptions = {"--type", "--angle", "--activation", "--rest", "--rise", "--hold",
+                                                   "--initial-angle", "--initial-velocity", "--onset", "--duration",
+                                                   "--load", "--rate", "--accuracy"};
+    for (const std::string& name : trialOptions) c->get_option("--settings")->excludes(c->get_option(name));
+    c->callback([o, c] {
+        const bool free = o->type == "free";
+        for (const char* name : {"--angle", "--rest", "--hold"})
+            if (free && c->count(name) > 0)
+                throw InputError(std::string(name) + " is an isometric trial's option: with --type free it would be "
+                                 "ignored (the free trial starts at --initial-angle)");
+        for (const char* name : {"--initial-angle", "--initial-velocity", "--onset", "--duration", "--load"})
+            if (!free && c->count(name) > 0)
+                throw InputError(std::string(name) + " is a free movement's option: the isometric trial (the default "
+                                 "--type) would ignore it; add --type free");
+        runTrialCommand(*o);
+    });
 }
 
 /// Main job: MVC at the thesis's five angles, in parallel.

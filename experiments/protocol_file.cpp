@@ -42,6 +42,13 @@ std::vector<double> requireNonEmpty(const ParamNode& n, const std::string& key, 
                                     const char* what) {
     if (v.empty())
         throw InputError(n.where(key) + ": field " + describeField(n.path(key)) + " is empty: expected at least one " + what);
+    // A value twice would be one condition run twice under one name (its trial files overwritten).
+    for (std::size_t i = 0; i < v.size(); ++i)
+        for (std::size_t j = 0; j < i; ++j)
+            if (v[i] == v[j])
+                throw InputError(n.where(key) + ": field " + describeField(n.path(key) + "[" + std::to_string(i) + "]") +
+                                 " = " + formatNumber(v[i]) + " is also entry " + std::to_string(j + 1) +
+                                 ": expected each " + what + " once (repeat conditions with `repetitions:`)");
     return v;
 }
 

@@ -50,7 +50,7 @@ void ArmParameters::validate() const {
                    Bound{0, 1e3, true, false, "a direction"});
         for (double c : r.axisPoint) checkField("forearm_rotation.axis_point", c, Bound::closed(-1, 1, "m"));
     }
-    checkField("gravity", gravity, Bound::nonNegative("m/s^2"));
+    checkField("gravity", gravity, Bound::closed(0, 100, "m/s^2; Earth 9.81, 0 for none"));
     checkField("hand_load", handLoad, bounds::kHandLoad);   // as a trial's hand_load
 }
 

@@ -6,6 +6,7 @@
 #include <Eigen/Dense>
 
 #include <algorithm>
+#include <cstdio>
 #include <cfloat>
 #include <cmath>
 #include <limits>
@@ -24,8 +25,21 @@ void IntegrationSettings::validate() const {
         checkField("max_step", maxStepSize, Bound{kMinStepSize, 1e300, false, false, "s, 0 or at least the 1e-12 s minimum step"});
 }
 
+namespace {
+std::string shortNumber(double v) {   // 3 significant digits, for a message
+    char text[32];
+    std::snprintf(text, sizeof text, "%.3g", v);
+    return text;
+}
+}  // namespace
+
 long calcNumSamples(double duration, double sampleRate) {
     const double n = std::round(duration * sampleRate) + 1;
+    if (duration > 0 && n < 2)   // the run would keep its start only: its end silently dropped
+        throw InputError("duration " + formatNumber(duration) + " s x sample_rate " + formatNumber(sampleRate) +
+                         " Hz = " + formatNumber(std::stod(shortNumber(duration * sampleRate))) +
+                         " samples after the start: expected at least one (raise the sample rate to " +
+                         shortNumber(1 / duration) + " Hz or more)");
     if (!(n <= kMaxSamples))
         throw InputError("duration " + formatNumber(duration) + " s x sample_rate " + formatNumber(sampleRate) +
                          " Hz = " + formatNumber(n) + " samples: expected at most " + formatNumber(kMaxSamples) +

@@ -421,8 +421,19 @@ void DesignSettings::validate() const {
     for (double q : flexionDeg) checkField("angles", q, Bound::closed(0, 180, "deg, 0 = extended"));
     for (double l : levels) checkField("levels", l, Bound::open(0, 1, "fraction of maximal, in (0, 1)"));
     for (double r : postures) checkField("postures", r, Bound::closed(-90, 90, "deg, + = supination"));
+    // A candidate given twice would be one condition listed twice in the designed protocol.
+    auto once = [](const std::vector<double>& v, const char* field) {
+        for (std::size_t i = 0; i < v.size(); ++i)
+            for (std::size_t j = 0; j < i; ++j)
+                if (v[i] == v[j])
+                    throw FieldError(field, "= " + formatNumber(v[i]) + " is listed twice: expected each value once");
+    };
+    once(flexionDeg, "angles");
+    once(levels, "levels");
+    once(postures, "postures");
     checkField("repetitions", repetitions, Bound::closed(1, 100));
-    checkField("trials", trials, Bound{double(repetitions), 10000, false, false, "at least one block of repetitions"});
+    // At most 100 trials: every pick may fall on one condition, whose repetitions a torque protocol bounds at 100.
+    checkField("trials", trials, Bound{double(repetitions), 100, false, false, "at least one block of repetitions, at most 100"});
     checkField("draws", draws, Bound::closed(1, 100000));
     checkField("activation_sd", activationSd, Bound::closed(0, 0.5));
     checkField("jobs", jobs, Bound::closed(1, 1024));
