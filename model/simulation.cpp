@@ -204,7 +204,7 @@ IntegrationStats ArmSimulation::advanceTo(double t) {
         throw FieldError("time_s", "= " + formatNumber(t) + " s: expected a time at or after the simulation's (" +
                                      formatNumber(now) + " s)");
     const double rate = settings_.sampleRate, eps = 1e-9 / rate;
-    calcNumSamples(t - now, rate);  // refuses a run of more samples than a table may hold
+    if ((t - now) * rate >= 0.5) calcNumSamples(t - now, rate);  // refuses more samples than a table may hold
     const IntegrationStats before = stats_;
     const State start = *state_;
     const int rows = samples_.getNumRows();
@@ -221,7 +221,8 @@ IntegrationStats ArmSimulation::advanceTo(double t) {
             integrate(end - at, 1.0 / (end - at));
             at = getTime();
         }
-        if (t - at > eps) integrate(t - at, rate);
+        // Shorter than half a sample interval: no grid point inside, one step to t (its end is not recorded).
+        if (t - at > eps) integrate(t - at, (t - at) * rate < 0.5 ? 1.0 / (t - at) : rate);
     } catch (...) {
         *state_ = start;
         samples_.truncateRows(rows);

@@ -270,3 +270,27 @@ TEST_F(OutputFolderTest, AddFilesReplacesARunInsideWhole) {
     EXPECT_TRUE(fs::exists(target / "run" / "a.csv"));
     EXPECT_EQ(countEntries(target), 3);
 }
+
+// A new folder several levels down: the levels made for its staging folder go again when the output
+// never appears (an error or a stop before commit), and stay when it does.
+TEST_F(OutputFolderTest, FoldersMadeForAnOutputThatNeverAppearsAreRemoved) {
+    {
+        OutputFolder f((root / "a" / "b" / "run").string(), OutputFolder::Mode::ReplaceRun);
+        f.write("x.txt", "x");
+        EXPECT_TRUE(fs::is_directory(root / "a" / "b"));
+    }   // not committed
+    EXPECT_FALSE(fs::exists(root / "a")) << "the folders made for the staging folder were left";
+    {
+        OutputFolder f((root / "a" / "b" / "run").string(), OutputFolder::Mode::ReplaceRun);
+        f.write("x.txt", "x");
+        f.commit();
+    }
+    EXPECT_TRUE(fs::exists(root / "a" / "b" / "run" / "x.txt"));
+    {   // a folder the user made, or that holds something else, is not removed
+        fs::create_directories(root / "c");
+        std::ofstream(root / "c" / "keep.txt") << "k";
+        OutputFolder f((root / "c" / "d" / "run").string(), OutputFolder::Mode::ReplaceRun);
+    }
+    EXPECT_TRUE(fs::exists(root / "c" / "keep.txt"));
+    EXPECT_FALSE(fs::exists(root / "c" / "d"));
+}

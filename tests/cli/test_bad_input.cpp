@@ -360,6 +360,52 @@ std::vector<BadInput> makeCatalogue() {
          {"none.yaml"}},
         {"MuscleSweepFromAboveTo", {}, "muscle sweep --from 0.4 --to 0.3 --out OUT/s.csv", {"--to", "--from"}},
         {"MainJobJobsZero", {}, "run --jobs 0 --out OUT/r", {"--jobs", "0"}},
+
+        // ---- a second sweep (421 probes): inputs overwritten, options ignored, work that keeps nothing ----
+        {"TrialOutIsTheSettings", {{"s.yaml", "type: isometric\nhold: 0.3\n"}}, "trial --settings IN/s.yaml --out IN/s.yaml",
+         {"--out", "s.yaml' is the file --settings reads", "would be overwritten"}},
+        {"MuscleTrialOutIsTheTrace", {{"u.csv", "time_s,activation\n0,0\n0.5,1\n"}},
+         "muscle trial --activation-trace IN/u.csv --duration 0.5 --out IN/u.csv", {"is the file --activation-trace reads"}},
+        {"SweepOutIsTheMuscleFile", {{"m.yaml", muscle}}, "muscle sweep --muscle IN/m.yaml --out IN/m.yaml",
+         {"is the file --muscle reads"}},
+        {"RenderStillIsTheTable", {{"t.csv", "time_s\n0\n"}}, "render IN/t.csv --still-at 0.1 --still IN/t.csv",
+         {"--still", "is the file the trial-table argument reads"}},
+        {"TrialSettingsWithAnOption", {{"s.yaml", "type: isometric\nhold: 0.3\n"}}, "trial --settings IN/s.yaml --angle 60 --out OUT/t.csv",
+         {"--settings excludes --angle"}},
+        {"FreeTrialWithAnIsometricOption", {}, "trial --type free --angle 60 --out OUT/f.csv", {"--angle is an isometric trial's option"}},
+        {"IsometricTrialWithAFreeOption", {}, "trial --load 5 --out OUT/t.csv", {"--load is a free movement's option", "--type free"}},
+        {"MuscleTrialTraceWithActivation", {{"u.csv", "time_s,activation\n0,0\n0.5,1\n"}},
+         "muscle trial --activation-trace IN/u.csv --activation 0.5 --out OUT/t.csv", {"--activation excludes --activation-trace"}},
+        {"MuscleTrialOnsetAfterTheEnd", {}, "muscle trial --onset 5 --duration 0.2 --out OUT/t.csv",
+         {"--onset 5 s", "--duration 0.2 s", "before the end"}},
+        {"TrialRateKeepsOnlyTheStart", {}, "trial --rate 0.1 --hold 1 --rest 0.5 --out OUT/t.csv",
+         {"sample_rate 0.1 Hz", "samples after the start: expected at least one"}},
+        {"IdentifyDataWithThesisCases", {}, "identify measured/thesis_measured.csv --thesis-cases --out OUT/id", {"excludes --thesis-cases"}},
+        {"IdentifyFaithfulOptionWithSteady", {}, "identify measured/thesis_measured.csv --estimate fixed-ratio --out OUT/id",
+         {"--estimate is an option of the faithful forward model", "--forward steady"}},
+        {"IdentifyBoundsBeyondTheMassBound", {}, "identify measured/thesis_measured.csv --bounds mass=0.2:100 --out OUT/id",
+         {"--bounds mass upper = 100", "(0, 10] (kg)"}},
+        {"IdentifyDefaultStartOutsideBounds", {}, "identify measured/thesis_measured.csv --bounds mass=0.1:0.3 --out OUT/id",
+         {"the default start of mass", "--start mass=VALUE"}},
+        {"IdentifyForceDataTooManyRows", {{"d.csv", [] {
+             std::string t = "angle_deg,force_N,trial\n";
+             for (int i = 0; i < 1001; ++i) t += std::to_string(45 + i % 100) + ",400," + std::to_string(i) + "\n";
+             return t;
+         }()}}, "identify IN/d.csv --out OUT/id", {"d.csv: 1001 data rows", "at most 1000"}},
+        {"TorqueActivationSdWithoutActivation", {}, "identify-torque measured/thesis_mvc_torque.csv --activation-sd 0.3 --out OUT/it",
+         {"--activation-sd requires --activation"}},
+        {"TorqueCrosstalkWithoutChannels", {}, "identify-torque measured/thesis_mvc_torque.csv --emg-crosstalk 0.3 --out OUT/it",
+         {"--emg-crosstalk requires --channels"}},
+        {"ProtocolVideoOptionWithoutVideo", {}, "protocol protocols/mvc_force_angle.yaml --video-width 3 --out OUT/run",
+         {"--video-width requires --video"}},
+        {"ProtocolRepeatedAngle", {{"p.yaml", kProtocolHead + kTrial + "conditions:\n  elbow_angles_deg: [90, 60, 90]\n"}},
+         "protocol IN/p.yaml --out OUT/run", {"p.yaml:12", "(entry 3) = 90 is also entry 1", "repetitions"}},
+        {"DesignRepeatedAngle", {}, "design --angles 90,90 --out OUT/d", {"--angles = 90 is listed twice"}},
+        {"DesignTrialsBeyondAProtocol", {}, "design --trials 10000 --out OUT/d", {"--trials = 10000", "at most 100"}},
+        {"ValidateMethodTwice", {}, "validate --methods lm,lm --seeds 0 --noise 0 --out OUT/v", {"--methods 'lm' is listed twice"}},
+        {"ArmFileGravityHuge", {{"a.yaml", replaceAll(arm, "gravity: 9.80665", "gravity: 1.0e6")}},
+         "trial --arm IN/a.yaml --hold 0.2 --out OUT/t.csv", {"a.yaml:", "'gravity' = 1e+06", "[0, 100]"}},
+        {"MainJobBadModelWritesNothing", {{"m.yaml", "name: m\n"}}, "run --model IN/m.yaml --out OUT/r", {"m.yaml:1", "'arm'"}},
     };
 }
 
