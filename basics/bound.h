@@ -32,6 +32,7 @@ constexpr Bound kHandLoad{0, 50, false, false, "kg"};   ///< a load held in the 
 constexpr Bound kMuscleMass{0, 10, true, false, "kg"};  ///< a muscle's mass (10 L; the largest muscles ~1 kg)
 constexpr Bound kTendonLength{0, 2, true, false, "m"};  ///< a muscle's optimal tendon length L0T
 constexpr Bound kMotorUnits{0, 1000, false, false, ""}; ///< motor units of one fibre type
+constexpr Bound kMaxIsometricForce{0, 1e5, true, false, "N"};  ///< a muscle's F0 (the strongest ~10 kN)
 }  // namespace bounds
 
 /// Throws FieldError naming field, value and bound unless value is finite and inside bound.

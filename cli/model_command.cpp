@@ -94,8 +94,10 @@ void addModelCommands(CLI::App& app) {
                       "an OpenSim model's coordinate to sweep (default: its only moving one)");
         c->callback([=] {
             checkOutputFolder("--out", *out);
-            if (!(*step > 0 && *step <= 90))   // before any folder is made
-                throw InputError("--step = " + formatNumber(*step) + " deg: expected in (0, 90] (the angle step)");
+            if (!(*step >= 0.01 && *step <= 90))   // before any folder is made; 0.01 deg: at most ~14000 angles
+                throw InputError("--step = " + formatNumber(*step) + " deg: expected in [0.01, 90] (the angle step" +
+                                 (*step > 0 && *step < 0.01 ? ", " + std::to_string(long(std::floor(140 / *step))) +
+                                                                  " angles over the elbow's range)" : std::string(")")));
             // An OpenSim model: a file ending .osim, or a shipped name with only an .osim file.
             const bool isOsim = (name->size() > 5 && name->compare(name->size() - 5, 5, ".osim") == 0) ||
                                 (name->find('/') == std::string::npos &&

@@ -36,8 +36,8 @@ std::vector<MvcTorqueReference> readMvcReferences(const ParamNode& root, const s
 }
 
 std::vector<double> calcAngles(const ArmSetup& setup, double stepDeg) {
-    if (!(stepDeg > 0 && stepDeg <= 90))
-        throw InputError("--step = " + formatNumber(stepDeg) + " deg: expected in (0, 90] (the angle step)");
+    if (!(stepDeg >= 0.01 && stepDeg <= 90))
+        throw InputError("--step = " + formatNumber(stepDeg) + " deg: expected in [0.01, 90] (the angle step)");
     const double lo = setup.arm.getMinFlexionDeg(), hi = setup.arm.getMaxFlexionDeg();
     std::vector<double> q;
     for (int k = 0; lo + k * stepDeg < hi - 1e-9; ++k) q.push_back(lo + k * stepDeg);

@@ -1,5 +1,6 @@
 #include "model/osim_file.h"
 
+#include "basics/bound.h"
 #include "basics/files.h"
 #include "basics/format.h"
 
@@ -456,12 +457,13 @@ private:
             mu.tendonSlackLength = number(f, "tendon_slack_length");
             mu.pennationAngleAtOptimal = number(f, "pennation_angle_at_optimal", false, 0);
             mu.maxContractionVelocity = number(f, "max_contraction_velocity", false, 10);
-            auto positive = [&](const char* tag, double v) {
-                if (!(v > 0)) fail(child(f, tag), std::string(tag) + " " + formatNumber(v) + ": expected > 0");
+            // The bounds an armsim model file has (basics/bound.h).
+            auto within = [&](const char* tag, double v, const Bound& b) {
+                if (!b.contains(v)) fail(child(f, tag), std::string(tag) + " " + formatNumber(v) + ": expected " + b.describe());
             };
-            positive("max_isometric_force", mu.maxIsometricForce);
-            positive("optimal_fiber_length", mu.optimalFiberLength);
-            positive("tendon_slack_length", mu.tendonSlackLength);
+            within("max_isometric_force", mu.maxIsometricForce, bounds::kMaxIsometricForce);
+            within("optimal_fiber_length", mu.optimalFiberLength, bounds::kTendonLength);
+            within("tendon_slack_length", mu.tendonSlackLength, bounds::kTendonLength);
             for (const std::string& p : props->second)
                 if (f->FirstChildElement(p.c_str())) mu.properties[p] = number(f, p.c_str());
             if (const std::string mode = text(f, "tendon_compliance_dynamics_mode"); !mode.empty() && mode != "explicit")

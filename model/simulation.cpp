@@ -36,13 +36,7 @@ void SimulationSettings::validate(const ArmParameters& arm) const {
     if (lockedElbow && elbowVelocity != 0)
         throw FieldError("elbow_velocity_degps", "= " + formatNumber(cleanDegrees(elbowVelocity)) +
                                                      " deg/s on a locked elbow: expected 0");
-    if (!std::isnan(forearmRotationDeg)) {
-        if (!arm.forearmRotation.enabled)
-            throw FieldError("rotation_deg", "= " + formatNumber(forearmRotationDeg) +
-                                                 ": this model has no forearm rotation (expected none)");
-        checkField("rotation_deg", forearmRotationDeg,
-                   Bound::closed(arm.forearmRotation.minDeg, arm.forearmRotation.maxDeg, "deg"));
-    }
+    checkForearmRotationDeg("rotation_deg", forearmRotationDeg, arm);
     checkField("hand_load", handLoad, bounds::kHandLoad);
     checkField("sample_rate", sampleRate, Bound::closed(1e-3, 1e6, "Hz"));
     integration.validate();

@@ -98,15 +98,16 @@ std::vector<ActivationProfile> readActivationProfiles(const ArmSetup& setup, con
 
 // ---- Isometric ----------------------------------------------------------------------------------
 
+void checkForearmRotationDeg(const std::string& field, double deg, const ArmParameters& arm) {
+    if (std::isnan(deg)) return;
+    if (!arm.forearmRotation.enabled)
+        throw FieldError(field, "= " + formatNumber(deg) + ": the model's arm has no forearm rotation (expected none)");
+    checkField(field, deg, Bound::closed(arm.forearmRotation.minDeg, arm.forearmRotation.maxDeg, "deg, + = supination"));
+}
+
 void IsometricTrialSettings::validate(const ArmParameters& arm) const {
     checkElbowAngle("elbow_angle_deg", elbowAngle, arm);
-    if (!std::isnan(forearmRotationDeg)) {
-        if (!arm.forearmRotation.enabled)
-            throw FieldError("forearm_rotation_deg", "= " + formatNumber(forearmRotationDeg) +
-                                                         ": the model's arm has no forearm rotation (expected none)");
-        checkField("forearm_rotation_deg", forearmRotationDeg,
-                   Bound::closed(arm.forearmRotation.minDeg, arm.forearmRotation.maxDeg, "deg, + = supination"));
-    }
+    checkForearmRotationDeg("forearm_rotation_deg", forearmRotationDeg, arm);
     const double angleDeg = cleanDegrees(elbowAngle);
     if (angleDeg >= 180)  // the straight-line biceps passes through the joint there
         throw FieldError("elbow_angle_deg", "= " + formatNumber(angleDeg) +

@@ -214,6 +214,10 @@ struct FreeMovementSettings {
 /// muscles, then the muscle states.
 Table runFreeMovement(const ArmSetup& setup, const FreeMovementSettings& settings, IntegrationStats* stats = nullptr);
 
+/// Throws FieldError naming `field` unless deg (a forearm rotation [deg], + = supination; NaN: none given)
+/// is NaN or inside the arm's forearm-rotation range (an arm without one takes none).
+void checkForearmRotationDeg(const std::string& field, double deg, const ArmParameters& arm);
+
 /// Integrates a free arm (FreeMovementSolver::MuscleBlocks) from `state` for `duration` seconds; on return
 /// `state` is the end state (realized to Stage::Time). sample gets a State realized to Stage::Time at
 /// state.getTime() + k / sampleRate, the start included. checkPartial: as

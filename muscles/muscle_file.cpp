@@ -173,7 +173,7 @@ void readMuscleFields(const ParamNode& root, MuscleParameters& p, bool required,
         p.mass = root.getNumber("volume", Bound{0, 0.01, true, false, "m^3"}) * p.coefficients.density;
     if (root.has("max_isometric_force")) {
         // A human muscle's F0 is a few kN at most (quadriceps heads in OpenSim models: under 5 kN).
-        const double F0 = root.getNumber("max_isometric_force", Bound{0, 1e5, true, false, "N"});
+        const double F0 = root.getNumber("max_isometric_force", bounds::kMaxIsometricForce);
         p.mass = F0 * p.optimalFascicleLength * p.coefficients.density / p.coefficients.sigma;
     }
     if (root.has("tendon_slack_length")) {

@@ -278,7 +278,7 @@ TEST(Cli, ModelShowWritesTablesAndPlots) {
 
     const CommandResult bad = runArmsim("model show --model elbow --step 0 --out " + d.string());
     EXPECT_NE(bad.exitCode, 0);
-    EXPECT_NE(bad.output.find("--step = 0 deg: expected in (0, 90]"), std::string::npos) << bad.output;
+    EXPECT_NE(bad.output.find("--step = 0 deg: expected in [0.01, 90]"), std::string::npos) << bad.output;
 }
 
 // A protocol without maximal efforts leaves synergist-va without its twitch-interpolation measurement:
