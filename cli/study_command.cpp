@@ -1,6 +1,7 @@
 // armsim study STUDY.yaml: a population study on threads, or over MPI ranks under mpirun.
 #include "basics/errors.h"
 #include "cli/commands.h"
+#include "basics/format.h"
 #include "cli/plugins.h"
 #include "studies/study.h"
 #include "studies/study_mpi.h"
@@ -86,8 +87,8 @@ void runStudyCommand(const StudyOptions& o) {
     } else {
         const Study study = readStudy(o.file);
         if (!isQuiet())   // the size before the work: a study of millions of tasks says so at once
-            std::fprintf(stderr, "study '%s': %s, about %.3g GB of journal and results\n", study.name.c_str(),
-                         study.describeSize().c_str(), double(study.getNumTasks()) * kStudyBytesPerTask / 1e9);
+            std::fprintf(stderr, "study '%s': %s, about %s of journal and results\n", study.name.c_str(),
+                         study.describeSize().c_str(), formatBytes(double(study.getNumTasks()) * kStudyBytesPerTask).c_str());
         done.emplace(study, runStudy(study, run));
     }
     const Study& study = done->first;

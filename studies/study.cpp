@@ -756,10 +756,9 @@ void checkStudyFitsOnDisk(const Study& study, long tasksToCompute, const std::st
     const double need = double(tasksToCompute) * kStudyBytesPerTask;
     if (need > double(space.available))
         throw InputError("study '" + study.name + "': " + study.describeSize() + ", " + std::to_string(tasksToCompute) +
-                         " to compute, need about " + fmt::format("{:.3g}", need / 1e9) + " GB for the journal and " +
+                         " to compute, need about " + formatBytes(need) + " for the journal and " +
                          "results (" + fmt::format("{:.0f}", kStudyBytesPerTask) + " B a task); " + at.string() +
-                         " has " + fmt::format("{:.3g}", double(space.available) / 1e9) +
-                         " GB free: expected a smaller study (subjects, noise levels, methods) or more space");
+                         " has " + formatBytes(double(space.available)) + " free: expected a smaller study (subjects, noise levels, methods) or more space");
 }
 
 }  // namespace armsim

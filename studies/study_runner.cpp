@@ -709,6 +709,11 @@ StudyOutcome runStudy(const Study& study, const StudyRunOptions& options, StudyC
         throw InputError("study: a shard (--shard) runs on its own threads: not with --merge or MPI ranks");
     // A new folder is checked before it is made (nothing left behind); an existing one for what it lacks, below.
     const bool existed = std::filesystem::exists(outcome.output);
+    if (options.merge && options.restart)
+        throw InputError("study: --merge with --restart: --restart discards the journals --merge would merge; give one");
+    if (options.merge && !existed)   // nothing made: a folder with only a lock would be left
+        throw InputError("study output '" + outcome.output + "': --merge: the folder does not exist, so there is "
+                         "nothing to merge (run the shards with --shard I/N into it first)");
     if (!options.merge && !existed) checkStudyFitsOnDisk(study, study.getNumTasks() / std::max(1, options.shards), outcome.output);
     StudyFolder folder(outcome.output, fingerprint, study, options.restart, options.shard, options.shards);
     outcome.journalDrops = folder.getDropped();

@@ -410,6 +410,10 @@ std::vector<BadInput> makeCatalogue() {
         {"ValidateMethodTwice", {}, "validate --methods lm,lm --seeds 0 --noise 0 --out OUT/v", {"--methods 'lm' is listed twice"}},
         {"ArmFileGravityHuge", {{"a.yaml", replaceAll(arm, "gravity: 9.80665", "gravity: 1.0e6")}},
          "trial --arm IN/a.yaml --hold 0.2 --out OUT/t.csv", {"a.yaml:", "'gravity' = 1e+06", "[0, 100]"}},
+        {"StudyMergeWithoutAFolder", {{"s.yaml", kStudyHead + "methods:\n  - {method: thesis}\n"}}, "study IN/s.yaml --merge --out OUT/s",
+         {"--merge: the folder does not exist", "nothing to merge"}},
+        {"StudyMergeWithRestart", {{"s.yaml", kStudyHead + "methods:\n  - {method: thesis}\n"}},
+         "study IN/s.yaml --merge --restart --out OUT/s", {"--merge with --restart"}},
         {"MainJobBadModelWritesNothing", {{"m.yaml", "name: m\n"}}, "run --model IN/m.yaml --out OUT/r", {"m.yaml:1", "'arm'"}},
     };
 }
