@@ -213,7 +213,8 @@ void writePlotPng(const std::string& path, const PlotSpec& spec) {
             legendScale = std::min(1.0, std::max(0.55, (maxMm / charHeight - 4.0) / (kCharWidth * double(longest))));
             legendMm = charHeight * (4.0 + legendScale * kCharWidth * double(longest));
         }
-        const double plotRight = longest > 0 ? std::min(vx1, 0.985 - legendMm / pageMm) : vx1;
+        // The axes keep at least 30 % of the page: a longer label runs past the page's edge instead.
+        const double plotRight = longest > 0 ? std::min(vx1, std::max(vx0 + 0.3, 0.985 - legendMm / pageMm)) : vx1;
         plvpor(vx0, plotRight, vy0, vy1);
         plwind(x0, x1, y0, y1);
         plcol0(1);

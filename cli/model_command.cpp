@@ -17,6 +17,8 @@
 #include <cmath>
 #include <cstdio>
 #include <memory>
+#include <string>
+#include <vector>
 
 namespace armsim::cli {
 
@@ -51,6 +53,17 @@ void showModel(const ArmSetup& setup, const std::string& out, double step, const
 void checkModel(const ArmSetup& setup, const std::vector<AnatomyTarget>& targets, const std::string& out) {
     const ModelCheckResult r = writeModelCheck(setup, targets, out);
     std::printf("model %s against %zu targets:\n", setup.name.c_str(), targets.size());
+    // Targets of muscles this model lacks are not scored (one target file serves several models): said, not silent.
+    std::vector<std::string> unscored;
+    for (const AnatomyTarget& t : targets) {
+        bool found = false;
+        for (const TargetScore& s : r.scores)
+            found = found || (s.target.where == t.where && s.target.muscle == t.muscle);
+        if (!found) unscored.push_back(t.where + (t.muscle.empty() ? "" : " (" + t.muscle + ")"));
+    }
+    if (!unscored.empty())
+        std::printf("  not scored: %zu targets the model has nothing for (no such muscle, or no forearm rotation): %s%s\n",
+                    unscored.size(), unscored.front().c_str(), unscored.size() > 1 ? ", ..." : "");
     for (const ScoreSummary& s : r.summary)
         std::printf("  %-14s %-9s %3d of %3d pass\n", getTargetKindName(s.kind), s.muscle.empty() ? "all" : s.muscle.c_str(),
                     s.passed, s.scored);

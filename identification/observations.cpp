@@ -84,10 +84,6 @@ ObservationSet makeObservations(const Table& t, const std::string& path, const O
                          " position columns: expected exactly one of path_m, path_cm, angle_deg");
     if (!t.hasColumn("force_N")) throw InputError(path + ": missing column 'force_N'");
     if (t.getNumRows() == 0) throw InputError(path + ": no data rows");
-    if (t.getNumRows() > kMaxForceRows)   // the fit's work and memory grow with the rows squared
-        throw InputError(path + ": " + std::to_string(t.getNumRows()) + " data rows: expected at most " +
-                         std::to_string(kMaxForceRows) + " (one row per effort or per averaged point; a force "
-                         "fit of a few unknowns needs tens)");
     if (t.hasColumn("angle_deg") && !options.pathFromAngle)
         throw InputError(path + ": angle_deg given but no angle-to-path conversion was supplied");
 
@@ -134,6 +130,11 @@ ObservationSet makeObservations(const Table& t, const std::string& path, const O
             o.pathLength = cm ? v * 0.01 : v;
         }
         set.points.push_back(o);
+        if (int(set.points.size()) > kMaxForceRows)   // the fit's work and memory grow with the rows squared
+            throw InputError(path + ": more than " + std::to_string(kMaxForceRows) + " data rows" +
+                             (options.subject >= 0 ? " of subject " + std::to_string(options.subject) : std::string()) +
+                             ": expected at most " + std::to_string(kMaxForceRows) + " (one row per effort or per "
+                             "averaged point; a force fit of a few unknowns needs tens)");
     }
     if (set.points.empty())
         throw InputError(path + ": no data rows for subject " + std::to_string(options.subject));

@@ -10,6 +10,9 @@
 
 namespace armsim {
 
+/// Rows a force data set may hold (the covariance and reports grow with their square: 10000 rows took 9 GB).
+constexpr int kMaxForceRows = 1000;
+
 class Table;
 
 /// One measured isometric force.
@@ -54,9 +57,6 @@ struct ObservationOptions {
 /// Throws InputError naming file, line, column and value for: a non-finite value, a negative force,
 /// a path <= 0, an angle outside (0, 180] deg, an activation outside [0, 1], a non-integer trial or
 /// subject, and a duplicate point (same subject, trial, path and activation as an earlier line).
-/// Rows a force data file may hold (the covariance and reports grow with their square: 10000 rows took 9 GB).
-constexpr int kMaxForceRows = 1000;
-
 ObservationSet readObservations(const std::string& path, const ObservationOptions& options = {});
 /// The same from a table already in memory (columns as in the file); `source` names it in messages.
 ObservationSet makeObservations(const Table& table, const std::string& source, const ObservationOptions& options = {});

@@ -134,6 +134,7 @@ std::vector<AnatomyTarget> loadAnatomyTargets(const std::string& path) {
         out.push_back(t);
     }
     root.finish();
+    if (out.empty()) throw InputError(root.where("targets") + ": field 'targets' is empty: expected at least one target");
     return out;
 }
 

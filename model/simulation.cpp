@@ -5,7 +5,9 @@
 #include "model/trial.h"
 #include "muscles/simbody_isometric.h"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 
 using namespace SimTK;
@@ -112,6 +114,18 @@ std::vector<std::string> ArmSimulation::getMuscleStateNames() const {
     return names;
 }
 
+void ArmSimulation::setState(const double* theta, const double* thetaDot, const std::vector<double>* muscleStates) {
+    const State saved = *state_;
+    try {
+        if (theta) setElbowAngle(*theta);
+        if (thetaDot) setElbowVelocity(*thetaDot);
+        if (muscleStates) setMuscleStates(*muscleStates);
+    } catch (...) {
+        *state_ = saved;   // the state as it was, whatever the checks allowed it to be
+        throw;
+    }
+}
+
 void ArmSimulation::setMuscleStates(const std::vector<double>& y) {
     const std::vector<std::string> names = getMuscleStateNames();
     if (y.size() != names.size())
@@ -168,11 +182,17 @@ void ArmSimulation::recordSample(const State& s) {
     samples_.appendRow(row);
 }
 
+// Times on the grid agree to this: a billionth of a sample interval, or a few ulps of t when that is more.
+double ArmSimulation::calcGridTolerance(double t) const {
+    return std::max(1e-9 / settings_.sampleRate, 64 * std::numeric_limits<double>::epsilon() * std::max(std::abs(t), std::abs(t0_)));
+}
+
 void ArmSimulation::integrate(double duration, double sampleRate) {
-    const double eps = 1e-9 / settings_.sampleRate;
     const auto sample = [&](const State& s) {
         const double k = std::round((s.getTime() - t0_) * settings_.sampleRate);
-        if (long(k) <= lastSample_ || std::abs(s.getTime() - (t0_ + k / settings_.sampleRate)) > eps) return;
+        if (long(k) <= lastSample_ ||
+            std::abs(s.getTime() - (t0_ + k / settings_.sampleRate)) > calcGridTolerance(s.getTime()))
+            return;
         recordSample(s);
         lastSample_ = long(k);
     };
@@ -192,13 +212,18 @@ void ArmSimulation::integrate(double duration, double sampleRate) {
     stats_.krylovIterations += st.krylovIterations;
 }
 
-IntegrationStats ArmSimulation::advanceTo(double t) {
+void ArmSimulation::checkAdvance(double t) const {
     const double now = getTime();
-    if (!(t >= now))
-        throw FieldError("time_s", "= " + formatNumber(t) + " s: expected a time at or after the simulation's (" +
+    if (!(t >= now) || !std::isfinite(t))
+        throw FieldError("time_s", "= " + formatNumber(t) + " s: expected a finite time at or after the simulation's (" +
                                      formatNumber(now) + " s)");
-    const double rate = settings_.sampleRate, eps = 1e-9 / rate;
-    if ((t - now) * rate >= 0.5) calcNumSamples(t - now, rate);  // refuses more samples than a table may hold
+    if ((t - now) * settings_.sampleRate >= 1) calcNumSamples(t - now, settings_.sampleRate);  // at most a table's rows
+}
+
+IntegrationStats ArmSimulation::advanceTo(double t) {
+    checkAdvance(t);
+    const double now = getTime();
+    const double rate = settings_.sampleRate, eps = calcGridTolerance(t);
     const IntegrationStats before = stats_;
     const State start = *state_;
     const int rows = samples_.getNumRows();
@@ -216,7 +241,7 @@ IntegrationStats ArmSimulation::advanceTo(double t) {
             at = getTime();
         }
         // Shorter than half a sample interval: no grid point inside, one step to t (its end is not recorded).
-        if (t - at > eps) integrate(t - at, (t - at) * rate < 0.5 ? 1.0 / (t - at) : rate);
+        if (t - at > eps) integrate(t - at, (t - at) * rate < 1 ? 1.0 / (t - at) : rate);
     } catch (...) {
         *state_ = start;
         samples_.truncateRows(rows);

@@ -74,6 +74,9 @@ public:
     /// Sets them; InputError naming the state for a wrong count or a value that is not finite or
     /// leaves a muscle's validity range (checked at once).
     void setMuscleStates(const std::vector<double>& y);
+    /// Sets any of angle, velocity and muscle states together: all are checked first, and a refused call
+    /// changes nothing (InputError naming the value).
+    void setState(const double* theta, const double* thetaDot, const std::vector<double>* muscleStates);
     /// "<muscle>_<state>" (a one-muscle model: "<state>").
     std::vector<std::string> getMuscleStateNames() const;
     /// Every muscle's tendon force Fse [N] in the present state.
@@ -92,6 +95,9 @@ public:
     /// Throws SimulationError when the integrator cannot go on (the state is left at the last good
     /// step's start: the call's start) and Interrupted on a stop request.
     IntegrationStats advanceTo(double t);
+    /// The checks advanceTo makes before any work (a finite time not before getTime(), a sample count a
+    /// table may hold): InputError otherwise.
+    void checkAdvance(double t) const;
 
     /// Every sample recorded since the start (columns above).
     const Table& getSamples() const { return samples_; }
@@ -101,6 +107,7 @@ public:
 private:
     void recordSample(const SimTK::State& s);
     void integrate(double duration, double sampleRate);
+    double calcGridTolerance(double t) const;
 
     ArmSetup setup_;
     SimulationSettings settings_;

@@ -35,7 +35,7 @@ std::string shortNumber(double v) {   // 3 significant digits, for a message
 
 long calcNumSamples(double duration, double sampleRate) {
     const double n = std::round(duration * sampleRate) + 1;
-    if (duration > 0 && n < 2)   // the run would keep its start only: its end silently dropped
+    if (duration > 0 && duration * sampleRate < 1 - 1e-9)   // no sample after the start: its end silently dropped
         throw InputError("duration " + formatNumber(duration) + " s x sample_rate " + formatNumber(sampleRate) +
                          " Hz = " + formatNumber(std::stod(shortNumber(duration * sampleRate))) +
                          " samples after the start: expected at least one (raise the sample rate to " +

@@ -55,7 +55,8 @@ using OdeRhs = std::function<void(double t, const double* y, double* ydot)>;
 using OdeVisitor = std::function<void(double t, const double* y)>;
 
 /// Integrates y' = f(t, y) from t0 for `duration` seconds; y holds y(t0) on entry and y(t0 + duration)
-/// on return. sample(t, y) is called at t0 + k / sampleRate, k = 0 .. round(duration * sampleRate),
+/// on return. sample(t, y) is called at t0 + k / sampleRate for every such time up to t0 + duration (k = 0
+/// .. round(duration * sampleRate), the last only when it is not beyond the end),
 /// with y from cubic Hermite interpolation between internal steps; the solver restarts at each
 /// breakpoint inside the interval; check(t, y) runs after every internal step and may throw
 /// SimulationError; every y is checked for NaN there too. Throws SimulationError naming the time

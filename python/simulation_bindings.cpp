@@ -8,6 +8,7 @@
 #include "python/module_support.h"
 
 #include <cmath>
+#include <map>
 #include <memory>
 #include <optional>
 
@@ -20,7 +21,23 @@ struct PySimulation {
     Model model;
     std::unique_ptr<ArmSimulation> sim;
     py::object callable;   ///< an excitation given as a callable of time (None otherwise)
+    bool busy = false;     ///< advance_to runs (without the GIL): other calls on this object are refused
 };
+
+// A Simulation is one object stepped by one thread at a time: while advance_to runs (the GIL released),
+// another thread's call on it would race with the integration.
+void requireIdle(const PySimulation& ps) {
+    if (ps.busy) throw std::runtime_error("armsim.Simulation: advance_to is running in another thread; one "
+                                          "Simulation is stepped by one thread at a time");
+}
+
+// 1-D float64 values, contiguous (a column of a result dict is a strided view).
+std::vector<double> toVector(const py::handle& v, const std::string& what) {
+    const auto a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(v);
+    if (!a) throw InputError(what + ": expected numbers");
+    if (a.ndim() != 1) throw InputError(what + ": expected a 1-D array, got " + std::to_string(a.ndim()) + " dimensions");
+    return std::vector<double>(a.data(), a.data() + a.size());
+}
 
 std::vector<std::string> muscleNames(const ArmSetup& setup) {
     std::vector<std::string> names;
@@ -55,7 +72,9 @@ std::vector<double> toValues(const ArmSetup& setup, const py::handle& v, const s
         return values;
     }
     if (py::isinstance<py::str>(v)) throw py::type_error(what + " = " + py::repr(v).cast<std::string>() + ": expected a number, one per muscle or a dict");
-    if (py::hasattr(v, "__len__") && !py::hasattr(v, "__float__")) {
+    if (py::isinstance<py::array>(v) && py::reinterpret_borrow<py::array>(v).ndim() == 0)
+        return std::vector<double>(n, toNumber(py::module_::import("builtins").attr("float")(v), what));
+    if (py::isinstance<py::array>(v) || (py::hasattr(v, "__len__") && !py::hasattr(v, "__float__"))) {
         const py::sequence s = py::reinterpret_borrow<py::sequence>(py::module_::import("builtins").attr("list")(v));
         if (int(s.size()) != n)
             throw InputError(what + ": " + std::to_string(s.size()) + " values for a model with " + std::to_string(n) +
@@ -103,12 +122,7 @@ std::vector<ActivationProfile> readControls(const ArmSetup& setup, const std::st
 
 // dict with a time_s key: {time_s: (T,), muscle: (T,) ...}, linear between the rows.
 std::vector<ActivationProfile> readTraces(const ArmSetup& setup, const py::dict& d) {
-    const py::module_ np = py::module_::import("numpy");
-    auto column = [&](const py::handle& v, const std::string& what) {
-        const py::array_t<double> a = np.attr("asarray")(v, "float64").cast<py::array_t<double>>();
-        if (a.ndim() != 1) throw InputError(what + ": expected a 1-D array, got " + std::to_string(a.ndim()) + " dimensions");
-        return std::vector<double>(a.data(), a.data() + a.size());
-    };
+    auto column = [&](const py::handle& v, const std::string& what) { return toVector(v, what); };
     const std::vector<double> time = column(d["time_s"], "excitation['time_s']");
     std::vector<ActivationProfile> p(setup.getNumMuscles(), ActivationProfile::constant(0.0));
     for (const auto& item : d) {
@@ -126,12 +140,15 @@ std::vector<ActivationProfile> readTraces(const ArmSetup& setup, const py::dict&
 }
 
 // What a user may pass as excitation; a callable is kept in ps.callable and sampled per advance_to.
-std::vector<ActivationProfile> toProfiles(PySimulation& ps, const ArmSetup& setup, const py::object& e) {
-    ps.callable = py::none();
+// The profiles an excitation gives (empty for a callable, which *callable receives; None otherwise).
+// Nothing of `ps` changes here: a refused excitation leaves the simulation as it was.
+std::vector<ActivationProfile> toProfiles(const ArmSetup& setup, const py::object& e, py::object* callable) {
+    *callable = py::none();
     if (e.is_none()) return constantProfiles(setup, std::vector<double>(setup.getNumMuscles(), 0.0), "excitation");
     if (PyCallable_Check(e.ptr()) && !py::isinstance<py::type>(e)) {
-        ps.callable = e;
-        return {};   // sampled at the first advance_to
+        toValues(setup, e(0.0), "excitation(0)");   // its values checked now, not at the first advance
+        *callable = e;
+        return {};   // sampled at each advance_to
     }
     if (py::isinstance<py::str>(e) || py::hasattr(e, "__fspath__"))
         return readControls(setup, py::str(py::module_::import("os").attr("fspath")(e)).cast<std::string>());
@@ -143,7 +160,7 @@ std::vector<ActivationProfile> toProfiles(PySimulation& ps, const ArmSetup& setu
 std::vector<ActivationProfile> sampleCallable(const PySimulation& ps, double t0, double t1) {
     const ArmSetup& setup = ps.model.setup;
     const double rate = ps.sim->getSettings().sampleRate;
-    const long steps = std::max(1L, long(std::ceil((t1 - t0) * rate - 1e-9)));
+    const long steps = std::max(1L, long(std::ceil((t1 - t0) * rate - 1e-9)));   // checkAdvance bounded it
     std::vector<double> times;
     std::vector<std::vector<double>> values(setup.getNumMuscles());
     for (long k = 0; k <= steps; ++k) {
@@ -200,12 +217,21 @@ void addSimulationBindings(py::module_& mod) {
                      throw InputError("start = '" + start + "': expected 'steady' or 'initial'");
                  s.startSteady = start == "steady";
                  if (accuracy) s.integration.accuracy = *accuracy;
-                 std::vector<ActivationProfile> profiles = toProfiles(*ps, m.setup, excitation);
+                 std::vector<ActivationProfile> profiles = toProfiles(m.setup, excitation, &ps->callable);
                  if (profiles.empty()) {   // a callable: its value at the start
                      const std::vector<double> v = toValues(m.setup, ps->callable(0.0), "excitation(0)");
                      profiles = constantProfiles(m.setup, v, "excitation");
                  }
-                 ps->sim = std::make_unique<ArmSimulation>(m.setup, s, std::move(profiles));
+                 try {   // errors name the arguments as typed
+                     ps->sim = std::make_unique<ArmSimulation>(m.setup, s, std::move(profiles));
+                 } catch (const FieldError& e) {
+                     static const std::map<std::string, std::string> argument = {
+                         {"elbow_angle_deg", "angle_deg"}, {"elbow_velocity_degps", "velocity_degps"},
+                         {"sample_rate", "rate"}, {"accuracy", "accuracy"}};
+                     const auto it = argument.find(e.getField());
+                     if (it == argument.end()) throw;
+                     throw InputError(it->second + " " + e.getDetail());
+                 }
                  return ps;
              }),
              py::arg("model"), py::arg("locked") = false, py::arg("angle_deg") = 90.0, py::arg("velocity_degps") = 0.0,
@@ -228,7 +254,7 @@ void addSimulationBindings(py::module_& mod) {
                                "the simulation's time [s]")
         .def_property_readonly("state_names", [](const PySimulation& ps) { return ps.sim->getMuscleStateNames(); },
                                "names of the muscle_states entries: '<muscle>_<state>'")
-        .def_property_readonly("state", &getState,
+        .def_property_readonly("state", [](const PySimulation& ps) { requireIdle(ps); return getState(ps); },
                                "dict: time_s, elbow_angle_deg, elbow_velocity_degps (+ = extending), muscle_states "
                                "(array, order of state_names)")
         .def_property_readonly(
@@ -238,6 +264,7 @@ void addSimulationBindings(py::module_& mod) {
             "set_state",
             [](PySimulation& ps, const py::object& state, std::optional<double> angleDeg,
                std::optional<double> velocityDegps, const py::object& muscleStates) {
+                requireIdle(ps);
                 py::object states = muscleStates;
                 if (!state.is_none()) {
                     if (!py::isinstance<py::dict>(state))
@@ -264,24 +291,9 @@ void addSimulationBindings(py::module_& mod) {
                 }
                 // All checked before any is set: a refused call changes nothing.
                 std::optional<std::vector<double>> y;
-                if (!states.is_none()) {
-                    const py::array_t<double> a =
-                        py::module_::import("numpy").attr("asarray")(states, "float64").cast<py::array_t<double>>();
-                    if (a.ndim() != 1) throw InputError("muscle_states: expected a 1-D array");
-                    y = std::vector<double>(a.data(), a.data() + a.size());
-                }
-                const double oldAngle = ps.sim->getElbowAngle(), oldVelocity = ps.sim->getElbowVelocity();
-                const std::vector<double> oldStates = ps.sim->getMuscleStates();
-                try {
-                    if (angleDeg) ps.sim->setElbowAngle(degToRad(*angleDeg));
-                    if (velocityDegps) ps.sim->setElbowVelocity(degToRad(*velocityDegps));
-                    if (y) ps.sim->setMuscleStates(*y);
-                } catch (...) {
-                    ps.sim->setElbowAngle(oldAngle);
-                    ps.sim->setElbowVelocity(oldVelocity);
-                    ps.sim->setMuscleStates(oldStates);
-                    throw;
-                }
+                if (!states.is_none()) y = toVector(states, "muscle_states");
+                const double theta = angleDeg ? degToRad(*angleDeg) : 0, thetaDot = velocityDegps ? degToRad(*velocityDegps) : 0;
+                ps.sim->setState(angleDeg ? &theta : nullptr, velocityDegps ? &thetaDot : nullptr, y ? &*y : nullptr);
             },
             py::arg("state") = py::none(), py::kw_only(), py::arg("elbow_angle_deg") = py::none(),
             py::arg("elbow_velocity_degps") = py::none(), py::arg("muscle_states") = py::none(),
@@ -291,8 +303,11 @@ void addSimulationBindings(py::module_& mod) {
         .def(
             "set_excitation",
             [](PySimulation& ps, const py::object& excitation) {
-                std::vector<ActivationProfile> p = toProfiles(ps, ps.model.setup, excitation);
+                requireIdle(ps);
+                py::object callable;
+                std::vector<ActivationProfile> p = toProfiles(ps.model.setup, excitation, &callable);
                 if (!p.empty()) ps.sim->setExcitations(std::move(p));
+                ps.callable = callable;
             },
             py::arg("excitation"),
             "Replaces every muscle's excitation (the forms of the constructor; times are absolute). The time\n"
@@ -300,9 +315,16 @@ void addSimulationBindings(py::module_& mod) {
         .def(
             "advance_to",
             [](PySimulation& ps, double t) {
+                requireIdle(ps);
+                ps.sim->checkAdvance(t);   // before the callable is sampled over the interval
                 if (!ps.callable.is_none() && t > ps.sim->getTime())
                     ps.sim->setExcitations(sampleCallable(ps, ps.sim->getTime(), t));
                 IntegrationStats st;
+                ps.busy = true;
+                struct Idle {
+                    bool& busy;
+                    ~Idle() { busy = false; }
+                } idle{ps.busy};
                 runInterruptible([&] { st = ps.sim->advanceTo(t); });
                 return getState(ps);
             },
@@ -311,7 +333,7 @@ void addSimulationBindings(py::module_& mod) {
             "Raises RuntimeError when the integrator cannot go on (the simulation stays where the call began).\n"
             "Releases the GIL; Ctrl-C raises KeyboardInterrupt (and leaves the simulation where the call began).")
         .def(
-            "samples", [](const PySimulation& ps) { return toDict(ps.sim->getSamples()); },
+            "samples", [](const PySimulation& ps) { requireIdle(ps); return toDict(ps.sim->getSamples()); },
             "Every sample so far as a dict of float64 arrays: time_s, elbow_angle_deg, elbow_velocity_degps,\n"
             "holding_torque_Nm (the lock's, + = flexion; NaN when free), forearm_holding_torque_Nm (a rotating\n"
             "forearm), then per muscle excitation_<m>, active_fraction_<m> (the muscle's activation: Virtual\n"

@@ -433,7 +433,10 @@ void DesignSettings::validate() const {
     once(postures, "postures");
     checkField("repetitions", repetitions, Bound::closed(1, 100));
     // At most 100 trials: every pick may fall on one condition, whose repetitions a torque protocol bounds at 100.
-    checkField("trials", trials, Bound{double(repetitions), 100, false, false, "at least one block of repetitions, at most 100"});
+    if (budgetMinutes > 0)   // across channels the budget is lab minutes; trials are not used
+        checkField("trials", trials, Bound{double(repetitions), 10000, false, false, "at least one block of repetitions"});
+    else
+        checkField("trials", trials, Bound{double(repetitions), 100, false, false, "at least one block of repetitions, at most 100"});
     checkField("draws", draws, Bound::closed(1, 100000));
     checkField("activation_sd", activationSd, Bound::closed(0, 0.5));
     checkField("jobs", jobs, Bound::closed(1, 1024));

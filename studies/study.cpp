@@ -144,10 +144,10 @@ void Study::validate() const {
         }
     };
     checkName("name", name);
-    // The default output folder is out/<name>: a name with a path in it would write elsewhere.
+    // The default output folder is out/study/<name>: a name with a path in it would write elsewhere.
     if (name.empty() || name == "." || name == ".." || name.find_first_of("/\\") != std::string::npos)
         throw FieldError("name", "= '" + name + "': expected a name without '/', '\\' or dots alone (the default "
-                                 "output folder is out/<name>)");
+                                 "output folder is out/study/<name>)");
     for (std::size_t i = 0; i < truths.size(); ++i) checkName("truths[" + std::to_string(i) + "].label", truths[i].label);
     for (std::size_t i = 0; i < protocols.size(); ++i)
         checkName("protocols[" + std::to_string(i) + "].name", protocols[i].protocol.name);

@@ -732,7 +732,9 @@ StudyOutcome runStudy(const Study& study, const StudyRunOptions& options, StudyC
     WorkQueue pending(study, folder, sharded ? options.shard : 0, sharded ? options.shards : 1);
     outcome.total = pending.getNumCells();
     outcome.resumed = outcome.total - pending.getNumMissing();
-    if (!options.merge && existed) checkStudyFitsOnDisk(study, pending.getNumMissing(), outcome.output);
+    // Resumed: the journal grows by what is missing, but the results and the sort's scratch cover every task.
+    if (!options.merge && existed && pending.getNumMissing() > 0)
+        checkStudyFitsOnDisk(study, study.getNumTasks() / std::max(1, options.shards), outcome.output);
     if (options.merge && pending.getNumMissing() > 0)
         throw InputError("study output '" + outcome.output + "': --merge: " + std::to_string(pending.getNumMissing()) +
                          " of " + std::to_string(outcome.total) + " cells are in no journal (a shard failed or has not " +

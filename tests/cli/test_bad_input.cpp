@@ -385,6 +385,8 @@ std::vector<BadInput> makeCatalogue() {
          {"--onset 5 s", "--duration 0.2 s", "before the end"}},
         {"TrialRateKeepsOnlyTheStart", {}, "trial --rate 0.1 --hold 1 --rest 0.5 --out OUT/t.csv",
          {"sample_rate 0.1 Hz", "samples after the start: expected at least one"}},
+        {"FreeTrialRateKeepsOnlyTheStart", {}, "trial --type free --duration 1.5 --rate 0.5 --out OUT/f.csv",
+         {"0.75 samples after the start: expected at least one"}},
         {"IdentifyDataWithThesisCases", {}, "identify measured/thesis_measured.csv --thesis-cases --out OUT/id", {"excludes --thesis-cases"}},
         {"IdentifyFaithfulOptionWithSteady", {}, "identify measured/thesis_measured.csv --estimate fixed-ratio --out OUT/id",
          {"--estimate is an option of the faithful forward model", "--forward steady"}},
@@ -396,7 +398,7 @@ std::vector<BadInput> makeCatalogue() {
              std::string t = "angle_deg,force_N,trial\n";
              for (int i = 0; i < 1001; ++i) t += std::to_string(45 + i % 100) + ",400," + std::to_string(i) + "\n";
              return t;
-         }()}}, "identify IN/d.csv --out OUT/id", {"d.csv: 1001 data rows", "at most 1000"}},
+         }()}}, "identify IN/d.csv --out OUT/id", {"d.csv: more than 1000 data rows", "at most 1000"}},
         {"TorqueActivationSdWithoutActivation", {}, "identify-torque measured/thesis_mvc_torque.csv --activation-sd 0.3 --out OUT/it",
          {"--activation-sd requires --activation"}},
         {"TorqueCrosstalkWithoutChannels", {}, "identify-torque measured/thesis_mvc_torque.csv --emg-crosstalk 0.3 --out OUT/it",
@@ -414,6 +416,8 @@ std::vector<BadInput> makeCatalogue() {
          {"--merge: the folder does not exist", "nothing to merge"}},
         {"StudyMergeWithRestart", {{"s.yaml", kStudyHead + "methods:\n  - {method: thesis}\n"}},
          "study IN/s.yaml --merge --restart --out OUT/s", {"--merge with --restart"}},
+        {"AnatomyTargetsEmpty", {{"t.yaml", "targets: []\n"}}, "model check --model twin --targets IN/t.yaml --out OUT/mc",
+         {"t.yaml:1", "'targets' is empty"}},
         {"MainJobBadModelWritesNothing", {{"m.yaml", "name: m\n"}}, "run --model IN/m.yaml --out OUT/r", {"m.yaml:1", "'arm'"}},
     };
 }
