@@ -40,6 +40,7 @@ Table readStorage(const std::string& path, StorageHeader* header) {
     };
     while (std::getline(in, line)) {
         ++lineNo;
+        if (lineNo == 1 && line.rfind("\xEF\xBB\xBF", 0) == 0) line.erase(0, 3);   // a UTF-8 byte-order mark
         if (!line.empty() && line.back() == '\r') line.pop_back();
         if (lineNo == 1) {
             h.name = line;

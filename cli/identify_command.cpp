@@ -193,8 +193,8 @@ void runIdentify(const IdentifyOptions& o) {
         if (f.rfind("unknowns.", 0) != 0 || dot == std::string::npos || dot < 9) throw;
         const std::string name = f.substr(9, dot - 9), what = f.substr(dot + 1);
         const bool started = std::any_of(o.starts.begin(), o.starts.end(), [&](const std::string& x) {
-            return x.rfind(name + "=", 0) == 0;
-        });
+            return parseParameter("--start", splitAssignment("--start", x).first) == parseParameter("--free", name);
+        });   // --start tendon_length=... names optimal_tendon_length too
         if (what == "lower" || what == "upper") throw InputError("--bounds " + name + " " + what + " " + e.getDetail());
         if (what == "start")
             throw InputError((started ? "--start " + name : "the default start of " + name + " (give --start " + name +

@@ -140,6 +140,7 @@ std::vector<ChannelObservation> readChannelData(const std::string& path) {
                                                    "repetition", "value", "sd", "clean_value"};
     while (std::getline(in, line)) {
         ++lineNo;
+        if (lineNo == 1 && line.rfind("\xEF\xBB\xBF", 0) == 0) line.erase(0, 3);   // a UTF-8 byte-order mark
         if (!line.empty() && line.back() == '\r') line.pop_back();
         const auto first = line.find_first_not_of(" \t");
         if (first == std::string::npos || line[first] == '#') continue;
