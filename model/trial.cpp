@@ -183,15 +183,7 @@ TransducerReading TransducerAtAngle::read(double strapForce, double muscleForce)
 
 TransducerReading calcTransducerReading(const ArmParameters& arm, double strapForce, double elbowAngle,
                                         double momentArm, double muscleForce) {
-    TransducerReading r;
-    r.saturated = std::abs(strapForce) > arm.transducerRange;
-    r.strapForce = r.saturated ? std::copysign(arm.transducerRange, strapForce) : strapForce;
-    r.forceMomentArm = calcBicepsForceFromTorque(r.strapForce * arm.strapDistance, momentArm);
-    r.forceFixedRatio = calcBicepsForceFixedRatio(r.strapForce, elbowAngle, kPi / 2);
-    const double F = muscleForce;
-    r.errorMomentArmPct = F > 0 ? 100 * (r.forceMomentArm - F) / F : NAN;
-    r.errorFixedRatioPct = F > 0 ? 100 * (r.forceFixedRatio - F) / F : NAN;
-    return r;
+    return TransducerAtAngle(arm, elbowAngle, momentArm).read(strapForce, muscleForce);
 }
 
 IsometricTrialResult runIsometricTrial(const ArmSetup& setup, const IsometricTrialSettings& settings) {

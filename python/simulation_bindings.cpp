@@ -140,15 +140,16 @@ std::vector<ActivationProfile> readTraces(const ArmSetup& setup, const py::dict&
 }
 
 // What a user may pass as excitation; a callable is kept in ps.callable and sampled per advance_to.
-// The profiles an excitation gives (empty for a callable, which *callable receives; None otherwise).
+// The profiles an excitation gives (a callable: its value at 0, and *callable receives it; None otherwise).
 // Nothing of `ps` changes here: a refused excitation leaves the simulation as it was.
 std::vector<ActivationProfile> toProfiles(const ArmSetup& setup, const py::object& e, py::object* callable) {
     *callable = py::none();
     if (e.is_none()) return constantProfiles(setup, std::vector<double>(setup.getNumMuscles(), 0.0), "excitation");
     if (PyCallable_Check(e.ptr()) && !py::isinstance<py::type>(e)) {
-        toValues(setup, e(0.0), "excitation(0)");   // its values checked now, not at the first advance
+        // Its value at 0, checked now; each advance_to replaces it with the callable sampled over the step.
+        std::vector<ActivationProfile> start = constantProfiles(setup, toValues(setup, e(0.0), "excitation(0)"), "excitation");
         *callable = e;
-        return {};   // sampled at each advance_to
+        return start;
     }
     if (py::isinstance<py::str>(e) || py::hasattr(e, "__fspath__"))
         return readControls(setup, py::str(py::module_::import("os").attr("fspath")(e)).cast<std::string>());
@@ -218,10 +219,6 @@ void addSimulationBindings(py::module_& mod) {
                  s.startSteady = start == "steady";
                  if (accuracy) s.integration.accuracy = *accuracy;
                  std::vector<ActivationProfile> profiles = toProfiles(m.setup, excitation, &ps->callable);
-                 if (profiles.empty()) {   // a callable: its value at the start
-                     const std::vector<double> v = toValues(m.setup, ps->callable(0.0), "excitation(0)");
-                     profiles = constantProfiles(m.setup, v, "excitation");
-                 }
                  try {   // errors name the arguments as typed
                      ps->sim = std::make_unique<ArmSimulation>(m.setup, s, std::move(profiles));
                  } catch (const FieldError& e) {
@@ -305,8 +302,7 @@ void addSimulationBindings(py::module_& mod) {
             [](PySimulation& ps, const py::object& excitation) {
                 requireIdle(ps);
                 py::object callable;
-                std::vector<ActivationProfile> p = toProfiles(ps.model.setup, excitation, &callable);
-                if (!p.empty()) ps.sim->setExcitations(std::move(p));
+                ps.sim->setExcitations(toProfiles(ps.model.setup, excitation, &callable));
                 ps.callable = callable;
             },
             py::arg("excitation"),
