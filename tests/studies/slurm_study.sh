@@ -81,6 +81,11 @@ wait_for() {  # wait_for SECONDS WHAT PREDICATE: polls every 0.1 s
 journal_results() { echo $(($(cat "$work/slurm/journal.log" 2> /dev/null | wc -l) - 1)); }
 has_a_group() { [ "$(journal_results)" -ge 2 ]; }
 is_pending() { [ "$(job_state)" = PENDING ]; }
+job_reason() { scontrol show job "$job" 2> /dev/null | sed -n 's/.*Reason=\([A-Za-z_]*\).*/\1/p' | head -1; }
+# No step daemon of the job left and the node idle (sinfo says "idle" only with no job completing).
+first_run_gone() {
+    ! pgrep -f "slurmstepd: \[$job\." > /dev/null && [ "$(sinfo -h -o %T 2> /dev/null | head -1)" = idle ]
+}
 has_ended() { case "$(job_state)" in COMPLETED | FAILED | CANCELLED | TIMEOUT | NODE_FAIL | OUT_OF_MEMORY) return 0 ;; esac; return 1; }
 
 if [ "$mode" = requeue ]; then
@@ -94,12 +99,31 @@ if [ "$mode" = requeue ]; then
     # A requeued suspended job is held, and Slurm delays any requeued job by two minutes: release it
     # and let it start now.
     wait_for 60 "the requeued job pending" is_pending
+    # Start the second run only once the first run's step daemons are gone: one still cleaning up
+    # removes the spool folder the second launch uses (same job id), the launch fails and Slurm holds
+    # the job (launch_failed_requeued_held), which a loaded machine showed.
+    wait_for 120 "the first run's processes gone" first_run_gone
     scontrol release "$job"
     scontrol update jobid="$job" starttime=now
     echo "requeued job $job after $before of $tasks results"
 fi
 
-wait_for 300 "job $job finished" has_ended
+# Slurm holds a job whose launch failed (a node-side failure, not the job's); an administrator releases
+# it. Do that once, saying so, and fail on a second launch failure.
+released_after_launch_failure=0
+ended_or_release() {
+    has_ended && return 0
+    if [ "$(job_reason)" = launch_failed_requeued_held ]; then
+        [ $released_after_launch_failure -eq 0 ] || fail "job $job: Slurm could not launch it twice"
+        released_after_launch_failure=1
+        echo "job $job: Slurm held it after a failed launch (its node, not the study); released once"
+        wait_for 120 "the failed launch's processes gone" first_run_gone
+        scontrol release "$job"
+        scontrol update jobid="$job" starttime=now
+    fi
+    return 1
+}
+wait_for 300 "job $job finished" ended_or_release
 state=$(job_state)
 cat "$work"/armsim-study-*.log
 [ "$state" = COMPLETED ] || fail "job $job ended $state"
