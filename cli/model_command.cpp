@@ -112,11 +112,7 @@ void addModelCommands(CLI::App& app) {
                                  (*step > 0 && *step < 0.01 ? ", " + std::to_string(long(std::floor(140 / *step))) +
                                                                   " angles over the elbow's range)" : std::string(")")));
             // An OpenSim model: a file ending .osim, or a shipped name with only an .osim file.
-            const bool isOsim = (name->size() > 5 && name->compare(name->size() - 5, 5, ".osim") == 0) ||
-                                (name->find('/') == std::string::npos &&
-                                 !doesPathExist(getAssetDirectory() + "/models/" + *name + ".yaml") &&
-                                 doesPathExist(getAssetDirectory() + "/models/" + *name + ".osim"));
-            if (isOsim) {
+            if (isOsimModel(*name)) {
                 const std::string osim = findOsimModelFile(*name);
                 const OsimModel m = readOsimFile(osim);
                 OsimReportSettings s;

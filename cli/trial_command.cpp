@@ -6,6 +6,8 @@
 #include "cli/commands.h"
 #include "cli/plugins.h"
 #include "model/geometry.h"
+#include "model/osim_forward.h"
+#include "model/osim_trial.h"
 #include "model/trial.h"
 #include "muscles/muscle_file.h"
 #ifdef ARMSIM_WITH_RENDER
@@ -23,6 +25,7 @@ namespace {
 struct TrialOptions {
     MuscleOptions muscle;
     std::string settingsFile;
+    std::string coordinate, effort = "positive";  // OpenSim models
     std::string type = "isometric";
     double angleDeg = 90, activation = 1.0, rest = 0.5, rise = 0.0, hold = 3.0;
     double initialAngleDeg = 150, initialVelocityDegps = 0, onset = 0.2, duration = 2.0, load = 0.0;
@@ -50,6 +53,56 @@ int renderVideo(const TrialOptions& o, const std::string& path, const ArmSetup& 
     (void)o, (void)path, (void)setup, (void)table, (void)handLoad;
     return 0;
 #endif
+}
+
+// An isometric trial of an OpenSim model: --coordinate locked at --angle (its value in deg), the others
+// at their defaults; the muscles that pull it the --effort way excited.
+void runOsimTrialCommand(const TrialOptions& o) {
+    OutputFiles files;
+    const std::string osim = findOsimModelFile(o.muscle.model);
+    files.addInput("--model", osim);
+    const std::string csvPath = files.add("--out", o.out, true), plotPath = files.add("--plot", o.plot);
+    const OsimModel model = readOsimFile(osim);
+    OsimIsometricTrialSettings s;
+    s.coordinate = o.coordinate;
+    s.angleDeg = o.angleDeg;
+    s.direction = o.effort == "positive" ? 1 : -1;
+    s.activation = o.activation;
+    s.restDuration = o.rest;
+    s.riseTime = o.rise;
+    s.holdDuration = o.hold;
+    s.averagingWindow = std::min(s.averagingWindow, o.hold);
+    s.sampleRate = o.rate;
+    s.integration.accuracy = o.accuracy;
+    s.muscleModel = o.muscle.muscleModel;
+    OsimIsometricTrialResult r;
+    runNamingOptions({{"coordinate", "--coordinate"}, {"angle_deg", "--angle"}, {"activation", "--activation"},
+                      {"rest", "--rest"}, {"rise", "--rise"}, {"hold", "--hold"}, {"sample_rate", "--rate"},
+                      {"accuracy", "--accuracy"}},
+                     [&] { r = runOsimIsometricTrial(model, s); });
+    const OsimIsometricSummary& m = r.summary;
+    files.writeWith(csvPath, [&](const std::string& p) { r.series.writeCsv(p); });
+    if (!o.plot.empty()) {
+        PlotSpec spec;
+        spec.title = model.name + ": isometric " + o.effort + " effort at " + m.coordinate + " = " + formatNumber(m.angleDeg) + " deg";
+        spec.xLabel = "time (s)";
+        spec.yLabel = "torque about " + m.coordinate + " (N m)";
+        spec.series.push_back({"muscle torque (tared)", r.series.getColumn("time_s"), r.series.getColumn("tared_torque_Nm")});
+        spec.series.push_back({"muscle torque (raw, passive included)", r.series.getColumn("time_s"),
+                               r.series.getColumn("muscle_torque_Nm"), false, 1});
+        files.writeWith(plotPath, [&](const std::string& p) { writePlotPng(p, spec); });
+    }
+    files.commit();
+    std::printf("isometric trial of %s (%s): %s locked at %s deg, the other coordinates at their defaults; %s effort\n",
+                model.name.c_str(), osim.c_str(), m.coordinate.c_str(), formatNumber(m.angleDeg).c_str(), o.effort.c_str());
+    std::printf("  torque about %s   %8.2f N m tared (mean of the last %s s); %.2f N m passive at rest\n",
+                m.coordinate.c_str(), m.meanTaredTorque, formatNumber(s.averagingWindow).c_str(), m.restTorque);
+    std::printf("  %-12s %16s %9s %14s %13s\n", "muscle", "moment arm (cm)", "agonist", "mean force (N)", "torque (N m)");
+    for (std::size_t i = 0; i < m.muscles.size(); ++i)
+        std::printf("  %-12s %16.2f %9s %14.1f %13.2f\n", m.muscles[i].c_str(), 100 * m.momentArms[i],
+                    m.agonists[i] ? "yes" : "no", m.meanForces[i], m.momentArms[i] * m.meanForces[i]);
+    std::printf("wrote %s\n", o.out.c_str());
+    if (!o.plot.empty()) std::printf("wrote %s\n", o.plot.c_str());
 }
 
 void runTrialCommand(const TrialOptions& o) {
@@ -154,12 +207,15 @@ void runTrialCommand(const TrialOptions& o) {
 
 void addTrialCommand(CLI::App& app) {
     auto o = std::make_shared<TrialOptions>();
-    CLI::App* c = app.add_subcommand("trial", "one trial of the arm: isometric (elbow locked) or free movement");
+    CLI::App* c = app.add_subcommand("trial", "one trial of the arm: isometric (elbow locked) or free movement; of an OpenSim model (.osim), "
+                                       "isometric about one coordinate");
     o->muscle.add(*c);
+    o->muscle.addMuscleModel(*c);
     c->add_option("--settings", o->settingsFile,
                   "YAML trial settings (type: isometric|free, and the keys of that trial type) instead of options");
     c->add_option("--type", o->type, "isometric | free")->capture_default_str()->check(CLI::IsMember({"isometric", "free"}));
-    c->add_option("--angle", o->angleDeg, "isometric: elbow angle [deg], 180 = extended")->capture_default_str();
+    c->add_option("--angle", o->angleDeg, "isometric: elbow angle [deg], 180 = extended (an OpenSim model: "
+                                        "--coordinate's value [deg])")->capture_default_str();
     c->add_option("--activation", o->activation, "target activation U in [0, 1]")->capture_default_str();
     c->add_option("--rest", o->rest, "isometric: rest before the effort, transducer tared [s]")->capture_default_str();
     c->add_option("--rise", o->rise, "activation ramp time [s] (0 = step)")->capture_default_str();
@@ -180,7 +236,32 @@ void addTrialCommand(CLI::App& app) {
                                                    "--initial-angle", "--initial-velocity", "--onset", "--duration",
                                                    "--load", "--rate", "--accuracy"};
     for (const std::string& name : trialOptions) c->get_option("--settings")->excludes(c->get_option(name));
+    c->add_option("--coordinate", o->coordinate,
+                  "an OpenSim model's coordinate to lock and act about (default: its only moving one)");
+    c->add_option("--effort", o->effort, "an OpenSim model: the effort's direction about --coordinate")
+        ->capture_default_str()
+        ->check(CLI::IsMember({"positive", "negative"}));
     c->callback([o, c] {
+        if (isOsimModel(o->muscle.model)) {
+            // What an OpenSim model's trial would ignore or cannot do yet is refused, naming the option.
+            if (o->type == "free")
+                throw InputError("--type free with the OpenSim model '" + o->muscle.model + "': a free movement of an .osim "
+                                 "model is `armsim forward --model " + o->muscle.model + " --controls FILE.sto`");
+            for (const char* name : {"--settings", "--video", "--muscle", "--arm", "--slow-units", "--fast-units", "--mass",
+                                     "--tendon-length", "--max-path", "--initial-angle", "--initial-velocity", "--onset",
+                                     "--duration", "--load"})
+                if (c->count(name) > 0)
+                    throw InputError(std::string(name) + " with the OpenSim model '" + o->muscle.model +
+                                     "': not for .osim models (their trial takes --coordinate, --angle (the coordinate's "
+                                     "value, deg), --effort, --activation, --rest, --rise, --hold, --rate, --accuracy, "
+                                     "--muscle-model, --out and --plot)");
+            runOsimTrialCommand(*o);
+            return;
+        }
+        for (const char* name : {"--coordinate", "--effort"})
+            if (c->count(name) > 0)
+                throw InputError(std::string(name) + ": only for OpenSim models (.osim); model '" + o->muscle.model +
+                                 "' is an armsim model (its trials act about the elbow)");
         const bool free = o->type == "free";
         for (const char* name : {"--angle", "--rest", "--hold"})
             if (free && c->count(name) > 0)

@@ -49,6 +49,12 @@ std::string findOsimModelFile(const std::string& model, const std::string& optio
     return model;
 }
 
+bool isOsimModel(const std::string& name) {
+    if (name.size() > 5 && name.compare(name.size() - 5, 5, ".osim") == 0) return true;
+    return name.find('/') == std::string::npos && !doesPathExist(getAssetDirectory() + "/models/" + name + ".yaml") &&
+           doesPathExist(getAssetDirectory() + "/models/" + name + ".osim");
+}
+
 void OsimForwardSettings::validate() const {
     if (std::isfinite(initialTime) && !(finalTime > initialTime))
         throw FieldError("final_time", "final time " + formatNumber(finalTime) + " s: expected after the initial time " +

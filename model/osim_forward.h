@@ -31,6 +31,9 @@ OsimStorage readOsimStorage(const std::string& path);
 /// The .osim file a user named: a path, or a shipped model's name (assets/models/NAME.osim). InputError
 /// naming `option` and the text when there is none.
 std::string findOsimModelFile(const std::string& nameOrFile, const std::string& option = "--model");
+/// true when a --model value names an OpenSim model: a file ending .osim, or a shipped name with an
+/// assets/models/NAME.osim and no NAME.yaml.
+bool isOsimModel(const std::string& nameOrFile);
 
 /// What to run.
 struct OsimForwardSettings {

@@ -8,6 +8,7 @@
 #include "basics/files.h"
 #include "studies/study.h"
 #include "model/osim_forward.h"
+#include "model/osim_trial.h"
 #include "model/mvc_curve.h"
 #include "model/trial.h"
 #include "muscles/simbody_isometric.h"
@@ -270,9 +271,9 @@ PYBIND11_MODULE(_armsim, mod) {
 
     mod.def(
         "forward",
-        [](const std::string& model, const py::object& controls, const py::object& initialStates, double finalTime,
+        [](const py::object& model, const py::object& controls, const py::object& initialStates, double finalTime,
            std::optional<double> initialTime, double rate, const std::string& muscleModel, double accuracy) {
-            const OsimModel m = readOsimFile(findOsimModelFile(model, "model"));
+            const OsimModel m = readOsimFile(findOsimModelFile(toPathString(model, "model"), "model"));
             // A storage file's path (str or os.PathLike) or a dict of equal-length columns, time first.
             auto storageOf = [](const py::object& o, const char* what) {
                 if (py::isinstance<py::dict>(o)) {
@@ -304,6 +305,58 @@ PYBIND11_MODULE(_armsim, mod) {
         "(time first, then one excitation per muscle; states by OpenSim's column names). Returns a dict of\n"
         "float64 arrays with OpenSim's column names: time, each coordinate (rad), <coordinate>_u,\n"
         "<muscle>.activation, <muscle>.fiber_length (m). Releases the GIL; Ctrl-C raises KeyboardInterrupt.");
+
+    mod.def(
+        "isometric_trial",
+        [](const py::object& model, const std::string& coordinate, double angleDeg, const std::string& effort,
+           double activation, double antagonist, double rest, double rise, double hold, double rate,
+           std::optional<double> window, const std::string& muscleModel, double accuracy) {
+            const OsimModel m = readOsimFile(findOsimModelFile(toPathString(model, "model"), "model"));
+            OsimIsometricTrialSettings s;
+            s.coordinate = coordinate;
+            s.angleDeg = angleDeg;
+            if (effort != "positive" && effort != "negative")
+                throw InputError("effort = '" + effort + "': expected 'positive' or 'negative' (the coordinate's direction)");
+            s.direction = effort == "positive" ? 1 : -1;
+            s.activation = activation;
+            s.antagonistActivation = antagonist;
+            s.restDuration = rest;
+            s.riseTime = rise;
+            s.holdDuration = hold;
+            s.sampleRate = rate;
+            s.averagingWindow = window ? *window : std::min(s.averagingWindow, s.holdDuration);
+            s.muscleModel = muscleModel;
+            s.integration.accuracy = accuracy;
+            OsimIsometricTrialResult r;
+            runInterruptible([&] { r = runOsimIsometricTrial(m, s); });
+            const OsimIsometricSummary& x = r.summary;
+            py::dict summary;
+            summary["coordinate"] = x.coordinate;
+            summary["angle_deg"] = x.angleDeg;
+            summary["muscles"] = x.muscles;
+            summary["agonists"] = x.agonists;
+            summary["path_lengths_m"] = x.pathLengths;
+            summary["moment_arms_m"] = x.momentArms;
+            summary["mean_forces_N"] = x.meanForces;
+            summary["rest_torque_Nm"] = x.restTorque;
+            summary["mean_muscle_torque_Nm"] = x.meanMuscleTorque;
+            summary["mean_tared_torque_Nm"] = x.meanTaredTorque;
+            return py::make_tuple(toDict(std::move(r.series)), summary);
+        },
+        py::arg("model"), py::arg("coordinate") = "", py::arg("angle_deg") = 90.0, py::arg("effort") = "positive",
+        py::arg("activation") = 1.0, py::arg("antagonist_activation") = 0.0, py::arg("rest") = 0.5,
+        py::arg("rise") = 0.0, py::arg("hold") = 3.0, py::arg("rate") = 1000.0,
+        py::arg("averaging_window") = py::none(), py::arg("muscle_model") = "", py::arg("accuracy") = 1e-4,
+        "An isometric trial of an OpenSim model, as `armsim trial --model FILE.osim`: model an .osim path or a\n"
+        "shipped name ('arm26'); `coordinate` locked at angle_deg (its value in degrees; '' = the model's only\n"
+        "moving coordinate), the others at their defaults; after `rest` [s] the muscles that pull it the\n"
+        "`effort` way ('positive' or 'negative') rise to `activation` over `rise` [s] and hold for `hold` [s],\n"
+        "the others go to antagonist_activation. Returns (series, summary): series a dict of float64 arrays\n"
+        "(time_s, excitation, <coordinate>_deg, muscle_torque_Nm, tared_torque_Nm, per muscle force_<m>_N,\n"
+        "torque_<m>_Nm, excitation_<m>, activation_<m>, fiber_length_<m>_m); summary: coordinate, angle_deg,\n"
+        "muscles, agonists, path_lengths_m, moment_arms_m, mean_forces_N, rest_torque_Nm,\n"
+        "mean_muscle_torque_Nm, mean_tared_torque_Nm (means over the last averaging_window [s]; None: 1 s or\n"
+        "the whole hold). Releases the GIL; Ctrl-C raises KeyboardInterrupt.");
 
     mod.def(
         "arm_trial",

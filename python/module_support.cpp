@@ -71,6 +71,13 @@ void throwFileNotFound(const std::string& path, const char* what) {
     throw py::error_already_set();
 }
 
+std::string toPathString(const py::object& o, const char* argument) {
+    if (!py::isinstance<py::str>(o) && !py::hasattr(o, "__fspath__"))
+        throw py::type_error(std::string(argument) + ": expected a name or a file path (str or os.PathLike), got " +
+                             py::str(py::type::of(o).attr("__name__")).cast<std::string>());
+    return py::str(py::module_::import("os").attr("fspath")(o));
+}
+
 std::string findFile(const std::string& name) {
     try {
         return findAsset(name);

@@ -49,6 +49,9 @@ py::array_t<double> toArray(const std::vector<double>& values);
 /// Rows (equal lengths) as an (n, m) float64 array.
 py::array_t<double> toArray(const std::vector<std::vector<double>>& rows);
 
+/// A str or os.PathLike argument as a path string; TypeError naming the argument and the type given
+/// otherwise.
+std::string toPathString(const py::object& o, const char* argument);
 /// Raises FileNotFoundError "<path>: cannot open <what> (no such file)".
 [[noreturn]] void throwFileNotFound(const std::string& path, const char* what);
 /// findAsset(name) (a path, or a name under the asset folder), FileNotFoundError with its message

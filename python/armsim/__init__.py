@@ -13,6 +13,7 @@ assets folder: ARMSIM_ASSETS if set, else the installed one (cmake --install) or
     model = armsim.Model.load("twin")
     series, summary = armsim.arm_trial(model, angle_deg=90, activation=1.0)
     sim = armsim.Simulation(model, angle_deg=120, excitation={"BRA": 0.3}); sim.advance_to(0.5)
+    series, summary = armsim.isometric_trial("arm26", coordinate="r_elbow_flex", angle_deg=80)  # OpenSim
     report = armsim.identify(armsim.Model.load("thesis"), "measured/thesis_measured.csv")
     armsim.render_video(model, series, "mvc.mp4")
 """
@@ -34,7 +35,7 @@ def _use_installed_assets():
 
 _use_installed_assets()
 
-from ._armsim import (Model, arm_trial, design_protocol, forward, identify, identify_torque, muscle_trial,
+from ._armsim import (Model, arm_trial, design_protocol, forward, identify, identify_torque, isometric_trial, muscle_trial,
                       read_torque_data, run_protocol, run_study, Simulation, steady_state, validate, validate_elbow, __version__)
 
 
@@ -60,5 +61,6 @@ def render_frame(model, series, time, width=640, height=360, overlay=True, super
     return _render.render_frame(model, series, time, width, height, overlay, supersample, color_by)
 
 
-__all__ = ["__version__", "Model", "arm_trial", "design_protocol", "forward", "identify", "identify_torque", "muscle_trial", "read_torque_data", "render_frame",
+__all__ = ["__version__", "Model", "arm_trial", "design_protocol", "forward", "identify", "identify_torque", "isometric_trial",
+           "muscle_trial", "read_torque_data", "render_frame",
            "render_video", "run_protocol", "run_study", "Simulation", "steady_state", "validate", "validate_elbow"]

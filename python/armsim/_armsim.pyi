@@ -59,10 +59,15 @@ def steady_state(model: Model, path_length: float, activation: float = 1.0,
 def muscle_trial(model: Model, path_length: float = 0.375, activation: float = 1.0, onset: float = 0.0,
                  rise: float = 0.0, duration: float = 3.0, rate: float = 1000.0, steady_start: bool = False,
                  muscle: Optional[str] = None) -> Dict[str, Array]: ...
-def forward(model: str, controls: Union[str, "os.PathLike[str]", Dict[str, Array]],
+def forward(model: Union[str, "os.PathLike[str]"], controls: Union[str, "os.PathLike[str]", Dict[str, Array]],
             initial_states: Union[None, str, "os.PathLike[str]", Dict[str, Array]] = None, final_time: float = 1.0,
             initial_time: Optional[float] = None, rate: float = 200.0, muscle_model: str = "",
             accuracy: float = 1e-5) -> Dict[str, Array]: ...
+def isometric_trial(model: Union[str, "os.PathLike[str]"], coordinate: str = "", angle_deg: float = 90.0,
+                    effort: str = "positive", activation: float = 1.0, antagonist_activation: float = 0.0,
+                    rest: float = 0.5, rise: float = 0.0, hold: float = 3.0, rate: float = 1000.0,
+                    averaging_window: Optional[float] = None, muscle_model: str = "",
+                    accuracy: float = 1e-4) -> Tuple[Dict[str, Array], Dict[str, Any]]: ...
 def arm_trial(model: Model, angle_deg: float = 90.0, activation: float = 1.0, effort: str = "flexion",
               antagonist_activation: float = 0.0, rest: float = 0.5, rise: float = 0.0, hold: float = 3.0,
               rate: float = 1000.0, averaging_window: Optional[float] = None,

@@ -422,6 +422,16 @@ std::vector<BadInput> makeCatalogue() {
          "study IN/s.yaml --merge --restart --out OUT/s", {"--merge with --restart"}},
         {"AnatomyTargetsEmpty", {{"t.yaml", "targets: []\n"}}, "model check --model twin --targets IN/t.yaml --out OUT/mc",
          {"t.yaml:1", "'targets' is empty"}},
+        {"OsimTrialWithoutACoordinate", {}, "trial --model arm26 --out OUT/t.csv",
+         {"--coordinate not given", "r_shoulder_elev, r_elbow_flex"}},
+        {"OsimTrialAngleOutsideTheRange", {}, "trial --model arm26 --coordinate r_elbow_flex --angle 150 --out OUT/t.csv",
+         {"--angle = 150", "[0, 130]"}},
+        {"OsimTrialUnknownCoordinate", {}, "trial --model arm26 --coordinate elbow --out OUT/t.csv",
+         {"--coordinate 'elbow'", "not a coordinate of arm26"}},
+        {"MainJobWithAnOsimModel", {}, "run --model arm26 --out OUT/r",
+         {"--model 'arm26'", "an OpenSim model", "`armsim trial` (isometric)"}},
+        {"CoordinateOnAnArmsimModel", {}, "trial --model thesis --coordinate r_elbow_flex --out OUT/t.csv",
+         {"--coordinate", "only for OpenSim models"}},
         {"MainJobBadModelWritesNothing", {{"m.yaml", "name: m\n"}}, "run --model IN/m.yaml --out OUT/r", {"m.yaml:1", "'arm'"}},
     };
 }

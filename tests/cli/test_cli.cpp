@@ -734,6 +734,37 @@ TEST(Cli, TheInstalledCommandRunsAndFindsItsPlugins) {
 // armsim forward from a Forward tool setup file as its only argument: the model, controls, times and
 // results folder come from the file (paths relative to it); states.sto has OpenSim's header and column
 // names, one row per 1/200 s, and matches a run given the same settings as options.
+// `armsim trial --model arm26`: the elbow locked at 80 deg, a 1 s flexion effort; the last sample's torque
+// (passive included) equals `model show`'s steady flexion torque at 80 deg (the steady isometric solve: a
+// second method) to 1e-3 relative, and the options an .osim trial cannot honour are refused by name.
+TEST(Cli, TrialOfAnOsimModelLocksACoordinate) {
+    const fs::path d = freshDir("osim_trial");
+    const CommandResult r = runArmsim("trial --model arm26 --coordinate r_elbow_flex --angle 80 --hold 1 --rate 200 --out " +
+                                      (d / "t.csv").string() + " --plot " + (d / "t.png").string());
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    EXPECT_NE(r.output.find("r_elbow_flex locked at 80 deg"), std::string::npos) << r.output;
+    EXPECT_TRUE(fs::exists(d / "t.png"));
+    const armsim::Table t = armsim::Table::readCsv((d / "t.csv").string());
+    ASSERT_EQ(t.getNumRows(), 301);
+    const double last = t.get(t.getNumRows() - 1, "muscle_torque_Nm");
+    EXPECT_NEAR(t.get(0, "tared_torque_Nm"), 0.0, 1e-12);
+    const CommandResult show = runArmsim("model show --model arm26 --coordinate r_elbow_flex --out " + (d / "show").string());
+    ASSERT_EQ(show.exitCode, 0) << show.output;
+    const armsim::Table mvc = armsim::Table::readCsv((d / "show" / "mvc_flexion.csv").string());
+    int row = -1;
+    for (int k = 0; k < mvc.getNumRows(); ++k)
+        if (std::abs(mvc.get(k, "flexion_deg") - 80) < 1e-9) row = k;
+    ASSERT_GE(row, 0);
+    EXPECT_NEAR(last, mvc.get(row, "torque_total_Nm"), 1e-3 * std::abs(mvc.get(row, "torque_total_Nm")));
+    for (const std::string& bad : {std::string("--type free"), std::string("--video v.mp4"), std::string("--mass 0.2")}) {
+        const CommandResult refused = runArmsim("trial --model arm26 --coordinate r_elbow_flex " + bad + " --out " +
+                                                (d / "bad.csv").string());
+        EXPECT_EQ(refused.exitCode, 2) << bad << ": " << refused.output;
+        EXPECT_NE(refused.output.find(bad.substr(0, bad.find(' '))), std::string::npos) << refused.output;
+        EXPECT_FALSE(fs::exists(d / "bad.csv")) << bad;
+    }
+}
+
 TEST(Cli, ForwardRunsAnOsimModelFromASetupFile) {
     const fs::path d = freshDir("forward");
     const std::string data = std::string(ARMSIM_SOURCE_DIR) + "/tests/data/opensim/arm26_forward/";

@@ -1,6 +1,7 @@
 """The Python module (issue 12): every bound function called, results equal to the C++ API's
 (tests/python/reference.cpp, 17 digits) to 1e-12 relative, numpy dtypes and shapes, errors with the
 command line's messages, and the GIL released during long calls."""
+import os
 import pathlib
 import re
 
@@ -222,6 +223,34 @@ def test_forward_runs_an_osim_model_as_the_command_does(tmp_path):
     assert "column 'BIC' names no muscle" in str(e.value)
 
 
+def test_isometric_trial_of_an_osim_model(tmp_path):
+    """armsim.isometric_trial on arm26 (a name, then a pathlib.Path): the elbow locked at 80 deg, a flexion
+    effort then an extension effort. Each muscle's torque column is its moment arm times its force, they
+    sum to muscle_torque_Nm, the tare is the first sample's torque, the agonists are the muscles pulling
+    the effort's way, and each effort turns the elbow its way; a wrong type raises TypeError, a bad value
+    ValueError naming the argument."""
+    series, summary = armsim.isometric_trial("arm26", coordinate="r_elbow_flex", angle_deg=80, hold=0.5, rate=200)
+    assert summary["coordinate"] == "r_elbow_flex" and series["r_elbow_flex_deg"][0] == 80
+    assert series["time_s"].shape == (201,)
+    total = sum(series[f"torque_{m}_Nm"] for m in summary["muscles"])
+    np.testing.assert_allclose(total, series["muscle_torque_Nm"], rtol=0, atol=1e-9)
+    for m, r in zip(summary["muscles"], summary["moment_arms_m"]):
+        np.testing.assert_allclose(series[f"torque_{m}_Nm"], r * series[f"force_{m}_N"], rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(series["tared_torque_Nm"], series["muscle_torque_Nm"] - summary["rest_torque_Nm"],
+                               rtol=0, atol=1e-12)
+    assert summary["agonists"] == [r > 0 for r in summary["moment_arms_m"]]
+    assert summary["mean_tared_torque_Nm"] > 30
+    osim = pathlib.Path(os.environ.get("ARMSIM_ASSETS", pathlib.Path(__file__).resolve().parents[2] / "assets"))
+    _, extension = armsim.isometric_trial(osim / "models" / "arm26.osim", coordinate="r_elbow_flex", angle_deg=80,
+                                          effort="negative", hold=0.5, rate=200)
+    assert extension["mean_tared_torque_Nm"] < -20
+    assert extension["agonists"] == [r < 0 for r in extension["moment_arms_m"]]
+    with pytest.raises(TypeError, match="model: expected a name or a file path"):
+        armsim.isometric_trial(3.0)
+    with pytest.raises(ValueError, match=re.escape("'angle_deg' = 150: expected in [0, 130] (deg)")):
+        armsim.isometric_trial("arm26", coordinate="r_elbow_flex", angle_deg=150)
+
+
 # The key-naming rule (README, Python): a returned key or column holding a quantity with a unit ends in
 # that unit; the dimensionless ones below have none. Model.parameters() and identify's "estimate" keep
 # the model files' parameter names (what with_muscle takes); a channel's value carries its unit beside it.
@@ -240,7 +269,7 @@ DIMENSIONLESS = {
     "tendon_length_covered", "mass_sd", "mass_sd_considered", "prior_mass_sd", "flexor_strength_sd",
     "prior_flexor_strength_sd", "max_force_sd", "prior_max_force_sd", "max_force_sd_considered", "parameter_names",
     "mass_correlation", "posterior_sd", "name", "trials", "draws_used", "criterion", "conditions", "protocol_yaml",
-    "predicted", "reference", "steps", "repetitions",
+    "predicted", "reference", "steps", "repetitions", "coordinate", "muscles", "agonists", "excitation",
 }   # mass_sd and max_force_sd: of ln M and ln F0; posterior_sd: per parameter_names entry; *_scale: ratios
 
 
@@ -269,6 +298,7 @@ def test_returned_keys_carry_their_units(thesis, elbow, tmp_path):
         "validate_elbow": armsim.validate_elbow(subjects=1, noise=[0.02], jobs=1),
         "validate": armsim.validate(thesis, noise=[0.02], methods=["lm"], jobs=1),
         "design_protocol": armsim.design_protocol(draws=2, trials=3, jobs=1),
+        "isometric_trial": armsim.isometric_trial("arm26", coordinate="r_elbow_flex", hold=0.1, rate=100),
     }
     bad = []
     for name, result in results.items():

@@ -1,0 +1,160 @@
+#include "model/osim_trial.h"
+
+#include "basics/bound.h"
+#include "basics/errors.h"
+#include "basics/format.h"
+#include "model/osim_arm.h"
+
+#include <cmath>
+#include <utility>
+
+namespace armsim {
+
+namespace {
+
+constexpr double kDeg = 3.14159265358979323846 / 180;
+
+int findTrialCoordinate(const OsimArm& arm, const std::string& name) {
+    std::string names;
+    for (int i = 0; i < arm.getNumCoordinates(); ++i) names += (i ? ", " : "") + arm.getCoordinate(i).name;
+    if (arm.getNumCoordinates() == 0) throw InputError("model " + arm.getModel().name + " has no moving coordinate");
+    if (name.empty()) {
+        if (arm.getNumCoordinates() == 1) return 0;
+        throw FieldError("coordinate", "not given: model " + arm.getModel().name + " has " +
+                                           std::to_string(arm.getNumCoordinates()) + " coordinates (" + names +
+                                           "): name the one to lock and act about");
+    }
+    const int i = arm.findCoordinate(name);
+    if (i < 0) throw FieldError("coordinate", "'" + name + "': not a coordinate of " + arm.getModel().name + " (" + names + ")");
+    if (!arm.getCoordinate(i).rotational)
+        throw FieldError("coordinate", "'" + name + "': translational; expected a rotational coordinate");
+    return i;
+}
+
+double mean(const std::vector<double>& v, std::size_t first) {
+    double s = 0;
+    for (std::size_t i = first; i < v.size(); ++i) s += v[i];
+    return s / double(v.size() - first);
+}
+
+}  // namespace
+
+void OsimIsometricTrialSettings::validate(const OsimArm& arm) const {
+    const int j = findTrialCoordinate(arm, coordinate);
+    const auto range = arm.getCoordinate(j).range;
+    // The range in degrees rounded to 1e-6 deg (a file's 2.26893 rad reads 130 deg, not 130.00000014).
+    checkField("angle_deg", angleDeg,
+               Bound::closed(std::round(range[0] / kDeg * 1e6) / 1e6, std::round(range[1] / kDeg * 1e6) / 1e6, "deg"));
+    if (direction != 1 && direction != -1)
+        throw FieldError("direction", "= " + std::to_string(direction) + ": expected +1 or -1");
+    checkField("activation", activation, Bound::closed(0, 1));
+    checkField("antagonist_activation", antagonistActivation, Bound::closed(0, 1));
+    checkField("rest", restDuration, Bound::positive("s"));
+    checkField("rise", riseTime, Bound::nonNegative("s"));
+    checkField("hold", holdDuration, Bound::positive("s"));
+    checkField("sample_rate", sampleRate, Bound::positive("Hz"));
+    checkField("averaging_window", averagingWindow, Bound::closed(0, holdDuration, "s"));
+    if (averagingWindow * sampleRate < 1)
+        throw FieldError("averaging_window", "= " + formatNumber(averagingWindow) + " s holds no sample at " +
+                                                 formatNumber(sampleRate) + " Hz: expected at least one sample interval");
+    calcNumSamples(getDuration(), sampleRate);
+    integration.validate();
+}
+
+OsimIsometricTrialResult runOsimIsometricTrial(const OsimModel& file, const OsimIsometricTrialSettings& settings) {
+    // Every coordinate held: the trial's at the angle, the others at their defaults; the paths are then
+    // fixed and the System is only needed for the geometry.
+    const OsimArm probe(file, {}, settings.muscleModel);
+    settings.validate(probe);
+    const int j = findTrialCoordinate(probe, settings.coordinate);
+    const std::string coordinate = probe.getCoordinate(j).name;
+    const int n = probe.getNumMuscles();
+
+    OsimIsometricTrialResult result;
+    OsimIsometricSummary& sum = result.summary;
+    sum.coordinate = coordinate;
+    sum.angleDeg = settings.angleDeg;
+    SimTK::State s = probe.getDefaultState();
+    probe.setCoordinateValue(s, j, settings.angleDeg * kDeg);
+    probe.getSystem().realize(s, SimTK::Stage::Position);
+    std::vector<const MuscleModel*> muscles;
+    for (int i = 0; i < n; ++i) {
+        sum.muscles.push_back(probe.getMuscleName(i));
+        sum.pathLengths.push_back(probe.calcPathLength(s, i));
+        sum.momentArms.push_back(probe.calcMomentArm(s, i, j));
+        sum.agonists.push_back(isOsimAgonist(settings.direction, sum.momentArms[i]));
+        muscles.push_back(&probe.getMuscleForce(i).getMuscle());
+        muscles[i]->checkPathLength(sum.pathLengths[i]);
+    }
+
+    // Excitations: 0 at rest, then each muscle to its level (a step, or a ramp over riseTime).
+    const double onset = settings.restDuration;
+    std::vector<ActivationProfile> excitation;
+    for (int i = 0; i < n; ++i) {
+        const double U = sum.agonists[i] ? settings.activation : settings.antagonistActivation;
+        excitation.push_back(settings.riseTime > 0 ? ActivationProfile::ramp(onset, onset + settings.riseTime, 0.0, U)
+                                                   : ActivationProfile::step(onset, 0.0, U));
+    }
+    const ActivationProfile agonistProfile =
+        settings.riseTime > 0 ? ActivationProfile::ramp(onset, onset + settings.riseTime, 0.0, settings.activation)
+                              : ActivationProfile::step(onset, 0.0, settings.activation);
+
+    // y: each muscle's states in turn, from its rest state at its path length.
+    OdeBlocks f;
+    std::vector<double> y;
+    for (int i = 0; i < n; ++i) {
+        f.first.push_back(int(y.size()));
+        f.size.push_back(muscles[i]->getNumStates());
+        const std::vector<double> y0 = muscles[i]->calcInitialState(sum.pathLengths[i]);
+        y.insert(y.end(), y0.begin(), y0.end());
+    }
+    f.banded = n > 1;
+    const std::vector<double>& P = sum.pathLengths;
+    f.calcBlock = [&](int b, double t, const double* yIn, double* ydot) {
+        muscles[b]->calcStateDerivative(P[b], excitation[b].getValue(t), yIn + f.first[b], ydot + f.first[b]);
+    };
+
+    std::vector<std::string> columns{"time_s", "excitation", coordinate + "_deg", "muscle_torque_Nm", "tared_torque_Nm"};
+    const std::pair<const char*, const char*> perMuscle[] = {
+        {"force_", "_N"}, {"torque_", "_Nm"}, {"excitation_", ""}, {"activation_", ""}, {"fiber_length_", "_m"}};
+    for (const auto& [prefix, unit] : perMuscle)
+        for (int i = 0; i < n; ++i) columns.push_back(prefix + sum.muscles[i] + unit);
+    result.series = Table(columns);
+    result.series.reserveRows(int(std::lround(settings.getDuration() * settings.sampleRate)) + 1);
+    std::vector<double> row, F(n), torque(n), U(n), a(n), L(n), ydot(y.size());
+    bool haveTare = false;
+    MuscleOutputs out;
+    auto sample = [&](double t, const double* yIn) {
+        double total = 0;
+        for (int i = 0; i < n; ++i) {
+            const double* yi = yIn + f.first[i];
+            U[i] = excitation[i].getValue(t);
+            F[i] = muscles[i]->calcForce(P[i], yi);
+            torque[i] = sum.momentArms[i] * F[i];
+            muscles[i]->calcStateDerivative(P[i], U[i], yi, ydot.data() + f.first[i], &out);
+            a[i] = out.activeFraction;
+            L[i] = muscles[i]->calcFascicleLength(P[i], yi);
+            total += torque[i];
+        }
+        if (!haveTare) sum.restTorque = total, haveTare = true;
+        row.assign({t, agonistProfile.getValue(t), settings.angleDeg, total, total - sum.restTorque});
+        for (const std::vector<double>* v : {&F, &torque, &U, &a, &L}) row.insert(row.end(), v->begin(), v->end());
+        result.series.appendRow(row);
+    };
+    sum.stats = integrateSampled(f, 0.0, y, settings.getDuration(), settings.sampleRate, agonistProfile.getBreakpoints(),
+                                 settings.integration, sample, [&](double t, const double* yIn) {
+                                     for (int i = 0; i < n; ++i) muscles[i]->checkStates(t, yIn + f.first[i]);
+                                 });
+
+    const Table& t = result.series;
+    const std::vector<double> time = t.getColumn("time_s");
+    const double from = time.back() - settings.averagingWindow - 1e-9;
+    std::size_t first = 0;
+    while (first < time.size() && time[first] < from) ++first;
+    sum.meanMuscleTorque = mean(t.getColumn("muscle_torque_Nm"), first);
+    sum.meanTaredTorque = mean(t.getColumn("tared_torque_Nm"), first);
+    for (int i = 0; i < n; ++i) sum.meanForces.push_back(mean(t.getColumn("force_" + sum.muscles[i] + "_N"), first));
+    return result;
+}
+
+}  // namespace armsim

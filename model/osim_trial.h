@@ -1,0 +1,82 @@
+// An isometric trial of an OpenSim model (model/osim_arm.h): one coordinate locked at a value, the
+// others at their defaults (locked too, as a dynamometer holds the limb), the muscles that move the
+// coordinate one way excited to a target after a rest, and the torque they put on it recorded, raw and
+// tared at rest as a dynamometer reads it. `armsim trial --model FILE.osim` and Python's
+// `armsim.isometric_trial` run it.
+//
+// With every coordinate locked the paths are fixed, so each muscle's states evolve alone at its path
+// length (numerics/stiff_ode.h OdeBlocks, a band Newton matrix: cost linear in the muscles), and the
+// torque is sum_i r_i F_i with r_i the moment arm by virtual work (OsimArm::calcMomentArm). The tests
+// check this against the whole Simbody System integrated with the coordinates locked, and the end of a
+// long hold against the steady isometric solve `model show` uses.
+#pragma once
+
+#include "basics/numbers.h"
+
+#include "basics/table.h"
+#include "model/osim_file.h"
+#include "muscles/activation.h"
+#include "numerics/stiff_ode.h"
+
+#include <string>
+#include <vector>
+
+namespace armsim {
+
+class OsimArm;
+
+/// What an osim isometric trial does.
+struct OsimIsometricTrialSettings {
+    std::string coordinate;        ///< the locked coordinate the effort acts about; "" = the model's only one
+    double angleDeg = 90;          ///< its value [deg] (OpenSim's convention: arm26's r_elbow_flex 0 = straight)
+    /// The effort's direction: +1 the coordinate's positive direction (arm26's elbow: flexion), -1 negative.
+    int direction = 1;
+    double activation = 1.0;            ///< excitation of the agonists during the hold [1]
+    double antagonistActivation = 0.0;  ///< excitation of the other muscles during the hold [1]
+    double restDuration = 0.5;     ///< muscles at rest, the torque tared at its start [s]
+    double riseTime = 0.0;         ///< ramp from 0 to the target; 0 = step [s]
+    double holdDuration = 3.0;     ///< time at the target [s]
+    double sampleRate = 1000.0;    ///< output rate [Hz]
+    double averagingWindow = 1.0;  ///< end of the hold averaged for the summary [s]
+    std::string muscleModel;       ///< "" = each muscle's type in the file (model/osim_arm.h)
+    IntegrationSettings integration;
+
+    double getDuration() const { return restDuration + riseTime + holdDuration; }
+    /// Throws InputError naming the field (its CLI option in runNamingOptions) for a bad value, an
+    /// angle outside the coordinate's range or a coordinate that is not there.
+    void validate(const OsimArm& arm) const;
+};
+
+/// true when a muscle with moment arm r [m] about the coordinate is an agonist of an effort in
+/// `direction` (+1/-1): it pulls that way (r direction > 0). `model show`'s MVC curves use the same rule.
+inline bool isOsimAgonist(int direction, double momentArm) { return direction * momentArm > 0; }
+
+/// Summary of an osim isometric trial (window means over the last averagingWindow of the hold).
+struct OsimIsometricSummary {
+    std::string coordinate;              ///< the locked coordinate
+    double angleDeg = 0;                 ///< its value [deg]
+    std::vector<std::string> muscles;    ///< names, file order
+    std::vector<bool> agonists;          ///< per muscle
+    std::vector<double> pathLengths;     ///< per muscle [m]
+    std::vector<double> momentArms;      ///< per muscle about the coordinate [m] (+ = its positive direction)
+    std::vector<double> meanForces;      ///< per muscle, window mean [N]
+    double restTorque = 0;               ///< muscle torque at the first sample (passive), the tare [N m]
+    double meanMuscleTorque = 0;         ///< sum_i r_i F_i, window mean [N m]
+    double meanTaredTorque = 0;          ///< meanMuscleTorque - restTorque [N m]
+    IntegrationStats stats;
+};
+
+struct OsimIsometricTrialResult {
+    /// Columns: time_s, excitation (of the agonists), <coordinate>_deg, muscle_torque_Nm (sum_i r_i F_i,
+    /// + = the coordinate's positive direction), tared_torque_Nm (less its value at the first sample),
+    /// then per muscle force_<m>_N, torque_<m>_Nm, excitation_<m>, activation_<m> (the model's active
+    /// fraction) and fiber_length_<m>_m.
+    Table series;
+    OsimIsometricSummary summary;
+};
+
+/// Runs the trial (its own Simbody System). muscleModel as OsimArm's. Throws InputError for bad
+/// settings, SimulationError when the integration fails.
+OsimIsometricTrialResult runOsimIsometricTrial(const OsimModel& model, const OsimIsometricTrialSettings& settings);
+
+}  // namespace armsim
