@@ -20,6 +20,8 @@ inline std::string formatNumber(double v) {
 /// v with `significantDigits` (1..17) significant digits in printf's %g form ("0.33599", "1e-05",
 /// "inf"): numbers in descriptions and progress messages, where the round-trip form would be noise.
 std::string formatNumber(double v, int significantDigits);
+/// A duration for a progress message: "42s", "3m05s", "2h10m"; "?" when not finite.
+std::string formatDuration(double seconds);
 /// A size in bytes for a message, 3 significant digits in B, kB, MB or GB (decimal): "15 GB", "1.5 kB".
 std::string formatBytes(double bytes);
 

@@ -86,8 +86,13 @@ void checkOutputFolder(const std::string& option, const std::string& dir);
 /// reported naming that option ("--fps = 0: expected in [1, 240] (1/s)"); other errors pass unchanged.
 void runNamingOptions(const std::map<std::string, std::string>& optionOfField, const std::function<void()>& f);
 
-/// Prints a one-line progress bar to stderr ("label [#####     ] 5/10"); nothing with --quiet.
+/// Prints a one-line progress bar to stderr ("label [#####     ] 5/10"); nothing with --quiet. When
+/// stderr is not a terminal (a log): the end ("label: 10/10 done") and, for long work, a line every 10 s
+/// (ARMSIM_PROGRESS_SECONDS) with the share done and the time left at the rate so far.
 void printProgress(const std::string& label, int done, int total);
+/// The same for a simulation at time t [s] of `duration` (a long forward or free run): "12.3/100 s"; on
+/// a log only for runs that last (a line every 10 s and the end).
+void printTimeProgress(const std::string& label, double t, double duration);
 /// --quiet (any command): progress lines are left out; results and errors are printed as always.
 void setQuiet(bool quiet);
 bool isQuiet();

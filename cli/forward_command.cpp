@@ -25,6 +25,7 @@ struct ForwardOptions {
     double initialTime = kNaN, finalTime = kNaN;
     double rate = 200;
     double accuracy = kNaN;  ///< NaN: the setup's tolerance, else 1e-5
+    double maxStepSize = 0;  ///< [s] the setup's maximum_integrator_step_size; 0: none
     std::string muscleModel;
     std::string out;
 };
@@ -42,6 +43,7 @@ void runForward(const ForwardOptions& given, CLI::Option* outOption) {
         if (!std::isfinite(o.finalTime)) o.finalTime = s.finalTime;
         if (o.out.empty()) o.out = s.resultsDirectory;
         if (!std::isfinite(o.accuracy)) o.accuracy = s.tolerance;
+        o.maxStepSize = s.maxStepSize;
     }
     if (o.model.empty()) throw InputError("forward: no model: give --model FILE.osim (or a Forward tool setup file)");
     if (o.controls.empty()) throw InputError("forward: no controls: give --controls FILE.sto (or a Forward tool setup file)");
@@ -60,6 +62,8 @@ void runForward(const ForwardOptions& given, CLI::Option* outOption) {
     s.sampleRate = o.rate;
     s.muscleModel = o.muscleModel;
     s.integration.accuracy = o.accuracy;
+    s.integration.maxStepSize = o.maxStepSize;
+    s.progress = [](double t, double duration) { printTimeProgress("forward", t, duration); };
     const auto start = std::chrono::steady_clock::now();
     const OsimForwardResult r = runOsimForward(model, controls, o.initialStates.empty() ? nullptr : &initial, s);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -176,6 +176,7 @@ void runIdentify(const IdentifyOptions& o) {
     io.noise = parseNoiseModelName(o.noise);
     if (io.noise == NoiseModel::Relative && !std::isnan(o.forceSd)) io.relativeForceSd = o.forceSd, io.forceSd = NAN;
     io.starts = o.multistart;
+    io.progress = [](int done, int total) { printProgress("lm starts", done, total); };
     io.seed = o.seed;
     io.maxIterations = o.maxIterations;
     io.forceTolerance = o.tolerance;

@@ -72,6 +72,29 @@ std::string findUnknownCommand(const CLI::App& app, int argc, char** argv) {
     return "";
 }
 
+// CLI11's "Could not convert: --rate = abc" with what the option expected: "--rate = 'abc': expected a
+// number"; the message as CLI11 gave it when the option is not found.
+std::string explainConversion(const CLI::App& app, const std::string& what) {
+    const std::string prefix = "Could not convert: ";
+    const std::size_t eq = what.find(" = ");
+    if (what.rfind(prefix, 0) != 0 || eq == std::string::npos) return what;
+    const std::string name = what.substr(prefix.size(), eq - prefix.size()), value = what.substr(eq + 3);
+    std::vector<const CLI::App*> apps{&app};
+    for (std::size_t k = 0; k < apps.size(); ++k)
+        for (const CLI::App* sub : apps[k]->get_subcommands({})) apps.push_back(sub);
+    for (const CLI::App* a : apps)
+        for (const CLI::Option* o : a->get_options()) {
+            if (o->get_name() != name && !o->check_name(name)) continue;
+            const std::string type = o->get_type_name();
+            const std::string expected = type == "FLOAT"  ? "a number"
+                                         : type == "INT"  ? "an integer"
+                                         : type == "UINT" ? "a whole number >= 0"
+                                                          : type;
+            return name + " = '" + value + "': expected " + expected;
+        }
+    return what;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -91,7 +114,10 @@ int main(int argc, char** argv) {
         try {   // FOLDER/index.html of a command that wrote a folder; the command's own files stand either way
             armsim::cli::writeCommandReport(app, argc, argv);
         } catch (const std::exception& e) {
-            std::cerr << "armsim: warning: no index.html: " << e.what() << "\n";
+            // Not a silent success: a script sees the exit status; the message says what is there.
+            std::cerr << "armsim: error: index.html (the folder's overview) not written: " << e.what()
+                      << " (the command's other files are complete)\n";
+            return 2;
         }
     } catch (const CLI::CallForHelp& e) {
         return app.exit(e);
@@ -99,6 +125,9 @@ int main(int argc, char** argv) {
         return app.exit(e);
     } catch (const CLI::CallForVersion& e) {
         return app.exit(e);
+    } catch (const CLI::ConversionError& e) {
+        std::cerr << "armsim: error: " << explainConversion(app, e.what()) << " (armsim COMMAND --help lists its options)\n";
+        return 2;
     } catch (const CLI::ParseError& e) {
         const std::string unknown = findUnknownCommand(app, argc, argv);
         std::cerr << "armsim: error: " << (unknown.empty() ? std::string(e.what()) : unknown)

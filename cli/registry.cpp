@@ -1,16 +1,22 @@
 #include "basics/errors.h"
 #include "basics/files.h"
+#include "basics/format.h"
 #include "basics/output_folder.h"
 #include "cli/commands.h"
 
+#include <fmt/format.h>
 #include <malloc.h>
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
+#include <map>
 #include <memory>
+#include <mutex>
 #include <unistd.h>
 #include <vector>
 
@@ -61,29 +67,52 @@ double parseNumber(const std::string& option, const std::string& text) {
     return v;
 }
 
+namespace {
+// The items of a list option's occurrences (each one comma-separated text; repeated occurrences add
+// up: --noise 1 --noise 2). Split here, not by CLI11, whose delimiter drops empty items ("1,,2" would
+// read as 1,2). `what`: "a finite number" or "a name".
+std::vector<std::string> splitListOption(const std::string& name, const std::vector<std::string>& texts, const char* what) {
+    std::vector<std::string> items;
+    for (const std::string& text : texts) {
+        if (text.empty())
+            throw InputError(name + " '': expected " + what + " (for no values, leave the option out)");
+        std::size_t begin = 0;
+        for (int item = 1;; ++item) {
+            const std::size_t comma = text.find(',', begin);
+            std::string part = text.substr(begin, comma == std::string::npos ? std::string::npos : comma - begin);
+            if (part.empty())
+                throw InputError(name + " '" + text + "': item " + std::to_string(item) + " is empty: expected " + what);
+            items.push_back(std::move(part));
+            if (comma == std::string::npos) break;
+            begin = comma + 1;
+        }
+    }
+    return items;
+}
+}  // namespace
+
 CLI::Option* addNumberListOption(CLI::App& app, const std::string& name, std::vector<double>& values,
                                  const std::string& description) {
-    const CLI::Validator finite(
-        [](std::string& item) -> std::string {
-            if (item.empty()) return "'': expected a finite number (for no values, leave the option out)";
-            try {
-                parseNumber("", item);
-            } catch (const InputError&) {
-                return "'" + item + "': expected a finite number";
-            }
-            return "";
+    CLI::Option* option = app.add_option_function<std::vector<std::string>>(
+        name,
+        [&values, name](const std::vector<std::string>& texts) {
+            std::vector<double> parsed;
+            for (const std::string& item : splitListOption(name, texts, "a finite number"))
+                parsed.push_back(parseNumber(name, item));
+            values = std::move(parsed);
         },
-        "");
-    return app.add_option(name, values, description)
-        ->delimiter(',')
-        ->check(finite)
-        ->allow_extra_args(false)
-        ->type_name("NUMBERS");
+        description);
+    option->default_function([&values] { return formatList(values); });
+    return option->allow_extra_args(false)->type_name("NUMBERS");
 }
 
 CLI::Option* addNameListOption(CLI::App& app, const std::string& name, std::vector<std::string>& values,
                                const std::string& description) {
-    return app.add_option(name, values, description)->delimiter(',')->allow_extra_args(false)->type_name("NAMES");
+    CLI::Option* option = app.add_option_function<std::vector<std::string>>(
+        name, [&values, name](const std::vector<std::string>& texts) { values = splitListOption(name, texts, "a name"); },
+        description);
+    option->default_function([&values] { return formatList(values); });
+    return option->allow_extra_args(false)->type_name("NAMES");
 }
 
 void runNamingOptions(const std::map<std::string, std::string>& optionOfField, const std::function<void()>& f) {
@@ -129,19 +158,77 @@ std::atomic<bool> gQuiet{false};
 void setQuiet(bool quiet) { gQuiet = quiet; }
 bool isQuiet() { return gQuiet; }
 
-void printProgress(const std::string& label, int done, int total) {
+namespace {
+// A log file's progress: when each label started and last printed (a run prints a handful of labels).
+struct LogProgress {
+    std::mutex mutex;
+    std::map<std::string, std::pair<std::chrono::steady_clock::time_point, std::chrono::steady_clock::time_point>> started;
+};
+LogProgress& logProgress() {
+    static LogProgress p;
+    return p;
+}
+}  // namespace
+
+namespace {
+// One progress report: `amount` is "5/10" or "12.3/100 s"; fraction in [0, 1].
+// quickEndSilent: on a log, no end line for work that ended before its first periodic line.
+void printProgressLine(const std::string& label, double fraction, const std::string& amount, bool finished,
+                       bool quickEndSilent = false) {
     if (isQuiet()) return;
     std::fflush(stdout);  // keep results and progress in order when both go to one log
-    if (!isatty(fileno(stderr))) {  // a log file gets one line, not a stream of carriage returns
-        if (done >= total) std::fprintf(stderr, "%s: %d/%d done\n", label.c_str(), done, total);
+    // A log file gets lines, not a stream of carriage returns: the end, and for long work a line at most
+    // every kLogInterval with the share done and the time left at the rate so far (so a batch job's log
+    // shows it is alive). A terminal's line is redrawn at most every kTerminalInterval.
+    // ARMSIM_PROGRESS_SECONDS sets the log's interval (a batch system's cadence; the tests' short one).
+    static const double kLogInterval = [] {
+        const char* v = std::getenv("ARMSIM_PROGRESS_SECONDS");
+        char* end = nullptr;
+        const double x = v ? std::strtod(v, &end) : 0;
+        return v && end != v && *end == '\0' && x >= 1e-3 && x <= 86400 ? x : 10.0;
+    }();
+    constexpr double kTerminalInterval = 0.1;  // [s]
+    using Clock = std::chrono::steady_clock;
+    const bool tty = isatty(fileno(stderr));
+    LogProgress& p = logProgress();
+    const std::lock_guard<std::mutex> lock(p.mutex);
+    const Clock::time_point now = Clock::now();
+    auto [at, inserted] = p.started.try_emplace(label, now, now);
+    const double sinceLast = std::chrono::duration<double>(now - at->second.second).count();
+    const double elapsed = std::chrono::duration<double>(now - at->second.first).count();
+    if (finished) p.started.erase(at);
+    if (!tty) {
+        if (finished) {
+            if (!quickEndSilent || elapsed >= kLogInterval) std::fprintf(stderr, "%s: %s done\n", label.c_str(), amount.c_str());
+        } else if (!inserted && sinceLast >= kLogInterval) {
+            at->second.second = now;
+            std::string left = "time left unknown";
+            if (fraction > 0) left = "about " + formatDuration(elapsed * (1 - fraction) / fraction) + " left";
+            std::fprintf(stderr, "%s: %s (%.0f %%) after %s, %s\n", label.c_str(), amount.c_str(), 100 * fraction,
+                         formatDuration(elapsed).c_str(), left.c_str());
+        }
+        std::fflush(stderr);
         return;
     }
+    if (!finished && !inserted && sinceLast < kTerminalInterval) return;
+    if (!finished) at->second.second = now;
     constexpr int kWidth = 30;
-    const int filled = total > 0 ? done * kWidth / total : kWidth;
-    std::fprintf(stderr, "\r%-28s [%s%s] %d/%d", label.c_str(), std::string(filled, '#').c_str(),
-                 std::string(kWidth - filled, ' ').c_str(), done, total);
-    if (done >= total) std::fprintf(stderr, "\n");
+    const int filled = int(std::clamp(fraction, 0.0, 1.0) * kWidth);
+    std::fprintf(stderr, "\r%-28s [%s%s] %s", label.c_str(), std::string(filled, '#').c_str(),
+                 std::string(kWidth - filled, ' ').c_str(), amount.c_str());
+    if (finished) std::fprintf(stderr, "\n");
     std::fflush(stderr);
+}
+}  // namespace
+
+void printProgress(const std::string& label, int done, int total) {
+    printProgressLine(label, total > 0 ? double(done) / total : 1.0, std::to_string(done) + "/" + std::to_string(total),
+                      done >= total);
+}
+
+void printTimeProgress(const std::string& label, double t, double duration) {
+    printProgressLine(label, duration > 0 ? t / duration : 1.0, fmt::format("{:.1f}/{} s", t, formatNumber(duration)),
+                      t >= duration * (1 - 1e-12), true);
 }
 
 void addRegisteredCommands(CLI::App& app) {

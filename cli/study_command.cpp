@@ -45,14 +45,6 @@ void parseShard(const std::string& text, int& shard, int& shards) {
         throw InputError("--shard '" + text + "': expected I/N, shard I of N with 0 <= I < N (e.g. 0/4 .. 3/4)");
 }
 
-std::string formatDuration(double seconds) {
-    if (!std::isfinite(seconds)) return "?";
-    const long s = long(std::lround(seconds));
-    if (s >= 3600) return fmt::format("{}h{:02}m", s / 3600, s / 60 % 60);
-    if (s >= 60) return fmt::format("{}m{:02}s", s / 60, s % 60);
-    return fmt::format("{}s", s);
-}
-
 // One line per report on a log; one updated line on a terminal.
 void printStudyProgress(const StudyProgress& p) {
     std::fflush(stdout);

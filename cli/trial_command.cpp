@@ -187,6 +187,7 @@ void runTrialCommand(const TrialOptions& o) {
                                r.series.getColumn("force_fixed_ratio_N"), false, 2});
     } else {
         IntegrationStats stats;
+        free.progress = [d = free.duration](double t) { printTimeProgress("free movement", t, d); };
         const Table t = runFreeMovement(setup, free, &stats);
         files.writeWith(csvPath, [&](const std::string& p) { t.writeCsv(p); });
         if (!o.video.empty())

@@ -76,6 +76,7 @@
 #include "identification/observations.h"
 #include "identification/unknowns.h"
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -131,6 +132,8 @@ struct IdentificationOptions {
     double confidenceLevel = 0.95;   ///< lm: two-sided interval level
     int starts = 1;                  ///< lm: number of starts (>= 1)
     unsigned seed = 1;               ///< lm: seed of the multi-start generator
+    /// Optional, lm with several starts: called with (starts done, starts) after each (progress).
+    std::function<void(int, int)> progress;
 };
 
 /// Why a run stopped.

@@ -237,6 +237,7 @@ SolverOutcome solveLeastSquares(SolverContext& ctx, IdentificationReport& report
         iterations += int(run.summary.iterations.size()) - 1;
         report.startCosts.push_back(run.cost);
         if (s == 0 || run.cost < best.cost) best = std::move(run);
+        if (ctx.options.progress && ctx.options.starts > 1) ctx.options.progress(s + 1, ctx.options.starts);
     }
 
     SolverOutcome out;

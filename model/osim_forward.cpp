@@ -14,6 +14,7 @@
 #include <cmath>
 #include <filesystem>
 #include <map>
+#include <set>
 #include <sstream>
 
 namespace armsim {
@@ -199,6 +200,7 @@ OsimForwardResult runOsimForward(const OsimModel& model, const OsimStorage& cont
             for (std::size_t k = 0; k < y.size(); ++k) row.push_back(y[k] * stateScales[i][k]);
         }
         result.states.appendRow(row);
+        if (settings.progress) settings.progress(x.getTime() - t0, settings.finalTime - t0);
     };
     // The excitations are continuous (linear between rows): the solver's error control takes their kinks
     // without restarts.
@@ -246,6 +248,39 @@ OsimForwardSetup readOsimForwardSetup(const std::string& path) {
                             "': expected a number");
         return x;
     };
+    // Every element of the tool is one it uses, one that cannot change the states (skipped), or one
+    // refused by name: a misspelt or unsupported element is never passed over silently.
+    static const std::set<std::string> kUsed = {"model_file", "results_directory", "initial_time", "final_time",
+                                                "integrator_error_tolerance", "maximum_integrator_step_size",
+                                                "states_file", "ControllerSet", "controls_file"};
+    // Output precision, step counts and floors, equilibrium of auxiliary states (armsim solves it when no
+    // states file is given), analyses (their own outputs), and force sets or loads left empty.
+    static const std::set<std::string> kHarmless = {"output_precision", "maximum_number_of_integrator_steps",
+                                                    "minimum_integrator_step_size", "integrator_fine_tolerance",
+                                                    "solve_for_equilibrium_for_auxiliary_states", "AnalysisSet",
+                                                    "replace_force_set", "print_every"};
+    static const std::set<std::string> kRefusedWhenSet = {"force_set_files", "external_loads_file",
+                                                          "external_loads_model_kinematics_file",
+                                                          "lowpass_cutoff_frequency_for_load_kinematics", "use_specified_dt"};
+    for (const XMLElement* e = tool->FirstChildElement(); e; e = e->NextSiblingElement()) {
+        const std::string name = e->Name();
+        const std::string where = path + ":" + std::to_string(e->GetLineNum()) + ": <" + name + ">";
+        if (kUsed.count(name) || kHarmless.count(name)) continue;
+        if (kRefusedWhenSet.count(name)) {
+            const std::string v = text(tool, name.c_str());
+            const bool unset = v.empty() || v == "Unassigned" || v == "false" ||
+                               (name == "lowpass_cutoff_frequency_for_load_kinematics" && v.find('-') == 0);
+            if (unset) continue;
+            throw OsimError(where + " '" + v + "': not supported yet (the Forward tool would " +
+                            (name == "use_specified_dt" ? std::string("step at the controls' times")
+                             : name == "force_set_files" ? std::string("add or replace forces")
+                                                         : std::string("apply external loads")) +
+                            "; armsim runs the model's own muscles only): remove it to run without");
+        }
+        throw OsimError(where + ": not an element of OpenSim's Forward tool setup (a misspelling?): expected model_file, "
+                                "results_directory, initial_time, final_time, integrator_error_tolerance, states_file, "
+                                "ControllerSet or another ForwardTool property");
+    }
     OsimForwardSetup s;
     s.modelFile = file(text(tool, "model_file"));
     if (s.modelFile.empty())
@@ -254,12 +289,17 @@ OsimForwardSetup readOsimForwardSetup(const std::string& path) {
     s.initialTime = number("initial_time", 0);
     s.finalTime = number("final_time", 1);
     s.tolerance = number("integrator_error_tolerance", 1e-5);
+    s.maxStepSize = number("maximum_integrator_step_size", 1);
+    if (!(s.maxStepSize > 0))
+        throw OsimError(path + ":" + std::to_string(tool->FirstChildElement("maximum_integrator_step_size")->GetLineNum()) +
+                        ": <maximum_integrator_step_size> " + formatNumber(s.maxStepSize) + ": expected > 0 s");
     s.statesFile = file(text(tool, "states_file"));
+    if (const std::string c = text(tool, "controls_file"); !c.empty() && c != "Unassigned") s.controlsFile = file(c);  // OpenSim 2.x
     for (const XMLElement* e = tool->FirstChildElement("ControllerSet"); e; e = nullptr)
         if (const XMLElement* objects = e->FirstChildElement("objects"))
             for (const XMLElement* ctl = objects->FirstChildElement(); ctl; ctl = ctl->NextSiblingElement()) {
                 const std::string f = text(ctl, "controls_file");
-                if (f.empty()) continue;
+                if (f.empty() || f == "Unassigned") continue;
                 if (f.size() >= 4 && f.substr(f.size() - 4) == ".xml")
                     throw OsimError(path + ":" + std::to_string(ctl->GetLineNum()) + ": <" + ctl->Name() + ">: controls file '" +
                                     f + "' is an XML ControlSet: not supported yet (expected a .sto storage file)");

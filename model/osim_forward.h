@@ -15,6 +15,7 @@
 #include "model/osim_file.h"
 #include "numerics/stiff_ode.h"
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -47,6 +48,8 @@ struct OsimForwardSettings {
         i.accuracy = 1e-5;
         return i;
     }();
+    /// Optional: called at every row with the time run so far and the run's length [s] (progress).
+    std::function<void(double, double)> progress;
     /// InputError naming the field for a bad value.
     void validate() const;
 };
@@ -71,9 +74,12 @@ struct OsimForwardSetup {
     std::string modelFile, controlsFile, statesFile, resultsDirectory;
     double initialTime = 0, finalTime = 1;
     double tolerance = 1e-5;
+    double maxStepSize = 1;  ///< maximum_integrator_step_size [s] (OpenSim's default 1)
 };
-/// Reads <ForwardTool>; OsimError naming the file and line for a missing element or a controls file
-/// that is not a storage file (an XML ControlSet: not supported yet).
+/// Reads <ForwardTool>; OsimError naming the file and line for a missing element, a controls file that
+/// is not a storage file (an XML ControlSet: not supported yet), an element that is not the tool's, or
+/// force sets, external loads or use_specified_dt given (not supported yet). Output precision, step
+/// counts, analyses and the auxiliary-state equilibrium flag cannot change the states and are skipped.
 OsimForwardSetup readOsimForwardSetup(const std::string& path);
 
 }  // namespace armsim

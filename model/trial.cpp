@@ -582,6 +582,7 @@ Table runFreeMovement(const ArmSetup& setup, const FreeMovementSettings& setting
         appendMuscleForces(row, activations, forces, s.getTime());
         model.appendMuscleStates(s, row);
         t.appendRow(std::move(row));
+        if (settings.progress) settings.progress(s.getTime());
     };
     IntegrationStats st;
     if (settings.solver == FreeMovementSolver::SimbodySystem) {

@@ -205,6 +205,8 @@ struct FreeMovementSettings {
     /// 1e-12 absolute where a tendon-force derivative cancels near equilibrium).
     bool checkPartialEvaluations = false;
     IntegrationSettings integration;
+    /// Optional: called with the time [s] of every sample (a long run's progress).
+    std::function<void(double)> progress;
     void validate(const ArmParameters& arm) const;
 };
 

@@ -17,6 +17,7 @@
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <regex>
 #include <sstream>
 #include <string>
 #include <tuple>
@@ -734,6 +735,39 @@ TEST(Cli, TheInstalledCommandRunsAndFindsItsPlugins) {
 // armsim forward from a Forward tool setup file as its only argument: the model, controls, times and
 // results folder come from the file (paths relative to it); states.sto has OpenSim's header and column
 // names, one row per 1/200 s, and matches a run given the same settings as options.
+// Long work shows progress in a log too (stderr not a terminal): a forward run prints a line with the
+// share done and the time left every ARMSIM_PROGRESS_SECONDS (10 s by default; 1 ms here), then its end.
+TEST(Cli, ProgressReachesALogFileWhileTheWorkRuns) {
+    const fs::path d = freshDir("progress_log");
+    const std::string data = std::string(ARMSIM_SOURCE_DIR) + "/tests/data/opensim/arm26_forward/";
+    const CommandResult r = armsim::testing::runCommand(
+        "ARMSIM_PROGRESS_SECONDS=0.001 " + std::string(ARMSIM_EXE) + " forward --model arm26 --controls " + data +
+        "arm26_controls.sto --final-time 1 --out " + (d / "f").string());
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    const std::regex line(R"(forward: [0-9.]+/1 s \([0-9]+ %\) after [0-9]+s, (about [0-9]+s left|time left unknown))");
+    EXPECT_TRUE(std::regex_search(r.output, line)) << r.output;
+    EXPECT_NE(r.output.find("forward: 1.0/1 s done"), std::string::npos) << r.output;
+    // Without the variable a 1 s run (tens of ms) prints no progress line in a log.
+    const CommandResult quiet = runArmsim("forward --model arm26 --controls " + data + "arm26_controls.sto --final-time 1 --out " +
+                                          (d / "g").string());
+    ASSERT_EQ(quiet.exitCode, 0) << quiet.output;
+    EXPECT_EQ(quiet.output.find("forward: "), quiet.output.find("forward: arm26")) << quiet.output;
+}
+
+// A folder whose overview cannot be written (an index.html that is not armsim's, here a folder): the
+// command's files are there and complete, and the exit status says the overview is missing (2, not 0).
+TEST(Cli, AnOverviewThatCannotBeWrittenIsAnError) {
+    const fs::path d = freshDir("index_not_written");
+    fs::create_directories(d / "out" / "index.html");
+    std::ofstream(d / "out" / "index.html" / "mine.txt") << "a user's file\n";
+    const CommandResult r = runArmsim("model show --model thesis --out " + (d / "out").string());
+    EXPECT_EQ(r.exitCode, 2) << r.output;
+    EXPECT_NE(r.output.find("index.html (the folder's overview) not written"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("the command's other files are complete"), std::string::npos) << r.output;
+    EXPECT_TRUE(fs::exists(d / "out" / "mvc_flexion.csv"));
+    EXPECT_TRUE(fs::exists(d / "out" / "index.html" / "mine.txt"));
+}
+
 // `armsim trial --model arm26`: the elbow locked at 80 deg, a 1 s flexion effort; the last sample's torque
 // (passive included) equals `model show`'s steady flexion torque at 80 deg (the steady isometric solve: a
 // second method) to 1e-3 relative, and the options an .osim trial cannot honour are refused by name.

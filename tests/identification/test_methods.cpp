@@ -63,7 +63,11 @@ TEST(LevenbergMarquardt, SeededMultiStartIsReproducibleAndKeepsTheBest) {
     IdentificationOptions o;
     o.starts = 4;
     o.seed = 7;
+    std::vector<std::pair<int, int>> reported;   // the progress callback: once per start, in order
+    o.progress = [&](int done, int total) { reported.emplace_back(done, total); };
     const IdentificationReport a = identify(makeProblem(data), SteadyForceModel(), o);
+    EXPECT_EQ(reported, (std::vector<std::pair<int, int>>{{1, 4}, {2, 4}, {3, 4}, {4, 4}}));
+    o.progress = nullptr;
     const IdentificationReport b = identify(makeProblem(data), SteadyForceModel(), o);
     ASSERT_EQ(a.startCosts.size(), 4u);
     EXPECT_EQ(a.startCosts, b.startCosts);

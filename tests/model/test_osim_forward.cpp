@@ -212,6 +212,34 @@ TEST(OsimForward, ForwardToolSetupFile) {
         EXPECT_NE(std::string(e.what()).find(":10: <ControlSetController>: controls file 'arm26_controls.xml' is an XML ControlSet"),
                   std::string::npos) << e.what();
     }
+    // Elements that cannot change the states are skipped; the step-size limit is read; an element that is
+    // not the tool's (a misspelling) and external loads are refused with the line.
+    auto withElements = [&](const std::string& elements) {
+        std::string text = setup;
+        text.replace(text.find("CONTROLS"), 8, "arm26_controls.sto");
+        text.insert(text.find("<states_file>"), elements);
+        std::ofstream(dir / "setup.xml") << text;
+        return (dir / "setup.xml").string();
+    };
+    const OsimForwardSetup skipped = readOsimForwardSetup(withElements(
+        "<output_precision>8</output_precision><maximum_integrator_step_size>0.01</maximum_integrator_step_size>\n"
+        "<AnalysisSet name=\"Analyses\"><objects/></AnalysisSet><external_loads_file>Unassigned</external_loads_file>\n"
+        "<force_set_files/><replace_force_set>false</replace_force_set>\n"));
+    EXPECT_EQ(skipped.maxStepSize, 0.01);
+    EXPECT_EQ(s.maxStepSize, 1.0);  // OpenSim's default
+    const std::pair<std::string, std::string> refused[] = {
+        {"<final_tme>2</final_tme>\n", ":12: <final_tme>: not an element of OpenSim's Forward tool setup"},
+        {"<external_loads_file>grf.xml</external_loads_file>\n", ":12: <external_loads_file> 'grf.xml': not supported yet"},
+        {"<use_specified_dt>true</use_specified_dt>\n", ":12: <use_specified_dt> 'true': not supported yet"},
+        {"<maximum_integrator_step_size>0</maximum_integrator_step_size>\n", ":12: <maximum_integrator_step_size> 0: expected > 0 s"}};
+    for (const auto& [elements, message] : refused) {
+        try {
+            readOsimForwardSetup(withElements(elements));
+            ADD_FAILURE() << elements << " was accepted";
+        } catch (const OsimError& e) {
+            EXPECT_NE(std::string(e.what()).find(message), std::string::npos) << e.what();
+        }
+    }
     fs::remove_all(dir);
 }
 
