@@ -125,9 +125,15 @@ bool isWholePng(const std::string& path) {
     return in && std::equal(head, head + 8, signature) && std::equal(tail, tail + 12, iend);
 }
 
-void writePlotPng(const std::string& path, const PlotSpec& spec) {
-    if (spec.series.empty()) throw std::invalid_argument("plot '" + spec.title + "': no series");
-    if (spec.width < 100 || spec.height < 100) throw std::invalid_argument("plot size below 100 pixels");
+namespace {
+
+// The axes' limits: the data's (padded 4 %) unless the spec fixes them; y in log10 with logY.
+struct PlotLimits {
+    double x0, x1, y0, y1;
+    double dataY0, dataY1;   ///< the data's padded y range (for the identical-curve tolerance)
+};
+
+PlotLimits calcPlotLimits(const PlotSpec& spec) {
     double x0 = std::numeric_limits<double>::infinity(), x1 = -x0, y0 = x0, y1 = -x0;
     for (const auto& s : spec.series) {
         if (s.x.size() != s.y.size())
@@ -155,6 +161,90 @@ void writePlotPng(const std::string& path, const PlotSpec& spec) {
     // all-zero curve; data wholly beyond a fixed limit) give way to the data's own range.
     if (!(x1 > x0)) x0 = dataX0, x1 = dataX1;
     if (!(y1 > y0)) y0 = dataY0, y1 = dataY1;
+    return {x0, x1, y0, y1, dataY0, dataY1};
+}
+
+// How each curve is drawn. Identical curves hide each other: a series equal to an earlier one is dashed
+// and its legend says which it equals; a colour used again by another curve (more curves than the
+// palette has colours) changes the dashes.
+struct CurveStyle {
+    int sameAs = -1;         ///< the earlier series it repeats, or -1
+    PLINT lineStyle = 1;     ///< PLplot's pllsty
+    std::string label;       ///< the legend's text ("" = not in the legend)
+};
+
+std::vector<CurveStyle> calcCurveStyles(const PlotSpec& spec, double sameTol) {
+    const std::size_t ns = spec.series.size();
+    std::vector<CurveStyle> styles(ns);
+    for (std::size_t i = 1; i < ns; ++i)
+        for (std::size_t j = 0; j < i && styles[i].sameAs < 0; ++j)
+            if (styles[j].sameAs < 0 && isSameCurve(spec.series[i], spec.series[j], sameTol)) styles[i].sameAs = int(j);
+    std::vector<int> uses(8, 0);
+    const PLINT reuseStyles[] = {1, 4, 5, 8};
+    for (std::size_t i = 0; i < ns; ++i) {
+        CurveStyle& c = styles[i];
+        const PlotSeries& s = spec.series[i];
+        c.label = s.label;
+        if (!c.label.empty() && c.sameAs >= 0)
+            c.label += " (= " + (spec.series[c.sameAs].label.empty() ? std::string("another") : spec.series[c.sameAs].label) + ")";
+        if (c.sameAs >= 0) {
+            c.lineStyle = 3;   // dashed over the curve it repeats
+            continue;
+        }
+        if (s.markers) continue;
+        const int colour = s.color % 8;
+        c.lineStyle = reuseStyles[std::min(uses[colour], 3)];
+        ++uses[colour];
+    }
+    return styles;
+}
+
+struct LegendEntry {
+    bool marker;
+    PLINT color, lineStyle;
+    std::string text;
+    const char* symbol;
+};
+
+// Hand-drawn (pllegend sizes its text with metrics the cairo driver does not use): a line or a marker and
+// the text per entry, top down, in a viewport right of the axes (from plotRight to the page's edge).
+void drawLegend(const std::vector<LegendEntry>& entries, double plotRight, PLFLT vy0, PLFLT vy1, double pageMm,
+                double pageHeightMm, double charHeight, double legendScale) {
+    plvpor(plotRight + 0.01, 0.995, vy0, vy1);
+    plwind(0, 1, 0, 1);
+    const double boxMm = (0.995 - plotRight - 0.01) * pageMm;
+    const double rowMm = 1.9 * charHeight * std::max(0.75, legendScale);
+    const double heightMm = (vy1 - vy0) * pageHeightMm;
+    const double row = rowMm / heightMm, symbolEnd = 2.6 * charHeight / boxMm, textAt = 3.2 * charHeight / boxMm;
+    plschr(0, 1.1 * legendScale);
+    for (std::size_t i = 0; i < entries.size(); ++i) {
+        const PLFLT y = 1.0 - (double(i) + 0.6) * row;
+        if (y < 0) break;   // more entries than fit: the rest are left out
+        const LegendEntry& e = entries[i];
+        plcol0(e.color);
+        plwidth(2.0);
+        if (e.marker) {
+            const PLFLT sx = 0.5 * symbolEnd, sy = y;
+            plstring(1, &sx, &sy, e.symbol);
+        } else {
+            const PLFLT lx[2] = {0.2 * symbolEnd, symbolEnd}, ly[2] = {y, y};
+            pllsty(e.lineStyle);
+            plline(2, lx, ly);
+            pllsty(1);
+        }
+        plcol0(1);
+        plptex(textAt, y, 1.0, 0.0, 0.0, e.text.c_str());
+    }
+    plschr(0, 1.1);
+}
+
+}  // namespace
+
+void writePlotPng(const std::string& path, const PlotSpec& spec) {
+    if (spec.series.empty()) throw std::invalid_argument("plot '" + spec.title + "': no series");
+    if (spec.width < 100 || spec.height < 100) throw std::invalid_argument("plot size below 100 pixels");
+    const PlotLimits lim = calcPlotLimits(spec);
+    const double x0 = lim.x0, x1 = lim.x1, y0 = lim.y0, y1 = lim.y1;
 
     const std::string tmp = beginPng(path);
     {
@@ -164,39 +254,10 @@ void writePlotPng(const std::string& path, const PlotSpec& spec) {
         plinit();
         plcol0(1);
         plschr(0, 1.1);
-        // Identical curves hide each other: a series equal to an earlier one is dashed and its legend
-        // says which it equals.
-        // A colour used again by another curve (more curves than the palette has colours) changes the dashes.
         const std::size_t ns = spec.series.size();
-        const double sameTol = 1e-4 * (spec.logY ? 0.0 : (dataY1 - dataY0));
-        std::vector<int> sameAs(ns, -1);
-        for (std::size_t i = 1; i < ns; ++i)
-            for (std::size_t j = 0; j < i && sameAs[i] < 0; ++j)
-                if (sameAs[j] < 0 && isSameCurve(spec.series[i], spec.series[j], sameTol)) sameAs[i] = int(j);
-        std::vector<PLINT> styles(ns, 1);
-        {
-            std::vector<int> uses(8, 0);
-            const PLINT reuseStyles[] = {1, 4, 5, 8};
-            for (std::size_t i = 0; i < ns; ++i) {
-                if (sameAs[i] >= 0) {
-                    styles[i] = 3;   // dashed over the curve it repeats
-                    continue;
-                }
-                if (spec.series[i].markers) continue;
-                const int c = spec.series[i].color % 8;
-                styles[i] = reuseStyles[std::min(uses[c], 3)];
-                ++uses[c];
-            }
-        }
-        std::vector<std::string> labels;
+        const std::vector<CurveStyle> styles = calcCurveStyles(spec, 1e-4 * (spec.logY ? 0.0 : (lim.dataY1 - lim.dataY0)));
         std::size_t longest = 0;
-        for (std::size_t i = 0; i < ns; ++i) {
-            std::string text = spec.series[i].label;
-            if (!text.empty() && sameAs[i] >= 0)
-                text += " (= " + (spec.series[sameAs[i]].label.empty() ? std::string("another") : spec.series[sameAs[i]].label) + ")";
-            labels.push_back(text);
-            longest = std::max(longest, text.size());
-        }
+        for (const CurveStyle& c : styles) longest = std::max(longest, c.label.size());
         // The legend stands right of the data, outside the axes: the viewport (plenv's standard one) is
         // narrowed by the legend's width, estimated from its longest text (drawn smaller if it is long).
         pladv(0);
@@ -227,15 +288,12 @@ void writePlotPng(const std::string& path, const PlotSpec& spec) {
         plwind(x0, x1, y0, y1);
         plmtex("l", 5.0, 0.5, 0.5, spec.yLabel.c_str());
 
-        std::vector<PLINT> opts, colors, lineStyles, markerColors;
-        std::vector<PLFLT> widths, scales;
-        std::vector<PLINT> markerCounts;
-        std::vector<const char*> texts, symbols;
+        std::vector<LegendEntry> legend;
         for (std::size_t i = 0; i < ns; ++i) {
             const PlotSeries& s = spec.series[i];
             const int color = 2 + (s.color % 8);
-            const PLINT style = styles[i];
-            const char* symbol = sameAs[i] >= 0 ? "#(727)" : "#(728)";   // open circle for a repeat
+            const PLINT style = styles[i].lineStyle;
+            const char* symbol = styles[i].sameAs >= 0 ? "#(727)" : "#(728)";   // open circle for a repeat
             std::vector<PLFLT> xs, ys;
             for (std::size_t k = 0; k < s.x.size(); ++k)
                 if (std::isfinite(s.x[k]) && std::isfinite(s.y[k]) && (!spec.logY || s.y[k] > 0)) {
@@ -248,46 +306,9 @@ void writePlotPng(const std::string& path, const PlotSpec& spec) {
             if (s.markers) plstring(PLINT(xs.size()), xs.data(), ys.data(), symbol);
             else if (xs.size() > 1) plline(PLINT(xs.size()), xs.data(), ys.data());
             pllsty(1);
-            if (labels[i].empty()) continue;
-            opts.push_back(s.markers ? PL_LEGEND_SYMBOL : PL_LEGEND_LINE);
-            colors.push_back(color);
-            lineStyles.push_back(style);
-            widths.push_back(2.0);
-            markerColors.push_back(color);
-            scales.push_back(1.0);
-            markerCounts.push_back(1);
-            texts.push_back(labels[i].c_str());
-            symbols.push_back(symbol);
+            if (!styles[i].label.empty()) legend.push_back({s.markers, color, style, styles[i].label, symbol});
         }
-        if (!texts.empty()) {
-            // Hand-drawn (pllegend sizes its text with metrics the cairo driver does not use): a line or a
-            // marker and the text per entry, top down, in a viewport right of the axes.
-            plvpor(plotRight + 0.01, 0.995, vy0, vy1);
-            plwind(0, 1, 0, 1);
-            const double boxMm = (0.995 - plotRight - 0.01) * pageMm;
-            const double rowMm = 1.9 * charHeight * std::max(0.75, legendScale);
-            const double heightMm = (vy1 - vy0) * (py1 - py0);
-            const double row = rowMm / heightMm, symbolEnd = 2.6 * charHeight / boxMm, textAt = 3.2 * charHeight / boxMm;
-            plschr(0, 1.1 * legendScale);
-            for (std::size_t i = 0; i < texts.size(); ++i) {
-                const PLFLT y = 1.0 - (double(i) + 0.6) * row;
-                if (y < 0) break;   // more entries than fit: the rest are left out
-                plcol0(colors[i]);
-                plwidth(2.0);
-                if (opts[i] == PL_LEGEND_SYMBOL) {
-                    const PLFLT sx = 0.5 * symbolEnd, sy = y;
-                    plstring(1, &sx, &sy, symbols[i]);
-                } else {
-                    const PLFLT lx[2] = {0.2 * symbolEnd, symbolEnd}, ly[2] = {y, y};
-                    pllsty(lineStyles[i]);
-                    plline(2, lx, ly);
-                    pllsty(1);
-                }
-                plcol0(1);
-                plptex(textAt, y, 1.0, 0.0, 0.0, texts[i]);
-            }
-            plschr(0, 1.1);
-        }
+        if (!legend.empty()) drawLegend(legend, plotRight, vy0, vy1, pageMm, py1 - py0, charHeight, legendScale);
         plend1();
         errors.throwIfAny(tmp, path, spec.title);
     }

@@ -55,6 +55,48 @@ void printPrediction(const ProtocolPrediction& p) {
     std::printf("\n");
 }
 
+// The greedy picks, one line each with the criterion after it (and the lab minutes so far).
+void printDesignSteps(const DesignResult& d, bool channels, int repetitions) {
+    std::printf("greedy picks (%s, criterion after the pick; 1 = both sds at the goals 10 %%, 1 cm):\n",
+                channels ? "largest drop per lab minute" : ("block of " + std::to_string(repetitions) + " trials each").c_str());
+    double minutes = 0;
+    for (std::size_t k = 0; k < d.steps.size(); ++k) {
+        const DesignStep& step = d.steps[k];
+        const std::string what = step.item == "torque" || step.item == "ultrasound"
+                                     ? std::string(step.item == "ultrasound" ? "ultrasound at " : "") +
+                                           getEffortName(step.condition.effort) + " " +
+                                           (step.condition.level == 1 ? "MVC" : formatNumber(100 * step.condition.level) + " %") +
+                                           " at " + formatNumber(step.condition.flexionDeg) + " deg" +
+                                           (std::isnan(step.condition.rotationDeg)
+                                                ? std::string()
+                                                : ", forearm " + formatNumber(step.condition.rotationDeg) + " deg")
+                                     : step.item;
+        minutes += std::isfinite(step.minutes) ? step.minutes : 0;
+        std::printf("  %2zu. %-38s criterion %.3f%s\n", k + 1, what.c_str(), step.criterion,
+                    channels ? (", " + formatNumber(minutes) + " min").c_str() : "");
+    }
+}
+
+// design_criterion.png: the criterion after each pick against trials or lab minutes spent.
+PlotSpec makeDesignPlot(const DesignResult& d, bool channels, int repetitions) {
+    PlotSpec plot;
+    plot.title = channels ? "Greedy design across channels: expected criterion after each pick"
+                          : "Greedy design: expected criterion after each block of trials";
+    plot.xLabel = channels ? "lab minutes" : "trials";
+    plot.yLabel = "criterion (1 = sds at the goals)";
+    PlotSeries greedy{"designed", {}, {}, false, 0};
+    double spent = 0;
+    for (std::size_t k = 0; k < d.steps.size(); ++k) {
+        spent += channels ? d.steps[k].minutes : double(repetitions);
+        greedy.x.push_back(spent);
+        greedy.y.push_back(d.steps[k].criterion);
+    }
+    plot.series = {greedy};
+    if (!channels)  // the reference's lab minutes are not on this axis with channels
+        plot.series.push_back({"thesis five angles", {double(d.reference.trials)}, {d.reference.criterion}, true, 1});
+    return plot;
+}
+
 void runDesign(const DesignOptions& o) {
     checkOutputFolder("--out", o.out);
     const Population population = o.population.empty() ? loadDefaultPopulation() : loadPopulation(o.population);
@@ -97,24 +139,7 @@ void runDesign(const DesignOptions& o) {
                                     : designProtocol(population, s, thesis, progress);
     const ProtocolPrediction& reference = d.reference;
 
-    std::printf("greedy picks (%s, criterion after the pick; 1 = both sds at the goals 10 %%, 1 cm):\n",
-                channels ? "largest drop per lab minute" : ("block of " + std::to_string(s.repetitions) + " trials each").c_str());
-    double minutes = 0;
-    for (std::size_t k = 0; k < d.steps.size(); ++k) {
-        const DesignStep& step = d.steps[k];
-        const std::string what = step.item == "torque" || step.item == "ultrasound"
-                                     ? std::string(step.item == "ultrasound" ? "ultrasound at " : "") +
-                                           getEffortName(step.condition.effort) + " " +
-                                           (step.condition.level == 1 ? "MVC" : formatNumber(100 * step.condition.level) + " %") +
-                                           " at " + formatNumber(step.condition.flexionDeg) + " deg" +
-                                           (std::isnan(step.condition.rotationDeg)
-                                                ? std::string()
-                                                : ", forearm " + formatNumber(step.condition.rotationDeg) + " deg")
-                                     : step.item;
-        minutes += std::isfinite(step.minutes) ? step.minutes : 0;
-        std::printf("  %2zu. %-38s criterion %.3f%s\n", k + 1, what.c_str(), step.criterion,
-                    channels ? (", " + formatNumber(minutes) + " min").c_str() : "");
-    }
+    printDesignSteps(d, channels, s.repetitions);
     std::printf("designed protocol: %s\n", describeConditions(d.protocol).c_str());
     std::printf("predicted uncertainty (Laplace, mean over prior draws):\n");
     printPrediction(reference);
@@ -137,21 +162,7 @@ void runDesign(const DesignOptions& o) {
                             protocolPath + "\n" + formatTorqueProtocol(d.protocol));
     out.write("design_predictions.csv", formatPredictionsCsv({reference, d.predicted}));
     out.write("design_steps.csv", formatDesignStepsCsv(d));
-    PlotSpec plot;
-    plot.title = channels ? "Greedy design across channels: expected criterion after each pick"
-                          : "Greedy design: expected criterion after each block of trials";
-    plot.xLabel = channels ? "lab minutes" : "trials";
-    plot.yLabel = "criterion (1 = sds at the goals)";
-    PlotSeries greedy{"designed", {}, {}, false, 0};
-    double spent = 0;
-    for (std::size_t k = 0; k < d.steps.size(); ++k) {
-        spent += channels ? d.steps[k].minutes : double(s.repetitions);
-        greedy.x.push_back(spent);
-        greedy.y.push_back(d.steps[k].criterion);
-    }
-    plot.series = {greedy};
-    if (!channels)  // the reference's lab minutes are not on this axis with channels
-        plot.series.push_back({"thesis five angles", {double(reference.trials)}, {reference.criterion}, true, 1});
+    const PlotSpec plot = makeDesignPlot(d, channels, s.repetitions);
     out.writeWith("design_criterion.png", [&](const std::string& p) { writePlotPng(p, plot); });
     // The design's files and its validation appear together at the end, or (an error, a stop) neither.
     auto commitDesign = [&] {
@@ -161,45 +172,25 @@ void runDesign(const DesignOptions& o) {
     };
     if (o.validateSubjects <= 0) return commitDesign();
     std::printf("validation of both protocols on %d subjects (seed %u):\n", o.validateSubjects, o.seed);
-    CsvText csv({"protocol", "method", "subjects", "converged", "mass_bias_pct", "mass_rmse_pct", "mass_coverage",
-                 "mass_interval_width_pct", "tendon_bias_mm", "tendon_rmse_mm", "tendon_coverage",
-                 "tendon_interval_width_mm", "predicted_mass_sd_pct", "predicted_tendon_sd_mm"});
-    for (const auto& [protocol, predicted] : {std::pair{thesis, reference}, std::pair{d.protocol, d.predicted}}) {
-        ElbowValidationSettings v;
-        v.subjects = capForQuickRun(o.validateSubjects, kQuickSubjects, "validation subjects");
-        v.seed = o.seed;
-        v.jobs = o.jobs;
-        v.activationSd = o.activationSd;
-        v.protocol = protocol;
-        v.freeSlowFraction = o.freeSlowFraction;
-        const std::vector<ElbowValidationRow> rows = runElbowValidation(
-            population, v, [label = "validate " + protocol.name](int done, int n) { printProgress(label, done, n); });
-        for (const ElbowValidationSummary& x : summarizeElbowValidation(rows)) {
-            if (x.method == "thesis") continue;
-            // With channels the prediction is the channels fit's (the torque-only fits' is the reference's).
-            if (channels && protocol.name == d.protocol.name && x.method != "channels") continue;
-            if (x.converged == 0)
-                std::printf("  %-9s %-13s no fit converged in %d subjects%s\n", protocol.name.c_str(), x.method.c_str(), x.subjects,
-                            x.method == "synergist-va" ? " (its twitch interpolation needs maximal efforts: the protocol has none)" : "");
-            else
+    const std::vector<DesignValidationRow> rows =
+        validateDesign(population, s, thesis, d, capForQuickRun(o.validateSubjects, kQuickSubjects, "validation subjects"),
+                       [](const std::string& protocol, int done, int n) { printProgress("validate " + protocol, done, n); });
+    for (const DesignValidationRow& r : rows) {
+        const ElbowValidationSummary& x = r.obtained;
+        if (x.converged == 0)
+            std::printf("  %-9s %-13s no fit converged in %d subjects%s\n", r.protocol.c_str(), x.method.c_str(), x.subjects,
+                        x.method == "synergist-va" ? " (its twitch interpolation needs maximal efforts: the protocol has none)" : "");
+        else
             std::printf("  %-9s %-13s mass bias %+5.1f %%  RMSE %5.1f %% (predicted sd %4.1f %%)  coverage %.2f  "
                         "95 %% width %5.1f %%   L0T RMSE %5.1f mm (predicted %4.1f mm)  coverage %.2f\n",
-                        protocol.name.c_str(), x.method.c_str(), 100 * x.massBias, 100 * x.massRmse,
-                        100 * predicted.massSd, x.massCoverage, 100 * x.massIntervalWidth, 1000 * x.tendonRmse,
-                        1000 * predicted.tendonSd, x.tendonCoverage);
-            CsvRow row;
-            row.addText(protocol.name).addText(x.method).addInteger(x.subjects).addInteger(x.converged);
-            row.addNumber(100 * x.massBias).addNumber(100 * x.massRmse).addNumber(x.massCoverage);
-            row.addNumber(100 * x.massIntervalWidth).addNumber(1000 * x.tendonBias).addNumber(1000 * x.tendonRmse);
-            row.addNumber(x.tendonCoverage).addNumber(1000 * x.tendonIntervalWidth).addNumber(100 * predicted.massSd);
-            row.addNumber(1000 * predicted.tendonSd);
-            csv.addRow(row);
-        }
+                        r.protocol.c_str(), x.method.c_str(), 100 * x.massBias, 100 * x.massRmse, 100 * r.predicted.massSd,
+                        x.massCoverage, 100 * x.massIntervalWidth, 1000 * x.tendonRmse, 1000 * r.predicted.tendonSd,
+                        x.tendonCoverage);
     }
     std::printf("  (predicted: %s; the RMSE is the obtained counterpart of the predicted sd)\n",
                 channels ? "the thesis protocol's for synergist-va, the design's for the channels fit"
                          : o.activationSd > 0 ? "synergist-va" : "synergist-aware");
-    out.write("design_validation.csv", csv.getText());
+    out.write("design_validation.csv", formatDesignValidationCsv(rows));
     commitDesign();
 }
 

@@ -186,6 +186,77 @@ TransducerReading calcTransducerReading(const ArmParameters& arm, double strapFo
     return TransducerAtAngle(arm, elbowAngle, momentArm).read(strapForce, muscleForce);
 }
 
+namespace {
+
+// TrialSolver::LockedOde: the locked arm's ODE on Simbody's own state vector (see runIsometricTrial).
+IntegrationStats integrateLockedArm(const State& state, const std::vector<int>& firstState,
+                                    const std::vector<const MuscleModel*>& muscles,
+                                    const std::vector<const ActivationProfile*>& activations, const std::vector<double>& P,
+                                    const IsometricTrialSettings& settings, const std::vector<double>& breakpoints,
+                                    const OdeVisitor& sample) {
+    const int n = int(muscles.size()), nqu = state.getNQ() + state.getNU();
+    // The locked arm's ODE on Simbody's own state vector: q' = u = 0 and u' = 0 (locked), each
+    // muscle's z' from its pure model at its fixed path length and its own activation. Blocks:
+    // [q u], then one per muscle (a Jacobian column evaluates one muscle).
+    std::vector<double> y(state.getNY());
+    for (int i = 0; i < state.getNY(); ++i) y[i] = state.getY()[i];
+    OdeBlocks f;
+    f.first.push_back(0);
+    f.size.push_back(nqu);
+    for (int i = 0; i < n; ++i) {
+        f.first.push_back(firstState[i]);
+        f.size.push_back(muscles[i]->getNumStates());
+    }
+    const bool analytic = settings.bandedNewton && settings.analyticJacobian;
+    f.banded = settings.bandedNewton && (n > 1 || analytic);
+    f.calcBlock = [&](int b, double t, const double* yIn, double* ydot) {
+        if (b == 0) {
+            std::fill(ydot, ydot + nqu, 0.0);
+            return;
+        }
+        const int i = b - 1;
+        muscles[i]->calcStateDerivative(P[i], activations[i]->getValue(t), yIn + firstState[i],
+                                        ydot + firstState[i]);
+    };
+    if (analytic)
+        f.calcBlockJacobian = [&](int b, double t, const double* yIn, double* J) {
+            if (b == 0) return true;   // q' = u' = 0: the zero block
+            const int i = b - 1;
+            return muscles[i]->calcStateJacobian(P[i], activations[i]->getValue(t), yIn + firstState[i], J);
+        };
+    return integrateSampled(
+        f, state.getTime(), y, settings.getDuration(), settings.sampleRate, breakpoints, settings.integration, sample,
+        [&](double t, const double* yIn) {
+            for (int i = 0; i < n; ++i) muscles[i]->checkStates(t, yIn + firstState[i]);
+        });
+}
+
+// The summary's window means from the trial's table.
+void summarizeIsometricSeries(const MuscleArm& model, const IsometricTrialSettings& settings, bool forearm,
+                              IsometricTrialResult& result) {
+    IsometricSummary& sum = result.summary;
+    const int n = model.getNumMuscles();
+    const Table& t = result.series;
+    const std::vector<double> time = t.getColumn("time_s");
+    const double from = time.back() - settings.averagingWindow - 1e-9;
+    std::size_t first = 0;
+    while (first < time.size() && time[first] < from) ++first;
+    sum.finalForce = t.get(t.getNumRows() - 1, "muscle_force_N");
+    sum.meanForce = mean(t.getColumn("muscle_force_N"), first);
+    const std::vector<double> fascicle = t.getColumn("fascicle_length_m");
+    sum.restFascicleLength = fascicle.front();
+    sum.meanFascicleLength = mean(fascicle, first);
+    sum.meanStrapForce = mean(t.getColumn("strap_force_N"), first);
+    sum.meanForceMomentArm = mean(t.getColumn("force_moment_arm_N"), first);
+    sum.meanForceFixedRatio = mean(t.getColumn("force_fixed_ratio_N"), first);
+    sum.meanMuscleTorque = mean(t.getColumn("muscle_torque_Nm"), first);
+    if (forearm) sum.meanForearmTorque = mean(t.getColumn("forearm_torque_Nm"), first);
+    for (int i = 0; i < n; ++i)
+        sum.meanForces.push_back(n == 1 ? sum.meanForce : mean(t.getColumn("force_" + model.getMuscleName(i) + "_N"), first));
+}
+
+}  // namespace
+
 IsometricTrialResult runIsometricTrial(const ArmSetup& setup, const IsometricTrialSettings& settings) {
     settings.validate(setup.arm);
     const ActivationProfile profile = settings.calcActivationProfile();
@@ -235,7 +306,6 @@ IsometricTrialResult runIsometricTrial(const ArmSetup& setup, const IsometricTri
     std::vector<const MuscleModel*> muscles;
     for (int i = 0; i < n; ++i) muscles.push_back(&model.getMuscle(i));
     const std::vector<const ActivationProfile*> activations = getActivationProfiles(model);
-    const int nqu = state.getNQ() + state.getNU();
     const std::vector<int> firstState = findMuscleStates(model, state, "runIsometricTrial");
     std::vector<double> forces(n), row;
 
@@ -275,42 +345,8 @@ IsometricTrialResult runIsometricTrial(const ArmSetup& setup, const IsometricTri
     };
 
     if (settings.solver == TrialSolver::LockedOde) {
-        // The locked arm's ODE on Simbody's own state vector: q' = u = 0 and u' = 0 (locked), each
-        // muscle's z' from its pure model at its fixed path length and its own activation. Blocks:
-        // [q u], then one per muscle (a Jacobian column evaluates one muscle).
-        std::vector<double> y(state.getNY());
-        for (int i = 0; i < state.getNY(); ++i) y[i] = state.getY()[i];
-        const std::vector<double>& P = sum.pathLengths;
-        OdeBlocks f;
-        f.first.push_back(0);
-        f.size.push_back(nqu);
-        for (int i = 0; i < n; ++i) {
-            f.first.push_back(firstState[i]);
-            f.size.push_back(muscles[i]->getNumStates());
-        }
-        const bool analytic = settings.bandedNewton && settings.analyticJacobian;
-        f.banded = settings.bandedNewton && (n > 1 || analytic);
-        f.calcBlock = [&](int b, double t, const double* yIn, double* ydot) {
-            if (b == 0) {
-                std::fill(ydot, ydot + nqu, 0.0);
-                return;
-            }
-            const int i = b - 1;
-            muscles[i]->calcStateDerivative(P[i], activations[i]->getValue(t), yIn + firstState[i],
-                                            ydot + firstState[i]);
-        };
-        if (analytic)
-            f.calcBlockJacobian = [&](int b, double t, const double* yIn, double* J) {
-                if (b == 0) return true;   // q' = u' = 0: the zero block
-                const int i = b - 1;
-                return muscles[i]->calcStateJacobian(P[i], activations[i]->getValue(t), yIn + firstState[i], J);
-            };
-        sum.stats = integrateSampled(
-            f, state.getTime(), y, settings.getDuration(), settings.sampleRate, profile.getBreakpoints(),
-            settings.integration, [&](double t, const double* yIn) { sample(t, yIn, nullptr); },
-            [&](double t, const double* yIn) {
-                for (int i = 0; i < n; ++i) muscles[i]->checkStates(t, yIn + firstState[i]);
-            });
+        sum.stats = integrateLockedArm(state, firstState, muscles, activations, sum.pathLengths, settings,
+                                       profile.getBreakpoints(), [&](double t, const double* y) { sample(t, y, nullptr); });
     } else {
         const bool perSample = settings.solver == TrialSolver::SimbodyPerSample;
         sum.stats = simulateSampled(
@@ -320,23 +356,7 @@ IsometricTrialResult runIsometricTrial(const ArmSetup& setup, const IsometricTri
             [&](const State& s) { model.checkMuscleStates(s); });
     }
 
-    const Table& t = result.series;
-    const std::vector<double> time = t.getColumn("time_s");
-    const double from = time.back() - settings.averagingWindow - 1e-9;
-    std::size_t first = 0;
-    while (first < time.size() && time[first] < from) ++first;
-    sum.finalForce = t.get(t.getNumRows() - 1, "muscle_force_N");
-    sum.meanForce = mean(t.getColumn("muscle_force_N"), first);
-    const std::vector<double> fascicle = t.getColumn("fascicle_length_m");
-    sum.restFascicleLength = fascicle.front();
-    sum.meanFascicleLength = mean(fascicle, first);
-    sum.meanStrapForce = mean(t.getColumn("strap_force_N"), first);
-    sum.meanForceMomentArm = mean(t.getColumn("force_moment_arm_N"), first);
-    sum.meanForceFixedRatio = mean(t.getColumn("force_fixed_ratio_N"), first);
-    sum.meanMuscleTorque = mean(t.getColumn("muscle_torque_Nm"), first);
-    if (forearm) sum.meanForearmTorque = mean(t.getColumn("forearm_torque_Nm"), first);
-    for (int i = 0; i < n; ++i)
-        sum.meanForces.push_back(n == 1 ? sum.meanForce : mean(t.getColumn("force_" + model.getMuscleName(i) + "_N"), first));
+    summarizeIsometricSeries(model, settings, forearm, result);
     return result;
 }
 

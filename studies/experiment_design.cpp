@@ -759,4 +759,48 @@ std::string formatPredictionsCsv(const std::vector<ProtocolPrediction>& predicti
     return csv.getText();
 }
 
+std::vector<DesignValidationRow> validateDesign(const Population& prior, const DesignSettings& settings,
+                                                const TorqueProtocol& reference, const DesignResult& design, int subjects,
+                                                const std::function<void(const std::string&, int, int)>& progress) {
+    const bool channels = settings.budgetMinutes > 0;
+    std::vector<DesignValidationRow> rows;
+    for (const auto& [protocol, predicted] :
+         {std::pair{reference, design.reference}, std::pair{design.protocol, design.predicted}}) {
+        ElbowValidationSettings v;
+        v.subjects = subjects;
+        v.seed = settings.seed;
+        v.jobs = settings.jobs;
+        v.activationSd = settings.activationSd;
+        v.protocol = protocol;
+        v.freeSlowFraction = settings.freeSlowFraction;
+        const std::string name = protocol.name;
+        const std::vector<ElbowValidationRow> validation = runElbowValidation(prior, v, [&](int done, int n) {
+            if (progress) progress(name, done, n);
+        });
+        for (const ElbowValidationSummary& x : summarizeElbowValidation(validation)) {
+            if (x.method == "thesis") continue;   // the prediction is about the synergist-aware fits
+            if (channels && name == design.protocol.name && x.method != "channels") continue;
+            rows.push_back({name, x, predicted});
+        }
+    }
+    return rows;
+}
+
+std::string formatDesignValidationCsv(const std::vector<DesignValidationRow>& rows) {
+    CsvText csv({"protocol", "method", "subjects", "converged", "mass_bias_pct", "mass_rmse_pct", "mass_coverage",
+                 "mass_interval_width_pct", "tendon_bias_mm", "tendon_rmse_mm", "tendon_coverage",
+                 "tendon_interval_width_mm", "predicted_mass_sd_pct", "predicted_tendon_sd_mm"});
+    for (const DesignValidationRow& r : rows) {
+        const ElbowValidationSummary& x = r.obtained;
+        CsvRow row;
+        row.addText(r.protocol).addText(x.method).addInteger(x.subjects).addInteger(x.converged);
+        row.addNumber(100 * x.massBias).addNumber(100 * x.massRmse).addNumber(x.massCoverage);
+        row.addNumber(100 * x.massIntervalWidth).addNumber(1000 * x.tendonBias).addNumber(1000 * x.tendonRmse);
+        row.addNumber(x.tendonCoverage).addNumber(1000 * x.tendonIntervalWidth).addNumber(100 * r.predicted.massSd);
+        row.addNumber(1000 * r.predicted.tendonSd);
+        csv.addRow(row);
+    }
+    return csv.getText();
+}
+
 }  // namespace armsim

@@ -23,6 +23,7 @@
 #include "basics/numbers.h"
 
 #include "identification/torque_identification.h"
+#include "studies/torque_validation.h"
 
 #include <functional>
 #include <string>
@@ -148,6 +149,28 @@ DesignResult designProtocol(const Population& prior, const DesignSettings& setti
 /// (Laplace approximation as the identifier's). Throws InputError when no MVC block fits the budget.
 DesignResult designChannelProtocol(const Population& prior, const DesignSettings& settings,
                                    const TorqueProtocol& reference, const std::function<void(int, int)>& progress = {});
+
+/// One row of a design's validation: a protocol, an identifier run on it, what it obtained on virtual
+/// subjects and what the design predicted for it.
+struct DesignValidationRow {
+    std::string protocol;                ///< the reference's name, or "designed"
+    ElbowValidationSummary obtained;     ///< bias, RMSE, coverage and widths over the subjects
+    ProtocolPrediction predicted;        ///< the prediction this method is compared with
+};
+
+/// The reference protocol and the design validated on `subjects` virtual subjects of the prior (seeded;
+/// settings' jobs, activation sd and slow-fraction option): the identifiers the prediction is about
+/// (not the thesis method), each beside its prediction. The design's prediction is its channels fit's
+/// when it was designed across channels (budgetMinutes > 0): other fits of the design are left out; the
+/// torque-only fits compare with the reference's. progress(protocol name, done, total).
+std::vector<DesignValidationRow> validateDesign(
+    const Population& prior, const DesignSettings& settings, const TorqueProtocol& reference, const DesignResult& design,
+    int subjects, const std::function<void(const std::string&, int, int)>& progress = {});
+
+/// design_validation.csv: protocol, method, subjects, converged, mass_bias_pct, mass_rmse_pct,
+/// mass_coverage, mass_interval_width_pct, tendon_bias_mm, tendon_rmse_mm, tendon_coverage,
+/// tendon_interval_width_mm, predicted_mass_sd_pct, predicted_tendon_sd_mm.
+std::string formatDesignValidationCsv(const std::vector<DesignValidationRow>& rows);
 
 /// CSV: one row per protocol: name, trials, criterion, mass_sd_pct, tendon_sd_mm, prior sds, the same
 /// widths with the consider parameters, and the mean posterior correlation of ln M with every parameter.
