@@ -132,24 +132,11 @@ std::string getProtocolKindName(ProtocolKind kind) {
     return "?";
 }
 
-Protocol readProtocol(const std::string& path) {
-    Protocol p;
-    p.sourcePath = path;
-    p.sourceText = readFileText(path);
-    const ParamNode root = ParamNode::loadString(p.sourceText, path);
-    p.name = root.getString("name");
-    if (p.name.empty() || p.name.find_first_of("/\\ \t") != std::string::npos)
-        throw InputError(root.where("name") + ": field 'name' = '" + p.name +
-                         "': expected a non-empty name without spaces or slashes");
-    p.description = root.getString("description", "");
-    root.getString("kind");  // required
-    const std::string kind = root.getChoice("kind", {"mvc", "submaximal", "force_length", "composition"}, "mvc");
-    p.kind = kind == "mvc" ? ProtocolKind::Mvc
-           : kind == "submaximal" ? ProtocolKind::Submaximal
-           : kind == "force_length" ? ProtocolKind::ForceLength
-                                    : ProtocolKind::Composition;
-    const bool armTrials = p.kind != ProtocolKind::Composition;
+namespace {
 
+// The protocol's `subject` section (model, arm and muscle files resolved against the protocol's folder,
+// effort overrides) and the subject it names, loaded.
+ArmSetup readProtocolSubjectSection(const ParamNode& root, Protocol& p) {
     if (root.has("subject")) {
         const ParamNode s = root.child("subject");
         p.model = s.getString("model", p.model);
@@ -181,20 +168,11 @@ Protocol readProtocol(const std::string& path) {
     } catch (const InputError& e) {
         throw InputError(root.where("subject") + ": subject: " + e.what());
     }
-    const ArmParameters& arm = subject.arm;
-    const double pMax = subject.calcBicepsParameters().maxPathLength;
+    return subject;
+}
 
-    if (armTrials) {
-        const double seed = root.getNumber("seed", Bound::closed(0, 9007199254740992.0));
-        if (seed != std::floor(seed))
-            throw InputError(root.where("seed") + ": field 'seed' = " + fmt::format("{:g}", seed) + ": expected a whole number");
-        p.seed = std::uint64_t(seed);
-        p.randomOrder = root.getChoice("order", {"random", "listed"}, "random") == "random";
-        p.repetitions = root.getInt("repetitions", 1, 1000, 1);
-        p.interTrialRest = root.getNumber("inter_trial_rest", Bound::nonNegative("s"), 0.0);
-        p.trial = root.has("trial") ? readTrialTemplate(root.child("trial"), arm) : p.trial;
-    }
-
+// The `conditions` section, by the protocol's kind (angles, levels, ranges, compositions).
+void readProtocolConditions(const ParamNode& root, Protocol& p, const ArmParameters& arm, double pMax) {
     const ParamNode c = root.child("conditions");
     // The moment arm vanishes at full extension, so efforts there have no measurable force.
     const Bound angle{arm.minElbowAngleDeg, arm.maxElbowAngleDeg, false, true, "deg, the subject's elbow range"};
@@ -247,6 +225,10 @@ Protocol readProtocol(const std::string& path) {
     }
     c.finish();
 
+}
+
+// The `sensors` section (transducer noise, EMG) and the EMG chain checked against the sample rate.
+void readProtocolSensors(const ParamNode& root, Protocol& p, bool armTrials) {
     if (armTrials && root.has("sensors")) {
         const ParamNode s = root.child("sensors");
         if (s.has("transducer")) {
@@ -266,9 +248,11 @@ Protocol readProtocol(const std::string& path) {
             throw InputError(root.where("trial") + ": trial.sample_rate does not suit the EMG defaults: " + e.what());
         }
     }
-    root.finish();
-    // The whole run's size: every trial's samples (and their CSV, .sto and EMG) are kept and written.
-    if (armTrials) {
+}
+
+// The whole run's size: every trial's samples (and their CSV, .sto and EMG) are kept and written.
+void checkProtocolSize(const std::string& path, const Protocol& p) {
+    if (p.kind != ProtocolKind::Composition) {
         const double trials = double(p.elbowAngles.size()) * std::max<std::size_t>(1, p.levels.size()) * p.repetitions;
         const double perTrial = double(calcNumSamples(p.trial.getDuration(), p.trial.sampleRate));
         const double rows = trials * perTrial;
@@ -277,6 +261,47 @@ Protocol readProtocol(const std::string& path) {
                              " samples in the run: expected at most 1e+08 (fewer repetitions, a shorter hold or a lower "
                              "sample rate)");
     }
+}
+
+}  // namespace
+
+Protocol readProtocol(const std::string& path) {
+    Protocol p;
+    p.sourcePath = path;
+    p.sourceText = readFileText(path);
+    const ParamNode root = ParamNode::loadString(p.sourceText, path);
+    p.name = root.getString("name");
+    if (p.name.empty() || p.name.find_first_of("/\\ \t") != std::string::npos)
+        throw InputError(root.where("name") + ": field 'name' = '" + p.name +
+                         "': expected a non-empty name without spaces or slashes");
+    p.description = root.getString("description", "");
+    root.getString("kind");  // required
+    const std::string kind = root.getChoice("kind", {"mvc", "submaximal", "force_length", "composition"}, "mvc");
+    p.kind = kind == "mvc" ? ProtocolKind::Mvc
+           : kind == "submaximal" ? ProtocolKind::Submaximal
+           : kind == "force_length" ? ProtocolKind::ForceLength
+                                    : ProtocolKind::Composition;
+    const bool armTrials = p.kind != ProtocolKind::Composition;
+
+    const ArmSetup subject = readProtocolSubjectSection(root, p);
+    const ArmParameters& arm = subject.arm;
+    const double pMax = subject.calcBicepsParameters().maxPathLength;
+
+    if (armTrials) {
+        const double seed = root.getNumber("seed", Bound::closed(0, 9007199254740992.0));
+        if (seed != std::floor(seed))
+            throw InputError(root.where("seed") + ": field 'seed' = " + fmt::format("{:g}", seed) + ": expected a whole number");
+        p.seed = std::uint64_t(seed);
+        p.randomOrder = root.getChoice("order", {"random", "listed"}, "random") == "random";
+        p.repetitions = root.getInt("repetitions", 1, 1000, 1);
+        p.interTrialRest = root.getNumber("inter_trial_rest", Bound::nonNegative("s"), 0.0);
+        p.trial = root.has("trial") ? readTrialTemplate(root.child("trial"), arm) : p.trial;
+    }
+
+    readProtocolConditions(root, p, arm, pMax);
+    readProtocolSensors(root, p, armTrials);
+    root.finish();
+    checkProtocolSize(path, p);
     return p;
 }
 

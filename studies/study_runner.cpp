@@ -691,6 +691,69 @@ std::vector<std::string> writeStudyFilesInto(OutputFolder& folder, const Study& 
 
 int defaultThreads() { return getNumUsableCpus(); }
 
+// The run options' combinations: a shard's range and company, --merge's needs.
+void checkStudyRunOptions(const StudyRunOptions& options, const std::string& output, bool existed, bool ranks) {
+    const bool sharded = options.shards > 0;
+    if (sharded && (options.shard < 0 || options.shard >= options.shards))
+        throw InputError("study: shard " + std::to_string(options.shard) + "/" + std::to_string(options.shards) +
+                         ": expected I/N with 0 <= I < N");
+    if (sharded && (options.merge || ranks))
+        throw InputError("study: a shard (--shard) runs on its own threads: not with --merge or MPI ranks");
+    if (options.merge && options.restart)
+        throw InputError("study: --merge with --restart: --restart discards the journals --merge would merge; give one");
+    if (options.merge && !existed)   // nothing made: a folder with only a lock would be left
+        throw InputError("study output '" + output + "': --merge: the folder does not exist, so there is "
+                         "nothing to merge (run the shards with --shard I/N into it first)");
+}
+
+// Hands the missing cells out (this process's threads, and MPI ranks through link) until every cell is
+// recorded and every rank told to stop; record() takes each batch of results, report() the progress
+// (called at most once a second).
+void dispatchStudyWork(const Study& study, int threads, WorkQueue& pending, StudyCoordinatorLink* link,
+                       const std::string& fingerprint, const StudyProgress& progress, StudyOutcome& outcome,
+                       const std::function<void(const std::vector<StudyResult>&)>& record,
+                       const std::function<void()>& report) {
+    LocalWorkers local(study, pending.isEmpty() ? 0 : threads, 0);
+    int localInFlight = 0, stopped = 0;
+    const int workers = link ? link->getNumWorkers() : 0;
+    std::vector<bool> told(workers + 1, false);
+    auto lastReport = Clock::now();
+    report();
+    while (progress.done < progress.total || stopped < workers) {
+        while (localInFlight < local.getNumThreads() && !pending.isEmpty()) {
+            local.add(pending.take(local.getNumThreads() - localInFlight));
+            ++outcome.units;
+            ++localInFlight;
+        }
+        int worker = 0;
+        std::string message;
+        while (link && link->receive(worker, message)) {
+            int want = 0;
+            std::string theirs;
+            const std::vector<StudyResult> results = parseRequest(message, want, theirs);
+            if (theirs != fingerprint)
+                throw InputError("rank " + std::to_string(worker) + " read a different study (fingerprint " + theirs +
+                                 ", rank 0: " + fingerprint + "): the study, protocol and population files must "
+                                 "be the same on every node");
+            record(results);
+            std::vector<GroupWork> give;
+            while (int(give.size()) < want && !pending.isEmpty()) {
+                give.push_back(pending.take(want - int(give.size())));
+                ++outcome.units;
+            }
+            link->send(worker, formatWork(give, pending.isEmpty()));
+            if (pending.isEmpty() && !told[worker]) told[worker] = true, ++stopped;
+        }
+        int groups = 0;
+        record(local.take(std::chrono::milliseconds(link ? 1 : 200), groups));
+        localInFlight -= groups;
+        if (Clock::now() - lastReport > std::chrono::seconds(1)) {
+            report();
+            lastReport = Clock::now();
+        }
+    }
+}
+
 }  // namespace
 
 StudyOutcome runStudy(const Study& study, const StudyRunOptions& options, StudyCoordinatorLink* link) {
@@ -702,18 +765,9 @@ StudyOutcome runStudy(const Study& study, const StudyRunOptions& options, StudyC
     if (outcome.output.empty()) throw InputError("study: no output folder (set `output:` or --out)");
     const std::string fingerprint = calcStudyFingerprint(study);
     const bool sharded = options.shards > 0;
-    if (sharded && (options.shard < 0 || options.shard >= options.shards))
-        throw InputError("study: shard " + std::to_string(options.shard) + "/" + std::to_string(options.shards) +
-                         ": expected I/N with 0 <= I < N");
-    if (sharded && (options.merge || link))
-        throw InputError("study: a shard (--shard) runs on its own threads: not with --merge or MPI ranks");
     // A new folder is checked before it is made (nothing left behind); an existing one for what it lacks, below.
     const bool existed = std::filesystem::exists(outcome.output);
-    if (options.merge && options.restart)
-        throw InputError("study: --merge with --restart: --restart discards the journals --merge would merge; give one");
-    if (options.merge && !existed)   // nothing made: a folder with only a lock would be left
-        throw InputError("study output '" + outcome.output + "': --merge: the folder does not exist, so there is "
-                         "nothing to merge (run the shards with --shard I/N into it first)");
+    checkStudyRunOptions(options, outcome.output, existed, link != nullptr);
     if (!options.merge && !existed) checkStudyFitsOnDisk(study, study.getNumTasks() / std::max(1, options.shards), outcome.output);
     StudyFolder folder(outcome.output, fingerprint, study, options.restart, options.shard, options.shards);
     outcome.journalDrops = folder.getDropped();
@@ -775,47 +829,7 @@ StudyOutcome runStudy(const Study& study, const StudyRunOptions& options, StudyC
     const int threads = options.threads > 0 ? options.threads : defaultThreads();
     outcome.threads = threads;
     outcome.ranks = 1 + (link ? link->getNumWorkers() : 0);
-    {
-        LocalWorkers local(study, pending.isEmpty() ? 0 : threads, 0);
-        int localInFlight = 0, stopped = 0;
-        const int workers = link ? link->getNumWorkers() : 0;
-        std::vector<bool> told(workers + 1, false);
-        auto lastReport = Clock::now();
-        report();
-        while (progress.done < progress.total || stopped < workers) {
-            while (localInFlight < local.getNumThreads() && !pending.isEmpty()) {
-                local.add(pending.take(local.getNumThreads() - localInFlight));
-                ++outcome.units;
-                ++localInFlight;
-            }
-            int worker = 0;
-            std::string message;
-            while (link && link->receive(worker, message)) {
-                int want = 0;
-                std::string theirs;
-                const std::vector<StudyResult> results = parseRequest(message, want, theirs);
-                if (theirs != fingerprint)
-                    throw InputError("rank " + std::to_string(worker) + " read a different study (fingerprint " + theirs +
-                                     ", rank 0: " + fingerprint + "): the study, protocol and population files must "
-                                     "be the same on every node");
-                record(results);
-                std::vector<GroupWork> give;
-                while (int(give.size()) < want && !pending.isEmpty()) {
-                    give.push_back(pending.take(want - int(give.size())));
-                    ++outcome.units;
-                }
-                link->send(worker, formatWork(give, pending.isEmpty()));
-                if (pending.isEmpty() && !told[worker]) told[worker] = true, ++stopped;
-            }
-            int groups = 0;
-            record(local.take(std::chrono::milliseconds(link ? 1 : 200), groups));
-            localInFlight -= groups;
-            if (Clock::now() - lastReport > std::chrono::seconds(1)) {
-                report();
-                lastReport = Clock::now();
-            }
-        }
-    }
+    dispatchStudyWork(study, threads, pending, link, fingerprint, progress, outcome, record, report);
     report();
 
     if (sharded) {  // the plain run (or --merge) after the job array writes the files
