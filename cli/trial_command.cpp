@@ -105,6 +105,63 @@ void runOsimTrialCommand(const TrialOptions& o) {
     if (!o.plot.empty()) std::printf("wrote %s\n", o.plot.c_str());
 }
 
+// A free movement of an OpenSim model: --coordinate free from --initial-angle (its default when not
+// given), the others held, the muscles pulling the --effort way excited from --onset.
+void runOsimFreeTrialCommand(const TrialOptions& o, bool initialAngleGiven, bool accuracyGiven) {
+    OutputFiles files;
+    const std::string osim = findOsimModelFile(o.muscle.model);
+    files.addInput("--model", osim);
+    const std::string csvPath = files.add("--out", o.out, true), plotPath = files.add("--plot", o.plot);
+    const OsimModel model = readOsimFile(osim);
+    OsimFreeMovementSettings s;
+    s.coordinate = o.coordinate;
+    s.initialAngleDeg = initialAngleGiven ? o.initialAngleDeg : kNaN;
+    s.initialVelocityDegps = o.initialVelocityDegps;
+    s.direction = o.effort == "positive" ? 1 : -1;
+    s.activation = o.activation;
+    s.onset = o.onset;
+    s.rise = o.rise;
+    s.duration = o.duration;
+    s.sampleRate = o.rate;
+    if (accuracyGiven) s.integration.accuracy = o.accuracy;
+    s.muscleModel = o.muscle.muscleModel;
+    s.progress = [d = o.duration](double t) { printTimeProgress("free movement", t, d); };
+    Table t;
+    IntegrationStats stats;
+    runNamingOptions({{"coordinate", "--coordinate"}, {"initial_angle_deg", "--initial-angle"},
+                      {"initial_velocity_degps", "--initial-velocity"}, {"activation", "--activation"},
+                      {"onset", "--onset"}, {"rise", "--rise"}, {"duration", "--duration"}, {"sample_rate", "--rate"},
+                      {"accuracy", "--accuracy"}},
+                     [&] { t = runOsimFreeMovement(model, s, &stats); });
+    const std::string coordinate = t.getColumnNames()[2].substr(0, t.getColumnNames()[2].size() - 4);  // "<c>_deg"
+    files.writeWith(csvPath, [&](const std::string& p) { t.writeCsv(p); });
+    if (!o.plot.empty()) {
+        PlotSpec spec;
+        spec.title = model.name + ": free movement of " + coordinate + " (" + o.effort + " effort)";
+        spec.xLabel = "time (s)";
+        spec.yLabel = coordinate + " (deg)";
+        spec.series.push_back({coordinate, t.getColumn("time_s"), t.getColumn(coordinate + "_deg")});
+        files.writeWith(plotPath, [&](const std::string& p) { writePlotPng(p, spec); });
+    }
+    files.commit();
+    const int last = t.getNumRows() - 1;
+    std::printf("free movement of %s (%s): %s %.1f -> %.1f deg in %s s, the other coordinates held (%d integrator steps)\n",
+                model.name.c_str(), osim.c_str(), coordinate.c_str(), t.get(0, 2), t.get(last, 2),
+                formatNumber(o.duration).c_str(), stats.steps);
+    if (const OsimCoordinate* c = model.findCoordinate(coordinate)) {   // ranges are not forces: say when it left its own
+        const double lo = c->range[0] * 180 / kPi, hi = c->range[1] * 180 / kPi;
+        for (int k = 0; k <= last; ++k)
+            if (t.get(k, 2) < lo - 1e-9 || t.get(k, 2) > hi + 1e-9) {
+                std::printf("note: %s left its range [%s, %s] deg at t = %s s (OpenSim's coordinate ranges are not forces; "
+                            "its forward dynamics let it pass them too)\n", coordinate.c_str(), formatNumber(lo, 4).c_str(),
+                            formatNumber(hi, 4).c_str(), formatNumber(t.get(k, 0)).c_str());
+                break;
+            }
+    }
+    std::printf("wrote %s\n", o.out.c_str());
+    if (!o.plot.empty()) std::printf("wrote %s\n", o.plot.c_str());
+}
+
 void runTrialCommand(const TrialOptions& o) {
     // Every output checked and staged before the trial; all appear together at the end, or none.
     OutputFiles files;
@@ -245,18 +302,25 @@ void addTrialCommand(CLI::App& app) {
     c->callback([o, c] {
         if (isOsimModel(o->muscle.model)) {
             // What an OpenSim model's trial would ignore or cannot do yet is refused, naming the option.
-            if (o->type == "free")
-                throw InputError("--type free with the OpenSim model '" + o->muscle.model + "': a free movement of an .osim "
-                                 "model is `armsim forward --model " + o->muscle.model + " --controls FILE.sto`");
+            const bool free = o->type == "free";
             for (const char* name : {"--settings", "--video", "--muscle", "--arm", "--slow-units", "--fast-units", "--mass",
-                                     "--tendon-length", "--max-path", "--initial-angle", "--initial-velocity", "--onset",
-                                     "--duration", "--load"})
+                                     "--tendon-length", "--max-path", "--load"})
                 if (c->count(name) > 0)
                     throw InputError(std::string(name) + " with the OpenSim model '" + o->muscle.model +
-                                     "': not for .osim models (their trial takes --coordinate, --angle (the coordinate's "
-                                     "value, deg), --effort, --activation, --rest, --rise, --hold, --rate, --accuracy, "
-                                     "--muscle-model, --out and --plot)");
-            runOsimTrialCommand(*o);
+                                     "': not for .osim models (their trials take --coordinate, --effort, --activation, "
+                                     "--rise, --rate, --accuracy, --muscle-model, --out, --plot; isometric --angle (the "
+                                     "coordinate's value, deg), --rest, --hold; free --initial-angle, --initial-velocity, "
+                                     "--onset, --duration)");
+            for (const char* name : {"--angle", "--rest", "--hold"})
+                if (free && c->count(name) > 0)
+                    throw InputError(std::string(name) + " is an isometric trial's option: with --type free it would be "
+                                     "ignored (the free trial starts at --initial-angle)");
+            for (const char* name : {"--initial-angle", "--initial-velocity", "--onset", "--duration"})
+                if (!free && c->count(name) > 0)
+                    throw InputError(std::string(name) + " is a free movement's option: the isometric trial (the default "
+                                     "--type) would ignore it; add --type free");
+            if (free) runOsimFreeTrialCommand(*o, c->count("--initial-angle") > 0, c->count("--accuracy") > 0);
+            else runOsimTrialCommand(*o);
             return;
         }
         for (const char* name : {"--coordinate", "--effort"})

@@ -4,8 +4,10 @@
 #include "basics/errors.h"
 #include "basics/format.h"
 #include "model/osim_arm.h"
+#include "muscles/simbody_isometric.h"
 
 #include <cmath>
+#include <map>
 #include <utility>
 
 namespace armsim {
@@ -155,6 +157,100 @@ OsimIsometricTrialResult runOsimIsometricTrial(const OsimModel& file, const Osim
     sum.meanTaredTorque = mean(t.getColumn("tared_torque_Nm"), first);
     for (int i = 0; i < n; ++i) sum.meanForces.push_back(mean(t.getColumn("force_" + sum.muscles[i] + "_N"), first));
     return result;
+}
+
+void OsimFreeMovementSettings::validate(const OsimArm& arm) const {
+    const int j = findTrialCoordinate(arm, coordinate);
+    const auto range = arm.getCoordinate(j).range;
+    if (!std::isnan(initialAngleDeg))
+        checkField("initial_angle_deg", initialAngleDeg,
+                   Bound::closed(std::round(range[0] / kDeg * 1e6) / 1e6, std::round(range[1] / kDeg * 1e6) / 1e6, "deg"));
+    checkField("initial_velocity_degps", initialVelocityDegps, Bound::closed(-2000, 2000, "deg/s"));
+    if (direction != 1 && direction != -1)
+        throw FieldError("direction", "= " + std::to_string(direction) + ": expected +1 or -1");
+    checkField("activation", activation, Bound::closed(0, 1));
+    checkField("onset", onset, Bound::nonNegative("s"));
+    checkField("rise", rise, Bound::nonNegative("s"));
+    checkField("duration", duration, Bound::positive("s"));
+    if (activation > 0 && !(onset < duration))
+        throw FieldError("onset", "= " + formatNumber(onset) + " s is not before the end of the movement (duration " +
+                                      formatNumber(duration) + " s): expected an onset before the end (the excitation "
+                                      "would never start)");
+    checkField("sample_rate", sampleRate, Bound::positive("Hz"));
+    calcNumSamples(duration, sampleRate);
+    integration.validate();
+}
+
+Table runOsimFreeMovement(const OsimModel& file, const OsimFreeMovementSettings& settings, IntegrationStats* stats) {
+    OsimModel model = file;
+    int j;
+    std::vector<bool> agonists;
+    {   // the settings checked, and the agonists found at the start pose
+        const OsimArm probe(model, {}, settings.muscleModel);
+        settings.validate(probe);
+        j = findTrialCoordinate(probe, settings.coordinate);
+        SimTK::State s = probe.getDefaultState();
+        if (!std::isnan(settings.initialAngleDeg)) probe.setCoordinateValue(s, j, settings.initialAngleDeg * kDeg);
+        probe.getSystem().realize(s, SimTK::Stage::Position);
+        for (int i = 0; i < probe.getNumMuscles(); ++i)
+            agonists.push_back(isOsimAgonist(settings.direction, probe.calcMomentArm(s, i, j)));
+    }
+    const std::string coordinate = [&] {
+        int k = 0;
+        for (OsimJoint& joint : model.joints)
+            for (OsimCoordinate& c : joint.coordinates)
+                if (k++ == j) return c.name;
+        return std::string();
+    }();
+    // The other coordinates held at their defaults; the free one starts where asked.
+    for (OsimJoint& joint : model.joints)
+        for (OsimCoordinate& c : joint.coordinates) {
+            if (c.name != coordinate) c.locked = true;
+            else if (!std::isnan(settings.initialAngleDeg)) c.defaultValue = settings.initialAngleDeg * kDeg, c.locked = false;
+            else c.locked = false;
+        }
+    const ActivationProfile agonist = settings.rise > 0
+        ? ActivationProfile::ramp(settings.onset, settings.onset + settings.rise, 0.0, settings.activation)
+        : ActivationProfile::step(settings.onset, 0.0, settings.activation);
+    std::map<std::string, ActivationProfile> excitations;
+    for (std::size_t i = 0; i < model.muscles.size(); ++i)
+        excitations[model.muscles[i].name] = agonists[i] ? agonist : ActivationProfile::constant(0.0);
+    const OsimArm arm(model, excitations, settings.muscleModel);
+    const int free = arm.findCoordinate(coordinate);
+    const int n = arm.getNumMuscles();
+    SimTK::State s = arm.getDefaultState();
+    arm.setCoordinateSpeed(s, free, settings.initialVelocityDegps * kDeg);
+    arm.getSystem().realize(s, SimTK::Stage::Velocity);
+    for (int i = 0; i < n; ++i) arm.getMuscleForce(i).setSteadyMuscleStates(s);   // equilibrium at U(0)
+
+    std::vector<std::string> columns{"time_s", "excitation", coordinate + "_deg", coordinate + "_speed_degps"};
+    const std::pair<const char*, const char*> perMuscle[] = {{"force_", "_N"}, {"activation_", ""}, {"fiber_length_", "_m"}};
+    for (const auto& [prefix, unit] : perMuscle)
+        for (int i = 0; i < n; ++i) columns.push_back(prefix + arm.getMuscleName(i) + unit);
+    Table t(columns);
+    t.reserveRows(int(std::lround(settings.duration * settings.sampleRate)) + 1);
+    std::vector<double> row;
+    auto sample = [&](const SimTK::State& x) {
+        arm.getSystem().realize(x, SimTK::Stage::Dynamics);
+        row.assign({x.getTime(), agonist.getValue(x.getTime()), arm.getCoordinateValue(x, free) / kDeg,
+                    arm.getCoordinateSpeed(x, free) / kDeg});
+        for (int i = 0; i < n; ++i) row.push_back(arm.getMuscleForce(i).getForce(x));
+        for (int i = 0; i < n; ++i) row.push_back(arm.getMuscleForce(i).calcOutputs(x).activeFraction);
+        for (int i = 0; i < n; ++i) row.push_back(arm.getMuscleForce(i).getFascicleLength(x));
+        t.appendRow(row);
+        if (settings.progress) settings.progress(x.getTime());
+    };
+    auto check = [&](const SimTK::State& x) {
+        for (int i = 0; i < n; ++i) {
+            const MuscleForce& f = arm.getMuscleForce(i);
+            const std::vector<double> y = f.getMuscleStates(x);
+            f.getMuscle().checkStates(x.getTime(), y.data());
+        }
+    };
+    const IntegrationStats st = simulateSampled(arm.getSystem(), s, settings.duration, settings.sampleRate,
+                                                agonist.getBreakpoints(), settings.integration, sample, check);
+    if (stats) *stats = st;
+    return t;
 }
 
 }  // namespace armsim

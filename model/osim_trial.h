@@ -1,8 +1,8 @@
 // An isometric trial of an OpenSim model (model/osim_arm.h): one coordinate locked at a value, the
 // others at their defaults (locked too, as a dynamometer holds the limb), the muscles that move the
 // coordinate one way excited to a target after a rest, and the torque they put on it recorded, raw and
-// tared at rest as a dynamometer reads it. `armsim trial --model FILE.osim` and Python's
-// `armsim.isometric_trial` run it.
+// tared at rest as a dynamometer reads it; and a free movement of one coordinate with the others held.
+// `armsim trial --model FILE.osim` and Python's `armsim.isometric_trial` run them.
 //
 // With every coordinate locked the paths are fixed, so each muscle's states evolve alone at its path
 // length (numerics/stiff_ode.h OdeBlocks, a band Newton matrix: cost linear in the muscles), and the
@@ -18,6 +18,7 @@
 #include "muscles/activation.h"
 #include "numerics/stiff_ode.h"
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -78,5 +79,39 @@ struct OsimIsometricTrialResult {
 /// Runs the trial (its own Simbody System). muscleModel as OsimArm's. Throws InputError for bad
 /// settings, SimulationError when the integration fails.
 OsimIsometricTrialResult runOsimIsometricTrial(const OsimModel& model, const OsimIsometricTrialSettings& settings);
+
+/// A free movement of an OpenSim model: one coordinate free from initialAngleDeg, the others held at
+/// their defaults, the muscles that pull it the `direction` way (at the start pose) excited from
+/// `onset` (a step, or a ramp over `rise`), the others at rest; from every muscle in equilibrium at
+/// the start. OpenSim's ranges are not forces (its forward dynamics ignore them too): the coordinate
+/// may leave its range.
+struct OsimFreeMovementSettings {
+    std::string coordinate;        ///< the free coordinate; "" = the model's only one
+    double initialAngleDeg = kNaN; ///< its value at t = 0 [deg]; NaN: its default
+    double initialVelocityDegps = 0;  ///< [deg/s]
+    int direction = 1;             ///< +1: the agonists pull the positive way, -1 the negative
+    double activation = 0.5;       ///< the agonists' excitation after the onset [1]
+    double onset = 0.2;            ///< [s]
+    double rise = 0.0;             ///< ramp time from 0; 0 = a step [s]
+    double duration = 2.0;         ///< [s]
+    double sampleRate = 200.0;     ///< [Hz]
+    std::string muscleModel;       ///< "" = each muscle's type in the file
+    /// CPodes; accuracy 1e-5 as OpenSim's Forward tool.
+    IntegrationSettings integration = [] {
+        IntegrationSettings i;
+        i.accuracy = 1e-5;
+        return i;
+    }();
+    /// Optional: called with the time of every sample [s] (a long run's progress).
+    std::function<void(double)> progress;
+    /// InputError naming the field for a bad value, a start outside the coordinate's range or a
+    /// coordinate that is not there.
+    void validate(const OsimArm& arm) const;
+};
+
+/// Columns: time_s, excitation (of the agonists), <coordinate>_deg, <coordinate>_speed_degps, then per
+/// muscle force_<m>_N, activation_<m>, fiber_length_<m>_m. stats: what the integration cost.
+Table runOsimFreeMovement(const OsimModel& model, const OsimFreeMovementSettings& settings,
+                          IntegrationStats* stats = nullptr);
 
 }  // namespace armsim

@@ -231,6 +231,16 @@ IntegrationStats integrateLockedArm(const State& state, const std::vector<int>& 
         });
 }
 
+// An isometric trial table's columns (IsometricTrialResult::series).
+std::vector<std::string> getIsometricColumns(const MuscleArm& model, bool forearm) {
+    std::vector<std::string> columns = {"time_s", "activation", "elbow_angle_deg", "elbow_velocity_degps", "muscle_force_N",
+                                        "fascicle_length_m", "fascicle_velocity_mps", "holding_torque_Nm",
+                                        "muscle_torque_Nm", "strap_force_N", "saturated", "force_moment_arm_N",
+                                        "force_fixed_ratio_N", "error_moment_arm_pct", "error_fixed_ratio_pct"};
+    if (forearm) columns.push_back("forearm_torque_Nm");
+    return withMuscleColumns(columns, model);
+}
+
 // The summary's window means from the trial's table.
 void summarizeIsometricSeries(const MuscleArm& model, const IsometricTrialSettings& settings, bool forearm,
                               IsometricTrialResult& result) {
@@ -294,13 +304,7 @@ IsometricTrialResult runIsometricTrial(const ArmSetup& setup, const IsometricTri
     const double forearmTare = forearm ? arm.calcForearmHoldingTorque(state) : 0.0;
     double Gf = forearmTare;
     for (int i = 0; i < n; ++i) Gf += sum.forearmMomentArms[i] * restForces[i];
-    std::vector<std::string> columns = {"time_s", "activation", "elbow_angle_deg", "elbow_velocity_degps", "muscle_force_N",
-                                        "fascicle_length_m", "fascicle_velocity_mps", "holding_torque_Nm",
-                                        "muscle_torque_Nm", "strap_force_N", "saturated", "force_moment_arm_N",
-                                        "force_fixed_ratio_N", "error_moment_arm_pct", "error_fixed_ratio_pct"};
-    if (forearm) columns.push_back("forearm_torque_Nm");
-
-    result.series = Table(withMuscleColumns(columns, model));
+    result.series = Table(getIsometricColumns(model, forearm));
     result.series.reserveRows(int(std::lround(settings.getDuration() * settings.sampleRate)) + 1);
     const double h = sum.momentArm;
     std::vector<const MuscleModel*> muscles;

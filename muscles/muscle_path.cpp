@@ -364,33 +364,95 @@ MusclePath::MusclePath(std::vector<PathElement> elements) : elements_(std::move(
     }
 }
 
-PathGeometry MusclePath::calcGeometry(const State& s, const std::string& muscleName, bool withPolyline) const {
-    PathGeometry g;
-    const int n = int(elements_.size());
-    g.wrapping.assign(n, false);
-    auto pointInGround = [&](int k) {
-        return elements_[k].body.getBodyTransform(s) * elements_[k].location;
-    };
-    auto addLoad = [&](int k, const Vec3& point, const Vec3& force) {
+namespace {
+
+// Builds one PathGeometry (MusclePath::calcGeometry): the length, the loads of a unit tension on the
+// bodies (points, tangent points, surfaces' centres with couples) and the polyline.
+class GeometryBuilder {
+public:
+    GeometryBuilder(const std::vector<PathElement>& elements, const State& s, const std::string& muscleName,
+                    bool withPolyline)
+        : elements_(elements), s_(s), muscleName_(muscleName), withPolyline_(withPolyline) {
+        g_.wrapping.assign(elements.size(), false);
+    }
+
+    PathGeometry build() {
+        const int n = int(elements_.size());
+        int i = 0;
+        Vec3 a = pointInGround(0);
+        if (withPolyline_) g_.polyline.push_back(a);
+        while (i < n - 1) {
+            int next = i + 1;
+            while (!isActive(next)) ++next;   // conditional points lie between points: next is a point or a surface
+            int j = next;                     // the surfaces between two points are next .. j - 1
+            while (elements_[j].isSurface()) ++j;
+            const Vec3 b = pointInGround(j);
+            if (j - next == 0) addStraight(i, j, a, b);
+            else if (j - next == 1) addOneSurface(i, next, j, a, b);   // the common case
+            else addChain(i, next, j, a, b);
+            if (withPolyline_) g_.polyline.push_back(b);
+            i = j;
+            a = b;
+        }
+        return std::move(g_);
+    }
+
+private:
+    Vec3 pointInGround(int k) const { return elements_[k].body.getBodyTransform(s_) * elements_[k].location; }
+
+    void addLoad(int k, const Vec3& point, const Vec3& force) {
         const MobilizedBody& body = elements_[k].body;
-        g.loads.push_back({k, body.getMobilizedBodyIndex(), point, point - body.getBodyTransform(s).p(), force});
-    };
-    auto isActive = [&](int k) {
+        g_.loads.push_back({k, body.getMobilizedBodyIndex(), point, point - body.getBodyTransform(s_).p(), force});
+    }
+
+    bool isActive(int k) const {
         const PathElement& e = elements_[k];
         if (!e.isConditional()) return true;
-        const double q = e.joint.getOneQ(s, MobilizerQIndex(0));
+        const double q = e.joint.getOneQ(s_, MobilizerQIndex(0));
         return q >= e.activeMin && q <= e.activeMax;
-    };
+    }
+
+    void addStraight(int i, int j, const Vec3& a, const Vec3& b) {
+        const Vec3 d = b - a;
+        const double len = d.norm();
+        g_.length += len;
+        const Vec3 u = len > 0 ? Vec3(d / len) : Vec3(0);
+        addLoad(i, a, u);
+        addLoad(j, b, -u);
+    }
+
+    void addArc(const SurfaceWrap& w) {
+        if (!withPolyline_) return;
+        g_.polyline.push_back(w.ta);
+        g_.polyline.insert(g_.polyline.end(), w.arc.begin(), w.arc.end());
+        g_.polyline.push_back(w.tb);
+    }
+
+    // One wrapping surface k between the points i and j.
+    void addOneSurface(int i, int k, int j, const Vec3& a, const Vec3& b) {
+        const SurfaceWrap w = wrapSurface(elements_[k], elements_[k].body.getBodyTransform(s_), a, b, muscleName_, withPolyline_);
+        if (!w.active) return addStraight(i, j, a, b);
+        g_.wrapping[k] = true;
+        g_.length += w.length;
+        addSurfaceLoads(i, k, j, a, b, w);
+        addArc(w);
+    }
+
+    void addSurfaceLoads(int i, int k, int j, const Vec3& a, const Vec3& b, const SurfaceWrap& w) {
+        if (elements_[k].kind == PathElement::Kind::Ellipsoid) addEllipsoidLoads(i, k, j, a, b, w);
+        else addTangentLoads(i, k, j, a, b, w);
+    }
+
     // Loads of an active ellipsoid alone between a and b: the gradient of its planar length (central
     // differences) at the points, and on its body what rigid invariance leaves (a force and a couple
     // about its centre).
-    auto addEllipsoidLoads = [&](int i, int k, int j, const Vec3& a, const Vec3& b, const SurfaceWrap& w) {
+    void addEllipsoidLoads(int i, int k, int j, const Vec3& a, const Vec3& b, const SurfaceWrap& w) {
         const PathElement& e = elements_[k];
-        const Transform& X_GB = e.body.getBodyTransform(s);
+        const Transform& X_GB = e.body.getBodyTransform(s_);
         const Vec3 c = X_GB * e.location;
         const double h = 1e-5 * std::min({e.radii[0], e.radii[1], e.radii[2]});
         auto lengthAt = [&](const Vec3& pa, const Vec3& pb) {
-            const SurfaceWrap x = wrapEllipsoid(e, X_GB, pa, pb, muscleName, false);
+            const SurfaceWrap x = wrapEllipsoid(e, X_GB, pa, pb, muscleName_, false);
             return x.active ? x.length : (pb - pa).norm();
         };
         Vec3 ga(0), gb(0);
@@ -413,121 +475,95 @@ PathGeometry MusclePath::calcGeometry(const State& s, const std::string& muscleN
             }
         }
         addLoad(k, c, ga + gb);
-        g.loads.back().moment = (a - c) % ga + (b - c) % gb;
+        g_.loads.back().moment = (a - c) % ga + (b - c) % gb;
         addLoad(i, a, -ga);
         addLoad(j, b, -gb);
-    };
+    }
+
     // Loads of one active cylinder or sphere: the tension at its tangent points (the path is a geodesic).
-    auto addTangentLoads = [&](int i, int k, int j, const Vec3& a, const Vec3& b, const SurfaceWrap& w) {
+    void addTangentLoads(int i, int k, int j, const Vec3& a, const Vec3& b, const SurfaceWrap& w) {
         addLoad(k, w.ta, Vec3(UnitVec3(a - w.ta).asVec3()));
         addLoad(k, w.tb, Vec3(UnitVec3(b - w.tb).asVec3()));
         addLoad(i, a, Vec3(UnitVec3(w.ta - a).asVec3()));
         addLoad(j, b, Vec3(UnitVec3(w.tb - b).asVec3()));
-    };
-    int i = 0;
-    Vec3 a = pointInGround(0);
-    if (withPolyline) g.polyline.push_back(a);
-    while (i < n - 1) {
-        int next = i + 1;
-        while (!isActive(next)) ++next;   // conditional points lie between points: next is a point or a surface
-        int j = next;                     // the surfaces between two points are next .. j - 1
-        while (elements_[j].isSurface()) ++j;
-        const Vec3 b = pointInGround(j);
-        auto addStraight = [&] {
-            const Vec3 d = b - a;
-            const double len = d.norm();
-            g.length += len;
-            const Vec3 u = len > 0 ? Vec3(d / len) : Vec3(0);
-            addLoad(i, a, u);
-            addLoad(j, b, -u);
-        };
-        auto addArc = [&](const SurfaceWrap& w) {
-            if (!withPolyline) return;
-            g.polyline.push_back(w.ta);
-            g.polyline.insert(g.polyline.end(), w.arc.begin(), w.arc.end());
-            g.polyline.push_back(w.tb);
-        };
-        if (j - next == 0) {
-            addStraight();
-        } else if (j - next == 1) {  // one surface (the common case)
-            const int k = next;
-            const SurfaceWrap w = wrapSurface(elements_[k], elements_[k].body.getBodyTransform(s), a, b, muscleName, withPolyline);
-            if (!w.active) {
-                addStraight();
-            } else {
-                g.wrapping[k] = true;
-                g.length += w.length;
-                if (elements_[k].kind == PathElement::Kind::Ellipsoid) addEllipsoidLoads(i, k, j, a, b, w);
-                else addTangentLoads(i, k, j, a, b, w);
-                addArc(w);
-            }
-        } else {
-            std::vector<int> ks;
-            std::vector<const PathElement*> es;
-            std::vector<Transform> X;
-            for (int k = next; k < j; ++k) {
-                ks.push_back(k);
-                es.push_back(&elements_[k]);
-                X.push_back(elements_[k].body.getBodyTransform(s));
-            }
-            const ChainWrap c = wrapChain(es, X, a, b, muscleName, withPolyline);
-            if (c.active == 0) {
-                addStraight();
-            } else {
-                g.length += c.length;
-                for (std::size_t m = 0; m < ks.size(); ++m) g.wrapping[ks[m]] = c.wraps[m].active;
-                if (c.active == 1) {
-                    std::size_t m = 0;
-                    while (m + 1 < c.wraps.size() && !c.wraps[m].active) ++m;
-                    if (elements_[ks[m]].kind == PathElement::Kind::Ellipsoid) addEllipsoidLoads(i, ks[m], j, a, b, c.wraps[m]);
-                    else addTangentLoads(i, ks[m], j, a, b, c.wraps[m]);
-                } else {
-                    // Several surfaces in use: loads from the gradient of the chain's length (central
-                    // differences) with respect to a, b and each active surface's pose (a force and a
-                    // couple about its centre), whatever their kinds.
-                    auto chainLength = [&](const Vec3& pa, const Vec3& pb, const std::vector<Transform>& XX) {
-                        return wrapChain(es, XX, pa, pb, muscleName, false).length;
-                    };
-                    const double h = 1e-7, hr = 1e-6;  // m, rad
-                    Vec3 ga(0), gb(0);
-                    for (int d = 0; d < 3; ++d) {
-                        Vec3 dx(0);
-                        dx[d] = h;
-                        ga[d] = (chainLength(a + dx, b, X) - chainLength(a - dx, b, X)) / (2 * h);
-                        gb[d] = (chainLength(a, b + dx, X) - chainLength(a, b - dx, X)) / (2 * h);
-                    }
-                    addLoad(i, a, -ga);
-                    addLoad(j, b, -gb);
-                    for (std::size_t m = 0; m < ks.size(); ++m) {
-                        if (!c.wraps[m].active) continue;
-                        const Vec3 centre = X[m] * elements_[ks[m]].location;
-                        Vec3 force(0), moment(0);
-                        for (int d = 0; d < 3; ++d) {
-                            std::vector<Transform> plus = X, minus = X;
-                            Vec3 dx(0);
-                            dx[d] = h;
-                            plus[m].updP() += dx;
-                            minus[m].updP() -= dx;
-                            force[d] = -(chainLength(a, b, plus) - chainLength(a, b, minus)) / (2 * h);
-                            for (int sign : {1, -1}) {
-                                const Rotation R(sign * hr, CoordinateAxis(d));
-                                (sign > 0 ? plus : minus)[m] = Transform(R * X[m].R(), centre + R * (X[m].p() - centre));
-                            }
-                            moment[d] = -(chainLength(a, b, plus) - chainLength(a, b, minus)) / (2 * hr);
-                        }
-                        addLoad(ks[m], centre, force);
-                        g.loads.back().moment = moment;
-                    }
-                }
-                for (const SurfaceWrap& w : c.wraps)
-                    if (w.active) addArc(w);
-            }
-        }
-        if (withPolyline) g.polyline.push_back(b);
-        i = j;
-        a = b;
     }
-    return g;
+
+    // The surfaces next .. j - 1 between the points i and j, wrapped in turn (wrapChain).
+    void addChain(int i, int next, int j, const Vec3& a, const Vec3& b) {
+        std::vector<int> ks;
+        std::vector<const PathElement*> es;
+        std::vector<Transform> X;
+        for (int k = next; k < j; ++k) {
+            ks.push_back(k);
+            es.push_back(&elements_[k]);
+            X.push_back(elements_[k].body.getBodyTransform(s_));
+        }
+        const ChainWrap c = wrapChain(es, X, a, b, muscleName_, withPolyline_);
+        if (c.active == 0) return addStraight(i, j, a, b);
+        g_.length += c.length;
+        for (std::size_t m = 0; m < ks.size(); ++m) g_.wrapping[ks[m]] = c.wraps[m].active;
+        if (c.active == 1) {
+            std::size_t m = 0;
+            while (m + 1 < c.wraps.size() && !c.wraps[m].active) ++m;
+            addSurfaceLoads(i, ks[m], j, a, b, c.wraps[m]);
+        } else {
+            addChainLoads(i, j, a, b, ks, es, X, c);
+        }
+        for (const SurfaceWrap& w : c.wraps)
+            if (w.active) addArc(w);
+    }
+
+    // Several surfaces in use: loads from the gradient of the chain's length (central differences) with
+    // respect to a, b and each active surface's pose (a force and a couple about its centre), whatever
+    // their kinds.
+    void addChainLoads(int i, int j, const Vec3& a, const Vec3& b, const std::vector<int>& ks,
+                       const std::vector<const PathElement*>& es, const std::vector<Transform>& X, const ChainWrap& c) {
+        auto chainLength = [&](const Vec3& pa, const Vec3& pb, const std::vector<Transform>& XX) {
+            return wrapChain(es, XX, pa, pb, muscleName_, false).length;
+        };
+        const double h = 1e-7, hr = 1e-6;  // m, rad
+        Vec3 ga(0), gb(0);
+        for (int d = 0; d < 3; ++d) {
+            Vec3 dx(0);
+            dx[d] = h;
+            ga[d] = (chainLength(a + dx, b, X) - chainLength(a - dx, b, X)) / (2 * h);
+            gb[d] = (chainLength(a, b + dx, X) - chainLength(a, b - dx, X)) / (2 * h);
+        }
+        addLoad(i, a, -ga);
+        addLoad(j, b, -gb);
+        for (std::size_t m = 0; m < ks.size(); ++m) {
+            if (!c.wraps[m].active) continue;
+            const Vec3 centre = X[m] * elements_[ks[m]].location;
+            Vec3 force(0), moment(0);
+            for (int d = 0; d < 3; ++d) {
+                std::vector<Transform> plus = X, minus = X;
+                Vec3 dx(0);
+                dx[d] = h;
+                plus[m].updP() += dx;
+                minus[m].updP() -= dx;
+                force[d] = -(chainLength(a, b, plus) - chainLength(a, b, minus)) / (2 * h);
+                for (int sign : {1, -1}) {
+                    const Rotation R(sign * hr, CoordinateAxis(d));
+                    (sign > 0 ? plus : minus)[m] = Transform(R * X[m].R(), centre + R * (X[m].p() - centre));
+                }
+                moment[d] = -(chainLength(a, b, plus) - chainLength(a, b, minus)) / (2 * hr);
+            }
+            addLoad(ks[m], centre, force);
+            g_.loads.back().moment = moment;
+        }
+    }
+
+    const std::vector<PathElement>& elements_;
+    const State& s_;
+    const std::string& muscleName_;
+    const bool withPolyline_;
+    PathGeometry g_;
+};
+
+}  // namespace
+
+PathGeometry MusclePath::calcGeometry(const State& s, const std::string& muscleName, bool withPolyline) const {
+    return GeometryBuilder(elements_, s, muscleName, withPolyline).build();
 }
 
 double MusclePath::calcLength(const State& s) const {

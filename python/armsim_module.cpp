@@ -359,6 +359,42 @@ PYBIND11_MODULE(_armsim, mod) {
         "the whole hold). Releases the GIL; Ctrl-C raises KeyboardInterrupt.");
 
     mod.def(
+        "free_movement",
+        [](const py::object& model, const std::string& coordinate, std::optional<double> initialAngleDeg,
+           double initialVelocityDegps, const std::string& effort, double activation, double onset, double rise,
+           double duration, double rate, const std::string& muscleModel, double accuracy) {
+            const OsimModel m = readOsimFile(findOsimModelFile(toPathString(model, "model"), "model"));
+            OsimFreeMovementSettings s;
+            s.coordinate = coordinate;
+            if (initialAngleDeg) s.initialAngleDeg = *initialAngleDeg;
+            s.initialVelocityDegps = initialVelocityDegps;
+            if (effort != "positive" && effort != "negative")
+                throw InputError("effort = '" + effort + "': expected 'positive' or 'negative' (the coordinate's direction)");
+            s.direction = effort == "positive" ? 1 : -1;
+            s.activation = activation;
+            s.onset = onset;
+            s.rise = rise;
+            s.duration = duration;
+            s.sampleRate = rate;
+            s.muscleModel = muscleModel;
+            s.integration.accuracy = accuracy;
+            Table t;
+            runInterruptible([&] { t = runOsimFreeMovement(m, s); });
+            return toDict(std::move(t));
+        },
+        py::arg("model"), py::arg("coordinate") = "", py::arg("initial_angle_deg") = py::none(),
+        py::arg("initial_velocity_degps") = 0.0, py::arg("effort") = "positive", py::arg("activation") = 0.5,
+        py::arg("onset") = 0.2, py::arg("rise") = 0.0, py::arg("duration") = 2.0, py::arg("rate") = 200.0,
+        py::arg("muscle_model") = "", py::arg("accuracy") = 1e-5,
+        "A free movement of an OpenSim model, as `armsim trial --model FILE.osim --type free`: `coordinate`\n"
+        "free from initial_angle_deg (None: its default), the other coordinates held at their defaults; the\n"
+        "muscles that pull it the `effort` way at the start ('positive' or 'negative') excited to\n"
+        "`activation` from `onset` [s] (a ramp over `rise` [s]; 0: a step), from every muscle in equilibrium.\n"
+        "OpenSim's ranges are not forces: the coordinate may leave its range. Returns a dict of float64\n"
+        "arrays: time_s, excitation, <coordinate>_deg, <coordinate>_speed_degps, per muscle force_<m>_N,\n"
+        "activation_<m>, fiber_length_<m>_m. Releases the GIL; Ctrl-C raises KeyboardInterrupt.");
+
+    mod.def(
         "arm_trial",
         [](const Model& m, double angleDeg, double activation, const std::string& effort, double antagonist,
            double rest, double rise, double hold, double rate, std::optional<double> window,

@@ -35,7 +35,7 @@ def _use_installed_assets():
 
 _use_installed_assets()
 
-from ._armsim import (Model, arm_trial, design_protocol, forward, identify, identify_torque, isometric_trial, muscle_trial,
+from ._armsim import (Model, arm_trial, design_protocol, forward, free_movement, identify, identify_torque, isometric_trial, muscle_trial,
                       read_torque_data, run_protocol, run_study, Simulation, steady_state, validate, validate_elbow, __version__)
 
 
@@ -61,6 +61,6 @@ def render_frame(model, series, time, width=640, height=360, overlay=True, super
     return _render.render_frame(model, series, time, width, height, overlay, supersample, color_by)
 
 
-__all__ = ["__version__", "Model", "arm_trial", "design_protocol", "forward", "identify", "identify_torque", "isometric_trial",
+__all__ = ["__version__", "Model", "arm_trial", "design_protocol", "forward", "free_movement", "identify", "identify_torque", "isometric_trial",
            "muscle_trial", "read_torque_data", "render_frame",
            "render_video", "run_protocol", "run_study", "Simulation", "steady_state", "validate", "validate_elbow"]

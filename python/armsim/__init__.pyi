@@ -4,7 +4,7 @@ from typing import Any, Dict
 import numpy as np
 import numpy.typing as npt
 
-from ._armsim import (Model, arm_trial, design_protocol, forward, identify, identify_torque, isometric_trial, muscle_trial,
+from ._armsim import (Model, arm_trial, design_protocol, forward, free_movement, identify, identify_torque, isometric_trial, muscle_trial,
                       read_torque_data, run_protocol, run_study, Simulation, steady_state, validate, validate_elbow, __version__)
 
 def render_video(model: Model, series: Dict[str, npt.NDArray[np.float64]], path: str, fps: float = 30.0,

@@ -63,6 +63,11 @@ def forward(model: Union[str, "os.PathLike[str]"], controls: Union[str, "os.Path
             initial_states: Union[None, str, "os.PathLike[str]", Dict[str, Array]] = None, final_time: float = 1.0,
             initial_time: Optional[float] = None, rate: float = 200.0, muscle_model: str = "",
             accuracy: float = 1e-5) -> Dict[str, Array]: ...
+def free_movement(model: Union[str, "os.PathLike[str]"], coordinate: str = "",
+                  initial_angle_deg: Optional[float] = None, initial_velocity_degps: float = 0.0,
+                  effort: str = "positive", activation: float = 0.5, onset: float = 0.2, rise: float = 0.0,
+                  duration: float = 2.0, rate: float = 200.0, muscle_model: str = "",
+                  accuracy: float = 1e-5) -> Dict[str, Array]: ...
 def isometric_trial(model: Union[str, "os.PathLike[str]"], coordinate: str = "", angle_deg: float = 90.0,
                     effort: str = "positive", activation: float = 1.0, antagonist_activation: float = 0.0,
                     rest: float = 0.5, rise: float = 0.0, hold: float = 3.0, rate: float = 1000.0,

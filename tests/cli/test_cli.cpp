@@ -790,13 +790,33 @@ TEST(Cli, TrialOfAnOsimModelLocksACoordinate) {
         if (std::abs(mvc.get(k, "flexion_deg") - 80) < 1e-9) row = k;
     ASSERT_GE(row, 0);
     EXPECT_NEAR(last, mvc.get(row, "torque_total_Nm"), 1e-3 * std::abs(mvc.get(row, "torque_total_Nm")));
-    for (const std::string& bad : {std::string("--type free"), std::string("--video v.mp4"), std::string("--mass 0.2")}) {
+    for (const std::string& bad : {std::string("--load 2"), std::string("--video v.mp4"), std::string("--mass 0.2")}) {
         const CommandResult refused = runArmsim("trial --model arm26 --coordinate r_elbow_flex " + bad + " --out " +
                                                 (d / "bad.csv").string());
         EXPECT_EQ(refused.exitCode, 2) << bad << ": " << refused.output;
         EXPECT_NE(refused.output.find(bad.substr(0, bad.find(' '))), std::string::npos) << refused.output;
         EXPECT_FALSE(fs::exists(d / "bad.csv")) << bad;
     }
+}
+
+// `armsim trial --model arm26 --type free`: the elbow free from 20 deg with the shoulder held; the table
+// starts there, the flexors flex it, and leaving the coordinate's range (no force stops it, as in
+// OpenSim) is said; options of the other trial type are refused by name.
+TEST(Cli, FreeTrialOfAnOsimModel) {
+    const fs::path d = freshDir("osim_free");
+    const CommandResult r = runArmsim("trial --model arm26 --type free --coordinate r_elbow_flex --initial-angle 20 "
+                                      "--activation 0.4 --duration 1 --rate 100 --out " + (d / "f.csv").string());
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    const armsim::Table t = armsim::Table::readCsv((d / "f.csv").string());
+    ASSERT_EQ(t.getNumRows(), 101);
+    EXPECT_EQ(t.get(0, "r_elbow_flex_deg"), 20.0);
+    EXPECT_GT(t.get(100, "r_elbow_flex_deg"), 130.0);
+    EXPECT_NE(r.output.find("note: r_elbow_flex left its range [0, 130] deg"), std::string::npos) << r.output;
+    const CommandResult hold = runArmsim("trial --model arm26 --type free --coordinate r_elbow_flex --hold 1 --out " +
+                                         (d / "g.csv").string());
+    EXPECT_EQ(hold.exitCode, 2) << hold.output;
+    EXPECT_NE(hold.output.find("--hold is an isometric trial's option"), std::string::npos) << hold.output;
+    EXPECT_FALSE(fs::exists(d / "g.csv"));
 }
 
 TEST(Cli, ForwardRunsAnOsimModelFromASetupFile) {

@@ -251,6 +251,25 @@ def test_isometric_trial_of_an_osim_model(tmp_path):
         armsim.isometric_trial("arm26", coordinate="r_elbow_flex", angle_deg=150)
 
 
+def test_free_movement_of_an_osim_model():
+    """armsim.free_movement on arm26: the elbow free from 20 deg, the flexors at 0.3 from 0.1 s. The angle
+    column is the integral of the speed column (trapezoid rule at 1000 Hz, to 0.05 deg: a second method
+    through the two outputs), the elbow flexes, the triceps stay unexcited; effort='negative' extends."""
+    s = armsim.free_movement("arm26", coordinate="r_elbow_flex", initial_angle_deg=20, activation=0.3, onset=0.1,
+                             duration=0.4, rate=1000)
+    assert s["time_s"].shape == (401,) and s["r_elbow_flex_deg"][0] == pytest.approx(20, abs=1e-12)
+    integral = 20 + np.concatenate(([0.0], np.cumsum(np.diff(s["time_s"]) * 0.5 *
+                                                      (s["r_elbow_flex_speed_degps"][1:] + s["r_elbow_flex_speed_degps"][:-1]))))
+    np.testing.assert_allclose(s["r_elbow_flex_deg"], integral, rtol=0, atol=0.05)
+    assert s["r_elbow_flex_deg"][-1] > 25
+    assert s["activation_BIClong"][-1] > 0.25 and s["activation_TRIlong"][-1] < 0.02
+    back = armsim.free_movement("arm26", coordinate="r_elbow_flex", initial_angle_deg=90, effort="negative",
+                                activation=0.3, onset=0.1, duration=0.3, rate=100)
+    assert back["r_elbow_flex_deg"][-1] < 85
+    with pytest.raises(ValueError, match="'initial_angle_deg' = 200"):
+        armsim.free_movement("arm26", coordinate="r_elbow_flex", initial_angle_deg=200)
+
+
 # The key-naming rule (README, Python): a returned key or column holding a quantity with a unit ends in
 # that unit; the dimensionless ones below have none. Model.parameters() and identify's "estimate" keep
 # the model files' parameter names (what with_muscle takes); a channel's value carries its unit beside it.
@@ -299,6 +318,7 @@ def test_returned_keys_carry_their_units(thesis, elbow, tmp_path):
         "validate": armsim.validate(thesis, noise=[0.02], methods=["lm"], jobs=1),
         "design_protocol": armsim.design_protocol(draws=2, trials=3, jobs=1),
         "isometric_trial": armsim.isometric_trial("arm26", coordinate="r_elbow_flex", hold=0.1, rate=100),
+        "free_movement": armsim.free_movement("arm26", coordinate="r_elbow_flex", duration=0.3, rate=100),
     }
     bad = []
     for name, result in results.items():
