@@ -19,6 +19,7 @@
 #include <filesystem>
 #include <map>
 #include <sstream>
+#include <type_traits>
 
 namespace armsim {
 
@@ -382,83 +383,105 @@ std::vector<StudyResult> runStudyGroup(const Study& study, long group, const std
 
 namespace {
 
-// results.csv's columns; the journal's lines hold the same, read back by name.
-const std::vector<std::string>& getResultColumns() {
-    static const std::vector<std::string> columns = {
-        "task", "truth", "subject", "protocol", "method", "noise", "status", "true_mass_kg", "mass_kg", "mass_lower_kg",
-        "mass_upper_kg", "mass_error", "mass_covered", "true_tendon_length_m", "tendon_length_m", "tendon_lower_m",
-        "tendon_upper_m", "tendon_error_m", "tendon_covered", "true_max_force_N", "max_force_N", "max_force_lower_N",
-        "max_force_upper_N", "max_force_error", "max_force_covered", "noise_estimate", "rms_residual_Nm", "iterations",
-        "parameters", "mass_tendon_correlation", "voluntary_activation", "co_contraction", "strength_level",
-        "biceps_short_scale", "synergist_scale", "reason"};
-    return columns;
+// results.csv's columns, each with how a result is written to its cell and read back from it: the one
+// description of a result that results.csv's header, its rows and the journal's lines all follow.
+struct ResultField {
+    const char* name;
+    std::function<std::string(const StudyResult&)> write;
+    std::function<bool(const std::string&, StudyResult&)> read;
+};
+
+// Fields by kind; `at` is a generic lambda giving the member of a (const or not) StudyResult.
+template <class At>
+ResultField numberField(const char* name, At at) {
+    return {name, [at](const StudyResult& r) { return CsvRow().addNumber(at(r)).getText(); },
+            [at](const std::string& s, StudyResult& r) { return parseDouble(s, at(r)); }};
+}
+template <class At>
+ResultField integerField(const char* name, At at) {
+    return {name, [at](const StudyResult& r) { return std::to_string(at(r)); },
+            [at](const std::string& s, StudyResult& r) {
+                long v = 0;
+                if (!parseLong(s, v)) return false;
+                at(r) = static_cast<std::remove_reference_t<decltype(at(r))>>(v);
+                return true;
+            }};
+}
+template <class At>
+ResultField textField(const char* name, At at) {
+    return {name, [at](const StudyResult& r) { return CsvRow().addText(at(r)).getText(); },
+            [at](const std::string& s, StudyResult& r) { return at(r) = s, true; }};
+}
+// 1/0: covered or not; empty: no interval (-1).
+template <class At>
+ResultField flagField(const char* name, At at) {
+    return {name, [at](const StudyResult& r) { return at(r) < 0 ? std::string() : std::to_string(at(r)); },
+            [at](const std::string& s, StudyResult& r) {
+                if (s.empty()) return at(r) = -1, true;
+                if (s != "0" && s != "1") return false;
+                return at(r) = s == "1", true;
+            }};
 }
 
-// The position of a results column (a programming error when it has none).
-std::size_t getResultColumn(const char* name) {
-    static const std::map<std::string, std::size_t> index = [] {
-        std::map<std::string, std::size_t> m;
-        for (std::size_t i = 0; i < getResultColumns().size(); ++i) m[getResultColumns()[i]] = i;
-        return m;
-    }();
-    const auto it = index.find(name);
-    if (it == index.end()) throw std::logic_error(std::string("study results: no column ") + name);
-    return it->second;
+#define ARMSIM_AT(member) [](auto& r) -> auto& { return r.member; }
+
+const std::vector<ResultField>& getResultFields() {
+    static const std::vector<ResultField> fields = {
+        integerField("task", ARMSIM_AT(task)),
+        textField("truth", ARMSIM_AT(truth)),
+        integerField("subject", ARMSIM_AT(row.subject)),
+        textField("protocol", ARMSIM_AT(protocol)),
+        {"method", [](const StudyResult& r) { return CsvRow().addText(r.row.method).getText(); },
+         [](const std::string& s, StudyResult& r) { return r.row.method = r.row.estimate.method = s, true; }},
+        numberField("noise", ARMSIM_AT(row.noise)),
+        textField("status", ARMSIM_AT(status)),
+        numberField("true_mass_kg", ARMSIM_AT(row.trueMass)),
+        numberField("mass_kg", ARMSIM_AT(row.estimate.mass)),
+        numberField("mass_lower_kg", ARMSIM_AT(row.estimate.massLower)),
+        numberField("mass_upper_kg", ARMSIM_AT(row.estimate.massUpper)),
+        numberField("mass_error", ARMSIM_AT(row.massError)),
+        flagField("mass_covered", ARMSIM_AT(row.massCovered)),
+        numberField("true_tendon_length_m", ARMSIM_AT(row.trueTendonLength)),
+        numberField("tendon_length_m", ARMSIM_AT(row.estimate.tendonLength)),
+        numberField("tendon_lower_m", ARMSIM_AT(row.estimate.tendonLower)),
+        numberField("tendon_upper_m", ARMSIM_AT(row.estimate.tendonUpper)),
+        numberField("tendon_error_m", ARMSIM_AT(row.tendonError)),
+        flagField("tendon_covered", ARMSIM_AT(row.tendonCovered)),
+        numberField("true_max_force_N", ARMSIM_AT(row.trueMaxForce)),
+        numberField("max_force_N", ARMSIM_AT(row.estimate.maxForce)),
+        numberField("max_force_lower_N", ARMSIM_AT(row.estimate.maxForceLower)),
+        numberField("max_force_upper_N", ARMSIM_AT(row.estimate.maxForceUpper)),
+        numberField("max_force_error", ARMSIM_AT(row.maxForceError)),
+        flagField("max_force_covered", ARMSIM_AT(row.maxForceCovered)),
+        numberField("noise_estimate", ARMSIM_AT(row.estimate.noiseLevel)),
+        numberField("rms_residual_Nm", ARMSIM_AT(row.estimate.rmsResidual)),
+        integerField("iterations", ARMSIM_AT(row.estimate.iterations)),
+        integerField("parameters", ARMSIM_AT(row.estimate.numParameters)),
+        numberField("mass_tendon_correlation", ARMSIM_AT(row.estimate.massTendonCorrelation)),
+        numberField("voluntary_activation", ARMSIM_AT(row.voluntaryActivation)),
+        numberField("co_contraction", ARMSIM_AT(row.coContraction)),
+        numberField("strength_level", ARMSIM_AT(row.strengthLevel)),
+        numberField("biceps_short_scale", ARMSIM_AT(row.bicepsShortScale)),
+        numberField("synergist_scale", ARMSIM_AT(row.synergistScale)),
+        textField("reason", ARMSIM_AT(reason)),
+    };
+    return fields;
 }
+
+#undef ARMSIM_AT
 
 }  // namespace
 
 std::string getStudyResultsHeader() {
     std::string header;
-    for (const std::string& c : getResultColumns()) header += (header.empty() ? "" : ",") + c;
+    for (const ResultField& f : getResultFields()) header += (header.empty() ? "" : ",") + std::string(f.name);
     return header;
 }
 
 std::string formatStudyResult(const StudyResult& r) {
-    const ElbowValidationRow& w = r.row;
-    const MuscleEstimate& e = w.estimate;
-    std::vector<std::string> cells(getResultColumns().size());
-    auto set = [&cells](const char* column, std::string text) { cells[getResultColumn(column)] = std::move(text); };
-    auto number = [&set](const char* column, double v) { set(column, CsvRow().addNumber(v).getText()); };
-    auto flag = [&set](const char* column, int v) { set(column, v < 0 ? "" : std::to_string(v)); };
-    set("task", std::to_string(r.task));
-    set("truth", CsvRow().addText(r.truth).getText());
-    set("subject", std::to_string(w.subject));
-    set("protocol", CsvRow().addText(r.protocol).getText());
-    set("method", CsvRow().addText(w.method).getText());
-    number("noise", w.noise);
-    set("status", CsvRow().addText(r.status).getText());
-    number("true_mass_kg", w.trueMass);
-    number("mass_kg", e.mass);
-    number("mass_lower_kg", e.massLower);
-    number("mass_upper_kg", e.massUpper);
-    number("mass_error", w.massError);
-    flag("mass_covered", w.massCovered);
-    number("true_tendon_length_m", w.trueTendonLength);
-    number("tendon_length_m", e.tendonLength);
-    number("tendon_lower_m", e.tendonLower);
-    number("tendon_upper_m", e.tendonUpper);
-    number("tendon_error_m", w.tendonError);
-    flag("tendon_covered", w.tendonCovered);
-    number("true_max_force_N", w.trueMaxForce);
-    number("max_force_N", e.maxForce);
-    number("max_force_lower_N", e.maxForceLower);
-    number("max_force_upper_N", e.maxForceUpper);
-    number("max_force_error", w.maxForceError);
-    flag("max_force_covered", w.maxForceCovered);
-    number("noise_estimate", e.noiseLevel);
-    number("rms_residual_Nm", e.rmsResidual);
-    set("iterations", std::to_string(e.iterations));
-    set("parameters", std::to_string(e.numParameters));
-    number("mass_tendon_correlation", e.massTendonCorrelation);
-    number("voluntary_activation", w.voluntaryActivation);
-    number("co_contraction", w.coContraction);
-    number("strength_level", w.strengthLevel);
-    number("biceps_short_scale", w.bicepsShortScale);
-    number("synergist_scale", w.synergistScale);
-    set("reason", CsvRow().addText(r.reason).getText());
+    const std::vector<ResultField>& fields = getResultFields();
     std::string line;
-    for (std::size_t i = 0; i < cells.size(); ++i) line += (i ? "," : "") + cells[i];
+    for (std::size_t i = 0; i < fields.size(); ++i) line += (i ? "," : "") + fields[i].write(r);
     return line;
 }
 
@@ -476,46 +499,16 @@ bool parseStudyJournalLine(const std::string& line, StudyResult& r) {
     if (tab == std::string::npos) return false;
     const std::vector<std::string> c = splitCsvRecord(body.substr(0, tab)),
                                    timing = splitCsvRecord(body.substr(tab + 1));
-    if (c.size() != getResultColumns().size() || timing.size() != 3) return false;
+    const std::vector<ResultField>& fields = getResultFields();
+    if (c.size() != fields.size() || timing.size() != 3) return false;
     r = StudyResult();
-    ElbowValidationRow& w = r.row;
-    MuscleEstimate& e = w.estimate;
-    long subject = 0, iterations = 0, parameters = 0, rank = 0;
-    auto cell = [&c](const char* column) -> const std::string& { return c[getResultColumn(column)]; };
-    auto number = [&cell](const char* column, double& v) { return parseDouble(cell(column), v); };
-    auto flag = [&cell](const char* column, int& v) {
-        const std::string& s = cell(column);
-        if (s.empty()) return v = -1, true;
-        if (s != "0" && s != "1") return false;
-        return v = s == "1", true;
-    };
-    bool ok = parseLong(cell("task"), r.task) && parseLong(cell("subject"), subject) && number("noise", w.noise) &&
-              number("true_mass_kg", w.trueMass) && number("mass_kg", e.mass) && number("mass_lower_kg", e.massLower) &&
-              number("mass_upper_kg", e.massUpper) && number("mass_error", w.massError) &&
-              flag("mass_covered", w.massCovered) && number("true_tendon_length_m", w.trueTendonLength) &&
-              number("tendon_length_m", e.tendonLength) && number("tendon_lower_m", e.tendonLower) &&
-              number("tendon_upper_m", e.tendonUpper) && number("tendon_error_m", w.tendonError) &&
-              flag("tendon_covered", w.tendonCovered) && number("true_max_force_N", w.trueMaxForce) &&
-              number("max_force_N", e.maxForce) && number("max_force_lower_N", e.maxForceLower) &&
-              number("max_force_upper_N", e.maxForceUpper) && number("max_force_error", w.maxForceError) &&
-              flag("max_force_covered", w.maxForceCovered) && number("noise_estimate", e.noiseLevel) &&
-              number("rms_residual_Nm", e.rmsResidual) && parseLong(cell("iterations"), iterations) &&
-              parseLong(cell("parameters"), parameters) && number("mass_tendon_correlation", e.massTendonCorrelation) &&
-              number("voluntary_activation", w.voluntaryActivation) && number("co_contraction", w.coContraction) &&
-              number("strength_level", w.strengthLevel) && number("biceps_short_scale", w.bicepsShortScale) &&
-              number("synergist_scale", w.synergistScale) && parseDouble(timing[0], r.synthesisTime) &&
-              parseDouble(timing[1], r.identificationTime) && parseLong(timing[2], rank);
-    if (!ok) return false;
-    w.subject = int(subject);
-    r.truth = cell("truth");
-    r.protocol = cell("protocol");
-    w.method = e.method = cell("method");
-    r.status = cell("status");
-    r.reason = cell("reason");
-    e.converged = r.status == "ok";
-    e.iterations = int(iterations);
-    e.numParameters = int(parameters);
+    for (std::size_t i = 0; i < fields.size(); ++i)
+        if (!fields[i].read(c[i], r)) return false;
+    long rank = 0;
+    if (!parseDouble(timing[0], r.synthesisTime) || !parseDouble(timing[1], r.identificationTime) || !parseLong(timing[2], rank))
+        return false;
     r.rank = int(rank);
+    r.row.estimate.converged = r.status == "ok";
     return r.status == "ok" || r.status == "not-converged" || r.status == "failed" || r.status == "skipped";
 }
 

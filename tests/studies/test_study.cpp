@@ -5,12 +5,14 @@
 // study files.
 #include "basics/errors.h"
 #include "basics/files.h"
+#include "basics/format.h"
 #include "basics/plot.h"
 #include "studies/study.h"
 #include "tests/support/temp_files.h"
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <set>
@@ -125,6 +127,21 @@ TEST(Study, JournalLinesRoundTripExactlyAndRejectTornOrAlteredLines) {
         EXPECT_EQ(formatStudyJournalLine(back), line);
         EXPECT_EQ(formatStudyResult(back), formatStudyResult(r));
         EXPECT_EQ(back.rank, 3);
+        // The fields themselves, not only their text (a field neither written nor read would pass above).
+        auto same = [](double a, double b) { return a == b || (std::isnan(a) && std::isnan(b)); };
+        EXPECT_EQ(back.task, r.task);
+        EXPECT_EQ(back.row.subject, r.row.subject);
+        EXPECT_EQ(back.row.method, r.row.method);
+        EXPECT_EQ(back.row.estimate.method, r.row.method);
+        EXPECT_EQ(back.row.estimate.converged, r.status == "ok");
+        EXPECT_EQ(back.row.estimate.iterations, r.row.estimate.iterations);
+        EXPECT_EQ(back.row.estimate.numParameters, r.row.estimate.numParameters);
+        EXPECT_EQ(back.row.massCovered, r.row.massCovered);
+        EXPECT_TRUE(same(back.row.estimate.mass, r.row.estimate.mass));
+        EXPECT_TRUE(same(back.row.estimate.tendonUpper, r.row.estimate.tendonUpper));
+        EXPECT_TRUE(same(back.row.trueMaxForce, r.row.trueMaxForce));
+        EXPECT_TRUE(same(back.row.synergistScale, r.row.synergistScale));
+        EXPECT_EQ(back.synthesisTime, std::stod(formatNumber(r.synthesisTime)));
         for (std::size_t cut : {line.size() - 1, line.size() / 2, std::size_t(20)})
             EXPECT_FALSE(parseStudyJournalLine(line.substr(0, cut), back)) << "torn at " << cut;
         std::string altered = line;
