@@ -16,6 +16,8 @@ namespace armsim {
 
 using detail::ArmTrialOutcome;
 using detail::ArmTrialPlan;
+using detail::getProtocolKindSpec;
+using detail::ProtocolKindSpec;
 using detail::kCsvDigits;
 using detail::ProtocolRun;
 using detail::uniqueSorted;
@@ -314,6 +316,7 @@ void runComposition(const Protocol& protocol, const ArmSetup& subject, ProtocolR
 /// 100 % MVC trials (the references), phase 2 = the rest; each phase shuffled with the seed unless
 /// listed order is asked for.
 void planArmTrials(const Protocol& protocol, ProtocolRun& run, std::vector<int>& phase1, std::vector<int>& phase2) {
+    const bool levelInId = getProtocolKindSpec(protocol.kind).levelInTrialId;
     for (double angle : protocol.elbowAngles)
         for (double level : protocol.levels)
             for (int rep = 1; rep <= protocol.repetitions; ++rep) {
@@ -324,7 +327,7 @@ void planArmTrials(const Protocol& protocol, ProtocolRun& run, std::vector<int>&
                 p.repetition = rep;
                 p.seed = trialSeed(protocol.seed, p.index);
                 p.id = angleId(angle);
-                if (protocol.kind == ProtocolKind::Submaximal) p.id += fmt::format("_l{:03.0f}", 100 * level);
+                if (levelInId) p.id += fmt::format("_l{:03.0f}", 100 * level);
                 if (protocol.repetitions > 1) p.id += "_r" + std::to_string(rep);
                 run.plans.push_back(p);
             }
@@ -405,21 +408,28 @@ void runTrials(const Protocol& protocol, const ArmSetup& subject, const VirtualM
     }
 }
 
-/// The fits of the protocol's kind: force-angle quadratics (mvc), EMG-to-activation (submaximal), the
-/// force-length peaks (force_length).
-void fitResults(const Protocol& protocol, ProtocolResult& result) {
-    if (protocol.kind == ProtocolKind::Mvc && result.trials.getNumRows() > 0 &&
-        uniqueSorted(result.trials.getColumn("elbow_angle_deg")).size() >= 3) {
-        const std::vector<double> a = result.trials.getColumn("elbow_angle_deg");
-        result.quadraticFits["muscle_force"] = fitQuadratic(a, result.trials.getColumn("muscle_force_N"));
-        result.quadraticFits["force_measured"] = fitQuadratic(a, result.trials.getColumn("force_measured_N"));
-        result.quadraticFits["force_fixed_ratio"] = fitQuadratic(a, result.trials.getColumn("force_fixed_ratio_N"));
-    }
-    if (protocol.kind == ProtocolKind::Submaximal && protocol.emgEnabled) {
-        const std::vector<double> e = result.trials.getColumn("emg_norm");
-        if (uniqueSorted(e).size() >= 3) result.emgToActivation = fitPolynomial(e, result.trials.getColumn("activation"), 2);
-    }
-    if (protocol.kind != ProtocolKind::ForceLength) return;
+}  // namespace
+
+namespace detail {
+
+// Force-angle quadratics of the MVC forces (three angles at least).
+void fitMvc(const Protocol&, ProtocolResult& result) {
+    if (result.trials.getNumRows() == 0 || uniqueSorted(result.trials.getColumn("elbow_angle_deg")).size() < 3) return;
+    const std::vector<double> a = result.trials.getColumn("elbow_angle_deg");
+    result.quadraticFits["muscle_force"] = fitQuadratic(a, result.trials.getColumn("muscle_force_N"));
+    result.quadraticFits["force_measured"] = fitQuadratic(a, result.trials.getColumn("force_measured_N"));
+    result.quadraticFits["force_fixed_ratio"] = fitQuadratic(a, result.trials.getColumn("force_fixed_ratio_N"));
+}
+
+// The EMG-to-activation map (thesis 6.2.3), with EMG and three distinct levels at least.
+void fitSubmaximal(const Protocol& protocol, ProtocolResult& result) {
+    if (!protocol.emgEnabled) return;
+    const std::vector<double> e = result.trials.getColumn("emg_norm");
+    if (uniqueSorted(e).size() >= 3) result.emgToActivation = fitPolynomial(e, result.trials.getColumn("activation"), 2);
+}
+
+// The force-length peaks: of the muscle alone and in the arm (mean over repetitions, by path length).
+void fitForceLength(const Protocol&, ProtocolResult& result) {
     if (result.muscleSweep.getNumRows() >= 3)
         if (auto f = fitPeak(result.muscleSweep.getColumn("path_length_m"), result.muscleSweep.getColumn("muscle_force_N"), 2))
             result.quadraticFits["muscle_alone_peak"] = *f;
@@ -438,7 +448,7 @@ void fitResults(const Protocol& protocol, ProtocolResult& result) {
     }
 }
 
-}  // namespace
+}  // namespace detail
 
 ProtocolResult runProtocol(const Protocol& protocol, const ArmSetup& subject, const ProtocolRunOptions& options) {
     // These protocols simulate the primary muscle's motor units (EMG spike trains, the activation for
@@ -456,15 +466,16 @@ ProtocolResult runProtocol(const Protocol& protocol, const ArmSetup& subject, co
     const Progress progress = [&](int done) {
         if (options.progress) options.progress(done, total);
     };
-    if (protocol.kind == ProtocolKind::Composition) {
+    const ProtocolKindSpec& kind = getProtocolKindSpec(protocol.kind);
+    if (!kind.armTrials) {
         total = protocol.slowUnitsTo - protocol.slowUnitsFrom + 1;
         runComposition(protocol, subject, run.result, progress);
     } else {
         total = int(protocol.elbowAngles.size() * protocol.levels.size()) * protocol.repetitions +
                 int(protocol.pathLengths.size());
         runTrials(protocol, subject, muscle, dir, options.jobs, run, progress);
-        fitResults(protocol, run.result);
     }
+    if (kind.fit) kind.fit(protocol, run.result);
     if (dir.isEnabled()) detail::writeProtocolFiles(dir, protocol, subject, muscle, run, options.beforeCommit);
     return std::move(run.result);
 }

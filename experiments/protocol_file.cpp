@@ -1,6 +1,7 @@
 #include "basics/files.h"
 #include "basics/param_node.h"
 #include "experiments/protocol.h"
+#include "experiments/protocol_run.h"
 #include "model/geometry.h"
 #include "muscles/muscle_file.h"
 
@@ -122,16 +123,6 @@ IsometricTrialSettings readTrialTemplate(const ParamNode& n, const ArmParameters
 
 }  // namespace
 
-std::string getProtocolKindName(ProtocolKind kind) {
-    switch (kind) {
-        case ProtocolKind::Mvc: return "mvc";
-        case ProtocolKind::Submaximal: return "submaximal";
-        case ProtocolKind::ForceLength: return "force_length";
-        case ProtocolKind::Composition: return "composition";
-    }
-    return "?";
-}
-
 namespace {
 
 // The protocol's `subject` section (model, arm and muscle files resolved against the protocol's folder,
@@ -171,62 +162,6 @@ ArmSetup readProtocolSubjectSection(const ParamNode& root, Protocol& p) {
     return subject;
 }
 
-// The `conditions` section, by the protocol's kind (angles, levels, ranges, compositions).
-void readProtocolConditions(const ParamNode& root, Protocol& p, const ArmParameters& arm, double pMax) {
-    const ParamNode c = root.child("conditions");
-    // The moment arm vanishes at full extension, so efforts there have no measurable force.
-    const Bound angle{arm.minElbowAngleDeg, arm.maxElbowAngleDeg, false, true, "deg, the subject's elbow range"};
-    auto toRadians = [](std::vector<double> v) {
-        for (double& a : v) a = degToRad(a);
-        return v;
-    };
-    switch (p.kind) {
-        case ProtocolKind::Mvc:
-            p.elbowAngles = toRadians(requireNonEmpty(c, "elbow_angles_deg", c.getNumbers("elbow_angles_deg", angle), "angle"));
-            p.levels = {1.0};
-            break;
-        case ProtocolKind::Submaximal: {
-            p.elbowAngles = toRadians(requireNonEmpty(c, "elbow_angles_deg", c.getNumbers("elbow_angles_deg", angle), "angle"));
-            std::vector<double> pct = requireNonEmpty(
-                c, "levels_pct_mvc", c.getNumbers("levels_pct_mvc", {0, 100, true, false, "% MVC"}), "level");
-            if (std::find(pct.begin(), pct.end(), 100.0) == pct.end())
-                throw InputError(c.where("levels_pct_mvc") + ": field 'conditions.levels_pct_mvc' lacks 100: the 100 % "
-                                 "MVC trials are the reference of the other levels and of the EMG normalisation");
-            for (double l : pct) p.levels.push_back(l / 100.0);
-            break;
-        }
-        case ProtocolKind::ForceLength: {
-            if (c.has("elbow_angle_range_deg")) p.elbowAngles = toRadians(readRange(c, "elbow_angle_range_deg", angle));
-            p.maxPathLength = c.getNumber("max_path_length", Bound::positive("m"), 0.0);
-            const double limit = p.maxPathLength > 0 ? p.maxPathLength : pMax;
-            if (c.has("path_range"))
-                p.pathLengths = readRange(c, "path_range", {0, limit, true, false,
-                                                           p.maxPathLength > 0 ? "m, up to max_path_length"
-                                                                               : "m, up to the muscle's P_max"});
-            p.levels = {1.0};
-            if (p.elbowAngles.empty() && p.pathLengths.empty())
-                throw InputError(c.where() + ": field 'conditions' has no trials: expected elbow_angle_range_deg "
-                                 "and/or path_range");
-            break;
-        }
-        case ProtocolKind::Composition: {
-            const ParamNode su = c.child("slow_units"), fu = c.child("fast_units");
-            p.slowUnitsFrom = su.getInt("from", 0, 100);
-            p.slowUnitsTo = su.getInt("to", p.slowUnitsFrom, 100);
-            p.fastUnitsFrom = fu.getInt("from", 0, 100);
-            p.fastUnitsTo = fu.getInt("to", p.fastUnitsFrom, 100);
-            su.finish();
-            fu.finish();
-            p.compositionActivation = c.getNumber("activation", Bound::closed(0, 1), p.compositionActivation);
-            p.compositionPath = c.getNumber("path_length", {0, pMax, true, false, "m, up to the muscle's P_max"},
-                                            p.compositionPath);
-            break;
-        }
-    }
-    c.finish();
-
-}
-
 // The `sensors` section (transducer noise, EMG) and the EMG chain checked against the sample rate.
 void readProtocolSensors(const ParamNode& root, Protocol& p, bool armTrials) {
     if (armTrials && root.has("sensors")) {
@@ -252,7 +187,7 @@ void readProtocolSensors(const ParamNode& root, Protocol& p, bool armTrials) {
 
 // The whole run's size: every trial's samples (and their CSV, .sto and EMG) are kept and written.
 void checkProtocolSize(const std::string& path, const Protocol& p) {
-    if (p.kind != ProtocolKind::Composition) {
+    if (detail::getProtocolKindSpec(p.kind).armTrials) {
         const double trials = double(p.elbowAngles.size()) * std::max<std::size_t>(1, p.levels.size()) * p.repetitions;
         const double perTrial = double(calcNumSamples(p.trial.getDuration(), p.trial.sampleRate));
         const double rows = trials * perTrial;
@@ -276,12 +211,14 @@ Protocol readProtocol(const std::string& path) {
                          "': expected a non-empty name without spaces or slashes");
     p.description = root.getString("description", "");
     root.getString("kind");  // required
-    const std::string kind = root.getChoice("kind", {"mvc", "submaximal", "force_length", "composition"}, "mvc");
-    p.kind = kind == "mvc" ? ProtocolKind::Mvc
-           : kind == "submaximal" ? ProtocolKind::Submaximal
-           : kind == "force_length" ? ProtocolKind::ForceLength
-                                    : ProtocolKind::Composition;
-    const bool armTrials = p.kind != ProtocolKind::Composition;
+    std::vector<std::string> kindNames;
+    for (const detail::ProtocolKindSpec& k : detail::getProtocolKindSpecs()) kindNames.push_back(k.name);
+    const std::string kindName = root.getChoice("kind", kindNames, kindNames.front());
+    const detail::ProtocolKindSpec* kind = nullptr;
+    for (const detail::ProtocolKindSpec& k : detail::getProtocolKindSpecs())
+        if (kindName == k.name) kind = &k;
+    p.kind = kind->kind;
+    const bool armTrials = kind->armTrials;
 
     const ArmSetup subject = readProtocolSubjectSection(root, p);
     const ArmParameters& arm = subject.arm;
@@ -298,7 +235,9 @@ Protocol readProtocol(const std::string& path) {
         p.trial = root.has("trial") ? readTrialTemplate(root.child("trial"), arm) : p.trial;
     }
 
-    readProtocolConditions(root, p, arm, pMax);
+    const ParamNode c = root.child("conditions");
+    kind->readConditions(c, p, arm, pMax);
+    c.finish();
     readProtocolSensors(root, p, armTrials);
     root.finish();
     checkProtocolSize(path, p);
@@ -322,5 +261,69 @@ ArmSetup loadProtocolSubject(const Protocol& protocol) {
     s.validate();
     return s;
 }
+
+namespace detail {
+
+namespace {
+
+// The elbow angles a kind's trials may use: the moment arm vanishes at full extension, so efforts there
+// have no measurable force.
+Bound getTrialAngleBound(const ArmParameters& arm) {
+    return {arm.minElbowAngleDeg, arm.maxElbowAngleDeg, false, true, "deg, the subject's elbow range"};
+}
+
+std::vector<double> toRadians(std::vector<double> v) {
+    for (double& a : v) a = degToRad(a);
+    return v;
+}
+
+}  // namespace
+
+void readMvcConditions(const ParamNode& c, Protocol& p, const ArmParameters& arm, double) {
+    p.elbowAngles = toRadians(
+        requireNonEmpty(c, "elbow_angles_deg", c.getNumbers("elbow_angles_deg", getTrialAngleBound(arm)), "angle"));
+    p.levels = {1.0};
+}
+
+void readSubmaximalConditions(const ParamNode& c, Protocol& p, const ArmParameters& arm, double) {
+    p.elbowAngles = toRadians(
+        requireNonEmpty(c, "elbow_angles_deg", c.getNumbers("elbow_angles_deg", getTrialAngleBound(arm)), "angle"));
+    std::vector<double> pct =
+        requireNonEmpty(c, "levels_pct_mvc", c.getNumbers("levels_pct_mvc", {0, 100, true, false, "% MVC"}), "level");
+    if (std::find(pct.begin(), pct.end(), 100.0) == pct.end())
+        throw InputError(c.where("levels_pct_mvc") + ": field 'conditions.levels_pct_mvc' lacks 100: the 100 % "
+                         "MVC trials are the reference of the other levels and of the EMG normalisation");
+    for (double l : pct) p.levels.push_back(l / 100.0);
+}
+
+void readForceLengthConditions(const ParamNode& c, Protocol& p, const ArmParameters& arm, double pMax) {
+    if (c.has("elbow_angle_range_deg"))
+        p.elbowAngles = toRadians(readRange(c, "elbow_angle_range_deg", getTrialAngleBound(arm)));
+    p.maxPathLength = c.getNumber("max_path_length", Bound::positive("m"), 0.0);
+    const double limit = p.maxPathLength > 0 ? p.maxPathLength : pMax;
+    if (c.has("path_range"))
+        p.pathLengths = readRange(c, "path_range", {0, limit, true, false,
+                                                   p.maxPathLength > 0 ? "m, up to max_path_length"
+                                                                       : "m, up to the muscle's P_max"});
+    p.levels = {1.0};
+    if (p.elbowAngles.empty() && p.pathLengths.empty())
+        throw InputError(c.where() + ": field 'conditions' has no trials: expected elbow_angle_range_deg "
+                         "and/or path_range");
+}
+
+void readCompositionConditions(const ParamNode& c, Protocol& p, const ArmParameters&, double pMax) {
+    const ParamNode su = c.child("slow_units"), fu = c.child("fast_units");
+    p.slowUnitsFrom = su.getInt("from", 0, 100);
+    p.slowUnitsTo = su.getInt("to", p.slowUnitsFrom, 100);
+    p.fastUnitsFrom = fu.getInt("from", 0, 100);
+    p.fastUnitsTo = fu.getInt("to", p.fastUnitsFrom, 100);
+    su.finish();
+    fu.finish();
+    p.compositionActivation = c.getNumber("activation", Bound::closed(0, 1), p.compositionActivation);
+    p.compositionPath = c.getNumber("path_length", {0, pMax, true, false, "m, up to the muscle's P_max"},
+                                    p.compositionPath);
+}
+
+}  // namespace detail
 
 }  // namespace armsim

@@ -156,7 +156,7 @@ nlohmann::ordered_json protocolJson(const Protocol& p) {
     j["kind"] = getProtocolKindName(p.kind);
     j["description"] = p.description;
     j["file"] = fs::path(p.sourcePath).filename().string();
-    if (p.kind != ProtocolKind::Composition) {
+    if (getProtocolKindSpec(p.kind).armTrials) {
         j["seed"] = p.seed;
         j["order"] = p.randomOrder ? "random" : "listed";
         j["repetitions"] = p.repetitions;
@@ -278,6 +278,20 @@ void plotForceLength(OutputFolder& dir, const ProtocolResult& result) {
 
 }  // namespace
 
+void writeMvcFiles(OutputFolder& dir, const Protocol&, const ProtocolResult& result) {
+    plotMvc(dir, result.trials, result.summary, result.quadraticFits);
+}
+
+void writeSubmaximalFiles(OutputFolder& dir, const Protocol&, const ProtocolResult& result) {
+    plotSubmaximal(dir, result.trials, result.emgToActivation);
+}
+
+void writeForceLengthFiles(OutputFolder& dir, const Protocol&, const ProtocolResult& result) { plotForceLength(dir, result); }
+
+void writeCompositionFiles(OutputFolder& dir, const Protocol& protocol, const ProtocolResult& result) {
+    writeComposition(dir, protocol, result.composition);
+}
+
 void writeProtocolFiles(OutputFolder& dir, const Protocol& protocol, const ArmSetup& subject,
                         const VirtualMuscle& muscle, ProtocolRun& run,
                         const std::function<void(OutputFolder&, const ProtocolResult&)>& beforeCommit) {
@@ -287,8 +301,9 @@ void writeProtocolFiles(OutputFolder& dir, const Protocol& protocol, const ArmSe
     manifest["simbody_version"] = ARMSIM_SIMBODY_VERSION;
     manifest["protocol"] = protocolJson(protocol);
     manifest["subject"] = subjectJson(protocol, subject, muscle);
-    if (protocol.kind == ProtocolKind::Composition) {
-        writeComposition(dir, protocol, result.composition);
+    const ProtocolKindSpec& kind = getProtocolKindSpec(protocol.kind);
+    if (!kind.armTrials) {
+        kind.write(dir, protocol, result);
     } else {
         if (!run.plans.empty()) {
             dir.write("trials.csv", result.trials.toCsv(kCsvDigits));
@@ -298,9 +313,7 @@ void writeProtocolFiles(OutputFolder& dir, const Protocol& protocol, const ArmSe
         if (result.muscleSweep.getNumRows() > 0) dir.write("muscle_sweep.csv", result.muscleSweep.toCsv(kCsvDigits));
         if (!result.quadraticFits.empty() || result.emgToActivation)
             dir.write("fits.csv", fitsCsv(result.quadraticFits, result.emgToActivation));
-        if (protocol.kind == ProtocolKind::Mvc) plotMvc(dir, result.trials, result.summary, result.quadraticFits);
-        if (protocol.kind == ProtocolKind::Submaximal) plotSubmaximal(dir, result.trials, result.emgToActivation);
-        if (protocol.kind == ProtocolKind::ForceLength) plotForceLength(dir, result);
+        kind.write(dir, protocol, result);
 
         nlohmann::ordered_json trialList = nlohmann::ordered_json::array();
         for (const auto& p : run.plans)

@@ -13,6 +13,10 @@
 #include <string>
 #include <vector>
 
+namespace armsim {
+class ParamNode;
+}
+
 namespace armsim::detail {
 
 /// One arm trial of the protocol.
@@ -53,6 +57,40 @@ inline std::vector<double> uniqueSorted(std::vector<double> v) {
 
 /// Significant digits of the numbers in result files.
 constexpr int kCsvDigits = 10;
+
+/// One protocol kind: its name in protocol files and what is particular to it. The table
+/// (protocol_kinds.cpp) has one row per kind: a new kind is an enum value, its functions and a row.
+struct ProtocolKindSpec {
+    ProtocolKind kind;
+    const char* name;        ///< `kind:` in protocol files
+    bool armTrials;          ///< runs arm trials (false: the slow x fast unit grid)
+    bool levelInTrialId;     ///< several levels per angle: trial files are named by level too
+    /// Reads the `conditions` section c into p (angles, levels, ranges or the unit grid); InputError
+    /// naming the file, line and field. arm: the subject's; pMax: its primary muscle's P_max [m].
+    void (*readConditions)(const ParamNode& c, Protocol& p, const ArmParameters& arm, double pMax);
+    /// The kind's fits of a computed run; nullptr: none.
+    void (*fit)(const Protocol& p, ProtocolResult& result);
+    /// The kind's own files in the run folder (its plots; the grid's tables).
+    void (*write)(OutputFolder& dir, const Protocol& p, const ProtocolResult& result);
+};
+
+/// Every kind, in the order protocol files' `kind:` lists them.
+const std::vector<ProtocolKindSpec>& getProtocolKindSpecs();
+const ProtocolKindSpec& getProtocolKindSpec(ProtocolKind kind);
+
+// The kinds' functions: conditions readers (protocol_file.cpp), fits (protocol.cpp), writers
+// (protocol_output.cpp).
+void readMvcConditions(const ParamNode& c, Protocol& p, const ArmParameters& arm, double pMax);
+void readSubmaximalConditions(const ParamNode& c, Protocol& p, const ArmParameters& arm, double pMax);
+void readForceLengthConditions(const ParamNode& c, Protocol& p, const ArmParameters& arm, double pMax);
+void readCompositionConditions(const ParamNode& c, Protocol& p, const ArmParameters& arm, double pMax);
+void fitMvc(const Protocol& p, ProtocolResult& result);
+void fitSubmaximal(const Protocol& p, ProtocolResult& result);
+void fitForceLength(const Protocol& p, ProtocolResult& result);
+void writeMvcFiles(OutputFolder& dir, const Protocol& p, const ProtocolResult& result);
+void writeSubmaximalFiles(OutputFolder& dir, const Protocol& p, const ProtocolResult& result);
+void writeForceLengthFiles(OutputFolder& dir, const Protocol& p, const ProtocolResult& result);
+void writeCompositionFiles(OutputFolder& dir, const Protocol& p, const ProtocolResult& result);
 
 /// Writes the run's tables, fits, plots, protocol.yaml, what beforeCommit adds and manifest.json into
 /// dir and commits it; fills run.result.files.
