@@ -55,13 +55,48 @@ int renderVideo(const TrialOptions& o, const std::string& path, const ArmSetup& 
 #endif
 }
 
+#ifdef ARMSIM_WITH_RENDER
+OsimVideoSettings makeOsimVideoSettings(const TrialOptions& o, const std::string& path) {
+    OsimVideoSettings v;
+    v.videoPath = path;
+    v.tableName = o.out;
+    v.muscleModel = o.muscle.muscleModel;
+    return v;
+}
+#endif
+
+// --video of an OpenSim model's trial: checked before the work (a missing renderer, a bad path), then
+// rendered from the table into `path` (the staged file); its frame count.
+void checkOsimVideo(const TrialOptions& o, const std::string& path) {
+    if (o.video.empty()) return;
+#ifdef ARMSIM_WITH_RENDER
+    getRenderPlugin("--video").validateOsim(makeOsimVideoSettings(o, path));
+#else
+    (void)path;
+    getRenderPlugin("--video");  // a missing renderer fails first
+#endif
+}
+
+int renderOsimVideo(const TrialOptions& o, const std::string& path, const OsimModel& model, const Table& table) {
+#ifdef ARMSIM_WITH_RENDER
+    return getRenderPlugin("--video")
+        .renderOsimTrialVideo(model, table, makeOsimVideoSettings(o, path), [](int d, int n) { printProgress("video", d, n); })
+        .frames;
+#else
+    (void)o, (void)path, (void)model, (void)table;
+    return 0;
+#endif
+}
+
 // An isometric trial of an OpenSim model: --coordinate locked at --angle (its value in deg), the others
 // at their defaults; the muscles that pull it the --effort way excited.
 void runOsimTrialCommand(const TrialOptions& o) {
     OutputFiles files;
     const std::string osim = findOsimModelFile(o.muscle.model);
     files.addInput("--model", osim);
-    const std::string csvPath = files.add("--out", o.out, true), plotPath = files.add("--plot", o.plot);
+    const std::string csvPath = files.add("--out", o.out, true), plotPath = files.add("--plot", o.plot),
+                      videoPath = files.add("--video", o.video);
+    checkOsimVideo(o, videoPath);
     const OsimModel model = readOsimFile(osim);
     OsimIsometricTrialSettings s;
     s.coordinate = o.coordinate;
@@ -82,6 +117,8 @@ void runOsimTrialCommand(const TrialOptions& o) {
                      [&] { r = runOsimIsometricTrial(model, s); });
     const OsimIsometricSummary& m = r.summary;
     files.writeWith(csvPath, [&](const std::string& p) { r.series.writeCsv(p); });
+    int frames = 0;
+    if (!o.video.empty()) files.writeWith(videoPath, [&](const std::string& p) { frames = renderOsimVideo(o, p, model, r.series); });
     if (!o.plot.empty()) {
         PlotSpec spec;
         spec.title = model.name + ": isometric " + o.effort + " effort at " + m.coordinate + " = " + formatNumber(m.angleDeg) + " deg";
@@ -102,6 +139,7 @@ void runOsimTrialCommand(const TrialOptions& o) {
         std::printf("  %-12s %16.2f %9s %14.1f %13.2f\n", m.muscles[i].c_str(), 100 * m.momentArms[i],
                     m.agonists[i] ? "yes" : "no", m.meanForces[i], m.momentArms[i] * m.meanForces[i]);
     std::printf("wrote %s\n", o.out.c_str());
+    if (!o.video.empty()) std::printf("wrote %s (%d frames)\n", o.video.c_str(), frames);
     if (!o.plot.empty()) std::printf("wrote %s\n", o.plot.c_str());
 }
 
@@ -111,7 +149,9 @@ void runOsimFreeTrialCommand(const TrialOptions& o, bool initialAngleGiven, bool
     OutputFiles files;
     const std::string osim = findOsimModelFile(o.muscle.model);
     files.addInput("--model", osim);
-    const std::string csvPath = files.add("--out", o.out, true), plotPath = files.add("--plot", o.plot);
+    const std::string csvPath = files.add("--out", o.out, true), plotPath = files.add("--plot", o.plot),
+                      videoPath = files.add("--video", o.video);
+    checkOsimVideo(o, videoPath);
     const OsimModel model = readOsimFile(osim);
     OsimFreeMovementSettings s;
     s.coordinate = o.coordinate;
@@ -135,6 +175,8 @@ void runOsimFreeTrialCommand(const TrialOptions& o, bool initialAngleGiven, bool
                      [&] { t = runOsimFreeMovement(model, s, &stats); });
     const std::string coordinate = t.getColumnNames()[2].substr(0, t.getColumnNames()[2].size() - 4);  // "<c>_deg"
     files.writeWith(csvPath, [&](const std::string& p) { t.writeCsv(p); });
+    int frames = 0;
+    if (!o.video.empty()) files.writeWith(videoPath, [&](const std::string& p) { frames = renderOsimVideo(o, p, model, t); });
     if (!o.plot.empty()) {
         PlotSpec spec;
         spec.title = model.name + ": free movement of " + coordinate + " (" + o.effort + " effort)";
@@ -159,6 +201,7 @@ void runOsimFreeTrialCommand(const TrialOptions& o, bool initialAngleGiven, bool
             }
     }
     std::printf("wrote %s\n", o.out.c_str());
+    if (!o.video.empty()) std::printf("wrote %s (%d frames)\n", o.video.c_str(), frames);
     if (!o.plot.empty()) std::printf("wrote %s\n", o.plot.c_str());
 }
 
@@ -303,12 +346,12 @@ void addTrialCommand(CLI::App& app) {
         if (isOsimModel(o->muscle.model)) {
             // What an OpenSim model's trial would ignore or cannot do yet is refused, naming the option.
             const bool free = o->type == "free";
-            for (const char* name : {"--settings", "--video", "--muscle", "--arm", "--slow-units", "--fast-units", "--mass",
+            for (const char* name : {"--settings", "--muscle", "--arm", "--slow-units", "--fast-units", "--mass",
                                      "--tendon-length", "--max-path", "--load"})
                 if (c->count(name) > 0)
                     throw InputError(std::string(name) + " with the OpenSim model '" + o->muscle.model +
                                      "': not for .osim models (their trials take --coordinate, --effort, --activation, "
-                                     "--rise, --rate, --accuracy, --muscle-model, --out, --plot; isometric --angle (the "
+                                     "--rise, --rate, --accuracy, --muscle-model, --out, --plot, --video; isometric --angle (the "
                                      "coordinate's value, deg), --rest, --hold; free --initial-angle, --initial-velocity, "
                                      "--onset, --duration)");
             for (const char* name : {"--angle", "--rest", "--hold"})

@@ -12,6 +12,11 @@ extern "C" __attribute__((visibility("default"))) const armsim::RenderPlugin* ar
         };
         p.readRenderSettings = &armsim::readRenderSettings;
         p.validate = [](const armsim::TrialVideoSettings& s) { s.validate(); };
+        p.renderOsimTrialVideo = [](const armsim::OsimModel& model, const armsim::Table& table,
+                                    const armsim::OsimVideoSettings& settings, const std::function<void(int, int)>& progress) {
+            return armsim::renderOsimTrialVideo(model, table, settings, progress);
+        };
+        p.validateOsim = [](const armsim::OsimVideoSettings& s) { s.validate(); };
         p.requestInterruption = &armsim::requestInterruption;
         return p;
     }();

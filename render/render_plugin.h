@@ -5,6 +5,7 @@
 // structures passed across are compiled from the same headers.
 #pragma once
 
+#include "render/osim_video.h"
 #include "render/trial_video.h"
 
 #include <functional>
@@ -18,11 +19,14 @@ struct RenderPlugin {
                                          const std::function<void(int, int)>& progress) = nullptr;
     RenderSettings (*readRenderSettings)(const ParamNode& node) = nullptr;
     void (*validate)(const TrialVideoSettings& settings) = nullptr;  ///< TrialVideoSettings::validate
+    OsimVideoResult (*renderOsimTrialVideo)(const OsimModel& model, const Table& table, const OsimVideoSettings& settings,
+                                            const std::function<void(int, int)>& progress) = nullptr;
+    void (*validateOsim)(const OsimVideoSettings& settings) = nullptr;  ///< OsimVideoSettings::validate
     /// The plugin's own copy of requestInterruption (it links its own ground-floor code).
     void (*requestInterruption)(int sig) = nullptr;
 };
 
-constexpr int kRenderPluginAbi = 2;                          ///< raised when RenderPlugin changes
+constexpr int kRenderPluginAbi = 3;                          ///< raised when RenderPlugin changes
 constexpr const char* kRenderPluginFile = "libarmsim_render_plugin.so";
 constexpr const char* kRenderPluginSymbol = "armsim_get_render_plugin";
 

@@ -790,7 +790,7 @@ TEST(Cli, TrialOfAnOsimModelLocksACoordinate) {
         if (std::abs(mvc.get(k, "flexion_deg") - 80) < 1e-9) row = k;
     ASSERT_GE(row, 0);
     EXPECT_NEAR(last, mvc.get(row, "torque_total_Nm"), 1e-3 * std::abs(mvc.get(row, "torque_total_Nm")));
-    for (const std::string& bad : {std::string("--load 2"), std::string("--video v.mp4"), std::string("--mass 0.2")}) {
+    for (const std::string& bad : {std::string("--load 2"), std::string("--settings s.yaml"), std::string("--mass 0.2")}) {
         const CommandResult refused = runArmsim("trial --model arm26 --coordinate r_elbow_flex " + bad + " --out " +
                                                 (d / "bad.csv").string());
         EXPECT_EQ(refused.exitCode, 2) << bad << ": " << refused.output;

@@ -137,3 +137,20 @@ TEST(RenderCli, ProtocolVideoRendersEveryTrial) {
         EXPECT_NEAR(v.fps, 20.0, kFpsTolerance) << id;
     }
 }
+
+// `armsim trial --model arm26 --video`: the OpenSim model's free and isometric trials rendered
+// (render/osim_video.h; its pixels are tested in test_osim_video.cpp), one frame per 1/30 s, 1280 x 720.
+TEST(RenderCli, OsimTrialVideos) {
+    ScratchDir dir;
+    const CommandResult free = runArmsim("trial --model arm26 --type free --coordinate r_elbow_flex --initial-angle 20 "
+                                         "--duration 0.3 --rate 100 --out " + dir.file("f.csv") + " --video " + dir.file("f.mp4"));
+    ASSERT_EQ(free.exitCode, 0) << free.output;
+    EXPECT_NE(free.output.find("(10 frames)"), std::string::npos) << free.output;
+    const VideoInfo fv = probe(dir.file("f.mp4"));
+    EXPECT_EQ(fv.frames, expectedFrames(0.3, 30));
+    EXPECT_EQ(fv.size, cv::Size(1280, 720));
+    const CommandResult iso = runArmsim("trial --model arm26 --coordinate r_elbow_flex --angle 80 --rest 0.2 --hold 0.3 "
+                                        "--rate 100 --out " + dir.file("i.csv") + " --video " + dir.file("i.mp4"));
+    ASSERT_EQ(iso.exitCode, 0) << iso.output;
+    EXPECT_EQ(probe(dir.file("i.mp4")).frames, expectedFrames(0.5, 30));
+}
