@@ -86,6 +86,11 @@ void checkOutputFolder(const std::string& option, const std::string& dir);
 /// reported naming that option ("--fps = 0: expected in [1, 240] (1/s)"); other errors pass unchanged.
 void runNamingOptions(const std::map<std::string, std::string>& optionOfField, const std::function<void()>& f);
 
+/// A range check for a numeric option, in place of CLI::Range: "'abc': expected a number in [1, 64]" for
+/// text that is no number (CLI::Range says "not in range"), the bounds as typed (1e-12, not 0.000000);
+/// an integral value is passed on in integer form, so an integer option takes 1e3 and 2.0 too.
+CLI::Validator inRange(double lo, double hi);
+
 /// Prints a one-line progress bar to stderr ("label [#####     ] 5/10"); nothing with --quiet. When
 /// stderr is not a terminal (a log): the end ("label: 10/10 done") and, for long work, a line every 10 s
 /// (ARMSIM_PROGRESS_SECONDS) with the share done and the time left at the rate so far.

@@ -135,8 +135,10 @@ void runDesign(const DesignOptions& o) {
                     formatNumber(s.costs.emgSetup).c_str(), formatNumber(s.costs.ultrasoundAngle).c_str(),
                     formatNumber(s.costs.volumeScan).c_str(), formatNumber(s.costs.anthropometry).c_str());
     auto progress = [](int done, int n) { printProgress("design", done, n); };
-    const DesignResult d = channels ? designChannelProtocol(population, s, thesis, progress)
-                                    : designProtocol(population, s, thesis, progress);
+    DesignResult d;
+    runNamingOptions({{"postures", "--postures"}}, [&] {
+        d = channels ? designChannelProtocol(population, s, thesis, progress) : designProtocol(population, s, thesis, progress);
+    });
     const ProtocolPrediction& reference = d.reference;
 
     printDesignSteps(d, channels, s.repetitions);
@@ -216,24 +218,24 @@ void addDesignCommand(CLI::App& app) {
     c->add_option("--budget", o->budget,
                   "lab minutes: design across channels (MVC blocks, ultrasound, EMG, volume scans, anthropometry; "
                   "costs in docs/channels.md) instead of a trial budget")
-        ->check(CLI::Range(1.0, 10000.0));
+        ->transform(inRange(1.0, 10000.0));
     c->add_flag("--free-slow-fraction", o->freeSlowFraction,
                 "the identifier frees the flexors' slow-fibre fractions (biceps heads, synergists)");
     c->add_option("--trials", o->trials, "budget: total trials (at most 100)")->capture_default_str();
     c->add_option("--repetitions", o->repetitions, "trials per picked condition (>= 2 lets the identifier estimate its noise)")
         ->capture_default_str()
-        ->check(CLI::Range(1, 100));
-    c->add_option("--draws", o->draws, "prior draws the expected uncertainty averages over")->capture_default_str()->check(CLI::Range(1, 100000));
+        ->transform(inRange(1, 100));
+    c->add_option("--draws", o->draws, "prior draws the expected uncertainty averages over")->capture_default_str()->transform(inRange(1, 100000));
     c->add_option("--seed", o->seed, "seed of the prior draws and of --validate-subjects")->capture_default_str();
     c->add_option("--activation-sd", o->activationSd,
                   "voluntary activation measured by twitch interpolation to this sd (0: not measured)")
         ->capture_default_str()
-        ->check(CLI::Range(0.0, 0.5));
-    c->add_option("--jobs", o->jobs, "threads")->capture_default_str()->check(CLI::Range(1, 64));
+        ->transform(inRange(0.0, 0.5));
+    c->add_option("--jobs", o->jobs, "threads")->capture_default_str()->transform(inRange(1, 64));
     c->add_option("--validate-subjects", o->validateSubjects,
                   "also run `validate --truth elbow` with the thesis's and the designed protocol on this many subjects")
         ->capture_default_str()
-        ->check(CLI::Range(0, 1000000));
+        ->transform(inRange(0, 1000000));
     c->add_option("--out", o->out, "output directory")->capture_default_str();
     c->callback([o] { runDesign(*o); });
 }

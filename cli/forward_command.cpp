@@ -12,6 +12,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <memory>
 
 namespace armsim::cli {
@@ -52,6 +53,20 @@ void runForward(const ForwardOptions& given, CLI::Option* outOption) {
     if (o.out.empty()) o.out = "out/forward";
     if (given.out.empty()) outOption->default_val(o.out);
     checkOutputFolder("--out", o.out);
+    // An input among the files written into --out would be replaced by an output.
+    {
+        namespace fs = std::filesystem;
+        std::error_code ec;
+        const std::pair<const char*, std::string> inputs[] = {
+            {"--model", o.model}, {"--controls", o.controls}, {"--initial-states", o.initialStates}, {"setup file", o.setup}};
+        for (const char* written : {"states.sto", "states.csv", "coordinates.png", "activations.png", "index.html"}) {
+            const fs::path target = fs::weakly_canonical(fs::path(o.out) / written, ec);
+            for (const auto& [what, file] : inputs)
+                if (!file.empty() && fs::weakly_canonical(file, ec) == target)
+                    throw InputError(std::string(what) + " '" + file + "' is " + written + " of --out '" + o.out +
+                                     "', which forward writes: expected another output folder (it would replace the input)");
+        }
+    }
     const OsimModel model = readOsimFile(findOsimModelFile(o.model));
     const OsimStorage controls = readOsimStorage(o.controls);
     OsimStorage initial;
@@ -115,15 +130,26 @@ void addForwardCommand(CLI::App& app) {
                   "in equilibrium)");
     c->add_option("--initial-time", o->initialTime, "[s] (default: the controls' first time)");
     c->add_option("--final-time", o->finalTime, "[s]");
-    c->add_option("--rate", o->rate, "rows of states.sto per second [Hz]")->capture_default_str()->check(CLI::Range(1e-3, 1e6));
+    c->add_option("--rate", o->rate, "rows of states.sto per second [Hz]")->capture_default_str()->transform(inRange(1e-3, 1e6));
     c->add_option("--accuracy", o->accuracy,
                   "integrator relative accuracy (default: the setup's integrator_error_tolerance, else 1e-5)")
-        ->check(CLI::Range(1e-12, 1e-1));
+        ->transform(inRange(1e-12, 1e-1));
     c->add_option("--muscle-model", o->muscleModel,
                   "every muscle under this model: thelen2003, thelen2003_opensim2 (OpenSim 2.x's equations) or "
                   "degroote2016 (default: each muscle's type in the file)");
     CLI::Option* out = c->add_option("--out", o->out, "output folder (default: the setup's results_directory, else out/forward)");
-    c->callback([o, out] { runForward(*o, out); });
+    c->callback([o, out, c] {
+        // NaN stands for "not given" inside: a NaN typed is refused, not read as absent.
+        const std::pair<const char*, double> numbers[] = {
+            {"--initial-time", o->initialTime}, {"--final-time", o->finalTime}, {"--accuracy", o->accuracy}};
+        for (const auto& [name, value] : numbers)
+            if (c->count(name) > 0 && !std::isfinite(value))
+                throw InputError(std::string(name) + " = " + formatNumber(value) + ": expected a finite number");
+        if (c->count("--muscle-model") > 0 && o->muscleModel.empty())
+            throw InputError("--muscle-model is empty: expected thelen2003, thelen2003_opensim2 or degroote2016 (or leave "
+                             "it out for each muscle's type in the file)");
+        runForward(*o, out);
+    });
 }
 
 }  // namespace

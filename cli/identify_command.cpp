@@ -71,7 +71,7 @@ struct ModelOptions {
         c.add_option("--hold", hold, "faithful: effort duration in iterations [s] (mean of the last third)")
             ->capture_default_str();
         c.add_option("--rate", rate, "faithful: transducer sample rate in iterations [Hz]")->capture_default_str();
-        c.add_option("--jobs", jobs, "faithful: trials run in parallel")->capture_default_str()->check(CLI::Range(1, 64));
+        c.add_option("--jobs", jobs, "faithful: trials run in parallel")->capture_default_str()->transform(inRange(1, 64));
     }
     ForwardModelChoice makeChoice() const {
         ForwardModelChoice c;
@@ -229,7 +229,7 @@ void addIdentifyCommand(CLI::App& app) {
         ->check(CLI::IsMember({"absolute", "relative"}));
     c->add_option("--multistart", o->multistart, "lm: starts (the first at --start, others seeded uniform in the bounds)")
         ->capture_default_str()
-        ->check(CLI::Range(1, 10000));
+        ->transform(inRange(1, 10000));
     c->add_option("--seed", o->seed, "lm multi-start seed")->capture_default_str();
     c->add_option("--max-iterations", o->maxIterations, "solver iterations")->capture_default_str();
     c->add_option("--tolerance", o->tolerance, "force tolerance [N] (forces reproduced)")->capture_default_str();
@@ -436,7 +436,7 @@ void addValidateCommand(CLI::App& app) {
     c->add_option("--estimate", o->estimate, "force the experimenter reports: moment-arm | fixed-ratio | true")
         ->capture_default_str()
         ->check(CLI::IsMember({"moment-arm", "fixed-ratio", "true"}));
-    c->add_option("--jobs", o->jobs, "trials run in parallel")->capture_default_str()->check(CLI::Range(1, 64));
+    c->add_option("--jobs", o->jobs, "trials run in parallel")->capture_default_str()->transform(inRange(1, 64));
     o->muscle.add(*c);
     c->add_option("--out", o->out, "output directory (validation.csv)")->capture_default_str();
     c->add_option("--truth", o->truth,
@@ -457,20 +457,20 @@ void addValidateCommand(CLI::App& app) {
                   "--truth elbow: sd of a twitch-interpolation measurement of voluntary activation for the "
                   "synergist-va identifier (0: leave it out)")
         ->capture_default_str()
-        ->check(CLI::Range(0.0, 0.5));
+        ->transform(inRange(0.0, 0.5));
     addNumberListOption(*c, "--angles", o->angles,
                   "--truth elbow: comma-separated flexion angles of the MVC protocol [deg, 0 = extended] "
                   "(default the thesis's 135,120,90,60,30)");
     c->add_option("--repetitions", o->repetitions, "--truth elbow: efforts per angle")
         ->capture_default_str()
-        ->check(CLI::Range(1, 100));
+        ->transform(inRange(1, 100));
     c->add_option("--protocol", o->protocol,
                   "--truth elbow: torque protocol file (kind: torque, e.g. written by `armsim design`) instead of "
                   "--angles/--repetitions; channels it records besides torque add the channels fit (e.g. "
                   "assets/protocols/recommended.yaml)");
     c->add_flag("--free-slow-fraction", o->freeSlowFraction,
                 "--truth elbow: the synergist identifiers free the flexors' slow-fibre fractions");
-    c->add_option("--subjects", o->subjects, "subjects for --truth elbow")->capture_default_str()->check(CLI::Range(1, 1000000));
+    c->add_option("--subjects", o->subjects, "subjects for --truth elbow")->capture_default_str()->transform(inRange(1, 1000000));
     c->callback([o, c] {
         o->noiseGiven = c->count("--noise") > 0;
         if (c->count("--protocol") && (c->count("--angles") || c->count("--repetitions")))

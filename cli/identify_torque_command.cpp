@@ -142,7 +142,7 @@ void addIdentifyTorqueCommand(CLI::App& app) {
     c->add_option("--population", o->population, "prior population (default assets/subjects/default_population.yaml)");
     c->add_option("--noise-level", o->noiseLevel,
                   "relative sd of one trial's torque (default: estimated from repeated trials)")
-        ->check(CLI::Range(1e-4, 0.5));
+        ->transform(inRange(1e-4, 0.5));
     c->add_option("--activation", o->activation, "measured voluntary activation (twitch interpolation): adds synergist-va")
         ->check(CLI::Validator(
             [](std::string& text) {
@@ -152,13 +152,13 @@ void addIdentifyTorqueCommand(CLI::App& app) {
                                        : "voluntary activation " + text + ": expected in (0, 1] (a fraction of full drive)";
             },
             "(0, 1]"));
-    c->add_option("--activation-sd", o->activationSd, "sd of that measurement")->capture_default_str()->check(CLI::Range(1e-4, 0.5))
+    c->add_option("--activation-sd", o->activationSd, "sd of that measurement")->capture_default_str()->transform(inRange(1e-4, 0.5))
         ->needs("--activation");
     c->add_option("--channels", o->channels,
                   "channel CSV (docs/channels.md: ultrasound fascicle length and volume, EMG, upper-arm length): adds "
                   "the channels fit");
     c->add_option("--emg-crosstalk", o->emgCrosstalk, "crosstalk c of the EMG measurement model")
-        ->capture_default_str()->check(CLI::Range(0.0, 0.5))
+        ->capture_default_str()->transform(inRange(0.0, 0.5))
         ->needs("--channels");
     c->add_flag("--free-slow-fraction", o->freeSlowFraction, "the synergist fits free the flexors' slow-fibre fractions");
     c->add_option("--out", o->out, "output directory")->capture_default_str();

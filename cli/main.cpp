@@ -85,12 +85,16 @@ std::string explainConversion(const CLI::App& app, const std::string& what) {
     for (const CLI::App* a : apps)
         for (const CLI::Option* o : a->get_options()) {
             if (o->get_name() != name && !o->check_name(name)) continue;
+            // "INT", or "INT:NUMBER in [1, 64]" with a range check (cli/commands.h: inRange).
             const std::string type = o->get_type_name();
-            const std::string expected = type == "FLOAT"  ? "a number"
-                                         : type == "INT"  ? "an integer"
-                                         : type == "UINT" ? "a whole number >= 0"
-                                                          : type;
-            return name + " = '" + value + "': expected " + expected;
+            const std::string base = type.substr(0, type.find(':'));
+            const std::size_t in = type.find(" in [");
+            const std::string range = in == std::string::npos ? "" : type.substr(in);
+            const std::string expected = base == "FLOAT"  ? "a number"
+                                         : base == "INT"  ? "an integer"
+                                         : base == "UINT" ? "a whole number >= 0"
+                                                          : base;
+            return name + " = '" + value + "': expected " + expected + range;
         }
     return what;
 }
@@ -127,6 +131,13 @@ int main(int argc, char** argv) {
         return app.exit(e);
     } catch (const CLI::ConversionError& e) {
         std::cerr << "armsim: error: " << explainConversion(app, e.what()) << " (armsim COMMAND --help lists its options)\n";
+        return 2;
+    } catch (const CLI::ValidationError& e) {
+        // CLI11's "--rate: = 0: expected ..." (inRange's message after the option's name) as "--rate = 0: ...".
+        std::string what = e.what();
+        if (const std::size_t at = what.find(": = "); at != std::string::npos && what.rfind("--", 0) == 0)
+            what.replace(at, 4, " = ");
+        std::cerr << "armsim: error: " << what << " (armsim COMMAND --help lists its options)\n";
         return 2;
     } catch (const CLI::ParseError& e) {
         const std::string unknown = findUnknownCommand(app, argc, argv);

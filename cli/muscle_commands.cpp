@@ -37,7 +37,8 @@ void MuscleOptions::add(CLI::App& app) {
 
 void MuscleOptions::addMuscleModel(CLI::App& app) {
     app.add_option("--muscle-model", muscleModel,
-                   "every muscle's model: virtual_muscle, thelen2003 or degroote2016 (default: the model file's)");
+                   "every muscle's model: virtual_muscle, thelen2003 or degroote2016; an OpenSim model's: thelen2003, "
+                   "degroote2016 or thelen2003_opensim2 (default: the model file's)");
 }
 
 ArmSetup loadModelWithMuscles(const std::string& name, const std::string& muscleModel) {

@@ -194,7 +194,7 @@ void addProtocolCommand(CLI::App& app) {
     CLI::App* c = app.add_subcommand("protocol", "run an experiment protocol (YAML file, e.g. protocols/mvc_force_angle.yaml)");
     c->add_option("file", o->file, "protocol file (path, or name under assets/)")->required();
     c->add_option("--out", o->out, "run directory (default out/<protocol name>); an earlier run there is replaced");
-    c->add_option("--jobs", o->jobs, "worker threads (results do not depend on it)")->capture_default_str()->check(CLI::Range(1, 64));
+    c->add_option("--jobs", o->jobs, "worker threads (results do not depend on it)")->capture_default_str()->transform(inRange(1, 64));
     c->add_flag("--video", o->video, "also render every trial's video (H.264) into <out>/videos/");
     c->add_option("--video-fps", o->videoFps, "video frame rate [1/s]")->capture_default_str()->needs("--video");
     c->add_option("--video-width", o->videoWidth, "video width [px]")->capture_default_str()->needs("--video");

@@ -91,14 +91,33 @@ std::vector<std::string> splitListOption(const std::string& name, const std::vec
 }
 }  // namespace
 
+CLI::Validator inRange(double lo, double hi) {
+    const std::string range = "[" + formatNumber(lo) + ", " + formatNumber(hi) + "]";
+    return CLI::Validator(
+        [lo, hi, range](std::string& text) -> std::string {
+            char* end = nullptr;
+            const double v = std::strtod(text.c_str(), &end);
+            if (text.empty() || end == text.c_str() || *end != '\0' || !std::isfinite(v))
+                return "= '" + text + "': expected a number in " + range;
+            if (v < lo || v > hi) return "= " + text + ": expected a number in " + range;
+            if (v == std::floor(v) && std::abs(v) < 9.0e15) text = std::to_string(static_cast<long long>(v));
+            return "";
+        },
+        "NUMBER in " + range);
+}
+
 CLI::Option* addNumberListOption(CLI::App& app, const std::string& name, std::vector<double>& values,
                                  const std::string& description) {
     CLI::Option* option = app.add_option_function<std::vector<std::string>>(
         name,
         [&values, name](const std::vector<std::string>& texts) {
             std::vector<double> parsed;
-            for (const std::string& item : splitListOption(name, texts, "a finite number"))
-                parsed.push_back(parseNumber(name, item));
+            for (const std::string& item : splitListOption(name, texts, "a finite number")) {
+                const double v = parseNumber(name, item);
+                if (std::find(parsed.begin(), parsed.end(), v) != parsed.end())
+                    throw InputError(name + " = " + formatNumber(v) + " is listed twice: expected each value once");
+                parsed.push_back(v);
+            }
             values = std::move(parsed);
         },
         description);
@@ -109,7 +128,20 @@ CLI::Option* addNumberListOption(CLI::App& app, const std::string& name, std::ve
 CLI::Option* addNameListOption(CLI::App& app, const std::string& name, std::vector<std::string>& values,
                                const std::string& description) {
     CLI::Option* option = app.add_option_function<std::vector<std::string>>(
-        name, [&values, name](const std::vector<std::string>& texts) { values = splitListOption(name, texts, "a name"); },
+        name,
+        [&values, name](const std::vector<std::string>& texts) {
+            std::vector<std::string> parsed;
+            for (std::string item : splitListOption(name, texts, "a name")) {
+                // Spaces around a name are not part of it ("--methods 'lm, ilc'").
+                item.erase(0, item.find_first_not_of(" \t"));
+                item.erase(item.find_last_not_of(" \t") + 1);
+                if (item.empty()) throw InputError(name + ": an item of spaces only: expected a name");
+                if (std::find(parsed.begin(), parsed.end(), item) != parsed.end())
+                    throw InputError(name + " '" + item + "' is listed twice: expected each name once");
+                parsed.push_back(std::move(item));
+            }
+            values = std::move(parsed);
+        },
         description);
     option->default_function([&values] { return formatList(values); });
     return option->allow_extra_args(false)->type_name("NAMES");
@@ -240,7 +272,7 @@ void addRegisteredCommands(CLI::App& app) {
     auto ctx = std::make_shared<MainJobContext>();
     CLI::App* run = app.add_subcommand("run", "the main job on built-in defaults (results and plots in --out)");
     run->add_option("--out", ctx->outDir, "output directory")->capture_default_str();
-    run->add_option("--jobs", ctx->jobs, "worker threads")->capture_default_str()->check(CLI::Range(1, 64));
+    run->add_option("--jobs", ctx->jobs, "worker threads")->capture_default_str()->transform(inRange(1, 64));
     ctx->muscle.add(*run);
     run->callback([ctx] {
         // glibc raises its mmap threshold (to 32 MB) each time a large block is freed, after which

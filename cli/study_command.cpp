@@ -119,7 +119,7 @@ void addStudyCommand(CLI::App& app) {
     c->add_option("--threads", o->threads, "worker threads per process (default: the CPUs it may use, its "
                                            "affinity mask as set by taskset or Slurm; shared by the ranks of a "
                                            "node under MPI when they all see the whole node)")
-        ->check(CLI::Range(1, kMaxStudyThreads));
+        ->transform(inRange(1, kMaxStudyThreads));
     c->add_flag("--restart", o->restart, "discard the output folder's journal and compute every task again");
     c->add_option("--shard", o->shard, "I/N: compute shard I of N (0 <= I < N; the groups g with g % N == I) "
                                        "into its own journal, for job arrays; the next run without --shard "

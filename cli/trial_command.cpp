@@ -343,7 +343,18 @@ void addTrialCommand(CLI::App& app) {
         ->capture_default_str()
         ->check(CLI::IsMember({"positive", "negative"}));
     c->callback([o, c] {
+        if (c->count("--coordinate") > 0 && o->coordinate.empty())
+            throw InputError("--coordinate is empty: expected a coordinate's name (or leave it out for a model with one)");
+        if (c->count("--muscle-model") > 0 && o->muscle.muscleModel.empty())
+            throw InputError("--muscle-model is empty: expected a muscle model's name (or leave it out for the model's own)");
         if (isOsimModel(o->muscle.model)) {
+            const std::string& mm = o->muscle.muscleModel;
+            if (!mm.empty() && mm != "thelen2003" && mm != "degroote2016" && mm != "thelen2003_opensim2")
+                throw InputError("--muscle-model '" + mm + "' with the OpenSim model '" + o->muscle.model + "': expected "
+                                 "thelen2003, degroote2016 or thelen2003_opensim2 (an .osim model's muscles are Hill-type)");
+            if (c->count("--initial-angle") > 0 && !std::isfinite(o->initialAngleDeg))
+                throw InputError("--initial-angle = " + formatNumber(o->initialAngleDeg) + ": expected a finite angle (deg; "
+                                 "leave it out to start at the coordinate's default)");
             // What an OpenSim model's trial would ignore or cannot do yet is refused, naming the option.
             const bool free = o->type == "free";
             for (const char* name : {"--settings", "--muscle", "--arm", "--slow-units", "--fast-units", "--mass",

@@ -7,6 +7,7 @@
 #include "basics/plot.h"
 #include "basics/table.h"
 #include "model/osim_arm.h"
+#include "model/osim_trial.h"
 
 #include <cmath>
 
@@ -37,6 +38,9 @@ OsimReportFiles writeOsimModelReport(const OsimModel& model, const OsimReportSet
     if (!(settings.stepDeg > 0 && settings.stepDeg <= 90))
         throw InputError("--step " + formatNumber(settings.stepDeg) + ": expected in (0, 90] deg");
     const OsimArm arm(model, {}, settings.muscleModel);
+    if (arm.getNumMuscles() == 0)
+        throw InputError("model " + model.name + " (" + model.file + ") has no muscles: `model show` reports muscles "
+                         "(`armsim forward` runs a model without them)");
     const int j = findSwept(arm, settings.coordinate);
     OsimReportFiles r;
     r.coordinate = arm.getCoordinate(j).name;
@@ -75,7 +79,7 @@ OsimReportFiles writeOsimModelReport(const OsimModel& model, const OsimReportSet
             double total = 0;
             for (int i = 0; i < n; ++i) {
                 const MuscleModel& m = arm.getMuscleForce(i).getMuscle();
-                const SteadyState ss = m.calcSteadyState(P[i], direction * R[i] > 0 ? 1.0 : 0.0);
+                const SteadyState ss = m.calcSteadyState(P[i], isOsimAgonist(direction, R[i]) ? 1.0 : 0.0);
                 if (!ss.converged)
                     throw SimulationError("muscle " + arm.getMuscleName(i) + " at " + r.coordinate + " = " + formatNumber(deg) +
                                           " deg: " + ss.message);

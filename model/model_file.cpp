@@ -386,9 +386,13 @@ ArmSetup loadModel(const std::string& nameOrFile) {
         if (!doesPathExist(asset)) {
             if (doesPathExist(getAssetDirectory() + "/models/" + nameOrFile + ".osim"))
                 throw InputError("--model '" + nameOrFile + "': assets/models/" + nameOrFile + ".osim is " + osimNote);
-            std::string known;
+            std::string known, osim;
             for (const std::string& m : listModels()) known += (known.empty() ? "" : ", ") + m;
+            std::error_code ec;
+            for (const auto& e : std::filesystem::directory_iterator(std::filesystem::path(getAssetDirectory()) / "models", ec))
+                if (e.path().extension() == ".osim") osim += (osim.empty() ? "" : ", ") + e.path().stem().string();
             throw InputError("--model '" + nameOrFile + "': no such model (shipped models: " + known +
+                             (osim.empty() ? std::string() : "; OpenSim models, for forward, trial and model show: " + osim) +
                              "; or give a model file path)");
         }
         file = asset;

@@ -196,7 +196,10 @@ OsimArm::OsimArm(OsimModel model, const std::map<std::string, ActivationProfile>
             if (j.kind == OsimJoint::Kind::Weld) {
                 bodies[b->name] = MobilizedBody::Weld(parent, X_PF, mass, X_BM);
             } else {
-                if (j.coordinates.size() != 1)
+                if (j.coordinates.empty())
+                    throw OsimError(at + "no coordinate: a moving joint needs one (expected one rotation; a joint that "
+                                    "does not move is a WeldJoint)");
+                if (j.coordinates.size() > 1)
                     throw OsimError(at + std::to_string(j.coordinates.size()) + " coordinates: joints with more than one "
                                     "coordinate are not supported yet (expected one rotation)");
                 if (!(b->mass > 0)) throw OsimError(at + "body '" + b->name + "' has no mass but moves: expected a mass > 0 kg");

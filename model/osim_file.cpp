@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <set>
 #include <sstream>
 
@@ -185,7 +186,12 @@ public:
         m.name = model->Attribute("name") ? model->Attribute("name") : "";
         m.credits = text(model, "credits");
         m.publications = text(model, "publications");
-        if (model->FirstChildElement("gravity")) m.gravity = vec3(model, "gravity");
+        if (model->FirstChildElement("gravity")) {
+            m.gravity = vec3(model, "gravity");
+            const double g = std::sqrt(m.gravity[0] * m.gravity[0] + m.gravity[1] * m.gravity[1] + m.gravity[2] * m.gravity[2]);
+            if (!(g <= 100))   // the arm files' bound (bounds: gravity in [0, 100] m/s^2)
+                fail(child(model, "gravity"), "magnitude " + formatNumber(g) + " m/s^2: expected at most 100 m/s^2");
+        }
         readBodies(model, m);
         readJoints(model, m);
         readForces(model, m);
@@ -498,6 +504,24 @@ private:
     void check(const OsimModel& m) const {
         auto isBody = [&](const std::string& b) { return b == "ground" || m.findBody(b); };
         auto where = [&](int line) { return source_ + ":" + std::to_string(line) + ": "; };
+        // Names are how everything else refers to a muscle, coordinate or body: each once.
+        auto unique = [&](const char* what, const std::vector<std::pair<std::string, int>>& named) {
+            std::map<std::string, int> first;
+            for (const auto& [name, line] : named) {
+                const auto [it, inserted] = first.emplace(name, line);
+                if (!inserted)
+                    throw OsimError(where(line) + std::string(what) + " '" + name + "' is named twice (first at line " +
+                                    std::to_string(it->second) + "): expected unique names");
+            }
+        };
+        std::vector<std::pair<std::string, int>> muscles, coordinates, bodies;
+        for (const OsimMuscle& mu : m.muscles) muscles.emplace_back(mu.name, mu.line);
+        for (const OsimJoint& j : m.joints)
+            for (const OsimCoordinate& c : j.coordinates) coordinates.emplace_back(c.name, c.line);
+        for (const OsimBody& b : m.bodies) bodies.emplace_back(b.name, b.line);
+        unique("muscle", muscles);
+        unique("coordinate", coordinates);
+        unique("body", bodies);
         for (const OsimJoint& j : m.joints) {
             if (!isBody(j.parent.body)) throw OsimError(where(j.line) + "joint '" + j.name + "': parent body '" + j.parent.body + "' does not exist");
             if (!isBody(j.child.body)) throw OsimError(where(j.line) + "joint '" + j.name + "': child body '" + j.child.body + "' does not exist");

@@ -11,7 +11,9 @@
 #include <tinyxml2.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <map>
 #include <set>
@@ -40,7 +42,7 @@ OsimStorage readOsimStorage(const std::string& path) {
 }
 
 std::string findOsimModelFile(const std::string& model, const std::string& option) {
-    if (model.find('/') == std::string::npos && model.find(".osim") == std::string::npos) {
+    if (model.find('/') == std::string::npos && !isOsimModel(model)) {
         const std::string asset = getAssetDirectory() + "/models/" + model + ".osim";
         if (!isRegularFile(asset))
             throw InputError(option + " '" + model + "': no shipped OpenSim model assets/models/" + model + ".osim");
@@ -51,7 +53,11 @@ std::string findOsimModelFile(const std::string& model, const std::string& optio
 }
 
 bool isOsimModel(const std::string& name) {
-    if (name.size() > 5 && name.compare(name.size() - 5, 5, ".osim") == 0) return true;
+    if (name.size() > 5) {   // the extension in any case (ARM26.OSIM)
+        std::string ext = name.substr(name.size() - 5);
+        for (char& ch : ext) ch = char(std::tolower(static_cast<unsigned char>(ch)));
+        if (ext == ".osim") return true;
+    }
     return name.find('/') == std::string::npos && !doesPathExist(getAssetDirectory() + "/models/" + name + ".yaml") &&
            doesPathExist(getAssetDirectory() + "/models/" + name + ".osim");
 }
@@ -70,6 +76,16 @@ OsimForwardResult runOsimForward(const OsimModel& model, const OsimStorage& cont
     settings.validate();
     OsimForwardResult result;
     const Table& c = controls.table;
+    // Times: finite and not decreasing (a row repeating a time replaces the earlier one).
+    for (int r = 0; r < c.getNumRows(); ++r) {
+        const double t = c.get(r, 0);
+        if (!std::isfinite(t) || std::abs(t) > 1e9)
+            throw InputError(controls.file + ": row " + std::to_string(r + 1) + ": time " + formatNumber(t) +
+                             ": expected a finite time within +/-1e9 s");
+        if (r > 0 && t < c.get(r - 1, 0))
+            throw InputError(controls.file + ": row " + std::to_string(r + 1) + ": time " + formatNumber(t) + " s is before the "
+                             "previous row's " + formatNumber(c.get(r - 1, 0)) + " s: expected times in increasing order");
+    }
     double t0 = std::isfinite(settings.initialTime) ? settings.initialTime : c.get(0, 0);
     // Initial states: the row at or before t0, or the first row when t0 is before it; the run starts at
     // that row's time (the Forward tool's rule). Else defaults and equilibrium.
@@ -88,6 +104,12 @@ OsimForwardResult runOsimForward(const OsimModel& model, const OsimStorage& cont
     if (!(settings.finalTime > t0))
         throw InputError("final time " + formatNumber(settings.finalTime) + " s: expected after the initial time " +
                          formatNumber(t0) + " s" + (initial ? " (from " + initial->file + ")" : std::string()));
+    if (settings.integration.maxStepSize > 0 && (settings.finalTime - t0) / settings.integration.maxStepSize > kMaxSamples)
+        throw FieldError("maximum_integrator_step_size",
+                         "= " + formatNumber(settings.integration.maxStepSize) + " s: " +
+                             formatNumber((settings.finalTime - t0) / settings.integration.maxStepSize, 3) + " steps over " +
+                             formatNumber(settings.finalTime - t0) + " s: expected at most " + formatNumber(kMaxSamples) +
+                             " steps (a larger step limit)");
 
     // Excitations as OpenSim's ControlLinear: linear between the rows (a row repeating a time replaces the
     // earlier one), extrapolated linearly beyond the first and last rows and clamped to [0, 1] (the
@@ -141,23 +163,31 @@ OsimForwardResult runOsimForward(const OsimModel& model, const OsimStorage& cont
     SimTK::State s = arm.getDefaultState();
     s.setTime(t0);
 
-    auto lookup = [&](const std::vector<std::string>& names, double& value) {
-        for (const std::string& n : names) {
-            const auto it = given.find(n);
-            if (it != given.end()) return value = it->second, true;
-        }
-        return false;
-    };
     std::map<std::string, std::string> jointOf;  // coordinate -> joint, for 4.x column names
     for (const OsimJoint& j : model.joints)
         for (const OsimCoordinate& k : j.coordinates) jointOf[k.name] = j.name;
     const double degree = initial && initial->header.inDegrees ? kPi / 180 : 1.0;
+    // Every value of the row used is finite, and the columns nothing reads are named in a note (a
+    // misspelt column would otherwise leave its state at the default).
+    std::set<std::string> used;
+    auto take = [&](const std::vector<std::string>& names, double& value) {
+        for (const std::string& n : names) {
+            const auto it = given.find(n);
+            if (it == given.end()) continue;
+            used.insert(n);
+            if (!std::isfinite(it->second))
+                throw InputError(initial->file + ": column '" + n + "' at t = " + formatNumber(t0) + " s: " +
+                                 formatNumber(it->second) + ": expected a finite number");
+            return value = it->second, true;
+        }
+        return false;
+    };
     for (int i = 0; i < arm.getNumCoordinates(); ++i) {
         const std::string& n = arm.getCoordinate(i).name;
         const std::string path = "/jointset/" + jointOf[n] + "/" + n;
         double v;
-        if (lookup({n, path + "/value"}, v)) arm.setCoordinateValue(s, i, v * (arm.getCoordinate(i).rotational ? degree : 1));
-        if (lookup({n + "_u", path + "/speed"}, v)) arm.setCoordinateSpeed(s, i, v * (arm.getCoordinate(i).rotational ? degree : 1));
+        if (take({n, path + "/value"}, v)) arm.setCoordinateValue(s, i, v * (arm.getCoordinate(i).rotational ? degree : 1));
+        if (take({n + "_u", path + "/speed"}, v)) arm.setCoordinateSpeed(s, i, v * (arm.getCoordinate(i).rotational ? degree : 1));
     }
     arm.getSystem().realize(s, SimTK::Stage::Velocity);
     // Each muscle state's names and its storage unit per state unit (OpenSim writes fibre lengths in
@@ -177,11 +207,26 @@ OsimForwardResult runOsimForward(const OsimModel& model, const OsimStorage& cont
         bool all = true;
         for (std::size_t k = 0; k < names.size(); ++k) {
             double v;
-            if (lookup({muscle + "." + names[k], "/forceset/" + muscle + "/" + names[k]}, v)) y[k] = v / stateScales[i][k];
-            else all = false;
+            if (take({muscle + "." + names[k], "/forceset/" + muscle + "/" + names[k]}, v)) {
+                if ((names[k] == "activation" && !(v >= 0 && v <= 1)) || (names[k] == "fiber_length" && !(v > 0)))
+                    throw InputError(initial->file + ": column '" + muscle + "." + names[k] + "' at t = " + formatNumber(t0) +
+                                     " s: " + formatNumber(v) + ": expected " +
+                                     (names[k] == "activation" ? "an activation in [0, 1]" : "a fibre length > 0 m"));
+                y[k] = v / stateScales[i][k];
+            } else {
+                all = false;
+            }
         }
         if (all) f.setMuscleStates(s, y);
         else f.setSteadyMuscleStates(s);  // equilibrium at the excitation of t0 (solve_for_equilibrium)
+    }
+
+    if (initial) {
+        std::string unused;
+        for (const auto& [name, value] : given)
+            if (!used.count(name)) unused += (unused.empty() ? "" : ", ") + name;
+        if (!unused.empty())
+            result.notes.push_back(initial->file + ": columns not used (no state of " + model.name + " by that name): " + unused);
     }
 
     // The states table.
@@ -241,9 +286,10 @@ OsimForwardSetup readOsimForwardSetup(const std::string& path) {
     auto number = [&](const char* tag, double fallback) {
         const std::string v = text(tool, tag);
         if (v.empty()) return fallback;
-        std::istringstream in(v);
-        double x;
-        if (!(in >> x) || !std::isfinite(x))
+        // The whole text a finite decimal number ("0.2abc" and hexadecimal "0x1p-2" are not).
+        char* end = nullptr;
+        const double x = std::strtod(v.c_str(), &end);
+        if (end == v.c_str() || *end != '\0' || !std::isfinite(x) || v.find_first_of("xX") != std::string::npos)
             throw OsimError(path + ":" + std::to_string(tool->FirstChildElement(tag)->GetLineNum()) + ": <" + tag + "> '" + v +
                             "': expected a number");
         return x;
@@ -262,9 +308,12 @@ OsimForwardSetup readOsimForwardSetup(const std::string& path) {
     static const std::set<std::string> kRefusedWhenSet = {"force_set_files", "external_loads_file",
                                                           "external_loads_model_kinematics_file",
                                                           "lowpass_cutoff_frequency_for_load_kinematics", "use_specified_dt"};
+    std::map<std::string, int> seen;   // element -> its first line
     for (const XMLElement* e = tool->FirstChildElement(); e; e = e->NextSiblingElement()) {
         const std::string name = e->Name();
         const std::string where = path + ":" + std::to_string(e->GetLineNum()) + ": <" + name + ">";
+        if (const auto [it, first] = seen.emplace(name, e->GetLineNum()); !first)
+            throw OsimError(where + ": given twice (first at line " + std::to_string(it->second) + "): expected once");
         if (kUsed.count(name) || kHarmless.count(name)) continue;
         if (kRefusedWhenSet.count(name)) {
             const std::string v = text(tool, name.c_str());
@@ -298,8 +347,15 @@ OsimForwardSetup readOsimForwardSetup(const std::string& path) {
     for (const XMLElement* e = tool->FirstChildElement("ControllerSet"); e; e = nullptr)
         if (const XMLElement* objects = e->FirstChildElement("objects"))
             for (const XMLElement* ctl = objects->FirstChildElement(); ctl; ctl = ctl->NextSiblingElement()) {
+                const std::string at = path + ":" + std::to_string(ctl->GetLineNum()) + ": <" + ctl->Name() + ">";
+                if (std::string(ctl->Name()) != "ControlSetController")
+                    throw OsimError(at + ": controller type " + ctl->Name() + " is not supported yet (expected a "
+                                    "ControlSetController with a controls_file)");
                 const std::string f = text(ctl, "controls_file");
                 if (f.empty() || f == "Unassigned") continue;
+                if (!s.controlsFile.empty())
+                    throw OsimError(at + ": a second controls file '" + f + "': expected one ControlSetController with a "
+                                    "controls file (merge the files' columns into one)");
                 if (f.size() >= 4 && f.substr(f.size() - 4) == ".xml")
                     throw OsimError(path + ":" + std::to_string(ctl->GetLineNum()) + ": <" + ctl->Name() + ">: controls file '" +
                                     f + "' is an XML ControlSet: not supported yet (expected a .sto storage file)");

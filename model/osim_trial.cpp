@@ -17,11 +17,15 @@ namespace {
 constexpr double kDeg = 3.14159265358979323846 / 180;
 
 int findTrialCoordinate(const OsimArm& arm, const std::string& name) {
+    if (arm.getNumMuscles() == 0)
+        throw InputError("model " + arm.getModel().name + " (" + arm.getModel().file + ") has no muscles: a trial excites "
+                         "muscles (`armsim forward` runs a model without them)");
     std::string names;
     for (int i = 0; i < arm.getNumCoordinates(); ++i) names += (i ? ", " : "") + arm.getCoordinate(i).name;
     if (arm.getNumCoordinates() == 0) throw InputError("model " + arm.getModel().name + " has no moving coordinate");
     if (name.empty()) {
         if (arm.getNumCoordinates() == 1) return 0;
+        if (arm.getNumCoordinates() == 0) throw InputError("model " + arm.getModel().name + " has no moving coordinate");
         throw FieldError("coordinate", "not given: model " + arm.getModel().name + " has " +
                                            std::to_string(arm.getNumCoordinates()) + " coordinates (" + names +
                                            "): name the one to lock and act about");
@@ -161,7 +165,11 @@ OsimIsometricTrialResult runOsimIsometricTrial(const OsimModel& file, const Osim
 
 void OsimFreeMovementSettings::validate(const OsimArm& arm) const {
     const int j = findTrialCoordinate(arm, coordinate);
-    const auto range = arm.getCoordinate(j).range;
+    const OsimCoordinate& c = arm.getCoordinate(j);
+    if (c.locked)
+        throw FieldError("coordinate", "'" + c.name + "' is locked in " + arm.getModel().file + " (line " + std::to_string(c.line) +
+                                           "): a free movement needs it free (an isometric trial holds it at an angle)");
+    const auto range = c.range;
     if (!std::isnan(initialAngleDeg))
         checkField("initial_angle_deg", initialAngleDeg,
                    Bound::closed(std::round(range[0] / kDeg * 1e6) / 1e6, std::round(range[1] / kDeg * 1e6) / 1e6, "deg"));

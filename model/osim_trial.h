@@ -44,13 +44,17 @@ struct OsimIsometricTrialSettings {
 
     double getDuration() const { return restDuration + riseTime + holdDuration; }
     /// Throws InputError naming the field (its CLI option in runNamingOptions) for a bad value, an
-    /// angle outside the coordinate's range or a coordinate that is not there.
+    /// angle outside the coordinate's range, a coordinate that is not there, or a model without muscles.
     void validate(const OsimArm& arm) const;
 };
 
+/// Smallest moment arm that makes a muscle an agonist [m]: a muscle that does not cross the coordinate
+/// has a moment arm of rounding size (1e-17 m), not zero.
+inline constexpr double kOsimAgonistMomentArm = 1e-4;
 /// true when a muscle with moment arm r [m] about the coordinate is an agonist of an effort in
-/// `direction` (+1/-1): it pulls that way (r direction > 0). `model show`'s MVC curves use the same rule.
-inline bool isOsimAgonist(int direction, double momentArm) { return direction * momentArm > 0; }
+/// `direction` (+1/-1): it pulls that way by more than kOsimAgonistMomentArm. `model show`'s MVC curves
+/// use the same rule.
+inline bool isOsimAgonist(int direction, double momentArm) { return direction * momentArm > kOsimAgonistMomentArm; }
 
 /// Summary of an osim isometric trial (window means over the last averagingWindow of the hold).
 struct OsimIsometricSummary {
@@ -104,8 +108,8 @@ struct OsimFreeMovementSettings {
     }();
     /// Optional: called with the time of every sample [s] (a long run's progress).
     std::function<void(double)> progress;
-    /// InputError naming the field for a bad value, a start outside the coordinate's range or a
-    /// coordinate that is not there.
+    /// InputError naming the field for a bad value, a start outside the coordinate's range, a
+    /// coordinate that is not there or that the file locks, or a model without muscles.
     void validate(const OsimArm& arm) const;
 };
 

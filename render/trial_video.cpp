@@ -229,7 +229,8 @@ struct TrialRenderer::Impl {
         for (const char* c : kRequiredColumns)
             if (!table.hasColumn(c))
                 throw InputError(name + " has no column '" + std::string(c) +
-                                 "': expected a table written by armsim trial");
+                                 "': expected a table written by armsim trial of an armsim model (an OpenSim model's "
+                                 "trial is rendered by `armsim trial --model FILE.osim ... --video`)");
         if (table.getNumRows() < 1) throw InputError(name + " has no rows: expected at least one sample");
         time = table.getColumn("time_s");
         angleDeg = table.getColumn("elbow_angle_deg");

@@ -63,6 +63,18 @@ struct Sensitivities {
 
 }  // namespace
 
+namespace {
+
+// The postures are the model's own one and these: each once (the model's is always a candidate).
+void checkPosturesBesideTheModels(const DesignSettings& settings, const ArmParameters& arm) {
+    for (double r : settings.postures)
+        if (arm.forearmRotation.enabled && r == arm.forearmRotation.postureDeg)
+            throw FieldError("postures", "lists " + formatNumber(r) + " deg, the model's own posture, which is always a "
+                                         "candidate: expected other postures only");
+}
+
+}  // namespace
+
 std::vector<std::vector<double>> drawFromPrior(const SynergistModel& model, unsigned seed, int draws) {
     const int n = model.getNumParameters();
     // Only the free coordinates are drawn (held ones stay at their mean), so the draws do not depend on
@@ -512,6 +524,7 @@ DesignResult designChannelProtocol(const Population& prior, const DesignSettings
     if (forearm && !base.arm.forearmRotation.enabled)
         throw InputError("design: postures need a model whose forearm rotates; the prior's model '" + base.name +
                          "' has none");
+    checkPosturesBesideTheModels(settings, base.arm);
     for (int c = 0; c < nc; ++c) {
         if (!takesChannels(result.candidates[c])) continue;
         for (const ChannelObservation& o : makeConditionRows(base, result.candidates[c], true, false)) {
@@ -664,6 +677,7 @@ DesignResult designProtocol(const Population& prior, const DesignSettings& setti
     if (forearm && !prior.base.arm.forearmRotation.enabled)
         throw InputError("design: postures need a model whose forearm rotates; the prior's model '" + prior.base.name +
                          "' has none");
+    checkPosturesBesideTheModels(settings, prior.base.arm);
     Sensitivities s = calcSensitivities(prior, result.candidates, settings, [&](int done, int) {
         if (progress) progress(done, total);
     }, {}, {}, forearm);

@@ -51,6 +51,19 @@ std::vector<BadInput> makeCatalogue() {
     const std::string sto = "c\nversion=1\nnRows=1\nnColumns=2\ninDegrees=no\nendheader\n";
     const std::string condition = "  - {flexion_deg: 90, effort: flexion, level: 1, repetitions: 3}\n";
     const std::string channelHead = "channel,muscle,flexion_deg,effort,level,repetition,value,sd\n";
+    const std::string arm26 = armsim::readFileText(armsim::getAssetDirectory() + "/models/arm26.osim");
+    // arm26 with its ForceSet's objects emptied, and with the elbow locked.
+    const std::string noMuscles = [&] {
+        const auto set = arm26.find("<ForceSet");
+        const auto open = arm26.find("<objects>", set), close = arm26.rfind("</objects>", arm26.find("</ForceSet>", set));
+        return arm26.substr(0, open + 9) + arm26.substr(close);
+    }();
+    const std::string lockedElbow = [&] {
+        std::string t = arm26;
+        const auto c = t.find("<Coordinate name=\"r_elbow_flex\">");
+        const auto l = t.find("<locked>false</locked>", c);
+        return t.replace(l, 22, "<locked>true</locked>");
+    }();
     return {
         // ---- command line -----------------------------------------------------------------------
         {"UnknownCommand", {}, "nosuch", {"unknown command 'nosuch'", "expected one of", "muscle"}},
@@ -172,6 +185,50 @@ std::vector<BadInput> makeCatalogue() {
         {"ForwardMuscleModelUnknown", {{"c.sto", "c\nversion=1\nnRows=1\nnColumns=2\ninDegrees=no\nendheader\ntime\tBIClong\n0\t0.1\n"}},
          "forward --model arm26 --controls IN/c.sto --final-time 0.1 --muscle-model hill --out OUT/f",
          {"muscle model 'hill'", "expected thelen2003, thelen2003_opensim2 or degroote2016"}},
+        {"ForwardFinalTimeNan", {{"c.sto", sto + "time\tBIClong\n0\t0.1\n"}},
+         "forward --model arm26 --controls IN/c.sto --final-time nan --out OUT/f", {"--final-time = nan", "expected a finite number"}},
+        {"ForwardControlsTimesBackwards", {{"c.sto", replaceAll(sto, "nRows=1", "nRows=2") + "time\tBIClong\n1\t0.1\n0\t0.2\n"}},
+         "forward --model arm26 --controls IN/c.sto --final-time 2 --out OUT/f", {"c.sto: row 2: time 0 s is before the previous row's 1 s"}},
+        {"ForwardStatesNotANumber", {{"c.sto", sto + "time\tBIClong\n0\t0.1\n"}, {"s.sto", sto + "time\tr_elbow_flex\n0\tnan\n"}},
+         "forward --model arm26 --controls IN/c.sto --initial-states IN/s.sto --final-time 0.1 --out OUT/f",
+         {"s.sto: column 'r_elbow_flex' at t = 0 s: nan: expected a finite number"}},
+        {"ForwardStatesActivationFive", {{"c.sto", sto + "time\tBIClong\n0\t0.1\n"}, {"s.sto", sto + "time\tBIClong.activation\n0\t5\n"}},
+         "forward --model arm26 --controls IN/c.sto --initial-states IN/s.sto --final-time 0.1 --out OUT/f",
+         {"s.sto: column 'BIClong.activation'", "expected an activation in [0, 1]"}},
+        {"ForwardOutputOnItsControls", {{"states.csv", "time,BIClong\n0,0.1\n"}},
+         "forward --model arm26 --controls IN/states.csv --final-time 0.1 --out IN",
+         {"--controls", "states.csv", "which forward writes", "it would replace the input"}},
+        {"ForwardSetupNumberWithText",
+         {{"s.xml", "<OpenSimDocument Version=\"40000\"><ForwardTool><model_file>x.osim</model_file>\n<final_time>0.2abc</final_time>"
+                    "</ForwardTool></OpenSimDocument>\n"}},
+         "forward IN/s.xml --out OUT/f", {"s.xml:2", "<final_time> '0.2abc': expected a number"}},
+        {"ForwardSetupElementTwice",
+         {{"s.xml", "<OpenSimDocument Version=\"40000\"><ForwardTool><model_file>x.osim</model_file>\n<final_time>1</final_time>\n"
+                    "<final_time>2</final_time></ForwardTool></OpenSimDocument>\n"}},
+         "forward IN/s.xml --out OUT/f", {"s.xml:3", "<final_time>: given twice (first at line 2)"}},
+        {"ForwardSetupOtherController",
+         {{"s.xml", "<OpenSimDocument Version=\"40000\"><ForwardTool><model_file>x.osim</model_file>\n<ControllerSet><objects>\n"
+                    "<PrescribedController/></objects></ControllerSet></ForwardTool></OpenSimDocument>\n"}},
+         "forward IN/s.xml --out OUT/f", {"s.xml:3", "controller type PrescribedController is not supported"}},
+        {"ForwardStepLimitTiny", {{"c.sto", sto + "time\tBIClong\n0\t0.1\n"},
+                                  {"s.xml", "<OpenSimDocument Version=\"40000\"><ForwardTool><model_file>arm26.osim</model_file>\n"
+                                            "<final_time>0.2</final_time><maximum_integrator_step_size>1e-12</maximum_integrator_step_size>"
+                                            "<ControllerSet><objects><ControlSetController><controls_file>c.sto</controls_file>"
+                                            "</ControlSetController></objects></ControllerSet></ForwardTool></OpenSimDocument>\n"},
+                                  {"arm26.osim", armsim::readFileText(armsim::getAssetDirectory() + "/models/arm26.osim")}},
+         "forward IN/s.xml --out OUT/f", {"maximum_integrator_step_size", "1e-12 s", "2e+11 steps", "expected at most 1e+07"}},
+        {"OsimTrialWithoutMuscles", {{"m.osim", noMuscles}}, "trial --model IN/m.osim --coordinate r_elbow_flex --out OUT/t.csv",
+         {"has no muscles", "a trial excites muscles"}},
+        {"OsimTrialFreeOfALockedCoordinate", {{"m.osim", lockedElbow}},
+         "trial --model IN/m.osim --type free --coordinate r_elbow_flex --out OUT/t.csv",
+         {"--coordinate 'r_elbow_flex' is locked in", "m.osim (line"}},
+        {"OsimTwoMusclesOfOneName", {{"m.osim", replaceAll(arm26, "<Thelen2003Muscle name=\"BICshort\">", "<Thelen2003Muscle name=\"BIClong\">")}},
+         "trial --model IN/m.osim --coordinate r_elbow_flex --out OUT/t.csv", {"m.osim:", "muscle 'BIClong' is named twice"}},
+        {"JobsNotAWholeNumber", {}, "design --jobs 1.5 --out OUT/d", {"--jobs = '1.5': expected an integer in [1, 64]"}},
+        {"RateNotANumberInARange", {}, "forward --model arm26 --rate abc --out OUT/f", {"--rate = 'abc': expected a number in [0.001, 1e+06]"}},
+        {"AccuracyZeroInARange", {}, "forward --model arm26 --accuracy 0 --out OUT/f", {"--accuracy = 0: expected a number in [1e-12, 0.1]"}},
+        {"TrialListDuplicateNoise", {}, "validate --noise 0,0 --out OUT/v", {"--noise = 0 is listed twice"}},
+        {"DesignPostureOfTheModel", {}, "design --postures 0 --draws 2 --out OUT/d", {"--postures", "the model's own posture"}},
         {"ModelFileMuscleModelUnknown",
          {{"m.yaml", "name: m\narm: arm/default_male.yaml\nmuscle_model: hill\nmuscles:\n  - name: A\n    mass: 0.1\n"}},
          "model show --model IN/m.yaml --out OUT/ms", {"m.yaml:3", "muscle_model", "'hill'", "expected one of"}},

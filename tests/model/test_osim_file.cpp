@@ -205,6 +205,18 @@ TEST(OsimFile, ProblemsAreNamedWithFileLineAndElement) {
     bad = replaced(bad, "</CustomJoint>", "</BallJoint>");
     e = errorOf(bad);
     EXPECT_NE(e.find("joint type BallJoint is not supported"), std::string::npos) << e;
+    // A name twice: everything else refers to muscles, coordinates and bodies by name.
+    bad = replaced(t, "<Thelen2003Muscle name=\"BICshort\">", "<Thelen2003Muscle name=\"BIClong\">");
+    e = errorOf(bad);
+    const auto second = bad.rfind("<Thelen2003Muscle name=\"BIClong\">");
+    const int secondLine = 1 + int(std::count(bad.begin(), bad.begin() + long(second), '\n'));
+    EXPECT_NE(e.find("bad.osim:" + std::to_string(secondLine) + ": muscle 'BIClong' is named twice (first at line " +
+                     std::to_string(lineOf(bad, "<Thelen2003Muscle name=\"BIClong\">")) + ")"),
+              std::string::npos) << e;
+    // Gravity beyond the arm files' bound.
+    bad = replaced(t, "<gravity>0 -9.8065999999999995 0</gravity>", "<gravity>0 -1e9 0</gravity>");
+    e = errorOf(bad);
+    EXPECT_NE(e.find("<gravity>: magnitude 1e+09 m/s^2: expected at most 100 m/s^2"), std::string::npos) << e;
     // Not an OpenSim document at all.
     e = errorOf("<?xml version=\"1.0\"?><html/>");
     EXPECT_NE(e.find("expected an <OpenSimDocument>"), std::string::npos) << e;

@@ -114,15 +114,39 @@ TEST(OsimIsometricTrial, LongHoldEndsAtTheSteadyTorque) {
             double steady = 0;
             for (int i = 0; i < arm.getNumMuscles(); ++i) {
                 const double R = arm.calcMomentArm(state, i, j);
+                const bool agonist = direction * R > kOsimAgonistMomentArm;
                 const SteadyState ss =
-                    arm.getMuscleForce(i).getMuscle().calcSteadyState(arm.calcPathLength(state, i), direction * R > 0 ? 1.0 : 0.0);
+                    arm.getMuscleForce(i).getMuscle().calcSteadyState(arm.calcPathLength(state, i), agonist ? 1.0 : 0.0);
                 ASSERT_TRUE(ss.converged) << ss.message;
                 steady += R * ss.force;
-                EXPECT_EQ(r.summary.agonists[i], direction * R > 0);
+                EXPECT_EQ(r.summary.agonists[i], agonist);
             }
             const double last = r.series.get(r.series.getNumRows() - 1, "muscle_torque_Nm");
             EXPECT_NEAR(last, steady, 1e-3 * std::abs(steady)) << deg << " deg, direction " << direction;
         }
+}
+
+// A muscle that does not cross the coordinate has a moment arm of rounding size about it, not zero: it
+// is no agonist either way (arm26's shoulder: BRA, TRIlat and TRImed span the elbow only).
+TEST(OsimIsometricTrial, MusclesThatDoNotCrossTheCoordinateAreNoAgonists) {
+    for (int direction : {1, -1}) {
+        OsimIsometricTrialSettings s;
+        s.coordinate = "r_shoulder_elev";
+        s.angleDeg = 80;
+        s.direction = direction;
+        s.holdDuration = 0.2;
+        s.restDuration = 0.1;
+        s.averagingWindow = 0.1;
+        s.sampleRate = 100;
+        const OsimIsometricTrialResult r = runOsimIsometricTrial(arm26(), s);
+        for (std::size_t i = 0; i < r.summary.muscles.size(); ++i) {
+            const std::string& m = r.summary.muscles[i];
+            if (m == "BRA" || m == "TRIlat" || m == "TRImed") {
+                EXPECT_LT(std::abs(r.summary.momentArms[i]), 1e-12) << m;
+                EXPECT_FALSE(r.summary.agonists[i]) << m << ", direction " << direction;
+            }
+        }
+    }
 }
 
 // Bad settings: the field, the value and what was expected.
@@ -139,6 +163,25 @@ TEST(OsimIsometricTrial, BadSettingsNameTheField) {
     s.coordinate = "";
     EXPECT_NE(errorOf(s).find("name the one to lock"), std::string::npos) << errorOf(s);
     s.coordinate = "r_elbow_flex";
+    OsimModel none = arm26();   // no muscles: nothing to excite
+    none.muscles.clear();
+    try {
+        runOsimIsometricTrial(none, s);
+        ADD_FAILURE() << "a model without muscles ran";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("has no muscles"), std::string::npos) << e.what();
+    }
+    OsimModel locked = arm26();   // a free movement of a coordinate the file locks
+    for (OsimJoint& j : locked.joints)
+        for (OsimCoordinate& c : j.coordinates) c.locked = c.locked || c.name == "r_elbow_flex";
+    OsimFreeMovementSettings f;
+    f.coordinate = "r_elbow_flex";
+    try {
+        runOsimFreeMovement(locked, f);
+        ADD_FAILURE() << "a locked coordinate moved";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("'r_elbow_flex' is locked in"), std::string::npos) << e.what();
+    }
     s.activation = 1.5;
     EXPECT_NE(errorOf(s).find("activation"), std::string::npos) << errorOf(s);
     s.activation = 1;
