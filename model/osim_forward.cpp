@@ -23,6 +23,18 @@ namespace armsim {
 
 namespace {
 
+// The .osim extension in any case (ARM26.OSIM).
+bool hasOsimExtension(const std::string& name) {
+    if (name.size() <= 5) return false;
+    std::string ext = name.substr(name.size() - 5);
+    for (char& ch : ext) ch = char(std::tolower(static_cast<unsigned char>(ch)));
+    return ext == ".osim";
+}
+
+}  // namespace
+
+namespace {
+
 constexpr double kPi = 3.14159265358979323846;
 
 // A muscle's column in a controls file: "<muscle>" or "/forceset/<muscle>".
@@ -42,7 +54,7 @@ OsimStorage readOsimStorage(const std::string& path) {
 }
 
 std::string findOsimModelFile(const std::string& model, const std::string& option) {
-    if (model.find('/') == std::string::npos && !isOsimModel(model)) {
+    if (model.find('/') == std::string::npos && !hasOsimExtension(model)) {
         const std::string asset = getAssetDirectory() + "/models/" + model + ".osim";
         if (!isRegularFile(asset))
             throw InputError(option + " '" + model + "': no shipped OpenSim model assets/models/" + model + ".osim");
@@ -53,11 +65,7 @@ std::string findOsimModelFile(const std::string& model, const std::string& optio
 }
 
 bool isOsimModel(const std::string& name) {
-    if (name.size() > 5) {   // the extension in any case (ARM26.OSIM)
-        std::string ext = name.substr(name.size() - 5);
-        for (char& ch : ext) ch = char(std::tolower(static_cast<unsigned char>(ch)));
-        if (ext == ".osim") return true;
-    }
+    if (hasOsimExtension(name)) return true;
     return name.find('/') == std::string::npos && !doesPathExist(getAssetDirectory() + "/models/" + name + ".yaml") &&
            doesPathExist(getAssetDirectory() + "/models/" + name + ".osim");
 }

@@ -388,7 +388,7 @@ std::vector<BadInput> makeCatalogue() {
         {"FreeTrialLoadHuge", {}, "trial --type free --load 1e6 --out OUT/f.csv", {"--load = 1e+06", "[0, 50] (kg)"}},
         {"ValidateSeedsNegative", {}, "validate --seeds -1 --out OUT/v", {"--seeds = -1", "[0, 1e+06]"}},
         {"ValidateNoisePercentHuge", {}, "validate --noise 60 --out OUT/v", {"--noise = 60", "[0, 50) (%"}},
-        {"ValidateJobsHuge", {}, "validate --jobs 100000 --out OUT/v", {"--jobs", "100000", "1 to 64"}},
+        {"ValidateJobsHuge", {}, "validate --jobs 100000 --out OUT/v", {"--jobs = 100000", "[1, 64]"}},
         {"ModelShowStepZero", {}, "model show --model twin --step 0 --out OUT/ms", {"--step = 0 deg", "[0.01, 90]"}},
         {"ModelShowStepTiny", {}, "model show --model twin --step 1e-6 --out OUT/ms", {"--step = 1e-06 deg", "140000000 angles"}},
         {"StudyNameWithAPath", {{"s.yaml", replaceAll(kStudyHead, "name: bad", "name: ../esc") + "methods:\n  - {method: thesis}\n"}},
