@@ -56,15 +56,20 @@ void runForward(const ForwardOptions& given, CLI::Option* outOption) {
     // An input among the files written into --out would be replaced by an output.
     {
         namespace fs = std::filesystem;
-        std::error_code ec;
         const std::pair<const char*, std::string> inputs[] = {
             {"--model", o.model}, {"--controls", o.controls}, {"--initial-states", o.initialStates}, {"setup file", o.setup}};
         for (const char* written : {"states.sto", "states.csv", "coordinates.png", "activations.png", "index.html"}) {
+            std::error_code ec;
             const fs::path target = fs::weakly_canonical(fs::path(o.out) / written, ec);
-            for (const auto& [what, file] : inputs)
-                if (!file.empty() && fs::weakly_canonical(file, ec) == target)
+            if (ec) continue;   // a path that cannot be resolved is checked when it is written
+            for (const auto& [what, file] : inputs) {
+                std::error_code ecFile;
+                if (file.empty()) continue;
+                const fs::path input = fs::weakly_canonical(file, ecFile);
+                if (!ecFile && input == target)
                     throw InputError(std::string(what) + " '" + file + "' is " + written + " of --out '" + o.out +
                                      "', which forward writes: expected another output folder (it would replace the input)");
+            }
         }
     }
     const OsimModel model = readOsimFile(findOsimModelFile(o.model));

@@ -11,6 +11,7 @@
 
 #include <pthread.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <chrono>
 #include <csignal>
@@ -79,9 +80,11 @@ std::string explainConversion(const CLI::App& app, const std::string& what) {
     const std::size_t eq = what.find(" = ");
     if (what.rfind(prefix, 0) != 0 || eq == std::string::npos) return what;
     const std::string name = what.substr(prefix.size(), eq - prefix.size()), value = what.substr(eq + 3);
+    // The command line's own chain of commands (the parsed ones), innermost last.
     std::vector<const CLI::App*> apps{&app};
     for (std::size_t k = 0; k < apps.size(); ++k)
-        for (const CLI::App* sub : apps[k]->get_subcommands({})) apps.push_back(sub);
+        for (const CLI::App* sub : apps[k]->get_subcommands()) apps.push_back(sub);
+    std::reverse(apps.begin(), apps.end());
     for (const CLI::App* a : apps)
         for (const CLI::Option* o : a->get_options()) {
             if (o->get_name() != name && !o->check_name(name)) continue;

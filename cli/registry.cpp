@@ -204,6 +204,18 @@ LogProgress& logProgress() {
 
 namespace {
 // One progress report: `amount` is "5/10" or "12.3/100 s"; fraction in [0, 1].
+// A log's progress interval [s]: ARMSIM_PROGRESS_SECONDS (a batch system's cadence; the tests' short one),
+// else 10 s.
+double getLogProgressInterval() {
+    static const double interval = [] {
+        const char* v = std::getenv("ARMSIM_PROGRESS_SECONDS");
+        char* end = nullptr;
+        const double x = v ? std::strtod(v, &end) : 0;
+        return v && end != v && *end == '\0' && x >= 1e-3 && x <= 86400 ? x : 10.0;
+    }();
+    return interval;
+}
+
 // quickEndSilent: on a log, no end line for work that ended before its first periodic line.
 void printProgressLine(const std::string& label, double fraction, const std::string& amount, bool finished,
                        bool quickEndSilent = false) {
@@ -212,13 +224,7 @@ void printProgressLine(const std::string& label, double fraction, const std::str
     // A log file gets lines, not a stream of carriage returns: the end, and for long work a line at most
     // every kLogInterval with the share done and the time left at the rate so far (so a batch job's log
     // shows it is alive). A terminal's line is redrawn at most every kTerminalInterval.
-    // ARMSIM_PROGRESS_SECONDS sets the log's interval (a batch system's cadence; the tests' short one).
-    static const double kLogInterval = [] {
-        const char* v = std::getenv("ARMSIM_PROGRESS_SECONDS");
-        char* end = nullptr;
-        const double x = v ? std::strtod(v, &end) : 0;
-        return v && end != v && *end == '\0' && x >= 1e-3 && x <= 86400 ? x : 10.0;
-    }();
+    const double kLogInterval = getLogProgressInterval();
     constexpr double kTerminalInterval = 0.1;  // [s]
     using Clock = std::chrono::steady_clock;
     const bool tty = isatty(fileno(stderr));
@@ -259,6 +265,15 @@ void printProgress(const std::string& label, int done, int total) {
 }
 
 void printTimeProgress(const std::string& label, double t, double duration) {
+    // Called at every sample (up to 1e7): most calls return here, before any formatting or locking.
+    using Clock = std::chrono::steady_clock;
+    static std::atomic<Clock::rep> last{0};
+    const bool finished = t >= duration * (1 - 1e-12);
+    const Clock::rep now = Clock::now().time_since_epoch().count();
+    const double throttle = std::min(0.05, getLogProgressInterval() / 10);   // [s], well below the log's interval
+    if (!finished && now - last.load() < std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(throttle)).count())
+        return;
+    last = now;
     printProgressLine(label, duration > 0 ? t / duration : 1.0, fmt::format("{:.1f}/{} s", t, formatNumber(duration)),
                       t >= duration * (1 - 1e-12), true);
 }

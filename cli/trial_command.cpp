@@ -88,16 +88,28 @@ int renderOsimVideo(const TrialOptions& o, const std::string& path, const OsimMo
 #endif
 }
 
+// An OpenSim model's trial outputs: every file checked and staged before the work, the model read.
+struct OsimTrialOutputs {
+    explicit OsimTrialOutputs(const TrialOptions& o) : osim(findOsimModelFile(o.muscle.model)) {
+        files.addInput("--model", osim);
+        csvPath = files.add("--out", o.out, true);
+        plotPath = files.add("--plot", o.plot);
+        videoPath = files.add("--video", o.video);
+        checkOsimVideo(o, videoPath);
+        model = readOsimFile(osim);
+    }
+    OutputFiles files;
+    std::string osim, csvPath, plotPath, videoPath;
+    OsimModel model;
+};
+
 // An isometric trial of an OpenSim model: --coordinate locked at --angle (its value in deg), the others
 // at their defaults; the muscles that pull it the --effort way excited.
 void runOsimTrialCommand(const TrialOptions& o) {
-    OutputFiles files;
-    const std::string osim = findOsimModelFile(o.muscle.model);
-    files.addInput("--model", osim);
-    const std::string csvPath = files.add("--out", o.out, true), plotPath = files.add("--plot", o.plot),
-                      videoPath = files.add("--video", o.video);
-    checkOsimVideo(o, videoPath);
-    const OsimModel model = readOsimFile(osim);
+    OsimTrialOutputs out(o);
+    OutputFiles& files = out.files;
+    const std::string &osim = out.osim, &csvPath = out.csvPath, &plotPath = out.plotPath, &videoPath = out.videoPath;
+    const OsimModel& model = out.model;
     OsimIsometricTrialSettings s;
     s.coordinate = o.coordinate;
     s.angleDeg = o.angleDeg;
@@ -146,13 +158,10 @@ void runOsimTrialCommand(const TrialOptions& o) {
 // A free movement of an OpenSim model: --coordinate free from --initial-angle (its default when not
 // given), the others held, the muscles pulling the --effort way excited from --onset.
 void runOsimFreeTrialCommand(const TrialOptions& o, bool initialAngleGiven, bool accuracyGiven) {
-    OutputFiles files;
-    const std::string osim = findOsimModelFile(o.muscle.model);
-    files.addInput("--model", osim);
-    const std::string csvPath = files.add("--out", o.out, true), plotPath = files.add("--plot", o.plot),
-                      videoPath = files.add("--video", o.video);
-    checkOsimVideo(o, videoPath);
-    const OsimModel model = readOsimFile(osim);
+    OsimTrialOutputs out(o);
+    OutputFiles& files = out.files;
+    const std::string &osim = out.osim, &csvPath = out.csvPath, &plotPath = out.plotPath, &videoPath = out.videoPath;
+    const OsimModel& model = out.model;
     OsimFreeMovementSettings s;
     s.coordinate = o.coordinate;
     s.initialAngleDeg = initialAngleGiven ? o.initialAngleDeg : kNaN;
@@ -309,7 +318,7 @@ void runTrialCommand(const TrialOptions& o) {
 void addTrialCommand(CLI::App& app) {
     auto o = std::make_shared<TrialOptions>();
     CLI::App* c = app.add_subcommand("trial", "one trial of the arm: isometric (elbow locked) or free movement; of an OpenSim model (.osim), "
-                                       "isometric about one coordinate");
+                                       "either about one coordinate (--coordinate)");
     o->muscle.add(*c);
     o->muscle.addMuscleModel(*c);
     c->add_option("--settings", o->settingsFile,
@@ -321,7 +330,8 @@ void addTrialCommand(CLI::App& app) {
     c->add_option("--rest", o->rest, "isometric: rest before the effort, transducer tared [s]")->capture_default_str();
     c->add_option("--rise", o->rise, "activation ramp time [s] (0 = step)")->capture_default_str();
     c->add_option("--hold", o->hold, "isometric: effort duration [s]")->capture_default_str();
-    c->add_option("--initial-angle", o->initialAngleDeg, "free: elbow angle at t = 0 [deg]")->capture_default_str();
+    c->add_option("--initial-angle", o->initialAngleDeg, "free: elbow angle at t = 0 [deg] (an OpenSim model: "
+                                                        "--coordinate's value, default its default value)")->capture_default_str();
     c->add_option("--initial-velocity", o->initialVelocityDegps, "free: elbow angular velocity at t = 0 [deg/s]");
     c->add_option("--onset", o->onset, "free: activation onset [s]")->capture_default_str();
     c->add_option("--duration", o->duration, "free: simulated time [s]")->capture_default_str();

@@ -267,6 +267,9 @@ OsimForwardResult runOsimForward(const OsimModel& model, const OsimStorage& cont
     };
     result.stats = simulateSampled(arm.getSystem(), s, settings.finalTime - t0, settings.sampleRate, breakpoints,
                                    settings.integration, sample, check);
+    // The sample grid may end short of the final time (its length x rate rounded): the run is done all the same.
+    const double last = result.states.get(result.states.getNumRows() - 1, 0);
+    if (settings.progress && last < settings.finalTime) settings.progress(settings.finalTime - t0, settings.finalTime - t0);
     return result;
 }
 
@@ -309,13 +312,19 @@ OsimForwardSetup readOsimForwardSetup(const std::string& path) {
                                                 "states_file", "ControllerSet", "controls_file"};
     // Output precision, step counts and floors, equilibrium of auxiliary states (armsim solves it when no
     // states file is given), analyses (their own outputs), and force sets or loads left empty.
-    static const std::set<std::string> kHarmless = {"output_precision", "maximum_number_of_integrator_steps",
-                                                    "minimum_integrator_step_size", "integrator_fine_tolerance",
-                                                    "solve_for_equilibrium_for_auxiliary_states", "AnalysisSet",
-                                                    "replace_force_set", "print_every"};
-    static const std::set<std::string> kRefusedWhenSet = {"force_set_files", "external_loads_file",
-                                                          "external_loads_model_kinematics_file",
-                                                          "lowpass_cutoff_frequency_for_load_kinematics", "use_specified_dt"};
+    // OpenSim 2.x's setups add the corrective springs of external loads (their parameters harmless while
+    // the springs are off) and output flags.
+    static const std::set<std::string> kHarmless = {
+        "output_precision", "maximum_number_of_integrator_steps", "minimum_integrator_step_size",
+        "integrator_fine_tolerance", "solve_for_equilibrium_for_auxiliary_states", "AnalysisSet", "print_every",
+        "output_detailed_results", "spring_transition_start_time", "spring_transition_end_time",
+        "spring_linear_stiffness", "spring_linear_damping", "spring_rotational_stiffness", "spring_rotational_damping",
+        "spring_force_threshold", "spring_torque_threshold", "tau"};
+    static const std::set<std::string> kRefusedWhenSet = {
+        "force_set_files", "replace_force_set", "external_loads_file", "external_loads_model_kinematics_file",
+        "lowpass_cutoff_frequency_for_load_kinematics", "use_specified_dt", "external_loads_body1", "external_loads_body2",
+        "body1_linear_corrective_spring_active", "body1_torsional_corrective_spring_active",
+        "body2_linear_corrective_spring_active", "body2_torsional_corrective_spring_active"};
     std::map<std::string, int> seen;   // element -> its first line
     for (const XMLElement* e = tool->FirstChildElement(); e; e = e->NextSiblingElement()) {
         const std::string name = e->Name();
@@ -329,9 +338,10 @@ OsimForwardSetup readOsimForwardSetup(const std::string& path) {
                                (name == "lowpass_cutoff_frequency_for_load_kinematics" && v.find('-') == 0);
             if (unset) continue;
             throw OsimError(where + " '" + v + "': not supported yet (the Forward tool would " +
-                            (name == "use_specified_dt" ? std::string("step at the controls' times")
-                             : name == "force_set_files" ? std::string("add or replace forces")
-                                                         : std::string("apply external loads")) +
+                            (name == "use_specified_dt"                                  ? std::string("step at the controls' times")
+                             : name == "force_set_files" || name == "replace_force_set" ? std::string("add or replace forces")
+                             : name.find("spring") != std::string::npos ? std::string("add corrective springs")
+                                                                        : std::string("apply external loads")) +
                             "; armsim runs the model's own muscles only): remove it to run without");
         }
         throw OsimError(where + ": not an element of OpenSim's Forward tool setup (a misspelling?): expected model_file, "

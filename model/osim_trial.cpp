@@ -4,6 +4,7 @@
 #include "basics/errors.h"
 #include "basics/format.h"
 #include "model/osim_arm.h"
+#include "model/trial.h"
 #include "muscles/simbody_isometric.h"
 
 #include <cmath>
@@ -24,7 +25,12 @@ int findTrialCoordinate(const OsimArm& arm, const std::string& name) {
     for (int i = 0; i < arm.getNumCoordinates(); ++i) names += (i ? ", " : "") + arm.getCoordinate(i).name;
     if (arm.getNumCoordinates() == 0) throw InputError("model " + arm.getModel().name + " has no moving coordinate");
     if (name.empty()) {
-        if (arm.getNumCoordinates() == 1) return 0;
+        if (arm.getNumCoordinates() == 1) {
+            if (!arm.getCoordinate(0).rotational)
+                throw FieldError("coordinate", "'" + arm.getCoordinate(0).name + "' (the model's only one): translational; "
+                                               "expected a rotational coordinate");
+            return 0;
+        }
         if (arm.getNumCoordinates() == 0) throw InputError("model " + arm.getModel().name + " has no moving coordinate");
         throw FieldError("coordinate", "not given: model " + arm.getModel().name + " has " +
                                            std::to_string(arm.getNumCoordinates()) + " coordinates (" + names +
@@ -53,17 +59,7 @@ void OsimIsometricTrialSettings::validate(const OsimArm& arm) const {
                Bound::closed(std::round(range[0] / kDeg * 1e6) / 1e6, std::round(range[1] / kDeg * 1e6) / 1e6, "deg"));
     if (direction != 1 && direction != -1)
         throw FieldError("direction", "= " + std::to_string(direction) + ": expected +1 or -1");
-    checkField("activation", activation, Bound::closed(0, 1));
-    checkField("antagonist_activation", antagonistActivation, Bound::closed(0, 1));
-    checkField("rest", restDuration, Bound::positive("s"));
-    checkField("rise", riseTime, Bound::nonNegative("s"));
-    checkField("hold", holdDuration, Bound::positive("s"));
-    checkField("sample_rate", sampleRate, Bound::positive("Hz"));
-    checkField("averaging_window", averagingWindow, Bound::closed(0, holdDuration, "s"));
-    if (averagingWindow * sampleRate < 1)
-        throw FieldError("averaging_window", "= " + formatNumber(averagingWindow) + " s holds no sample at " +
-                                                 formatNumber(sampleRate) + " Hz: expected at least one sample interval");
-    calcNumSamples(getDuration(), sampleRate);
+    checkIsometricEffort(activation, antagonistActivation, restDuration, riseTime, holdDuration, sampleRate, averagingWindow);
     integration.validate();
 }
 
@@ -191,32 +187,24 @@ void OsimFreeMovementSettings::validate(const OsimArm& arm) const {
 
 Table runOsimFreeMovement(const OsimModel& file, const OsimFreeMovementSettings& settings, IntegrationStats* stats) {
     OsimModel model = file;
-    int j;
+    std::string coordinate;
     std::vector<bool> agonists;
     {   // the settings checked, and the agonists found at the start pose
         const OsimArm probe(model, {}, settings.muscleModel);
         settings.validate(probe);
-        j = findTrialCoordinate(probe, settings.coordinate);
+        const int j = findTrialCoordinate(probe, settings.coordinate);
+        coordinate = probe.getCoordinate(j).name;
         SimTK::State s = probe.getDefaultState();
         if (!std::isnan(settings.initialAngleDeg)) probe.setCoordinateValue(s, j, settings.initialAngleDeg * kDeg);
         probe.getSystem().realize(s, SimTK::Stage::Position);
         for (int i = 0; i < probe.getNumMuscles(); ++i)
             agonists.push_back(isOsimAgonist(settings.direction, probe.calcMomentArm(s, i, j)));
     }
-    const std::string coordinate = [&] {
-        int k = 0;
-        for (OsimJoint& joint : model.joints)
-            for (OsimCoordinate& c : joint.coordinates)
-                if (k++ == j) return c.name;
-        return std::string();
-    }();
-    // The other coordinates held at their defaults; the free one starts where asked.
+    // The other coordinates held at their defaults (the model's default pose, which also places the
+    // wraps, is unchanged); the free one starts where asked, in the state.
     for (OsimJoint& joint : model.joints)
-        for (OsimCoordinate& c : joint.coordinates) {
+        for (OsimCoordinate& c : joint.coordinates)
             if (c.name != coordinate) c.locked = true;
-            else if (!std::isnan(settings.initialAngleDeg)) c.defaultValue = settings.initialAngleDeg * kDeg, c.locked = false;
-            else c.locked = false;
-        }
     const ActivationProfile agonist = settings.rise > 0
         ? ActivationProfile::ramp(settings.onset, settings.onset + settings.rise, 0.0, settings.activation)
         : ActivationProfile::step(settings.onset, 0.0, settings.activation);
@@ -227,6 +215,7 @@ Table runOsimFreeMovement(const OsimModel& file, const OsimFreeMovementSettings&
     const int free = arm.findCoordinate(coordinate);
     const int n = arm.getNumMuscles();
     SimTK::State s = arm.getDefaultState();
+    if (!std::isnan(settings.initialAngleDeg)) arm.setCoordinateValue(s, free, settings.initialAngleDeg * kDeg);
     arm.setCoordinateSpeed(s, free, settings.initialVelocityDegps * kDeg);
     arm.getSystem().realize(s, SimTK::Stage::Velocity);
     for (int i = 0; i < n; ++i) arm.getMuscleForce(i).setSteadyMuscleStates(s);   // equilibrium at U(0)
@@ -257,6 +246,8 @@ Table runOsimFreeMovement(const OsimModel& file, const OsimFreeMovementSettings&
     };
     const IntegrationStats st = simulateSampled(arm.getSystem(), s, settings.duration, settings.sampleRate,
                                                 agonist.getBreakpoints(), settings.integration, sample, check);
+    // The sample grid may end short of the duration (duration x rate rounded): the run is done all the same.
+    if (settings.progress && t.get(t.getNumRows() - 1, 0) < settings.duration) settings.progress(settings.duration);
     if (stats) *stats = st;
     return t;
 }

@@ -116,15 +116,20 @@ void IsometricTrialSettings::validate(const ArmParameters& arm) const {
     if (isForearmEffort(effort) && !arm.forearmRotation.enabled)
         throw FieldError("effort", std::string("= ") + getEffortName(effort) +
                                        ": the model's arm has no forearm rotation (expected flexion or extension)");
+    checkIsometricEffort(activation, antagonistActivation, restDuration, riseTime, holdDuration, sampleRate, averagingWindow);
+    integration.validate();
+}
+
+void checkIsometricEffort(double activation, double antagonistActivation, double rest, double rise, double hold,
+                          double sampleRate, double averagingWindow) {
     checkField("activation", activation, Bound::closed(0, 1));
     checkField("antagonist_activation", antagonistActivation, Bound::closed(0, 1));
-    checkField("rest", restDuration, Bound::positive("s"));
-    checkField("rise", riseTime, Bound::nonNegative("s"));
-    checkField("hold", holdDuration, Bound::positive("s"));
+    checkField("rest", rest, Bound::positive("s"));
+    checkField("rise", rise, Bound::nonNegative("s"));
+    checkField("hold", hold, Bound::positive("s"));
     checkField("sample_rate", sampleRate, Bound::positive("Hz"));
-    checkField("averaging_window", averagingWindow, {0, holdDuration, true, false, "s, within the hold"});
-    calcNumSamples(getDuration(), sampleRate);
-    integration.validate();
+    checkField("averaging_window", averagingWindow, {0, hold, true, false, "s, within the hold"});
+    calcNumSamples(rest + rise + hold, sampleRate);
 }
 
 namespace {

@@ -93,6 +93,13 @@ struct IsometricTrialSettings {
     double getDuration() const { return restDuration + riseTime + holdDuration; }
 };
 
+/// The checks every isometric trial's effort and timing share (IsometricTrialSettings::validate and
+/// OpenSim models' trials): activations in [0, 1], rest and hold > 0, rise >= 0, a positive sample rate,
+/// a window in (0, hold] (its mean takes the last sample at least), and the run's sample count. FieldError naming the
+/// field (activation, antagonist_activation, rest, rise, hold, sample_rate, averaging_window).
+void checkIsometricEffort(double activation, double antagonistActivation, double rest, double rise, double hold,
+                          double sampleRate, double averagingWindow);
+
 /// Summary of an isometric trial, averaged over the last averagingWindow of the hold.
 struct IsometricSummary {
     double elbowAngle = 0;          ///< theta [rad]

@@ -221,23 +221,13 @@ OsimVideoResult renderOsimTrialVideo(const OsimModel& model, const Table& table,
     const double t0 = table.get(0, "time_s"), t1 = table.get(table.getNumRows() - 1, "time_s");
     if (settings.stillTime) checkField("still_at", *settings.stillTime, Bound::closed(t0, t1, "s, within the trial"));
     OsimVideoResult result;
-    VideoWriter writer;
-    if (!settings.videoPath.empty())
-        writer.open(settings.videoPath, {settings.fps, settings.render.width, settings.render.height, settings.codec});
-    if (settings.stillTime) {
-        writePng(settings.stillPath, renderer.renderRow(renderer.findRow(*settings.stillTime)));
-        result.stillPath = settings.stillPath;
-    }
-    if (!writer.isOpen()) return result;
-    const int n = renderer.getNumFrames();
-    for (int k = 0; k < n; ++k) {
-        checkInterruption();   // Ctrl-C: the writer's destructor removes the partial video
-        writer.write(renderer.renderRow(renderer.findRow(renderer.getFrameTime(k))));
-        if (progress) progress(k + 1, n);
-    }
-    writer.close();
-    result.frames = n;
-    result.videoPath = settings.videoPath;
+    result.frames = writeTrialVideoAndStill(
+        settings.videoPath, {settings.fps, settings.render.width, settings.render.height, settings.codec},
+        renderer.getNumFrames(), [&](int k) { return renderer.findRow(renderer.getFrameTime(k)); }, settings.stillPath,
+        settings.stillTime ? renderer.findRow(*settings.stillTime) : -1, [&](int row) { return renderer.renderRow(row); },
+        progress);
+    if (settings.stillTime) result.stillPath = settings.stillPath;
+    if (!settings.videoPath.empty()) result.videoPath = settings.videoPath;
     return result;
 }
 

@@ -1,6 +1,7 @@
 #include "render/video.h"
 
 #include "basics/bound.h"
+#include "basics/errors.h"
 
 #include <png.h>
 
@@ -459,6 +460,22 @@ void writePng(const std::string& path, const cv::Mat& frame) {
         removeQuietly(temporary);
         throw InputError("image file '" + path + "': cannot be written: " + (ec ? ec.message() : failure));
     }
+}
+
+int writeTrialVideoAndStill(const std::string& videoPath, const VideoSettings& video, int frames,
+                            const std::function<int(int)>& rowOfFrame, const std::string& stillPath, int stillRow,
+                            const std::function<cv::Mat(int)>& render, const std::function<void(int, int)>& progress) {
+    VideoWriter writer;
+    if (!videoPath.empty()) writer.open(videoPath, video);   // checked before the still is drawn
+    if (stillRow >= 0) writePng(stillPath, render(stillRow));
+    if (!writer.isOpen()) return 0;
+    for (int k = 0; k < frames; ++k) {
+        checkInterruption();   // Ctrl-C: the writer's destructor removes the partial video
+        writer.write(render(rowOfFrame(k)));
+        if (progress) progress(k + 1, frames);
+    }
+    writer.close();
+    return frames;
 }
 
 }  // namespace armsim

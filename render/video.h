@@ -6,6 +6,7 @@
 
 #include <opencv2/core.hpp>
 
+#include <functional>
 #include <memory>
 #include <string>
 
@@ -62,6 +63,13 @@ private:
     struct Impl;
     std::unique_ptr<Impl> impl_;
 };
+
+/// A replayed trial's video and still: the still (stillRow >= 0) to stillPath, then, when videoPath is
+/// not empty, `frames` frames, frame k drawn by render(rowOfFrame(k)), with a stop checked before each
+/// (Ctrl-C: the partial video is removed) and progress(k + 1, frames) after. Returns the frames written.
+int writeTrialVideoAndStill(const std::string& videoPath, const VideoSettings& video, int frames,
+                            const std::function<int(int)>& rowOfFrame, const std::string& stillPath, int stillRow,
+                            const std::function<cv::Mat(int)>& render, const std::function<void(int, int)>& progress);
 
 /// Writes frame (CV_8UC1, CV_8UC3 BGR or CV_8UC4 BGRA) to a .png path atomically (temporary, then
 /// rename). Throws InputError naming the path for a wrong extension, missing or unwritable

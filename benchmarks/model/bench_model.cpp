@@ -5,6 +5,7 @@
 #include "model/muscle_arm.h"
 #include "model/mvc_curve.h"
 #include "model/osim_forward.h"
+#include "model/osim_trial.h"
 #include "model/trial.h"
 
 #include <benchmark/benchmark.h>
@@ -280,5 +281,40 @@ void BM_Arm26Forward(benchmark::State& state, const char* muscleModel) {
 }
 BENCHMARK_CAPTURE(BM_Arm26Forward, thelen2003_opensim2, "thelen2003_opensim2")->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_Arm26Forward, thelen2003, "")->Unit(benchmark::kMillisecond);
+
+// arm26's isometric trial (model/osim_trial.h): the elbow locked at 80 deg, 0.5 s rest and a 3 s flexion
+// effort sampled at 1000 Hz, as the armsim models' MVC benchmarks; the model read once, each iteration
+// builds the System for the geometry and integrates the six muscles at their fixed paths.
+void BM_Arm26IsometricTrial(benchmark::State& state) {
+    const OsimModel model = readOsimFile(std::string(ARMSIM_ASSET_DIR) + "/models/arm26.osim");
+    OsimIsometricTrialSettings s;
+    s.coordinate = "r_elbow_flex";
+    s.angleDeg = 80;
+    int steps = 0;
+    for (auto _ : state) {
+        const OsimIsometricTrialResult r = runOsimIsometricTrial(model, s);
+        steps = r.summary.stats.steps;
+        benchmark::DoNotOptimize(r.summary.meanTaredTorque);
+    }
+    state.counters["steps"] = steps;
+}
+BENCHMARK(BM_Arm26IsometricTrial)->Unit(benchmark::kMillisecond);
+
+// arm26's free trial: the elbow from 20 deg, the flexors at 0.2 from 0.2 s, 1 s at 200 Hz (CPodes 1e-5).
+void BM_Arm26FreeTrial(benchmark::State& state) {
+    const OsimModel model = readOsimFile(std::string(ARMSIM_ASSET_DIR) + "/models/arm26.osim");
+    OsimFreeMovementSettings s;
+    s.coordinate = "r_elbow_flex";
+    s.initialAngleDeg = 20;
+    s.activation = 0.2;
+    s.duration = 1;
+    IntegrationStats stats;
+    for (auto _ : state) {
+        const Table t = runOsimFreeMovement(model, s, &stats);
+        benchmark::DoNotOptimize(t.getNumRows());
+    }
+    state.counters["steps"] = stats.steps;
+}
+BENCHMARK(BM_Arm26FreeTrial)->Unit(benchmark::kMillisecond);
 
 }  // namespace

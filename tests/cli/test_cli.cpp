@@ -747,6 +747,12 @@ TEST(Cli, ProgressReachesALogFileWhileTheWorkRuns) {
     const std::regex line(R"(forward: [0-9.]+/1 s \([0-9]+ %\) after [0-9]+s, (about [0-9]+s left|time left unknown))");
     EXPECT_TRUE(std::regex_search(r.output, line)) << r.output;
     EXPECT_NE(r.output.find("forward: 1.0/1 s done"), std::string::npos) << r.output;
+    // A run whose sample grid ends short of its final time (1.232 s at 200 Hz: the last row at 1.23 s) ends too.
+    const CommandResult shortGrid = armsim::testing::runCommand(
+        "ARMSIM_PROGRESS_SECONDS=0.001 " + std::string(ARMSIM_EXE) + " forward --model arm26 --controls " + data +
+        "arm26_controls.sto --final-time 1.232 --out " + (d / "h").string());
+    ASSERT_EQ(shortGrid.exitCode, 0) << shortGrid.output;
+    EXPECT_NE(shortGrid.output.find("forward: 1.2/1.232 s done"), std::string::npos) << shortGrid.output;
     // Without the variable a 1 s run (tens of ms) prints no progress line in a log.
     const CommandResult quiet = runArmsim("forward --model arm26 --controls " + data + "arm26_controls.sto --final-time 1 --out " +
                                           (d / "g").string());

@@ -224,13 +224,18 @@ TEST(OsimForward, ForwardToolSetupFile) {
     const OsimForwardSetup skipped = readOsimForwardSetup(withElements(
         "<output_precision>8</output_precision><maximum_integrator_step_size>0.01</maximum_integrator_step_size>\n"
         "<AnalysisSet name=\"Analyses\"><objects/></AnalysisSet><external_loads_file>Unassigned</external_loads_file>\n"
-        "<force_set_files/><replace_force_set>false</replace_force_set>\n"));
+        "<force_set_files/><replace_force_set>false</replace_force_set>\n"
+        "<output_detailed_results>false</output_detailed_results><body1_linear_corrective_spring_active>false"
+        "</body1_linear_corrective_spring_active><spring_linear_stiffness>10</spring_linear_stiffness>\n"));
     EXPECT_EQ(skipped.maxStepSize, 0.01);
     EXPECT_EQ(s.maxStepSize, 1.0);  // OpenSim's default
     const std::pair<std::string, std::string> refused[] = {
         {"<final_tme>2</final_tme>\n", ":12: <final_tme>: not an element of OpenSim's Forward tool setup"},
         {"<external_loads_file>grf.xml</external_loads_file>\n", ":12: <external_loads_file> 'grf.xml': not supported yet"},
         {"<use_specified_dt>true</use_specified_dt>\n", ":12: <use_specified_dt> 'true': not supported yet"},
+        {"<replace_force_set>true</replace_force_set>\n", ":12: <replace_force_set> 'true': not supported yet (the Forward tool would add or replace forces"},
+        {"<body1_linear_corrective_spring_active>true</body1_linear_corrective_spring_active>\n",
+         ":12: <body1_linear_corrective_spring_active> 'true': not supported yet (the Forward tool would add corrective springs"},
         {"<maximum_integrator_step_size>0</maximum_integrator_step_size>\n", ":12: <maximum_integrator_step_size> 0: expected > 0 s"}};
     for (const auto& [elements, message] : refused) {
         try {
