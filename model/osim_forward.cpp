@@ -273,40 +273,20 @@ OsimForwardResult runOsimForward(const OsimModel& model, const OsimStorage& cont
     return result;
 }
 
-OsimForwardSetup readOsimForwardSetup(const std::string& path) {
-    using namespace tinyxml2;
-    if (!isRegularFile(path)) throw InputError(path + ": no such Forward tool setup file");
-    XMLDocument doc;
-    if (doc.LoadFile(path.c_str()) != XML_SUCCESS)
-        throw OsimError(path + ":" + std::to_string(doc.ErrorLineNum()) + ": not XML: " + doc.ErrorStr());
-    const XMLElement* root = doc.RootElement();
-    const XMLElement* tool = root ? (std::string(root->Name()) == "ForwardTool" ? root : root->FirstChildElement("ForwardTool")) : nullptr;
-    if (!tool) throw OsimError(path + ": no <ForwardTool>: expected an OpenSim Forward tool setup file");
-    const std::string folder = std::filesystem::path(path).parent_path().string();
-    auto text = [&](const XMLElement* e, const char* tag) {
-        const XMLElement* c = e->FirstChildElement(tag);
-        std::string v = c && c->GetText() ? c->GetText() : "";
-        const std::size_t b = v.find_first_not_of(" \t\r\n");
-        return b == std::string::npos ? std::string() : v.substr(b, v.find_last_not_of(" \t\r\n") - b + 1);
-    };
-    auto file = [&](const std::string& name) {
-        if (name.empty()) return name;
-        const std::filesystem::path p(name);
-        return p.is_absolute() || folder.empty() ? name : (std::filesystem::path(folder) / p).string();
-    };
-    auto number = [&](const char* tag, double fallback) {
-        const std::string v = text(tool, tag);
-        if (v.empty()) return fallback;
-        // The whole text a finite decimal number ("0.2abc" and hexadecimal "0x1p-2" are not).
-        char* end = nullptr;
-        const double x = std::strtod(v.c_str(), &end);
-        if (end == v.c_str() || *end != '\0' || !std::isfinite(x) || v.find_first_of("xX") != std::string::npos)
-            throw OsimError(path + ":" + std::to_string(tool->FirstChildElement(tag)->GetLineNum()) + ": <" + tag + "> '" + v +
-                            "': expected a number");
-        return x;
-    };
-    // Every element of the tool is one it uses, one that cannot change the states (skipped), or one
-    // refused by name: a misspelt or unsupported element is never passed over silently.
+namespace {
+
+// An element's text without surrounding white space ("" when absent).
+std::string elementText(const tinyxml2::XMLElement* e, const char* tag) {
+    const tinyxml2::XMLElement* c = e->FirstChildElement(tag);
+    std::string v = c && c->GetText() ? c->GetText() : "";
+    const std::size_t b = v.find_first_not_of(" \t\r\n");
+    return b == std::string::npos ? std::string() : v.substr(b, v.find_last_not_of(" \t\r\n") - b + 1);
+}
+
+// Every element of <ForwardTool> is one readOsimForwardSetup uses, one that cannot change the states
+// (skipped), or one refused naming its line; none twice.
+void checkForwardToolElements(const tinyxml2::XMLElement* tool, const std::string& path) {
+    using tinyxml2::XMLElement;
     static const std::set<std::string> kUsed = {"model_file", "results_directory", "initial_time", "final_time",
                                                 "integrator_error_tolerance", "maximum_integrator_step_size",
                                                 "states_file", "ControllerSet", "controls_file"};
@@ -333,7 +313,7 @@ OsimForwardSetup readOsimForwardSetup(const std::string& path) {
             throw OsimError(where + ": given twice (first at line " + std::to_string(it->second) + "): expected once");
         if (kUsed.count(name) || kHarmless.count(name)) continue;
         if (kRefusedWhenSet.count(name)) {
-            const std::string v = text(tool, name.c_str());
+            const std::string v = elementText(tool, name.c_str());
             const bool unset = v.empty() || v == "Unassigned" || v == "false" ||
                                (name == "lowpass_cutoff_frequency_for_load_kinematics" && v.find('-') == 0);
             if (unset) continue;
@@ -348,6 +328,38 @@ OsimForwardSetup readOsimForwardSetup(const std::string& path) {
                                 "results_directory, initial_time, final_time, integrator_error_tolerance, states_file, "
                                 "ControllerSet or another ForwardTool property");
     }
+}
+
+}  // namespace
+
+OsimForwardSetup readOsimForwardSetup(const std::string& path) {
+    using namespace tinyxml2;
+    if (!isRegularFile(path)) throw InputError(path + ": no such Forward tool setup file");
+    XMLDocument doc;
+    if (doc.LoadFile(path.c_str()) != XML_SUCCESS)
+        throw OsimError(path + ":" + std::to_string(doc.ErrorLineNum()) + ": not XML: " + doc.ErrorStr());
+    const XMLElement* root = doc.RootElement();
+    const XMLElement* tool = root ? (std::string(root->Name()) == "ForwardTool" ? root : root->FirstChildElement("ForwardTool")) : nullptr;
+    if (!tool) throw OsimError(path + ": no <ForwardTool>: expected an OpenSim Forward tool setup file");
+    const std::string folder = std::filesystem::path(path).parent_path().string();
+    auto text = [](const XMLElement* e, const char* tag) { return elementText(e, tag); };
+    auto file = [&](const std::string& name) {
+        if (name.empty()) return name;
+        const std::filesystem::path p(name);
+        return p.is_absolute() || folder.empty() ? name : (std::filesystem::path(folder) / p).string();
+    };
+    auto number = [&](const char* tag, double fallback) {
+        const std::string v = text(tool, tag);
+        if (v.empty()) return fallback;
+        // The whole text a finite decimal number ("0.2abc" and hexadecimal "0x1p-2" are not).
+        char* end = nullptr;
+        const double x = std::strtod(v.c_str(), &end);
+        if (end == v.c_str() || *end != '\0' || !std::isfinite(x) || v.find_first_of("xX") != std::string::npos)
+            throw OsimError(path + ":" + std::to_string(tool->FirstChildElement(tag)->GetLineNum()) + ": <" + tag + "> '" + v +
+                            "': expected a number");
+        return x;
+    };
+    checkForwardToolElements(tool, path);
     OsimForwardSetup s;
     s.modelFile = file(text(tool, "model_file"));
     if (s.modelFile.empty())
