@@ -101,7 +101,19 @@ std::shared_ptr<const MuscleModel> makeMuscle(const OsimModel& model, const Osim
     try {
         return std::make_shared<Muscle>(p);
     } catch (const FieldError& e) {
-        throw OsimError(where(model, mu.line, "<" + mu.type + " name=\"" + mu.name + "\">") + e.what());
+        // The model's field ("muscle 'BIClong': pennation_angle") as the file's element, at its line.
+        static const std::map<std::string, std::string> kElement = {
+            {"pennation_angle", "pennation_angle_at_optimal"}, {"vmax", "max_contraction_velocity"},
+            {"fmax_tendon_strain", "FmaxTendonStrain"}, {"fmax_muscle_strain", "FmaxMuscleStrain"},
+            {"kshape_active", "KshapeActive"}, {"kshape_passive", "KshapePassive"}, {"af", "Af"}, {"flen", "Flen"}};
+        const std::string& field = e.getField();
+        std::string element = field.substr(field.rfind(": ") == std::string::npos ? 0 : field.rfind(": ") + 2);
+        if (const auto it = kElement.find(element); it != kElement.end()) element = it->second;
+        const auto line = mu.propertyLines.find(element);
+        const std::string what = e.what(), value = what.substr(what.find("' ") == std::string::npos ? 0 : what.find("' ") + 2);
+        if (line == mu.propertyLines.end())
+            throw OsimError(where(model, mu.line, "<" + mu.type + " name=\"" + mu.name + "\">") + element + " (default) " + value);
+        throw OsimError(model.file + ":" + std::to_string(line->second) + ": <" + element + "> (muscle '" + mu.name + "') " + value);
     }
 }
 

@@ -472,6 +472,7 @@ private:
             within("tendon_slack_length", mu.tendonSlackLength, bounds::kTendonLength);
             for (const std::string& p : props->second)
                 if (f->FirstChildElement(p.c_str())) mu.properties[p] = number(f, p.c_str());
+            for (const XMLElement* e = f->FirstChildElement(); e; e = e->NextSiblingElement()) mu.propertyLines[e->Name()] = e->GetLineNum();
             if (const std::string mode = text(f, "tendon_compliance_dynamics_mode"); !mode.empty() && mode != "explicit")
                 fail(child(f, "tendon_compliance_dynamics_mode"), "'" + mode + "': expected explicit (implicit is for direct collocation)");
             if (flag(f, "ignore_tendon_compliance", false))

@@ -143,6 +143,9 @@ struct OsimMuscle {
     /// The model's other numeric properties as the file gives them (OpenSim's names, e.g.
     /// "FmaxTendonStrain", "activation_time_constant"); absent ones take the model's defaults.
     std::map<std::string, double> properties;
+    /// The line of each numeric property element the file gives (OpenSim's names, max_isometric_force etc.
+    /// included), for messages about its value.
+    std::map<std::string, int> propertyLines;
     std::vector<OsimPathPoint> path;
     std::vector<OsimPathWrap> wraps;
     bool appliesForce = true;
