@@ -196,7 +196,14 @@ void runIdentify(const IdentifyOptions& o) {
         const bool started = std::any_of(o.starts.begin(), o.starts.end(), [&](const std::string& x) {
             return parseParameter("--start", splitAssignment("--start", x).first) == parseParameter("--free", name);
         });   // --start tendon_length=... names optimal_tendon_length too
-        if (what == "lower" || what == "upper") throw InputError("--bounds " + name + " " + what + " " + e.getDetail());
+        if (what == "lower" || what == "upper") {
+            const bool bounded = std::any_of(o.bounds.begin(), o.bounds.end(), [&](const std::string& b) {
+                return parseParameter("--bounds", splitAssignment("--bounds", b).first) == parseParameter("--free", name);
+            });
+            throw InputError((bounded ? "--bounds " + name + " " + what
+                                      : "the default " + what + " bound of " + name + " (give --bounds " + name + "=LO:HI)") +
+                             " " + e.getDetail());
+        }
         if (what == "start")
             throw InputError((started ? "--start " + name : "the default start of " + name + " (give --start " + name +
                                                                 "=VALUE inside --bounds)") + " " + e.getDetail());

@@ -204,8 +204,9 @@ IdentificationReport identify(const IdentificationProblem& problem, const ForceM
                          formatNumber(problem.base.maxPathLength, 8) + " m of muscle '" + problem.base.name +
                          "': expected paths no longer than the anatomical limit");
     if (pmax != unknowns.end() && pmax->lower < maxPath)
-        throw InputError("unknowns.max_path_length.lower = " + formatNumber(pmax->lower, 8) + " m: expected >= the longest path " +
-                         formatNumber(maxPath, 8) + " m (" + data.where(maxPathIndex) + ")");
+        throw FieldError("unknowns.max_path_length.lower", "= " + formatNumber(pmax->lower, 8) +
+                                                               " m: expected >= the longest path " + formatNumber(maxPath, 8) +
+                                                               " m (" + data.where(maxPathIndex) + ")");
 
     if (options.method == Method::LevenbergMarquardt && options.noise == NoiseModel::Relative)
         for (int k = 0; k < n; ++k)
