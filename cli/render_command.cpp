@@ -6,6 +6,7 @@
 #include "cli/commands.h"
 #include "cli/plugins.h"
 #include "model/geometry.h"
+#include "model/osim_forward.h"
 #include "model/trial.h"
 #include "muscles/muscle_file.h"
 
@@ -37,6 +38,49 @@ struct RenderOptions {
     CLI::Option* widthOption = nullptr;
     CLI::Option* heightOption = nullptr;
 };
+
+// armsim render of an OpenSim model's trial table (--model FILE.osim): render/osim_video.h. The arm
+// scene's options (hand load, arrow, floor, colouring) do not apply and are refused by the caller.
+void runOsimRenderCommand(const RenderOptions& o) {
+    OsimVideoSettings v;
+    v.render.width = o.width;
+    v.render.height = o.height;
+    v.render.supersample = o.supersample;
+    v.fps = o.fps;
+    v.codec = o.codec;
+    v.playbackSpeed = o.speed;
+    v.overlay = !o.noOverlay;
+    if (o.stillAtOption->count()) v.stillTime = o.stillAt;
+    v.tableName = o.table;
+    v.muscleModel = o.muscle.muscleModel;
+    if (o.out.empty() && !v.stillTime)
+        throw InputError("armsim render: nothing to write: expected --out VIDEO and/or --still-at T --still FILE.png");
+    v.videoPath = o.out;
+    v.stillPath = o.still;
+    runNamingOptions({{"fps", "--fps"}, {"codec", "--codec"}, {"playback_speed", "--speed"}, {"still_at", "--still-at"},
+                      {"still", "--still"}, {"width", "--width"}, {"height", "--height"}, {"supersample", "--supersample"}},
+                     [&] { getRenderPlugin("render").validateOsim(v); });   // before the table is read
+    OutputFiles files;
+    const std::string osim = findOsimModelFile(o.muscle.model);
+    files.addInput("--model", osim);
+    files.addInput("the trial-table argument", o.table);
+    v.videoPath = files.add("--out", o.out);
+    v.stillPath = files.add("--still", o.still);
+    const OsimModel model = readOsimFile(osim);
+    const Table table = Table::readCsv(o.table);
+    OsimVideoResult r;
+    files.writeWith(v.videoPath.empty() ? v.stillPath : v.videoPath, [&](const std::string&) {
+        runNamingOptions({{"still_at", "--still-at"}}, [&] {
+            r = getRenderPlugin("render").renderOsimTrialVideo(model, table, v,
+                                                               [](int d, int n) { printProgress("rendering", d, n); });
+        });
+    });
+    files.commit();
+    if (!r.stillPath.empty()) std::printf("wrote %s (still at t = %.3f s)\n", o.still.c_str(), *v.stillTime);
+    if (!r.videoPath.empty())
+        std::printf("wrote %s (%d frames, %dx%d, %g fps, %s)\n", o.out.c_str(), r.frames, v.render.width, v.render.height,
+                    v.fps, v.codec.c_str());
+}
 
 void runRenderCommand(const RenderOptions& o) {
     TrialVideoSettings v;
@@ -97,7 +141,8 @@ void runRenderCommand(const RenderOptions& o) {
 void addRenderCommand(CLI::App& app) {
     auto o = std::make_shared<RenderOptions>();
     CLI::App* c = app.add_subcommand("render", "video and/or PNG still of a recorded trial table (armsim trial CSV)");
-    c->add_option("table", o->table, "trial table written by armsim trial (CSV with state_* columns)")
+    c->add_option("table", o->table, "trial table written by armsim trial (CSV with state_* columns; an OpenSim "
+                                     "model's: with --model FILE.osim)")
         ->required()->check(CLI::ExistingFile);
     c->add_option("--out", o->out, "video file: .mp4 (h264) or .avi (mjpg)");
     c->add_option("--fps", o->fps, "video frames per second")->capture_default_str();
@@ -124,7 +169,24 @@ void addRenderCommand(CLI::App& app) {
     c->add_flag("--no-floor", o->noFloor, "no floor (with 10 cm ticks)");
     c->add_flag("--no-overlay", o->noOverlay, "no text panel and plots");
     o->muscle.add(*c);
-    c->callback([o] { runRenderCommand(*o); });
+    o->muscle.addMuscleModel(*c);
+    c->callback([o, c] {
+        if (isOsimModel(o->muscle.model)) {
+            for (const char* name : {"--render-settings", "--color-by", "--fixed-thickness", "--arrow", "--arrow-scale", "--load",
+                                     "--no-floor", "--muscle", "--arm", "--slow-units", "--fast-units", "--mass",
+                                     "--tendon-length", "--max-path"})
+                if (c->count(name) > 0)
+                    throw InputError(std::string(name) + " with the OpenSim model '" + o->muscle.model +
+                                     "': not for .osim models (their videos take --out, --fps, --width, --height, --codec, "
+                                     "--speed, --supersample, --still-at, --still, --no-overlay)");
+            runOsimRenderCommand(*o);
+            return;
+        }
+        if (c->count("--muscle-model") > 0)
+            throw InputError("--muscle-model: only for OpenSim models here (an armsim model's trial table records its "
+                             "own muscles' states)");
+        runRenderCommand(*o);
+    });
 }
 
 /// Main job: one MVC video of the anatomical twin (isometric at 90 deg, the virtual subject's

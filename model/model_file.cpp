@@ -378,7 +378,7 @@ ArmSetup loadModel(const std::string& nameOrFile) {
     std::string file = nameOrFile;
     const bool looksLikeName = nameOrFile.find('/') == std::string::npos &&
                                nameOrFile.find(".yaml") == std::string::npos;
-    const std::string osimNote = "an OpenSim model: `armsim forward`, `armsim trial`, `armsim model show` and Python's "
+    const std::string osimNote = "an OpenSim model: `armsim forward`, `armsim trial`, `armsim model show`, `armsim render` and Python's "
                                  "armsim.forward, armsim.isometric_trial and armsim.free_movement take .osim files; "
                                  "this command takes an armsim model file (.yaml) yet";
     if (looksLikeName) {

@@ -230,7 +230,7 @@ struct TrialRenderer::Impl {
             if (!table.hasColumn(c))
                 throw InputError(name + " has no column '" + std::string(c) +
                                  "': expected a table written by armsim trial of an armsim model (an OpenSim model's "
-                                 "trial is rendered by `armsim trial --model FILE.osim ... --video`)");
+                                 "trial table: armsim render TABLE --model FILE.osim)");
         if (table.getNumRows() < 1) throw InputError(name + " has no rows: expected at least one sample");
         time = table.getColumn("time_s");
         angleDeg = table.getColumn("elbow_angle_deg");

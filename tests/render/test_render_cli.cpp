@@ -6,6 +6,8 @@
 
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
+
+#include <filesystem>
 #include <opencv2/videoio.hpp>
 
 #include <algorithm>
@@ -153,4 +155,21 @@ TEST(RenderCli, OsimTrialVideos) {
                                         "--rate 100 --out " + dir.file("i.csv") + " --video " + dir.file("i.mp4"));
     ASSERT_EQ(iso.exitCode, 0) << iso.output;
     EXPECT_EQ(probe(dir.file("i.mp4")).frames, expectedFrames(0.5, 30));
+    // The saved table rendered again (armsim render TABLE --model arm26), with a still; the arm scene's
+    // options refused by name, and the table refused without the model it belongs to.
+    const CommandResult again = runArmsim("render " + dir.file("f.csv") + " --model arm26 --out " + dir.file("r.mp4") +
+                                          " --fps 20 --width 320 --height 240 --still-at 0.2 --still " + dir.file("s.png"));
+    ASSERT_EQ(again.exitCode, 0) << again.output;
+    const VideoInfo rv = probe(dir.file("r.mp4"));
+    EXPECT_EQ(rv.frames, expectedFrames(0.3, 20));
+    EXPECT_EQ(rv.size, cv::Size(320, 240));
+    EXPECT_EQ(cv::imread(dir.file("s.png")).size(), cv::Size(320, 240));
+    const CommandResult load = runArmsim("render " + dir.file("f.csv") + " --model arm26 --load 2 --out " + dir.file("l.mp4"));
+    EXPECT_EQ(load.exitCode, 2) << load.output;
+    EXPECT_NE(load.output.find("--load with the OpenSim model 'arm26'"), std::string::npos) << load.output;
+    const CommandResult armsimModel = runArmsim("render " + dir.file("f.csv") + " --out " + dir.file("m.mp4"));
+    EXPECT_EQ(armsimModel.exitCode, 2) << armsimModel.output;
+    EXPECT_NE(armsimModel.output.find("armsim render TABLE --model FILE.osim"), std::string::npos) << armsimModel.output;
+    EXPECT_FALSE(std::filesystem::exists(dir.file("l.mp4")));
+    EXPECT_FALSE(std::filesystem::exists(dir.file("m.mp4")));
 }
