@@ -4,6 +4,8 @@
 // and render_frame import it on first use.
 #include "basics/bound.h"
 #include "python/module_support.h"
+#include "model/osim_forward.h"
+#include "render/osim_video.h"
 #include "render/trial_video.h"
 
 #include <opencv2/imgproc.hpp>
@@ -24,6 +26,24 @@ TrialVideoSettings makeSettings(int width, int height, int supersample, bool ove
         throw InputError("color_by = '" + colorBy + "': expected activation or force");
     v.tableName = "series";
     return v;
+}
+
+OsimVideoSettings makeOsimSettings(int width, int height, int supersample, bool overlay) {
+    OsimVideoSettings v;
+    v.render.width = width;
+    v.render.height = height;
+    v.render.supersample = supersample;
+    v.overlay = overlay;
+    v.tableName = "series";
+    return v;
+}
+
+py::array_t<std::uint8_t> toRgbArray(const cv::Mat& bgr) {
+    cv::Mat rgb;
+    cv::cvtColor(bgr, rgb, cv::COLOR_BGR2RGB);
+    py::array_t<std::uint8_t> a({rgb.rows, rgb.cols, 3});
+    for (int r = 0; r < rgb.rows; ++r) std::memcpy(a.mutable_data(r, 0, 0), rgb.ptr(r), std::size_t(rgb.cols) * 3);
+    return a;
 }
 
 }  // namespace
@@ -86,4 +106,40 @@ forces and live plots. Written whole or not at all. Returns {'path', 'frames'}. 
         R"(One frame of a recorded trial (the series dict arm_trial returns) at the sample nearest to
 `time` [s]: an (height, width, 3) uint8 RGB array (for matplotlib's imshow), the same pixels as the
 video's frame at that sample.)");
+
+    mod.def(
+        "render_osim_video",
+        [](const py::object& model, const py::dict& series, const std::string& path, double fps, int width, int height,
+           double playbackSpeed, bool overlay, const std::string& codec, int supersample) {
+            if (path.empty()) throw InputError("path: expected a video file (.mp4 for h264, .avi for mjpg)");
+            OsimVideoSettings v = makeOsimSettings(width, height, supersample, overlay);
+            v.fps = fps;
+            v.playbackSpeed = playbackSpeed;
+            v.codec = codec;
+            v.videoPath = path;
+            const OsimModel m = readOsimFile(findOsimModelFile(toPathString(model, "model"), "model"));
+            const Table table = toTable(series, "series");
+            OsimVideoResult r;
+            runInterruptible([&] { r = renderOsimTrialVideo(m, table, v); });
+            py::dict d;
+            d["path"] = r.videoPath;
+            d["frames"] = r.frames;
+            return d;
+        },
+        "model"_a, "series"_a, "path"_a, "fps"_a = 30.0, "width"_a = 1280, "height"_a = 720, "playback_speed"_a = 1.0,
+        "overlay"_a = true, "codec"_a = "h264", "supersample"_a = 2,
+        R"(render_video for an OpenSim model's trial (the series isometric_trial or free_movement returns).)");
+
+    mod.def(
+        "render_osim_frame",
+        [](const py::object& model, const py::dict& series, double time, int width, int height, bool overlay, int supersample) {
+            const OsimVideoSettings v = makeOsimSettings(width, height, supersample, overlay);
+            const OsimModel m = readOsimFile(findOsimModelFile(toPathString(model, "model"), "model"));
+            const Table table = toTable(series, "series");
+            cv::Mat bgr;
+            runInterruptible([&] { bgr = renderOsimTrialFrame(m, table, v, time); });
+            return toRgbArray(bgr);
+        },
+        "model"_a, "series"_a, "time"_a, "width"_a = 640, "height"_a = 360, "overlay"_a = true, "supersample"_a = 2,
+        R"(render_frame for an OpenSim model's trial.)");
 }

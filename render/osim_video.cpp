@@ -203,6 +203,13 @@ Camera calcOsimTrialCamera(const OsimModel& model, const Table& table, const Osi
     return fitOsimCamera(arm, j, angleDeg, double(settings.render.width) / settings.render.height);
 }
 
+cv::Mat renderOsimTrialFrame(const OsimModel& model, const Table& table, const OsimVideoSettings& settings, double time) {
+    settings.render.validate();
+    OsimTrialRenderer renderer(model, table, settings);
+    checkField("still_at", time, Bound::closed(table.get(0, "time_s"), table.get(table.getNumRows() - 1, "time_s"), "s, within the trial"));
+    return renderer.renderRow(renderer.findRow(time));
+}
+
 void OsimVideoSettings::validate() const {
     render.validate();
     VideoSettings{fps, render.width, render.height, codec}.validate();

@@ -11,6 +11,8 @@
 #include "model/osim_file.h"
 #include "render/renderer.h"
 
+#include <opencv2/core.hpp>
+
 #include <functional>
 #include <optional>
 #include <string>
@@ -38,6 +40,10 @@ struct OsimVideoResult {
     int frames = 0;
     std::string videoPath, stillPath;
 };
+
+/// One frame of the table at the row nearest to time [s] (within the table; FieldError "still_at"
+/// otherwise): the video's frame there, a CV_8UC3 BGR image of settings.render's size.
+cv::Mat renderOsimTrialFrame(const OsimModel& model, const Table& table, const OsimVideoSettings& settings, double time);
 
 /// The camera renderOsimTrialVideo uses for this table (settings: the frame size and muscle model).
 Camera calcOsimTrialCamera(const OsimModel& model, const Table& table, const OsimVideoSettings& settings);

@@ -41,13 +41,20 @@ from ._armsim import (Model, arm_trial, design_protocol, forward, free_movement,
 
 def render_video(model, series, path, fps=30.0, width=1280, height=720, playback_speed=1.0, overlay=True,
                  codec="h264", supersample=2, color_by="activation"):
-    """Renders a recorded trial (the series dict arm_trial returns) to an .mp4 (h264) or .avi (mjpg).
+    """Renders a recorded trial (the series dict arm_trial returns; with an OpenSim model's name or
+    .osim path as model, the series isometric_trial or free_movement returns) to an .mp4 (h264) or .avi (mjpg).
 
     Offscreen (OSMesa, no display). fps: video frames per second; playback_speed: trial seconds per
     video second; width, height: even, in [16, 4096]; color_by: 'activation' or 'force'. Written
     whole or not at all. Returns {'path', 'frames'}. Releases the GIL.
     """
     from . import _render  # the render stack loads on first use only
+    path = _os.fspath(path) if isinstance(path, _os.PathLike) else path
+    if isinstance(model, (str, _os.PathLike)):   # an OpenSim model (.osim path or shipped name): its trial's series
+        if color_by != "activation":
+            raise ValueError(f"color_by = {color_by!r}: an OpenSim model's muscles are coloured by activation")
+        return _render.render_osim_video(model, series, path, fps, width, height, playback_speed, overlay, codec,
+                                         supersample)
     return _render.render_video(model, series, path, fps, width, height, playback_speed, overlay, codec,
                                 supersample, color_by)
 
@@ -58,6 +65,10 @@ def render_frame(model, series, time, width=640, height=360, overlay=True, super
     The same pixels as the video's frame at that sample; show it with matplotlib's imshow.
     """
     from . import _render
+    if isinstance(model, (str, _os.PathLike)):
+        if color_by != "activation":
+            raise ValueError(f"color_by = {color_by!r}: an OpenSim model's muscles are coloured by activation")
+        return _render.render_osim_frame(model, series, time, width, height, overlay, supersample)
     return _render.render_frame(model, series, time, width, height, overlay, supersample, color_by)
 
 

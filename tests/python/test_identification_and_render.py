@@ -165,6 +165,29 @@ def test_render_video_writes_an_mp4_of_the_trials_frames(elbow, reference, tmp_p
     assert out.read_bytes()[4:8] == b"ftyp"  # an MP4 container
 
 
+def test_render_of_an_osim_models_trial(reference, tmp_path):
+    """render_frame and render_video with an OpenSim model's name and the series free_movement returns:
+    the muscles blue at rest (no red pixels), red once the flexors are fully excited; the video has a
+    frame per 1/fps of the trial; the arm scene's colouring by force is refused."""
+    if not reference["frame_rgb_sums"]:
+        pytest.skip("built without the renderer")
+    series = armsim.free_movement("arm26", coordinate="r_elbow_flex", initial_angle_deg=20, activation=1.0, onset=0.1,
+                                  duration=0.3, rate=100)
+    def red_blue(frame):
+        r, b = frame[..., 0].astype(int), frame[..., 2].astype(int)
+        return int(np.sum(r > b + 80)), int(np.sum(b > r + 80))
+    start = armsim.render_frame("arm26", series, 0.0, width=320, height=240, overlay=False, supersample=1)
+    end = armsim.render_frame("arm26", series, 0.3, width=320, height=240, overlay=False, supersample=1)
+    assert start.shape == (240, 320, 3) and start.dtype == np.uint8
+    assert red_blue(start)[0] == 0 and red_blue(start)[1] > 50
+    assert red_blue(end)[0] > 50
+    out = tmp_path / "free.mp4"
+    r = armsim.render_video("arm26", series, out, fps=20, width=160, height=120)
+    assert r["frames"] == 7 and out.read_bytes()[4:8] == b"ftyp"
+    with pytest.raises(ValueError, match="coloured by activation"):
+        armsim.render_frame("arm26", series, 0.0, color_by="force")
+
+
 @pytest.mark.parametrize("call, error, message", [
     (lambda m: armsim.identify(m, {"angle_deg": [90.0]}), ValueError, "data: missing column 'force_N'"),
     (lambda m: armsim.identify(m, {"angle_deg": [90.0], "force_N": [1.0], "emg": [0.0]}), ValueError,
