@@ -91,15 +91,13 @@ OsimIsometricTrialResult runOsimIsometricTrial(const OsimModel& file, const Osim
 
     // Excitations: 0 at rest, then each muscle to its level (a step, or a ramp over riseTime).
     const double onset = settings.restDuration;
+    auto riseTo = [&](double U) {
+        return settings.riseTime > 0 ? ActivationProfile::ramp(onset, onset + settings.riseTime, 0.0, U)
+                                     : ActivationProfile::step(onset, 0.0, U);
+    };
     std::vector<ActivationProfile> excitation;
-    for (int i = 0; i < n; ++i) {
-        const double U = sum.agonists[i] ? settings.activation : settings.antagonistActivation;
-        excitation.push_back(settings.riseTime > 0 ? ActivationProfile::ramp(onset, onset + settings.riseTime, 0.0, U)
-                                                   : ActivationProfile::step(onset, 0.0, U));
-    }
-    const ActivationProfile agonistProfile =
-        settings.riseTime > 0 ? ActivationProfile::ramp(onset, onset + settings.riseTime, 0.0, settings.activation)
-                              : ActivationProfile::step(onset, 0.0, settings.activation);
+    for (int i = 0; i < n; ++i) excitation.push_back(riseTo(sum.agonists[i] ? settings.activation : settings.antagonistActivation));
+    const ActivationProfile agonistProfile = riseTo(settings.activation);
 
     // y: each muscle's states in turn, from its rest state at its path length.
     OdeBlocks f;
@@ -123,9 +121,8 @@ OsimIsometricTrialResult runOsimIsometricTrial(const OsimModel& file, const Osim
         for (int i = 0; i < n; ++i) columns.push_back(prefix + sum.muscles[i] + unit);
     result.series = Table(columns);
     result.series.reserveRows(int(std::lround(settings.getDuration() * settings.sampleRate)) + 1);
-    std::vector<double> row, F(n), torque(n), U(n), a(n), L(n), ydot(y.size());
+    std::vector<double> row, F(n), torque(n), U(n), a(n), L(n);
     bool haveTare = false;
-    MuscleOutputs out;
     auto sample = [&](double t, const double* yIn) {
         double total = 0;
         for (int i = 0; i < n; ++i) {
@@ -133,8 +130,7 @@ OsimIsometricTrialResult runOsimIsometricTrial(const OsimModel& file, const Osim
             U[i] = excitation[i].getValue(t);
             F[i] = muscles[i]->calcForce(P[i], yi);
             torque[i] = sum.momentArms[i] * F[i];
-            muscles[i]->calcStateDerivative(P[i], U[i], yi, ydot.data() + f.first[i], &out);
-            a[i] = out.activeFraction;
+            a[i] = muscles[i]->calcOutputs(P[i], U[i], yi).activeFraction;
             L[i] = muscles[i]->calcFascicleLength(P[i], yi);
             total += torque[i];
         }

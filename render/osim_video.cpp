@@ -228,11 +228,9 @@ OsimVideoResult renderOsimTrialVideo(const OsimModel& model, const Table& table,
     const double t0 = table.get(0, "time_s"), t1 = table.get(table.getNumRows() - 1, "time_s");
     if (settings.stillTime) checkField("still_at", *settings.stillTime, Bound::closed(t0, t1, "s, within the trial"));
     OsimVideoResult result;
-    result.frames = writeTrialVideoAndStill(
-        settings.videoPath, {settings.fps, settings.render.width, settings.render.height, settings.codec},
-        renderer.getNumFrames(), [&](int k) { return renderer.findRow(renderer.getFrameTime(k)); }, settings.stillPath,
-        settings.stillTime ? renderer.findRow(*settings.stillTime) : -1, [&](int row) { return renderer.renderRow(row); },
-        progress);
+    result.frames = writeReplay(renderer, settings.videoPath,
+                                {settings.fps, settings.render.width, settings.render.height, settings.codec},
+                                settings.stillTime, settings.stillPath, progress);
     if (settings.stillTime) result.stillPath = settings.stillPath;
     if (!settings.videoPath.empty()) result.videoPath = settings.videoPath;
     return result;

@@ -8,6 +8,7 @@
 
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 
 namespace armsim {
@@ -70,6 +71,17 @@ private:
 int writeTrialVideoAndStill(const std::string& videoPath, const VideoSettings& video, int frames,
                             const std::function<int(int)>& rowOfFrame, const std::string& stillPath, int stillRow,
                             const std::function<cv::Mat(int)>& render, const std::function<void(int, int)>& progress);
+
+/// writeTrialVideoAndStill for a trial renderer (TrialRenderer, the OpenSim trials' renderer: getNumFrames,
+/// getFrameTime, findRow, renderRow): its frames over the trial and the still at stillTime (none: no still).
+template <class Renderer>
+int writeReplay(Renderer& renderer, const std::string& videoPath, const VideoSettings& video,
+                const std::optional<double>& stillTime, const std::string& stillPath,
+                const std::function<void(int, int)>& progress) {
+    return writeTrialVideoAndStill(
+        videoPath, video, renderer.getNumFrames(), [&](int k) { return renderer.findRow(renderer.getFrameTime(k)); },
+        stillPath, stillTime ? renderer.findRow(*stillTime) : -1, [&](int row) { return renderer.renderRow(row); }, progress);
+}
 
 /// Writes frame (CV_8UC1, CV_8UC3 BGR or CV_8UC4 BGRA) to a .png path atomically (temporary, then
 /// rename). Throws InputError naming the path for a wrong extension, missing or unwritable
