@@ -50,11 +50,7 @@ MusclePath buildMusclePath(const ArmModel& arm, const MuscleSpec& muscle) {
 
 double calcPathMomentArm(const SimbodyMatterSubsystem& matter, const MobilizedBody& joint, const State& s,
                          const PathGeometry& g) {
-    Vector_<SpatialVec> bodyForces(matter.getNumBodies(), SpatialVec(Vec3(0), Vec3(0)));
-    MusclePath::applyTension(g, 1.0, bodyForces);
-    Vector f;
-    matter.multiplyBySystemJacobianTranspose(s, bodyForces, f);
-    return f[joint.getFirstUIndex(s)];
+    return calcPathGeneralizedForces(matter, s, g)[joint.getFirstUIndex(s)];
 }
 
 // ---- MuscleArm ----------------------------------------------------------------------------------

@@ -1,5 +1,6 @@
 #include "model/osim_arm.h"
 
+#include "model/osim_function.h"
 #include "muscles/degroote2016_muscle.h"
 #include "muscles/thelen2003_muscle.h"
 #include "muscles/thelen2003_opensim2_muscle.h"
@@ -290,13 +291,12 @@ OsimArm::OsimArm(OsimModel model, const std::map<std::string, ActivationProfile>
         std::vector<PathElement> points;
         for (const OsimPathPoint& pp : mu.path) {
             const std::string at = where(m, pp.line, "<PathPoint name=\"" + pp.name + "\">");
-            if (pp.kind == OsimPathPoint::Kind::Moving)
-                throw OsimError(at + "MovingPathPoint is not supported yet");
             if (!bodies.count(pp.body)) throw OsimError(at + "body '" + pp.body + "' is not built");
             PathElement e;
             e.body = bodies.at(pp.body);
             e.location = toVec3(pp.location);
             e.label = pp.name;
+            if (pp.kind == OsimPathPoint::Kind::Moving) setMovingLocation(m, pp, e);
             if (pp.kind == OsimPathPoint::Kind::Conditional) {
                 e.joint = coordinateBody(pp.coordinate, pp.line, "<ConditionalPathPoint name=\"" + pp.name + "\">");
                 e.activeMin = pp.range[0];
@@ -329,8 +329,8 @@ OsimArm::OsimArm(OsimModel model, const std::map<std::string, ActivationProfile>
             double bestDistance = std::numeric_limits<double>::infinity(), bestT = 0;
             for (int k = first; k < last; ++k) {
                 if (points[k].isConditional() || points[k + 1].isConditional()) continue;
-                const Vec3 a = points[k].body.getBodyTransform(pose) * points[k].location;
-                const Vec3 b = points[k + 1].body.getBodyTransform(pose) * points[k + 1].location;
+                const Vec3 a = points[k].body.getBodyTransform(pose) * points[k].findLocation(pose);
+                const Vec3 b = points[k + 1].body.getBodyTransform(pose) * points[k + 1].findLocation(pose);
                 const Vec3 d = b - a;
                 const double t = d.normSqr() > 0 ? std::clamp(dot(c - a, d) / d.normSqr(), 0.0, 1.0) : 0.0;
                 const double distance = (a + t * d - c).norm() / size;
@@ -367,6 +367,45 @@ OsimArm::OsimArm(OsimModel model, const std::map<std::string, ActivationProfile>
     system_.realize(defaultState_, Stage::Position);
 }
 
+void OsimArm::setMovingLocation(const OsimModel& m, const OsimPathPoint& pp, PathElement& e) const {
+    const std::string at = where(m, pp.line, "<MovingPathPoint name=\"" + pp.name + "\">");
+    // One coordinate drives the point, as OpenSim requires; a component without one is its function at 0.
+    std::string name;
+    static const char* kAxis[] = {"x", "y", "z"};
+    std::array<bool, 3> driven{};
+    for (int k = 0; k < 3; ++k) {
+        const std::string& c = pp.locationCoordinates[k];
+        driven[k] = !c.empty();
+        if (c.empty()) continue;
+        if (!name.empty() && c != name)
+            throw OsimError(at + "its " + kAxis[k] + " location follows '" + c + "' and another follows '" + name +
+                            "': expected one coordinate for x, y and z (as OpenSim requires)");
+        name = c;
+    }
+    std::array<OsimFunctionEvaluator, 3> f;
+    for (int k = 0; k < 3; ++k) f[k] = OsimFunctionEvaluator(pp.locationFunctions[k]);
+    if (name.empty()) {   // nothing drives it: a fixed point
+        e.location = Vec3(f[0].calcValue(0), f[1].calcValue(0), f[2].calcValue(0));
+        return;
+    }
+    const int i = findCoordinate(name);
+    if (i < 0) throw OsimError(at + "coordinate '" + name + "' does not move a built joint");
+    if (!coordinates_[i].spec.rotational)
+        throw OsimError(at + "coordinate '" + name + "' translates: only rotational coordinates are built");
+    e.mover = coordinates_[i].body;
+    const std::array<double, 2> range = coordinates_[i].spec.range;
+    // OpenSim evaluates each function at the coordinate clamped to its range; beyond the range the point
+    // stays put, so its derivative there is 0 (OpenSim's getdPointdQ takes the slope at the unclamped
+    // value, which disagrees with its own location outside the range).
+    e.calcMovingLocation = [f, driven, range](double q, Vec3& p, Vec3& dpdq) {
+        const double qc = std::clamp(q, range[0], range[1]);
+        for (int k = 0; k < 3; ++k) {
+            p[k] = f[k].calcValue(driven[k] ? qc : 0.0);
+            dpdq[k] = driven[k] && q == qc ? f[k].calcDerivative(qc) : 0.0;
+        }
+    };
+}
+
 int OsimArm::findCoordinate(const std::string& name) const {
     for (int i = 0; i < getNumCoordinates(); ++i)
         if (coordinates_[i].spec.name == name) return i;
@@ -382,11 +421,7 @@ double OsimArm::calcPathLength(const State& s, int i) const { return forces_.at(
 
 double OsimArm::calcMomentArm(const State& s, int muscle, int coordinate) const {
     const PathGeometry g = forces_.at(muscle).calcPathGeometry(s);
-    Vector_<SpatialVec> bodyForces(matter_.getNumBodies(), SpatialVec(Vec3(0), Vec3(0)));
-    MusclePath::applyTension(g, 1.0, bodyForces);
-    Vector f;
-    matter_.multiplyBySystemJacobianTranspose(s, bodyForces, f);
-    return f[coordinates_.at(coordinate).body.getFirstUIndex(s)];
+    return calcPathGeneralizedForces(matter_, s, g)[coordinates_.at(coordinate).body.getFirstUIndex(s)];
 }
 
 }  // namespace armsim

@@ -13,7 +13,9 @@
 //   - Coordinates start at their default value; a locked coordinate is locked there. Ranges are not
 //     forces in OpenSim's forward dynamics either (no CoordinateLimitForce is read).
 //   - Path points on their bodies; a ConditionalPathPoint is a via point active while its coordinate is
-//     within its range. MovingPathPoint is refused (not supported yet).
+//     within its range. A MovingPathPoint sits at its x, y and z functions (model/osim_function.h) of one
+//     coordinate clamped to that coordinate's range; its tension also drives the coordinate with the
+//     generalized force f . dp/dq, as OpenSim's GeometryPath adds it.
 //   - Wrap objects: WrapCylinder (its z axis; no wrap when both tangent points lie beyond its length,
 //     as OpenSim), WrapSphere and WrapEllipsoid, with the quadrant as the side the path passes (all: the
 //     shorter way); as in OpenSim a wrap is off while a neighbouring path point lies inside its object,
@@ -91,6 +93,9 @@ public:
     /// @}
 
 private:
+    // A MovingPathPoint's location function and the mobilizer of its coordinate (OsimError otherwise).
+    void setMovingLocation(const OsimModel& m, const OsimPathPoint& pp, PathElement& e) const;
+
     struct Coordinate {
         OsimCoordinate spec;
         SimTK::MobilizedBody body;

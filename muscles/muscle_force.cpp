@@ -54,9 +54,9 @@ public:
         }
     }
 
-    void calcForce(const State& s, Vector_<SpatialVec>& bodyForces, Vector_<Vec3>&, Vector&) const override {
+    void calcForce(const State& s, Vector_<SpatialVec>& bodyForces, Vector_<Vec3>&, Vector& mobilityForces) const override {
         const PathGeometry& g = cachedGeometry(s);
-        MusclePath::applyTension(g, muscle_->calcForce(g.length, z(s)), bodyForces);
+        MusclePath::applyTension(g, muscle_->calcForce(g.length, z(s)), bodyForces, mobilityForces);
     }
 
     Real calcPotentialEnergy(const State&) const override { return 0; }

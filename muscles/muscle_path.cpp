@@ -328,6 +328,13 @@ CircleWrap calcCircleWrap(const Vec2& p, const Vec2& q, double R, const Vec2& si
     return w;
 }
 
+Vec3 PathElement::findLocation(const State& s) const {
+    if (!isMoving()) return location;
+    Vec3 p, dpdq;
+    calcMovingLocation(mover.getOneQ(s, MobilizerQIndex(0)), p, dpdq);
+    return p;
+}
+
 MusclePath::MusclePath(const MobilizedBody& originBody, const Vec3& origin, const MobilizedBody& insertionBody,
                        const Vec3& insertion) {
     PathElement o, i;
@@ -355,7 +362,10 @@ MusclePath::MusclePath(std::vector<PathElement> elements) : elements_(std::move(
         }
     }
     for (int k = 0; k < n; ++k) {
-        if (!elements_[k].isConditional()) continue;
+        const PathElement& e = elements_[k];
+        if (e.isMoving() && (e.isSurface() || e.isConditional() || !e.calcMovingLocation))
+            throw InputError("muscle path: '" + e.label + "' moves with a coordinate: it must be a point with a location function");
+        if (!e.isConditional()) continue;
         if (k == 0 || k == n - 1 || elements_[k].isSurface() || elements_[k - 1].isSurface() || elements_[k + 1].isSurface())
             throw InputError("muscle path: '" + elements_[k].label +
                              "' is used over a range of rotation: it must be a via point between two points, not next to a wrapping surface");
@@ -398,11 +408,18 @@ public:
     }
 
 private:
-    Vec3 pointInGround(int k) const { return elements_[k].body.getBodyTransform(s_) * elements_[k].location; }
+    Vec3 pointInGround(int k) const { return elements_[k].body.getBodyTransform(s_) * elements_[k].findLocation(s_); }
 
     void addLoad(int k, const Vec3& point, const Vec3& force) {
-        const MobilizedBody& body = elements_[k].body;
+        const PathElement& e = elements_[k];
+        const MobilizedBody& body = e.body;
         g_.loads.push_back({k, body.getMobilizedBodyIndex(), point, point - body.getBodyTransform(s_).p(), force});
+        if (e.isMoving()) {
+            // The point's own motion on its body: the force's virtual work along d point / dq.
+            Vec3 location, dLocationDq;
+            e.calcMovingLocation(e.mover.getOneQ(s_, MobilizerQIndex(0)), location, dLocationDq);
+            g_.mobilityLoads.push_back({e.mover.getFirstUIndex(s_), dot(force, body.getBodyRotation(s_) * dLocationDq)});
+        }
     }
 
     bool isActive(int k) const {
@@ -568,8 +585,8 @@ PathGeometry MusclePath::calcGeometry(const State& s, const std::string& muscleN
 
 double MusclePath::calcLength(const State& s) const {
     if (isStraight())
-        return (elements_[1].body.getBodyTransform(s) * elements_[1].location -
-                elements_[0].body.getBodyTransform(s) * elements_[0].location).norm();
+        return (elements_[1].body.getBodyTransform(s) * elements_[1].findLocation(s) -
+                elements_[0].body.getBodyTransform(s) * elements_[0].findLocation(s)).norm();
     return calcGeometry(s).length;
 }
 
@@ -580,14 +597,25 @@ double MusclePath::calcLengtheningSpeed(const State& s, const PathGeometry& g) c
         const SpatialVec V = elements_[l.element].body.getBodyVelocity(s);
         power += dot(l.force, V[1] + cross(V[0], l.arm)) + dot(l.moment, V[0]);
     }
+    for (const PathMobilityLoad& m : g.mobilityLoads) power += m.force * s.getU()[m.u];
     return -power;
 }
 
-void MusclePath::applyTension(const PathGeometry& g, double tension, Vector_<SpatialVec>& bodyForces) {
+void MusclePath::applyTension(const PathGeometry& g, double tension, Vector_<SpatialVec>& bodyForces,
+                              Vector& mobilityForces) {
     for (const PathLoad& l : g.loads) {
         const Vec3 f = tension * l.force;
         bodyForces[l.body] += SpatialVec(l.arm % f + tension * l.moment, f);
     }
+    for (const PathMobilityLoad& m : g.mobilityLoads) mobilityForces[m.u] += tension * m.force;
+}
+
+Vector calcPathGeneralizedForces(const SimbodyMatterSubsystem& matter, const State& s, const PathGeometry& g) {
+    Vector_<SpatialVec> bodyForces(matter.getNumBodies(), SpatialVec(Vec3(0), Vec3(0)));
+    Vector mobilityForces(s.getNU(), 0.0), f;
+    MusclePath::applyTension(g, 1.0, bodyForces, mobilityForces);
+    matter.multiplyBySystemJacobianTranspose(s, bodyForces, f);
+    return f + mobilityForces;
 }
 
 void appendPathDecorations(const MusclePath& path, const PathGeometry& g, const Vec3& color, double lineThickness,
@@ -602,6 +630,7 @@ void appendPathDecorations(const MusclePath& path, const PathGeometry& g, const 
         const int body = int(e.body.getMobilizedBodyIndex());
         if (e.kind == PathElement::Kind::Point) {
             if (k == 0 || k + 1 == elements.size()) continue;  // origin and insertion: the line ends there
+            if (e.isMoving()) continue;  // drawn where the line bends (its location needs the state)
             geometry.push_back(DecorativeSphere(kViaRadius).setBodyId(body).setTransform(Transform(e.location))
                                    .setColor(Vec3(0.9, 0.9, 0.2)));
             continue;

@@ -33,6 +33,7 @@
 
 #include "muscles/simbody.h"
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -66,6 +67,14 @@ struct PathElement {
     SimTK::MobilizedBody joint;
     double activeMin = 0, activeMax = 0;   ///< [rad]
     bool isConditional() const { return !joint.isEmptyHandle(); }
+    /// A point that moves on its body with `mover`'s coordinate q (OpenSim's moving path point):
+    /// calcMovingLocation(q, location, dLocation/dq), both in the body's frame [m, m/rad]; `location`
+    /// above is then unused. Its tension also does work on q: a generalized force (PathGeometry).
+    SimTK::MobilizedBody mover;
+    std::function<void(double q, SimTK::Vec3& location, SimTK::Vec3& dLocationDq)> calcMovingLocation;
+    bool isMoving() const { return !mover.isEmptyHandle(); }
+    /// The point's location in its body's frame at the state's configuration [m] (Stage::Position).
+    SimTK::Vec3 findLocation(const SimTK::State& s) const;
     std::string label;                ///< for messages and drawing ("via 1", "cylinder TRI")
     bool isSurface() const { return kind != Kind::Point; }
 };
@@ -80,11 +89,19 @@ struct PathLoad {
     SimTK::Vec3 moment{0};            ///< a couple on the body per newton of tension, Ground [m] (ellipsoids)
 };
 
+/// A unit-tension generalized force on one mobility: what a moving point's own motion on its body
+/// does (the tension's force on the point . d point / dq, Ground).
+struct PathMobilityLoad {
+    SimTK::UIndex u;                  ///< the mover's (one) mobility
+    double force = 0;                 ///< per newton of tension [m]
+};
+
 /// The path at one configuration.
 struct PathGeometry {
     double length = 0;                       ///< P [m]
     std::vector<SimTK::Vec3> polyline;       ///< the path in Ground, arcs sampled (for drawing) [m]
     std::vector<PathLoad> loads;             ///< unit-tension loads on the bodies
+    std::vector<PathMobilityLoad> mobilityLoads;  ///< unit-tension generalized forces (moving points)
     std::vector<bool> wrapping;              ///< per element: a surface the path touches now
 };
 
@@ -113,12 +130,19 @@ public:
     /// dP/dt [m/s] of the path whose geometry at s is g (Stage::Velocity): minus the power of a unit
     /// tension along it (virtual power; wrapping arcs roll with their surfaces).
     double calcLengtheningSpeed(const SimTK::State& s, const PathGeometry& g) const;
-    /// Adds the forces of a tension [N] along the path to bodyForces (Simbody's calcForce layout).
-    static void applyTension(const PathGeometry& g, double tension, SimTK::Vector_<SimTK::SpatialVec>& bodyForces);
+    /// Adds the forces of a tension [N] along the path to bodyForces and mobilityForces (Simbody's
+    /// calcForce layout; mobilityForces takes the moving points' generalized forces).
+    static void applyTension(const PathGeometry& g, double tension, SimTK::Vector_<SimTK::SpatialVec>& bodyForces,
+                             SimTK::Vector& mobilityForces);
 
 private:
     std::vector<PathElement> elements_;
 };
+
+/// The generalized forces of a unit tension along the path whose geometry at s is g (one per mobility;
+/// Stage::Position): minus dP/dq by virtual work, i.e. the moment arms about each mobility [m].
+SimTK::Vector calcPathGeneralizedForces(const SimTK::SimbodyMatterSubsystem& matter, const SimTK::State& s,
+                                        const PathGeometry& g);
 
 /// Appends the drawing of a path to `geometry` (Ground frame): the polyline of g (calcGeometry with
 /// withPolyline) as lines of the given colour and thickness, its via points as small spheres and its

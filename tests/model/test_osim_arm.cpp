@@ -144,3 +144,98 @@ TEST(OsimArm, UnsupportedJointsAndPointsNameTheirLine) {
         }
     }
 }
+
+namespace {
+
+// arm26 with the brachialis inserting on a MovingPathPoint: x and y follow the elbow (SimmSpline,
+// NaturalCubicSpline), z is a Constant; `yCoordinate` drives y.
+std::string arm26WithMovingBrachialis(const std::string& yCoordinate = "/jointset/r_elbow/r_elbow_flex") {
+    std::string text = readFileText(std::string(ARMSIM_ASSET_DIR) + "/models/arm26.osim");
+    const std::size_t begin = text.find("<PathPoint name=\"BRA-P2\">");
+    const std::size_t end = text.find("</PathPoint>", begin) + std::string("</PathPoint>").size();
+    const std::string moving =
+        "<MovingPathPoint name=\"BRA-P2\">"
+        "<socket_parent_frame>/bodyset/r_ulna_radius_hand</socket_parent_frame>"
+        "<x_location><SimmSpline><x>0 0.6 1.2 1.8 2.4</x><y>-0.0032 0.002 0.006 0.004 -0.001</y></SimmSpline></x_location>"
+        "<y_location><NaturalCubicSpline><x>0 1.2 2.4</x><y>-0.0239 -0.03 -0.026</y></NaturalCubicSpline></y_location>"
+        "<z_location><Constant><value>0.0009</value></Constant></z_location>"
+        "<socket_x_coordinate>/jointset/r_elbow/r_elbow_flex</socket_x_coordinate>"
+        "<socket_y_coordinate>" + yCoordinate + "</socket_y_coordinate>"
+        "</MovingPathPoint>";
+    text.replace(begin, end - begin, moving);
+    return text;
+}
+
+}  // namespace
+
+// A MovingPathPoint (OpenSim's: location functions of one coordinate clamped to its range, and the
+// generalized force f . dp/dq on that coordinate). Moment arms by virtual work, which now include that
+// generalized force, equal -dP/dq by central differences (1e-9 m) over the elbow's range; the term
+// itself is more than 1 mm somewhere, so leaving it out fails the test. The path's lengthening speed
+// equals -r u, the point stays put beyond the coordinate's range, and the System's mobility forces
+// (MuscleForce::calcForce) carry tension x the term.
+TEST(OsimArm, MovingPathPointMomentArmsIncludeItsGeneralizedForce) {
+    const OsimArm arm(readOsimText(arm26WithMovingBrachialis(), "moving.osim"));
+    const int bra = 5, elbow = 1;
+    ASSERT_EQ(arm.getMuscleName(bra), "BRA");
+    SimTK::State s = arm.getDefaultState();
+    const double h = 1e-6;
+    double largestTerm = 0;
+    for (double q = 5; q <= 125; q += 5) {   // inside the range: at its ends the location has a kink
+        auto lengthAt = [&](double dq) {
+            arm.setCoordinateValue(s, elbow, q * kDeg + dq);
+            arm.getSystem().realize(s, SimTK::Stage::Position);
+            return arm.calcPathLength(s, bra);
+        };
+        const double fd = -(lengthAt(h) - lengthAt(-h)) / (2 * h);
+        lengthAt(0);
+        EXPECT_NEAR(arm.calcMomentArm(s, bra, elbow), fd, 1e-9) << q;
+        EXPECT_NEAR(arm.calcMomentArm(s, bra, 0), 0.0, 1e-9) << "about the shoulder at " << q;
+        const PathGeometry g = arm.getMuscleForce(bra).calcPathGeometry(s);
+        ASSERT_EQ(g.mobilityLoads.size(), 1u);
+        largestTerm = std::max(largestTerm, std::abs(g.mobilityLoads[0].force));
+        arm.setCoordinateSpeed(s, elbow, 0.7);
+        arm.getSystem().realize(s, SimTK::Stage::Velocity);
+        EXPECT_NEAR(arm.getMuscleForce(bra).getPath().calcLengtheningSpeed(s, g), -fd * 0.7, 1e-9) << q;
+        arm.setCoordinateSpeed(s, elbow, 0);
+    }
+    EXPECT_GT(largestTerm, 1e-3);
+
+    // Beyond the range (arm26: 0 to 130 deg) the point stays where the range ends.
+    const SimTK::Vec3 top = [&] {
+        arm.setCoordinateValue(s, elbow, arm.getCoordinate(elbow).range[1]);
+        arm.getSystem().realize(s, SimTK::Stage::Position);
+        return arm.getMuscleForce(bra).getPath().getElements()[1].findLocation(s);
+    }();
+    arm.setCoordinateValue(s, elbow, arm.getCoordinate(elbow).range[1] + 0.2);
+    arm.getSystem().realize(s, SimTK::Stage::Position);
+    EXPECT_EQ(arm.getMuscleForce(bra).getPath().getElements()[1].findLocation(s), top);
+    EXPECT_TRUE(std::isfinite(arm.calcMomentArm(s, bra, elbow)));
+    EXPECT_TRUE(arm.getMuscleForce(bra).calcPathGeometry(s).mobilityLoads[0].force == 0.0);
+
+    // Through the System: at 60 deg with the muscles in their initial states, the elbow's mobility force
+    // is the brachialis tension times the term (no other force applies mobility forces).
+    arm.setCoordinateValue(s, elbow, 60 * kDeg);
+    arm.getSystem().realize(s, SimTK::Stage::Position);
+    for (int i = 0; i < arm.getNumMuscles(); ++i) {
+        const MuscleForce& f = arm.getMuscleForce(i);
+        f.setMuscleStates(s, f.getMuscle().calcInitialState(f.getPathLength(s)));
+    }
+    arm.getSystem().realize(s, SimTK::Stage::Dynamics);
+    const double tension = arm.getMuscleForce(bra).getForce(s);
+    EXPECT_GT(tension, 0);
+    const double term = arm.getMuscleForce(bra).calcPathGeometry(s).mobilityLoads[0].force;
+    const SimTK::Vector& mobility = arm.getSystem().getMobilityForces(s, SimTK::Stage::Dynamics);
+    EXPECT_NEAR(mobility[arm.getCoordinateBody(elbow).getFirstUIndex(s)], tension * term, 1e-12 * tension);
+}
+
+// OpenSim requires one coordinate for x, y and z: two are named with the line.
+TEST(OsimArm, MovingPathPointWithTwoCoordinatesIsRefused) {
+    try {
+        OsimArm arm(readOsimText(arm26WithMovingBrachialis("/jointset/r_shoulder/r_shoulder_elev"), "two.osim"));
+        ADD_FAILURE() << "built";
+    } catch (const OsimError& e) {
+        EXPECT_NE(std::string(e.what()).find("expected one coordinate for x, y and z"), std::string::npos) << e.what();
+        EXPECT_TRUE(std::regex_search(std::string(e.what()), std::regex("two\\.osim:[0-9]+: <MovingPathPoint name=\"BRA-P2\">"))) << e.what();
+    }
+}

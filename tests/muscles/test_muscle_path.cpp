@@ -27,11 +27,7 @@ struct PinRig {
     }
     // Generalized force of a unit tension on the pin: the moment arm by virtual work.
     double calcMomentArm(const PathGeometry& g) {
-        Vector_<SpatialVec> bodyForces(matter.getNumBodies(), SpatialVec(Vec3(0), Vec3(0)));
-        MusclePath::applyTension(g, 1.0, bodyForces);
-        Vector f;
-        matter.multiplyBySystemJacobianTranspose(state, bodyForces, f);
-        return f[0];
+        return calcPathGeneralizedForces(matter, state, g)[0];
     }
     void setAngle(double q) {
         body.setOneQ(state, 0, q);
