@@ -282,6 +282,17 @@ void ParamNode::throwLocated(const FieldError& e) const {
     std::stringstream parts(field);
     std::string part;
     while (std::getline(parts, part, '.')) {
+        // "conditions[2]": the key, then entry 2 of its list.
+        std::size_t index = std::string::npos;
+        const std::size_t open = part.find('[');
+        if (open != std::string::npos && part.back() == ']') {
+            try {
+                index = std::stoul(part.substr(open + 1, part.size() - open - 2));
+            } catch (const std::exception&) {
+                index = std::string::npos;
+            }
+            part = part.substr(0, open);
+        }
         if (!n.IsMap()) break;
         bool found = false;
         for (auto it = n.begin(); it != n.end(); ++it)
@@ -292,6 +303,11 @@ void ParamNode::throwLocated(const FieldError& e) const {
                 break;
             }
         if (!found) break;
+        if (index != std::string::npos) {
+            if (!n.IsSequence() || index >= n.size()) break;
+            n = YAML::Node(n[index]);
+            line = n.Mark().line;
+        }
     }
     throw InputError(impl_->source + ":" + std::to_string(line + 1) + ": field " + describeField(path(field)) + " " +
                      e.getDetail());

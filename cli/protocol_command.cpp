@@ -146,14 +146,13 @@ std::string defaultOut(const Protocol& p) { return "out/" + p.name; }
 void runTorqueProtocolCommand(const ProtocolOptions& o, const std::string& file) {
     if (o.video) throw InputError("--video: torque protocols have no per-trial series to render; run `armsim trial`");
     const TorqueProtocol protocol = readTorqueProtocol(file);
-    const VirtualSubject subject = loadTorqueProtocolSubject(protocol);
     const std::string out = o.out.empty() ? "out/" + protocol.name : o.out;
-    std::printf("protocol %s (torque): %s\n  %d trials: %s\n  subject: %s\n", protocol.name.c_str(),
-                protocol.description.c_str(), protocol.getNumTrials(), describeConditions(protocol).c_str(),
-                protocol.population.empty() ? ("model " + protocol.model).c_str()
-                                            : (protocol.population + " person " + std::to_string(protocol.subjectIndex)).c_str());
+    std::printf("protocol %s (torque): %s\n  %d trials: %s\n", protocol.name.c_str(), protocol.description.c_str(),
+                protocol.getNumTrials(), describeConditions(protocol).c_str());
     std::fflush(stdout);
-    const std::vector<TorqueObservation> data = synthesizeTorqueData(subject, protocol, protocol.seed, o.jobs);
+    const TorqueProtocolRun run = runTorqueProtocol(protocol, o.jobs);
+    const std::vector<TorqueObservation>& data = run.data;
+    std::printf("  subject: %s\n", run.subject.c_str());
     const bool twoAxis = protocol.readsForearmTorque();
     std::printf("  %-10s %6s %7s %6s %4s %12s%s\n", "effort", "angle", "forearm", "level", "rep", "torque (N m)",
                 twoAxis ? "  forearm axis (N m, + = supination)" : "");
@@ -163,8 +162,7 @@ void runTorqueProtocolCommand(const ProtocolOptions& o, const std::string& file)
         if (twoAxis) std::printf("  %12.2f", d.forearmTorque);
         std::printf("\n");
     }
-    const std::vector<ChannelObservation> channels =
-        protocol.hasChannels() ? synthesizeChannelData(subject, protocol, data, protocol.seed) : std::vector<ChannelObservation>{};
+    const std::vector<ChannelObservation>& channels = run.channels;
     if (!channels.empty()) std::printf("  channels besides torque: %zu measurements (channel_data.csv)\n", channels.size());
     const std::vector<std::string> files = writeTorqueProtocolRun(out, protocol, data, channels);
     std::printf("wrote");

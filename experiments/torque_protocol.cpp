@@ -7,7 +7,11 @@
 #include "basics/plot.h"
 #include "basics/portable_random.h"
 #include "basics/table.h"
+#include "basics/parallel.h"
 #include "model/geometry.h"
+#include "model/osim_arm.h"
+#include "model/osim_forward.h"
+#include "model/osim_trial.h"
 #include "model/trial.h"
 #include "muscles/muscle_file.h"
 
@@ -67,12 +71,41 @@ bool TorqueProtocol::hasChannels() const {
            std::any_of(conditions.begin(), conditions.end(), [](const TorqueCondition& c) { return c.ultrasound || c.emg; });
 }
 
+bool TorqueProtocol::usesOsimModel() const { return population.empty() && isOsimModel(model); }
+
+namespace {
+
+// What an OpenSim model's protocol cannot have: the channels, the forearm axis and postures need an
+// armsim model's muscles and forearm.
+void checkOsimProtocol(const TorqueProtocol& p) {
+    const std::string why = "an OpenSim model's protocol reads the torque about its coordinate alone";
+    for (std::size_t k = 0; k < p.conditions.size(); ++k) {
+        const TorqueCondition& c = p.conditions[k];
+        if (isForearmEffort(c.effort))
+            throw FieldError(conditionField(k, "effort"), std::string("= ") + getEffortName(c.effort) + ": " + why +
+                                                              ": expected flexion (the positive direction) or extension");
+        if (!std::isnan(c.rotationDeg))
+            throw FieldError(conditionField(k, "rotation_deg"), why + ": expected no forearm posture");
+        if (c.ultrasound || c.emg)
+            throw FieldError(conditionField(k, "channels"), why + ": expected torque only");
+        checkField(conditionField(k, "flexion_deg"), c.flexionDeg, Bound::closed(-3600, 3600, "deg, the coordinate's value"));
+    }
+    if (!p.volumeScan.empty() || p.anthropometry || p.forearmTorque)
+        throw FieldError("measurements", why + ": expected no volume scan, anthropometry or forearm torque");
+}
+
+}  // namespace
+
 void TorqueProtocol::validate() const {
     if (conditions.empty()) throw FieldError("conditions", "is empty: expected at least one condition");
+    const bool osim = usesOsimModel();
+    if (!coordinate.empty() && !osim)
+        throw FieldError("subject.coordinate", "= '" + coordinate + "': only an OpenSim model (subject.model: NAME.osim) has coordinates to name");
+    if (osim) checkOsimProtocol(*this);
     std::set<ConditionKey> seen;
     for (std::size_t k = 0; k < conditions.size(); ++k) {
         const TorqueCondition& c = conditions[k];
-        checkField(conditionField(k, "flexion_deg"), c.flexionDeg, Bound::closed(0, 180, "deg, 0 = extended"));
+        if (!osim) checkField(conditionField(k, "flexion_deg"), c.flexionDeg, Bound::closed(0, 180, "deg, 0 = extended"));
         checkField(conditionField(k, "level"), c.level, Bound{0, 1, true, false, "fraction of maximal, in (0, 1]"});
         checkField(conditionField(k, "repetitions"), c.repetitions, Bound::closed(1, 100));
         if (isForearmEffort(c.effort) && (c.ultrasound || c.emg))
@@ -135,6 +168,10 @@ std::string describeConditions(const TorqueProtocol& protocol) {
     return out;
 }
 
+namespace {
+OsimModel loadOsimProtocolModel(const TorqueProtocol& protocol);
+}  // namespace
+
 TorqueProtocol readTorqueProtocol(const std::string& path) {
     const ParamNode root = ParamNode::loadFile(path);
     TorqueProtocol p;
@@ -159,6 +196,12 @@ TorqueProtocol readTorqueProtocol(const std::string& path) {
             p.subjectIndex = s.getInt("index", 0, 1000000, 0);
         } else {
             p.model = s.getString("model", p.model);
+            if (isOsimModel(p.model) && p.model.find('/') != std::string::npos) {
+                // A file next to the protocol, or as given.
+                const std::string relative = root.getDirectory().empty() ? p.model : root.getDirectory() + "/" + p.model;
+                if (doesPathExist(relative)) p.model = relative;
+            }
+            p.coordinate = s.getString("coordinate", "");
             p.transducerNoise = s.getNumber("transducer_noise", Bound::closed(0, 0.5), p.transducerNoise);
         }
         s.finish();
@@ -183,7 +226,7 @@ TorqueProtocol readTorqueProtocol(const std::string& path) {
     p.conditions.clear();
     for (const ParamNode& c : root.children("conditions")) {
         TorqueCondition tc;
-        tc.flexionDeg = c.getNumber("flexion_deg", Bound::closed(0, 180, "deg, 0 = extended"));
+        tc.flexionDeg = c.getNumber("flexion_deg", Bound::any());   // validate(): the range the subject's model has
         tc.effort = parseEffortName(c.getChoice("effort", {"flexion", "extension", "supination", "pronation"}, "flexion"));
         tc.level = c.getNumber("level", Bound{0, 1, true, false, "fraction of maximal, in (0, 1]"}, 1.0);
         tc.repetitions = c.getInt("repetitions", 1, 100, 1);
@@ -206,6 +249,7 @@ TorqueProtocol readTorqueProtocol(const std::string& path) {
     }
     root.finish();
     root.rethrowWithLocation([&] { p.validate(); });
+    if (p.usesOsimModel()) root.rethrowWithLocation([&] { loadOsimProtocolModel(p); });
     return p;
 }
 
@@ -222,7 +266,8 @@ std::string formatTorqueProtocol(const TorqueProtocol& p) {
     if (!p.population.empty())
         out += "  population: " + p.population + "\n  index: " + std::to_string(p.subjectIndex) + "\n";
     else
-        out += "  model: " + p.model + "\n  transducer_noise: " + formatNumber(p.transducerNoise) + "\n";
+        out += "  model: " + p.model + "\n" + (p.coordinate.empty() ? "" : "  coordinate: " + p.coordinate + "\n") +
+               "  transducer_noise: " + formatNumber(p.transducerNoise) + "\n";
     if (p.hasChannels() || p.forearmTorque) {
         std::string names;
         for (const std::string& v : p.volumeScan) names += (names.empty() ? "" : ", ") + v;
@@ -282,6 +327,8 @@ bool hasPostures(const std::vector<TorqueObservation>& data) {
 std::vector<TorqueObservation> synthesizeTorqueData(const VirtualSubject& subject, const TorqueProtocol& protocol,
                                                     unsigned noiseSeed, int jobs) {
     protocol.validate();
+    for (std::size_t k = 0; k < protocol.conditions.size(); ++k)   // an OpenSim protocol's angles are its coordinate's
+        checkField(conditionField(k, "flexion_deg"), protocol.conditions[k].flexionDeg, Bound::closed(0, 180, "deg, 0 = extended"));
     PortableRandom rng{noiseSeed, subject.seed, unsigned(subject.index)};
     // The forearm axis's noise from a stream of its own: the flexion axis's draws stay what they were.
     PortableRandom forearmRng{noiseSeed, subject.seed, unsigned(subject.index), 2u};
@@ -328,6 +375,95 @@ std::vector<TorqueObservation> synthesizeTorqueData(const VirtualSubject& subjec
         data[k].fascicleLength = results[k].summary.meanFascicleLength;
     }
     return setTransducerNoise(std::move(data), subject.transducerNoise);
+}
+
+namespace {
+
+// Condition c of an OpenSim protocol as an isometric trial.
+OsimIsometricTrialSettings makeOsimTrial(const TorqueProtocol& protocol, const TorqueCondition& c) {
+    OsimIsometricTrialSettings s;
+    s.coordinate = protocol.coordinate;
+    s.angleDeg = c.flexionDeg;
+    s.direction = c.effort == Effort::Extension ? -1 : 1;
+    s.activation = c.level;
+    s.restDuration = protocol.restDuration;
+    s.holdDuration = protocol.holdDuration;
+    s.averagingWindow = protocol.averagingWindow;
+    s.sampleRate = protocol.sampleRate;
+    return s;
+}
+
+// Every condition's trial checked on the model before any runs: FieldErrors named as the protocol's
+// fields (subject.coordinate, conditions[k].flexion_deg).
+OsimModel loadOsimProtocolModel(const TorqueProtocol& protocol) {
+    OsimModel model;
+    try {
+        model = readOsimFile(findOsimModelFile(protocol.model, "subject.model"));
+    } catch (const InputError& e) {
+        throw FieldError("subject.model", std::string("= '") + protocol.model + "': " + e.what());
+    }
+    const OsimArm arm(model);
+    for (std::size_t k = 0; k < protocol.conditions.size(); ++k) {
+        try {
+            makeOsimTrial(protocol, protocol.conditions[k]).validate(arm);
+        } catch (const FieldError& e) {
+            if (e.getField() == "coordinate") throw FieldError("subject.coordinate", e.getDetail());
+            if (e.getField() == "angle_deg")
+                throw FieldError(conditionField(k, "flexion_deg"), e.getDetail() + " (the range of coordinate " +
+                                                                       (protocol.coordinate.empty() ? "of the model" : protocol.coordinate) + ")");
+            throw;
+        }
+    }
+    return model;
+}
+
+}  // namespace
+
+std::vector<TorqueObservation> synthesizeOsimTorqueData(const TorqueProtocol& protocol, unsigned noiseSeed, int jobs) {
+    protocol.validate();
+    if (!protocol.usesOsimModel())
+        throw InputError("protocol '" + protocol.name + "': subject.model = '" + protocol.model + "' is not an OpenSim model");
+    const OsimModel model = loadOsimProtocolModel(protocol);
+    PortableRandom rng{noiseSeed, 0u, 0u};
+    int maxRepetitions = 0;
+    for (const TorqueCondition& c : protocol.conditions) maxRepetitions = std::max(maxRepetitions, c.repetitions);
+    std::vector<OsimIsometricTrialSettings> trials;
+    std::vector<TorqueObservation> data;
+    for (int r = 0; r < maxRepetitions; ++r)   // repetition-major, as synthesizeTorqueData
+        for (const TorqueCondition& c : protocol.conditions) {
+            if (r >= c.repetitions) continue;
+            trials.push_back(makeOsimTrial(protocol, c));
+            TorqueObservation o;
+            o.flexionDeg = c.flexionDeg;
+            o.effort = c.effort;
+            o.level = c.level;
+            o.repetition = r;
+            o.activation = c.level;
+            o.antagonistActivation = 0;
+            o.noiseDraw = rng.drawNormal();
+            data.push_back(o);
+        }
+    std::vector<double> torques(trials.size());
+    runParallel(int(trials.size()), jobs,
+                [&](int k) { torques[k] = runOsimIsometricTrial(model, trials[k]).summary.meanTaredTorque; });
+    for (std::size_t k = 0; k < data.size(); ++k) data[k].cleanTorque = torques[k];
+    return setTransducerNoise(std::move(data), protocol.transducerNoise);
+}
+
+TorqueProtocolRun runTorqueProtocol(const TorqueProtocol& protocol, int jobs) {
+    TorqueProtocolRun run;
+    if (protocol.usesOsimModel()) {
+        run.subject = "OpenSim model " + protocol.model +
+                      (protocol.coordinate.empty() ? std::string() : ", coordinate " + protocol.coordinate);
+        run.data = synthesizeOsimTorqueData(protocol, protocol.seed, jobs);
+        return run;
+    }
+    run.subject = protocol.population.empty() ? "model " + protocol.model
+                                              : protocol.population + " person " + std::to_string(protocol.subjectIndex);
+    const VirtualSubject subject = loadTorqueProtocolSubject(protocol);
+    run.data = synthesizeTorqueData(subject, protocol, protocol.seed, jobs);
+    if (protocol.hasChannels()) run.channels = synthesizeChannelData(subject, protocol, run.data, protocol.seed);
+    return run;
 }
 
 std::vector<TorqueObservation> setTransducerNoise(std::vector<TorqueObservation> data, double sd) {

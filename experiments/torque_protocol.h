@@ -74,6 +74,9 @@ struct TorqueProtocol {
     std::string population;
     int subjectIndex = 0;
     std::string model = kDefaultSubjectModel;
+    /// An OpenSim model's (usesOsimModel) coordinate the efforts act about, "" = its only one. Its
+    /// conditions' flexion_deg is then that coordinate's value [deg], flexion its positive direction.
+    std::string coordinate;
     double transducerNoise = 0.02;   ///< relative sd (model subject only) [1]
     unsigned seed = 1;               ///< population and noise seed
     /// Muscles whose volume a panoramic ultrasound scan measures (once each; names in the model).
@@ -93,6 +96,8 @@ struct TorqueProtocol {
     bool hasChannels() const;
     /// true when the trials read the forearm axis too: forearmTorque or a rotation effort.
     bool readsForearmTorque() const;
+    /// true when the subject is an OpenSim model (model/osim_forward.h isOsimModel).
+    bool usesOsimModel() const;
     /// FieldError naming the field ("conditions[2].level", ...) unless every value is in range.
     void validate() const;
 };
@@ -142,6 +147,26 @@ struct TorqueObservation {
     /// A maximal flexion effort in the model's forearm posture: what the thesis's method uses.
     bool isThesisMvc() const { return isFlexionMvc() && std::isnan(rotationDeg); }
 };
+
+/// What a torque protocol's run on the subject it names gives.
+struct TorqueProtocolRun {
+    std::string subject;                       ///< who ran it, for reports ("model twin", "arm26 (OpenSim) ...")
+    std::vector<TorqueObservation> data;       ///< per trial, with its truth columns
+    std::vector<ChannelObservation> channels;  ///< the channels besides torque (hasChannels)
+};
+
+/// Runs the protocol on its subject (`armsim protocol`, Python's run_protocol): synthesizeTorqueData
+/// and synthesizeChannelData on a population person or an armsim model, synthesizeOsimTorqueData on an
+/// OpenSim model. Seeded with the protocol's seed; trials on `jobs` threads.
+TorqueProtocolRun runTorqueProtocol(const TorqueProtocol& protocol, int jobs = 1);
+
+/// The protocol's trials on its OpenSim model (usesOsimModel): each an isometric trial
+/// (model/osim_trial.h) of the coordinate locked at flexion_deg, the muscles that pull it the effort's
+/// way (flexion: its positive direction) excited to `level` and the others at rest, read as the tared
+/// torque about the coordinate (+ = its positive direction) with the protocol's relative transducer
+/// noise. No voluntary-activation deficit or trial variation (the file has no such model), no channels
+/// and no forearm axis (validate refuses them). Reproducible from noiseSeed; trials on `jobs` threads.
+std::vector<TorqueObservation> synthesizeOsimTorqueData(const TorqueProtocol& protocol, unsigned noiseSeed, int jobs = 1);
 
 /// What makes a condition: (flexion, effort, level, rotation), the model's posture (NaN) as +inf so
 /// keys compare and sort.

@@ -569,19 +569,17 @@ py::dict runProtocolPy(const py::object& file, const py::object& outArgument, in
     py::dict d;
     if (isTorqueProtocolFile(path)) {
         const TorqueProtocol protocol = readTorqueProtocol(path);
-        std::vector<TorqueObservation> data;
-        std::vector<ChannelObservation> channels;
+        TorqueProtocolRun run;
         std::vector<std::string> files;
         runInterruptible([&] {
-            const VirtualSubject subject = loadTorqueProtocolSubject(protocol);
-            data = synthesizeTorqueData(subject, protocol, protocol.seed, jobs);
-            if (protocol.hasChannels()) channels = synthesizeChannelData(subject, protocol, data, protocol.seed);
-            if (!out.empty()) files = writeTorqueProtocolRun(out, protocol, data, channels);
+            run = runTorqueProtocol(protocol, jobs);
+            if (!out.empty()) files = writeTorqueProtocolRun(out, protocol, run.data, run.channels);
         });
         d["name"] = protocol.name;
         d["kind"] = "torque";
-        d["data"] = toDict(data);
-        d["channels"] = toDict(channels);
+        d["subject"] = run.subject;
+        d["data"] = toDict(run.data);
+        d["channels"] = toDict(run.channels);
         d["files"] = files;
         return d;
     }

@@ -2,6 +2,8 @@
 // with file, line and field, and synthesized trials follow the stated effort model.
 #include "basics/errors.h"
 #include "experiments/torque_protocol.h"
+#include "model/osim_file.h"
+#include "model/osim_trial.h"
 #include "muscles/muscle_file.h"
 
 #include "tests/support/temp_files.h"
@@ -229,4 +231,83 @@ TEST(TorqueProtocol, TwoAxisTrialsReadTheForearmAxis) {
     TorqueProtocol withEmg = p;
     withEmg.conditions[1].emg = true;
     EXPECT_THROW(withEmg.validate(), InputError);
+}
+
+namespace {
+
+// arm26_torque.yaml cut short: flexion MVC at 90 deg x 2, extension MVC at 90, half flexion at 60.
+TorqueProtocol makeArm26Protocol() {
+    TorqueProtocol p = readTorqueProtocol(std::string(ARMSIM_ASSET_DIR) + "/protocols/arm26_torque.yaml");
+    p.conditions = {{90, Effort::Flexion, 1.0, 2}, {90, Effort::Extension, 1.0, 1}, {60, Effort::Flexion, 0.5, 1}};
+    p.holdDuration = 0.5;
+    p.averagingWindow = 0.25;
+    return p;
+}
+
+}  // namespace
+
+// A protocol on an OpenSim model runs each condition as that model's isometric trial (second method:
+// runOsimIsometricTrial called directly with the condition's coordinate, angle, direction and level):
+// the clean torque is its tared window mean to the last bit, the reading carries the relative transducer
+// noise, flexion pulls the positive way and extension the other, and the result does not depend on
+// the number of threads.
+TEST(TorqueProtocol, OsimModelTrialsAreItsIsometricTrialsWithTransducerNoise) {
+    const TorqueProtocol p = makeArm26Protocol();
+    ASSERT_TRUE(p.usesOsimModel());
+    const std::vector<TorqueObservation> data = synthesizeOsimTorqueData(p, 5, 2);
+    ASSERT_EQ(data.size(), 4u);
+    const OsimModel model = readOsimFile(std::string(ARMSIM_ASSET_DIR) + "/models/arm26.osim");
+    for (const TorqueObservation& o : data) {
+        OsimIsometricTrialSettings s;
+        s.coordinate = "r_elbow_flex";
+        s.angleDeg = o.flexionDeg;
+        s.direction = o.effort == Effort::Extension ? -1 : 1;
+        s.activation = o.level;
+        s.holdDuration = 0.5;
+        s.averagingWindow = 0.25;
+        s.sampleRate = p.sampleRate;
+        EXPECT_EQ(o.cleanTorque, runOsimIsometricTrial(model, s).summary.meanTaredTorque) << o.flexionDeg;
+        EXPECT_DOUBLE_EQ(o.torque, o.cleanTorque * (1 + p.transducerNoise * o.noiseDraw));
+        EXPECT_EQ(o.activation, o.level);
+    }
+    EXPECT_GT(data[0].cleanTorque, 10);   // flexion MVC at 90 deg (arm26: about 63 N m)
+    EXPECT_LT(data[1].cleanTorque, -10);  // extension
+    EXPECT_LT(data[2].cleanTorque, data[0].cleanTorque);
+    EXPECT_EQ(data[3].cleanTorque, data[0].cleanTorque);  // repetition 2: same trial, its own noise
+    EXPECT_NE(data[3].torque, data[0].torque);
+    const std::vector<TorqueObservation> oneThread = synthesizeOsimTorqueData(p, 5, 1);
+    for (std::size_t k = 0; k < data.size(); ++k) EXPECT_EQ(oneThread[k].torque, data[k].torque) << k;
+    // The protocol file says what ran it, and reads back.
+    const std::string text = formatTorqueProtocol(p);
+    EXPECT_NE(text.find("coordinate: r_elbow_flex"), std::string::npos) << text;
+    const TorqueProtocol back = readTorqueProtocol(writeTemp("armsim_arm26_back.yaml", text));
+    EXPECT_EQ(back.coordinate, "r_elbow_flex");
+    EXPECT_EQ(back.conditions.size(), p.conditions.size());
+}
+
+// What an OpenSim model's protocol cannot do is refused with the file, the line and the field.
+TEST(TorqueProtocol, OsimProtocolRefusesWhatItsModelCannotDoAtItsLine) {
+    const std::string head = "name: t\nkind: torque\nsubject: {model: arm26, coordinate: r_elbow_flex}\nconditions:\n";
+    auto read = [&](const std::string& body, const std::string& h) {
+        return errorOf([&] { readTorqueProtocol(writeTemp("armsim_osim_torque.yaml", h + body)); });
+    };
+    struct Case {
+        std::string header, body, expected;
+    };
+    const std::vector<Case> cases = {
+        {head, "  - {flexion_deg: 90}\n  - {flexion_deg: 150}\n", "armsim_osim_torque.yaml:6: field 'flexion_deg' (conditions, entry 2) = 150: expected in [0, 130]"},
+        {head, "  - {flexion_deg: 90, effort: supination}\n", "expected flexion (the positive direction) or extension"},
+        {head, "  - {flexion_deg: 90, rotation_deg: 30}\n", "expected no forearm posture"},
+        {head, "  - {flexion_deg: 90, channels: [torque, ultrasound]}\n", "expected torque only"},
+        {"name: t\nkind: torque\nsubject: {model: arm26, coordinate: r_elbow_flex}\nmeasurements: {forearm_torque: true}\n"
+         "conditions:\n", "  - {flexion_deg: 90}\n", "expected no volume scan, anthropometry or forearm torque"},
+        {"name: t\nkind: torque\nsubject: {model: arm26, coordinate: elbow}\nconditions:\n", "  - {flexion_deg: 90}\n",
+         "armsim_osim_torque.yaml:3: field 'subject.coordinate' 'elbow': not a coordinate of arm26"},
+        {"name: t\nkind: torque\nsubject: {model: twin, coordinate: r_elbow_flex}\nconditions:\n", "  - {flexion_deg: 90}\n",
+         "only an OpenSim model"},
+    };
+    for (const Case& c : cases) {
+        const std::string e = read(c.body, c.header);
+        EXPECT_NE(e.find(c.expected), std::string::npos) << e;
+    }
 }

@@ -118,6 +118,21 @@ def test_run_protocol_torque_equals_the_cpp_api_and_feeds_identify_torque(refere
     assert [e["mass_kg"] for e in from_dict] == pytest.approx([e["mass_kg"] for e in from_file], rel=1e-12)
 
 
+def test_run_protocol_on_an_opensim_model_reads_its_coordinates_torque(tmp_path):
+    run = armsim.run_protocol("protocols/arm26_torque.yaml", out=tmp_path / "arm26")
+    assert run["subject"] == "OpenSim model arm26, coordinate r_elbow_flex"
+    data = run["data"]
+    assert len(data["torque_Nm"]) == 14
+    # the clean torque is the isometric trial's: flexion MVC at 90 deg through isometric_trial itself
+    _, summary = armsim.isometric_trial("arm26", coordinate="r_elbow_flex", angle_deg=90, hold=1.0,
+                                        averaging_window=0.5, rate=200)
+    at90 = [k for k in range(14) if data["flexion_deg"][k] == 90 and data["effort"][k] == 1 and data["level"][k] == 1]
+    assert len(at90) == 2
+    for k in at90:
+        assert data["clean_torque_Nm"][k] == pytest.approx(summary["mean_tared_torque_Nm"], rel=1e-12)
+    assert (tmp_path / "arm26" / "torque_data.csv").exists()
+
+
 def test_forearm_postures_reach_python_and_feed_identify_torque(tmp_path):
     run = armsim.run_protocol("protocols/forearm_postures.yaml", out=str(tmp_path / "run"))
     rot = np.asarray(run["data"]["rotation_deg"])
