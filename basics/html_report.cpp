@@ -93,7 +93,8 @@ h1{font-size:1.6em}h2{font-size:1.25em;border-bottom:1px solid #ccc;margin-top:2
 table{border-collapse:collapse;font-size:.85em}td,th{border:1px solid #ddd;padding:2px 6px;text-align:right}
 th{background:#f3f3f3}.facts td{text-align:left}.table{overflow-x:auto;margin:.5em 0 1em}
 figure{margin:1em 0}figure img,figure video{max-width:100%;border:1px solid #ddd}
-figcaption,.caption{color:#444;font-size:.95em;margin:.3em 0}ul.files li{margin:.2em 0}code{font-size:.95em})";
+figcaption,.caption{color:#444;font-size:.95em;margin:.3em 0}ul.files li{margin:.2em 0}code{font-size:.95em}
+pre.printed{background:#f7f7f7;border:1px solid #ddd;padding:.5em;font-size:.8em;max-height:40em;overflow:auto})";
 
 // On load: every image and video must have loaded; the result goes to body[data-resources].
 constexpr const char* kCheck = R"(<script>
@@ -159,6 +160,9 @@ void writeFolderReport(const std::string& dir, const FolderReport& report) {
     for (const auto& [label, value] : report.facts)
         h << "<tr><th>" << escape(label) << "</th><td><code>" << escape(value) << "</code></td></tr>";
     h << "</table>\n";
+    if (!report.printed.empty())
+        h << "<h2>What it printed</h2>\n<p class=\"caption\">the command's results and key numbers, as on the terminal</p>\n"
+          << "<pre class=\"printed\">" << escape(report.printed) << "</pre>\n";
     for (auto& [folder, files] : byFolder) {
         std::sort(files.begin(), files.end());
         h << "<h2>" << (folder.empty() ? "Files" : escape(folder) + "/") << "</h2>\n";

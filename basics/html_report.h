@@ -14,6 +14,8 @@ namespace armsim {
 struct FolderReport {
     std::string title;                                        ///< e.g. "armsim run"
     std::vector<std::pair<std::string, std::string>> facts;   ///< (label, value): command line, version, time, settings
+    /// What the command printed (its results and key numbers), shown under the facts; "" : nothing.
+    std::string printed;
     /// One sentence on what a file shows, from its path relative to the folder ("" : none known).
     std::function<std::string(const std::string& relativePath)> describe;
 };

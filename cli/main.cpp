@@ -105,6 +105,7 @@ std::string explainConversion(const CLI::App& app, const std::string& what) {
 }  // namespace
 
 int main(int argc, char** argv) {
+    armsim::cli::startStdoutCapture();   // the report shows what the command printed
     startSignalThread();
     armsim::quietCeresLogging();  // once, before any thread: armsim reports what Ceres would log
     CLI::App app{"armsim: a Simbody elbow with a Virtual Muscle biceps (simulate, identify, render)"};
@@ -168,7 +169,7 @@ int main(int argc, char** argv) {
     std::cout.flush();
     const bool flushed = std::fflush(stdout) == 0 && !std::ferror(stdout) && std::cout.good();
     if (!flushed) {
-        const int error = errno;
+        const int error = errno ? errno : armsim::cli::getStdoutWriteError();
         std::cerr << "armsim: error: cannot write to standard output" << (error ? std::string(": ") + std::strerror(error) : "")
                   << " (the results printed there are incomplete)\n";
         return 2;

@@ -2,8 +2,12 @@
 
 #include "basics/html_report.h"
 
+#include <cerrno>
 #include <chrono>
+#include <cstdio>
 #include <cstdlib>
+#include <mutex>
+#include <unistd.h>
 #include <ctime>
 #include <filesystem>
 #include <regex>
@@ -86,6 +90,42 @@ const std::vector<std::pair<std::regex, std::string>>& getCaptions() {
     return captions;
 }
 
+struct Captured {
+    std::mutex mutex;
+    std::string text;
+    bool cut = false;
+    int writeError = 0;   // errno of the first failed write
+};
+Captured& getCaptured() {
+    static Captured c;
+    return c;
+}
+
+// The stdout stream's writer: every byte to file descriptor 1 (a failure is the stream's error, as
+// for the real stdout), and a copy into the buffer.
+ssize_t writeTee(void*, const char* data, std::size_t size) {
+    std::size_t done = 0;
+    while (done < size) {
+        const ssize_t n = ::write(STDOUT_FILENO, data + done, size - done);
+        if (n < 0) {
+            if (errno == EINTR) continue;
+            const int error = errno;
+            Captured& c = getCaptured();
+            std::lock_guard<std::mutex> lock(c.mutex);
+            if (!c.writeError) c.writeError = error;
+            errno = error;
+            return -1;
+        }
+        done += std::size_t(n);
+    }
+    Captured& c = getCaptured();
+    std::lock_guard<std::mutex> lock(c.mutex);
+    const std::size_t room = kMaxCapturedStdout - std::min(kMaxCapturedStdout, c.text.size());
+    c.text.append(data, std::min(room, size));
+    if (size > room) c.cut = true;
+    return ssize_t(size);
+}
+
 std::string quote(const std::string& a) {
     if (!a.empty() && a.find_first_of(" \t\"'\\$`*?;&|<>()") == std::string::npos) return a;
     std::string q = "'";
@@ -94,6 +134,29 @@ std::string quote(const std::string& a) {
 }
 
 }  // namespace
+
+void startStdoutCapture() {
+    cookie_io_functions_t io{};
+    io.write = writeTee;
+    FILE* tee = fopencookie(nullptr, "w", io);
+    if (!tee) return;   // no capture: the report shows no printed text
+    // The real stdout's buffering: by line to a terminal, in blocks otherwise.
+    std::setvbuf(tee, nullptr, isatty(STDOUT_FILENO) ? _IOLBF : _IOFBF, BUFSIZ);
+    std::fflush(stdout);
+    stdout = tee;
+}
+
+int getStdoutWriteError() {
+    Captured& c = getCaptured();
+    std::lock_guard<std::mutex> lock(c.mutex);
+    return c.writeError;
+}
+
+std::string getCapturedStdout() {
+    Captured& c = getCaptured();
+    std::lock_guard<std::mutex> lock(c.mutex);
+    return c.cut ? c.text + "\n[... cut at " + std::to_string(kMaxCapturedStdout / 1024) + " kB]\n" : c.text;
+}
 
 std::string describeOutputFile(const std::string& relativePath) {
     const std::string name = std::filesystem::path(relativePath).filename().string();
@@ -143,6 +206,8 @@ void writeCommandReport(const CLI::App& app, int argc, char** argv) {
         r.facts.emplace_back(o->get_name(), v.empty() ? "-" : v);
     }
     r.describe = describeOutputFile;
+    std::fflush(stdout);
+    r.printed = getCapturedStdout();
     writeFolderReport(dir, r);
 }
 

@@ -12,6 +12,16 @@ namespace armsim::cli {
 /// (the caller warns: the command's own files stand).
 void writeCommandReport(const CLI::App& app, int argc, char** argv);
 
+/// From now on, what the program writes through C's stdout also goes into a buffer (at most
+/// kMaxCapturedStdout bytes; the rest is noted as cut), which writeCommandReport shows. Standard output
+/// itself is unchanged: the same bytes, buffering and write errors (ferror(stdout)). Call once, first.
+void startStdoutCapture();
+/// The buffer so far.
+std::string getCapturedStdout();
+/// errno of the first write to standard output that failed (0: none), for the message at exit.
+int getStdoutWriteError();
+constexpr std::size_t kMaxCapturedStdout = 1 << 20;
+
 /// One sentence on what an armsim output file shows, from its path relative to its folder ("" : not
 /// an armsim name).
 std::string describeOutputFile(const std::string& relativePath);

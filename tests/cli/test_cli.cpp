@@ -774,6 +774,36 @@ TEST(Cli, AnOverviewThatCannotBeWrittenIsAnError) {
     EXPECT_TRUE(fs::exists(d / "out" / "index.html" / "mine.txt"));
 }
 
+// The overview shows what the command printed (its results and key numbers) byte for byte as standard
+// output got it, and a full standard output is still named with its reason.
+TEST(Cli, TheOverviewShowsWhatTheCommandPrinted) {
+    const fs::path d = freshDir("overview_printed");
+    const CommandResult r = armsim::testing::runCommand(std::string(ARMSIM_EXE) + " model show --model twin --out " +
+                                                        (d / "out").string() + " > " + (d / "stdout.txt").string());
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    auto read = [](const fs::path& p) {
+        std::ifstream in(p);
+        std::stringstream ss;
+        ss << in.rdbuf();
+        return ss.str();
+    };
+    const std::string printed = read(d / "stdout.txt"), html = read(d / "out" / "index.html");
+    EXPECT_NE(printed.find("flexion MVC: peak"), std::string::npos) << printed;
+    const std::string open = "<pre class=\"printed\">";
+    const std::size_t begin = html.find(open), end = html.find("</pre>", begin);
+    ASSERT_NE(begin, std::string::npos) << html.substr(0, 2000);
+    std::string shown = html.substr(begin + open.size(), end - begin - open.size());
+    for (const auto& [entity, c] : std::vector<std::pair<std::string, std::string>>{{"&lt;", "<"}, {"&gt;", ">"}, {"&quot;", "\""}, {"&amp;", "&"}})
+        for (std::size_t at = shown.find(entity); at != std::string::npos; at = shown.find(entity, at + 1)) shown.replace(at, entity.size(), c);
+    EXPECT_EQ(shown, printed);
+    const CommandResult full = armsim::testing::runCommand("( " + std::string(ARMSIM_EXE) + " model show --model thesis --out " +
+                                                           (d / "full").string() + " 2> " + (d / "stderr.txt").string() +
+                                                           " > /dev/full )");
+    EXPECT_EQ(full.exitCode, 2) << full.output;
+    const std::string err = read(d / "stderr.txt");
+    EXPECT_NE(err.find("cannot write to standard output: No space left on device"), std::string::npos) << err;
+}
+
 // `armsim trial --model arm26`: the elbow locked at 80 deg, a 1 s flexion effort; the last sample's torque
 // (passive included) equals `model show`'s steady flexion torque at 80 deg (the steady isometric solve: a
 // second method) to 1e-3 relative, and the options an .osim trial cannot honour are refused by name.
