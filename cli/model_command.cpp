@@ -49,10 +49,10 @@ void showModel(const ArmSetup& setup, const std::string& out, double step, const
     for (const std::string& f : r.files) std::printf("wrote %s\n", showPath(f).c_str());
 }
 
-// Writes the scorecard to out and prints the per-kind summary and every failed target.
-void checkModel(const ArmSetup& setup, const std::vector<AnatomyTarget>& targets, const std::string& out) {
-    const ModelCheckResult r = writeModelCheck(setup, targets, out);
-    std::printf("model %s against %zu targets:\n", setup.name.c_str(), targets.size());
+// Prints the per-kind summary, what was not scored and every failed target of a check written to files.
+void printModelCheck(const std::string& name, const ModelCheckResult& r, const std::vector<AnatomyTarget>& targets,
+                     const char* unscoredWhy) {
+    std::printf("model %s against %zu targets:\n", name.c_str(), targets.size());
     // Targets of muscles this model lacks are not scored (one target file serves several models): said, not silent.
     std::vector<std::string> unscored;
     for (const AnatomyTarget& t : targets) {
@@ -62,8 +62,8 @@ void checkModel(const ArmSetup& setup, const std::vector<AnatomyTarget>& targets
         if (!found) unscored.push_back(t.where + (t.muscle.empty() ? "" : " (" + t.muscle + ")"));
     }
     if (!unscored.empty())
-        std::printf("  not scored: %zu targets the model has nothing for (no such muscle, or no forearm rotation): %s%s\n",
-                    unscored.size(), unscored.front().c_str(), unscored.size() > 1 ? ", ..." : "");
+        std::printf("  not scored: %zu targets the model has nothing for (%s): %s%s\n", unscored.size(), unscoredWhy,
+                    unscored.front().c_str(), unscored.size() > 1 ? ", ..." : "");
     for (const ScoreSummary& s : r.summary)
         std::printf("  %-14s %-9s %3d of %3d pass\n", getTargetKindName(s.kind), s.muscle.empty() ? "all" : s.muscle.c_str(),
                     s.passed, s.scored);
@@ -74,6 +74,11 @@ void checkModel(const ArmSetup& setup, const std::vector<AnatomyTarget>& targets
                         std::isfinite(s.target.flexionDeg) ? (" at " + formatNumber(s.target.flexionDeg) + " deg").c_str() : "",
                         s.value, s.target.lower, s.target.upper, s.target.tolerance, s.target.where.c_str());
     for (const std::string& f : r.files) std::printf("wrote %s\n", showPath(f).c_str());
+}
+
+// Writes the scorecard of an armsim model to out and prints it.
+void checkModel(const ArmSetup& setup, const std::vector<AnatomyTarget>& targets, const std::string& out) {
+    printModelCheck(setup.name, writeModelCheck(setup, targets, out), targets, "no such muscle, a share family missing, or no forearm rotation");
 }
 
 void addModelCommands(CLI::App& app) {
@@ -147,9 +152,21 @@ void addModelCommands(CLI::App& app) {
                       "every muscle's model: virtual_muscle, thelen2003 or degroote2016 (default: the model file's)");
         c->add_option("--targets", *targets, "target file (default assets/reference/elbow_targets.yaml)");
         c->add_option("--out", *out, "output directory")->capture_default_str();
+        auto coordinate = std::make_shared<std::string>();
+        c->add_option("--coordinate", *coordinate,
+                      "an OpenSim model's coordinate scored as the elbow: its value in deg as flexion, + = flexion "
+                      "(default: its only moving one)");
         c->callback([=] {
             checkOutputFolder("--out", *out);
-            checkModel(loadModelWithMuscles(*name, *muscleModel), targets->empty() ? loadDefaultAnatomyTargets() : loadAnatomyTargets(*targets), *out);
+            const std::vector<AnatomyTarget> t = targets->empty() ? loadDefaultAnatomyTargets() : loadAnatomyTargets(*targets);
+            if (isOsimModel(*name)) {
+                const OsimModel m = readOsimFile(findOsimModelFile(*name));
+                printModelCheck(m.name + " (OpenSim)", writeOsimModelCheck(m, *coordinate, *muscleModel, t, *out), t,
+                                "no such muscle, a share family missing, no muscle masses for volumes, no armsim forearm");
+                return;
+            }
+            if (!coordinate->empty()) throw InputError("--coordinate '" + *coordinate + "': only for OpenSim models (.osim)");
+            checkModel(loadModelWithMuscles(*name, *muscleModel), t, *out);
         });
     }
 

@@ -6,6 +6,7 @@
 #include "basics/files.h"
 #include "basics/plot.h"
 #include "model/mvc_curve.h"
+#include "model/osim_anatomy.h"
 
 #include <algorithm>
 #include <cmath>
@@ -42,10 +43,13 @@ void addBands(PlotSpec& spec, const std::vector<TargetScore>& scores, TargetKind
 
 }  // namespace
 
-ModelCheckResult writeModelCheck(const ArmSetup& setup, const std::vector<AnatomyTarget>& targets,
+namespace {
+
+// The scorecard, its summary and the two plots (curves over the range) into outDir.
+ModelCheckResult writeCheckFiles(std::vector<TargetScore> scores, const AnatomyCurves& curves, const std::string& xLabel,
                                  const std::string& outDir) {
     ModelCheckResult r;
-    r.scores = scoreAnatomy(setup, targets);
+    r.scores = std::move(scores);
     r.summary = summarizeScores(r.scores);
     OutputFolder folder(outDir, OutputFolder::Mode::AddFiles);  // every file appears at the end, or none
     auto path = [&](const std::string& f) { return folder.getTargetPath(f); };
@@ -73,27 +77,26 @@ ModelCheckResult writeModelCheck(const ArmSetup& setup, const std::vector<Anatom
     r.files = {path("scorecard.csv"), path("score_summary.csv")};
 
     // Moment arms: every muscle's curve, the bands of its targets in the same colour.
-    const std::vector<double> angles = sweepAngles(setup);
-    const MvcGeometry g = calcMvcGeometry(setup, angles);
+    const std::vector<double>& angles = curves.flexionDeg;
     PlotSpec arms;
     arms.title = "Moment arms; markers: published band +/- tolerance";
-    arms.xLabel = "elbow flexion (deg)";
+    arms.xLabel = xLabel;
     arms.yLabel = "moment arm (mm), + = flexor";
-    for (int m = 0; m < setup.getNumMuscles(); ++m) {
-        PlotSeries c{setup.muscles[m].params.name, angles, {}, false, m % 8};
-        for (std::size_t a = 0; a < angles.size(); ++a) c.y.push_back(1000 * g.momentArm[a][m]);
+    for (int m = 0; m < int(curves.muscles.size()); ++m) {
+        PlotSeries c{curves.muscles[m], angles, {}, false, m % 8};
+        for (std::size_t a = 0; a < angles.size(); ++a) c.y.push_back(1000 * curves.momentArm[a][m]);
         arms.series.push_back(c);
-        addBands(arms, r.scores, TargetKind::MomentArm, setup.muscles[m].params.name, MuscleGroup::Flexor, 1000, m % 8, "");
+        addBands(arms, r.scores, TargetKind::MomentArm, curves.muscles[m], MuscleGroup::Flexor, 1000, m % 8, "");
     }
     folder.writeWith("check_moment_arms.png", [&](const std::string& p) { writePlotPng(p, arms); });
 
     PlotSpec mvc;
     mvc.title = "Steady MVC torque; markers: published band +/- tolerance";
-    mvc.xLabel = "elbow flexion (deg)";
+    mvc.xLabel = xLabel;
     mvc.yLabel = "net torque magnitude (N m)";
     const MuscleGroup groups[2] = {MuscleGroup::Flexor, MuscleGroup::Extensor};
     for (int k = 0; k < 2; ++k) {
-        const SteadyMvcCurve c = calcSteadyMvcCurve(setup.muscles, g, groups[k], setup.effort);
+        const SteadyMvcCurve& c = k == 0 ? curves.flexion : curves.extension;
         PlotSeries s{std::string(k == 0 ? "flexion" : "extension") + " MVC (model)", angles, {}, false, k};
         for (double t : c.totalTorque) s.y.push_back(std::abs(t));
         mvc.series.push_back(s);
@@ -104,6 +107,26 @@ ModelCheckResult writeModelCheck(const ArmSetup& setup, const std::vector<Anatom
     r.files.push_back(path("check_mvc.png"));
     folder.commit();
     return r;
+}
+
+}  // namespace
+
+ModelCheckResult writeModelCheck(const ArmSetup& setup, const std::vector<AnatomyTarget>& targets,
+                                 const std::string& outDir) {
+    return writeCheckFiles(scoreAnatomy(setup, targets), calcAnatomyCurves(setup, sweepAngles(setup)), "elbow flexion (deg)",
+                           outDir);
+}
+
+ModelCheckResult writeOsimModelCheck(const OsimModel& model, const std::string& coordinate, const std::string& muscleModel,
+                                     const std::vector<AnatomyTarget>& targets, const std::string& outDir) {
+    const std::array<double, 2> range = getOsimCoordinateRangeDeg(model, coordinate);
+    const AnatomyCurves scored =
+        calcOsimAnatomyCurves(model, coordinate, findAnatomyAngles(targets, range[0], range[1]), muscleModel);
+    std::vector<double> angles;
+    for (double d = range[0]; d <= range[1] + 1e-9; d += 2) angles.push_back(d);
+    const AnatomyCurves drawn = calcOsimAnatomyCurves(model, coordinate, angles, muscleModel);
+    return writeCheckFiles(scoreAnatomyCurves(scored, targets), drawn,
+                           (coordinate.empty() ? std::string("the coordinate") : coordinate) + " (deg, as elbow flexion)", outDir);
 }
 
 }  // namespace armsim

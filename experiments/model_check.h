@@ -3,6 +3,7 @@
 #pragma once
 
 #include "model/anatomy_targets.h"
+#include "model/osim_file.h"
 
 #include <string>
 #include <vector>
@@ -23,5 +24,11 @@ struct ModelCheckResult {
 /// curves with their bands). Files are written whole or not at all.
 ModelCheckResult writeModelCheck(const ArmSetup& setup, const std::vector<AnatomyTarget>& targets,
                                  const std::string& outDir);
+
+/// The same for an OpenSim model (model/osim_anatomy.h): `coordinate` as the elbow (its value in
+/// degrees as flexion), each muscle's model from the file or muscleModel. Volume and forearm targets are
+/// not scored (the file has no muscle masses or armsim forearm).
+ModelCheckResult writeOsimModelCheck(const OsimModel& model, const std::string& coordinate, const std::string& muscleModel,
+                                     const std::vector<AnatomyTarget>& targets, const std::string& outDir);
 
 }  // namespace armsim

@@ -1,5 +1,7 @@
 #include "experiments/osim_report.h"
 
+#include "model/osim_anatomy.h"
+
 #include "basics/errors.h"
 #include "basics/files.h"
 #include "basics/format.h"
@@ -17,21 +19,6 @@ namespace {
 
 constexpr double kDeg = 3.14159265358979323846 / 180;
 
-int findSwept(const OsimArm& arm, const std::string& name) {
-    std::string names;
-    for (int i = 0; i < arm.getNumCoordinates(); ++i) names += (i ? ", " : "") + arm.getCoordinate(i).name;
-    if (name.empty()) {
-        if (arm.getNumCoordinates() == 1) return 0;
-        throw InputError("--coordinate: model " + arm.getModel().name + " has " + std::to_string(arm.getNumCoordinates()) +
-                         " coordinates (" + names + "): name the one to sweep");
-    }
-    const int i = arm.findCoordinate(name);
-    if (i < 0) throw InputError("--coordinate '" + name + "': not a coordinate of " + arm.getModel().name + " (" + names + ")");
-    if (!arm.getCoordinate(i).rotational)
-        throw InputError("--coordinate '" + name + "': translational; expected a rotational coordinate");
-    return i;
-}
-
 }  // namespace
 
 OsimReportFiles writeOsimModelReport(const OsimModel& model, const OsimReportSettings& settings, const std::string& outDir) {
@@ -41,7 +28,7 @@ OsimReportFiles writeOsimModelReport(const OsimModel& model, const OsimReportSet
     if (arm.getNumMuscles() == 0)
         throw InputError("model " + model.name + " (" + model.file + ") has no muscles: `model show` reports muscles "
                          "(`armsim forward` runs a model without them)");
-    const int j = findSwept(arm, settings.coordinate);
+    const int j = findOsimSweptCoordinate(arm, settings.coordinate);
     OsimReportFiles r;
     r.coordinate = arm.getCoordinate(j).name;
     const int n = arm.getNumMuscles();

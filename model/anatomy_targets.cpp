@@ -27,11 +27,28 @@ struct Unit {
 const Unit kUnits[] = {{"mm", "m", 1e-3}, {"N m", "N m", 1}, {"cm^3", "m^3", 1e-6}, {"1", "1", 1},
                        {"deg", "deg", 1},  {"N m", "N m", 1}, {"1", "1", 1}};
 
-std::vector<int> findCovered(const ArmSetup& setup, const std::string& family) {
+std::vector<int> findCovered(const std::vector<std::string>& muscles, const std::string& family) {
     std::vector<int> out;
-    for (int i = 0; i < setup.getNumMuscles(); ++i)
-        if (doesFamilyCoverMuscle(family, setup.muscles[i].params.name)) out.push_back(i);
+    for (int i = 0; i < int(muscles.size()); ++i)
+        if (doesFamilyCoverMuscle(family, muscles[i])) out.push_back(i);
     return out;
+}
+
+// An armsim model's curves on a geometry already computed.
+AnatomyCurves makeAnatomyCurves(const ArmSetup& setup, const MvcGeometry& geometry) {
+    AnatomyCurves c;
+    for (const MuscleSpec& m : setup.muscles) {
+        c.muscles.push_back(m.params.name);
+        c.volume.push_back(m.params.mass / m.params.coefficients.density);
+    }
+    c.minFlexionDeg = setup.arm.getMinFlexionDeg();
+    c.maxFlexionDeg = setup.arm.getMaxFlexionDeg();
+    c.flexionDeg = geometry.flexionDeg;
+    c.momentArm = geometry.momentArm;
+    c.flexion = calcSteadyMvcCurve(setup.muscles, geometry, MuscleGroup::Flexor, setup.effort);
+    c.extension = calcSteadyMvcCurve(setup.muscles, geometry, MuscleGroup::Extensor, setup.effort);
+    c.full = calcSteadyMvcCurve(setup.muscles, geometry, MuscleGroup::Flexor, SubjectEffort{1, 0});
+    return c;
 }
 
 // Flexion angle where the fibre length crosses 1 going along the samples (linear interpolation); NaN
@@ -142,20 +159,27 @@ std::vector<AnatomyTarget> loadDefaultAnatomyTargets() {
     return loadAnatomyTargets(getAssetDirectory() + "/reference/elbow_targets.yaml");
 }
 
-AnatomySweep calcAnatomySweep(const ArmSetup& setup, const std::vector<AnatomyTarget>& targets) {
-    const double maxFlexion = setup.arm.getMaxFlexionDeg(), minFlexion = setup.arm.getMinFlexionDeg();
-    AnatomySweep sweep;
-    std::vector<double>& angles = sweep.flexionDeg;
+std::vector<double> findAnatomyAngles(const std::vector<AnatomyTarget>& targets, double minDeg, double maxDeg) {
+    std::vector<double> angles;
     const bool optimumAngles = std::any_of(targets.begin(), targets.end(),
                                            [](const AnatomyTarget& t) { return t.kind == TargetKind::OptimumAngle; });
     if (optimumAngles)
-        for (double a = minFlexion; a <= maxFlexion + 1e-9; a += 1) angles.push_back(a);
+        for (double a = minDeg; a <= maxDeg + 1e-9; a += 1) angles.push_back(a);
     for (const AnatomyTarget& t : targets)
-        if (std::isfinite(t.flexionDeg) && t.flexionDeg >= minFlexion && t.flexionDeg <= maxFlexion)
-            angles.push_back(t.flexionDeg);
+        if (std::isfinite(t.flexionDeg) && t.flexionDeg >= minDeg && t.flexionDeg <= maxDeg) angles.push_back(t.flexionDeg);
     std::sort(angles.begin(), angles.end());
     angles.erase(std::unique(angles.begin(), angles.end()), angles.end());
-    sweep.geometry = calcMvcGeometry(setup, angles);
+    return angles;
+}
+
+AnatomyCurves calcAnatomyCurves(const ArmSetup& setup, const std::vector<double>& flexionDeg) {
+    return makeAnatomyCurves(setup, calcMvcGeometry(setup, flexionDeg));
+}
+
+AnatomySweep calcAnatomySweep(const ArmSetup& setup, const std::vector<AnatomyTarget>& targets) {
+    AnatomySweep sweep;
+    sweep.flexionDeg = findAnatomyAngles(targets, setup.arm.getMinFlexionDeg(), setup.arm.getMaxFlexionDeg());
+    sweep.geometry = calcMvcGeometry(setup, sweep.flexionDeg);
 
     std::set<double> forearmAngles, rotations;
     for (const AnatomyTarget& t : targets)
@@ -173,27 +197,12 @@ std::vector<TargetScore> scoreAnatomy(const ArmSetup& setup, const std::vector<A
     return scoreAnatomy(setup, targets, calcAnatomySweep(setup, targets));
 }
 
-std::vector<TargetScore> scoreAnatomy(const ArmSetup& setup, const std::vector<AnatomyTarget>& targets,
-                                      const AnatomySweep& sweep) {
-    const double maxFlexion = setup.arm.getMaxFlexionDeg(), minFlexion = setup.arm.getMinFlexionDeg();
-    const std::vector<double>& angles = sweep.flexionDeg;
-    auto indexOf = [&](double deg) {
-        return int(std::lower_bound(angles.begin(), angles.end(), deg) - angles.begin());
-    };
-    const MvcGeometry& geometry = sweep.geometry;
-    const SteadyMvcCurve flexion = calcSteadyMvcCurve(setup.muscles, geometry, MuscleGroup::Flexor, setup.effort);
-    const SteadyMvcCurve extension = calcSteadyMvcCurve(setup.muscles, geometry, MuscleGroup::Extensor, setup.effort);
-    const SteadyMvcCurve full = calcSteadyMvcCurve(setup.muscles, geometry, MuscleGroup::Flexor, SubjectEffort{1, 0});
+namespace {
 
-    std::vector<int> sharedMuscles;   // every muscle a share target names
-    for (int i = 0; i < setup.getNumMuscles(); ++i)
-        if (std::any_of(targets.begin(), targets.end(), [&](const AnatomyTarget& t) {
-                return t.kind == TargetKind::Share && doesFamilyCoverMuscle(t.muscle, setup.muscles[i].params.name);
-            }))
-            sharedMuscles.push_back(i);
-
-    std::vector<TargetScore> out;
-    auto add = [&](const AnatomyTarget& t, const std::string& muscle, double value, double fitValue = NAN) {
+// Appends the score of one target that the curves answer (not a forearm target).
+void scoreCurveTarget(const AnatomyCurves& c, const AnatomyTarget& t, const std::vector<int>& sharedMuscles,
+                      std::vector<TargetScore>& out) {
+    auto add = [&](const std::string& muscle, double value, double fitValue = NAN) {
         TargetScore s;
         s.target = t;
         s.muscle = muscle;
@@ -202,59 +211,102 @@ std::vector<TargetScore> scoreAnatomy(const ArmSetup& setup, const std::vector<A
         s.pass = std::isfinite(value) && value >= t.lower - t.tolerance && value <= t.upper + t.tolerance;
         out.push_back(s);
     };
+    auto indexOf = [&](double deg) {
+        return int(std::lower_bound(c.flexionDeg.begin(), c.flexionDeg.end(), deg) - c.flexionDeg.begin());
+    };
+    if (t.kind == TargetKind::Mvc) {
+        const SteadyMvcCurve& curve = t.direction == MuscleGroup::Flexor ? c.flexion : c.extension;
+        return add("", std::abs(curve.totalTorque[indexOf(t.flexionDeg)]));
+    }
+    const std::vector<int> covered = findCovered(c.muscles, t.muscle);
+    if (covered.empty()) return;
+    switch (t.kind) {
+    case TargetKind::MomentArm:
+        for (int m : covered) add(c.muscles[m], c.momentArm[indexOf(t.flexionDeg)][m]);
+        break;
+    case TargetKind::OptimumAngle:
+        for (int m : covered) add(c.muscles[m], findOptimumAngle(c.full, m), extrapolateOptimumAngle(c.full, m));
+        break;
+    case TargetKind::Volume: {
+        double v = 0;
+        for (int m : covered) v += c.volume[m];
+        if (std::isfinite(v)) add(t.muscle, v);   // a model that does not know its volumes is not scored
+        break;
+    }
+    case TargetKind::Share: {
+        // Like-for-like with share sources (Kawakami 1994's three add up to 1): the family's flexion
+        // torque over that of every muscle a share target names.
+        if (sharedMuscles.empty()) break;   // a family of the sources is missing: not comparable
+        const int a = indexOf(t.flexionDeg);
+        double part = 0, whole = 0;
+        for (int m : covered) part += std::max(0.0, c.flexion.points[a][m].torque);
+        for (int m : sharedMuscles) whole += std::max(0.0, c.flexion.points[a][m].torque);
+        add(t.muscle, whole > 0 ? part / whole : NAN);
+        break;
+    }
+    case TargetKind::Mvc:
+    case TargetKind::ForearmMvc:
+    case TargetKind::PostureRatio: break;
+    }
+}
+
+// Every muscle a share target names; none when a family the share targets name has no muscle in the
+// model (the sources' shares add up to 1 over all their families: without one they are not comparable).
+std::vector<int> findSharedMuscles(const std::vector<std::string>& muscles, const std::vector<AnatomyTarget>& targets) {
+    for (const AnatomyTarget& t : targets)
+        if (t.kind == TargetKind::Share && findCovered(muscles, t.muscle).empty()) return {};
+    std::vector<int> shared;
+    for (int i = 0; i < int(muscles.size()); ++i)
+        if (std::any_of(targets.begin(), targets.end(), [&](const AnatomyTarget& t) {
+                return t.kind == TargetKind::Share && doesFamilyCoverMuscle(t.muscle, muscles[i]);
+            }))
+            shared.push_back(i);
+    return shared;
+}
+
+bool isInRange(const AnatomyTarget& t, double minDeg, double maxDeg) {
+    return !std::isfinite(t.flexionDeg) || (t.flexionDeg >= minDeg && t.flexionDeg <= maxDeg);
+}
+
+}  // namespace
+
+std::vector<TargetScore> scoreAnatomyCurves(const AnatomyCurves& curves, const std::vector<AnatomyTarget>& targets) {
+    const std::vector<int> shared = findSharedMuscles(curves.muscles, targets);
+    std::vector<TargetScore> out;
+    for (const AnatomyTarget& t : targets)
+        if (t.kind != TargetKind::ForearmMvc && t.kind != TargetKind::PostureRatio &&
+            isInRange(t, curves.minFlexionDeg, curves.maxFlexionDeg))
+            scoreCurveTarget(curves, t, shared, out);
+    return out;
+}
+
+std::vector<TargetScore> scoreAnatomy(const ArmSetup& setup, const std::vector<AnatomyTarget>& targets,
+                                      const AnatomySweep& sweep) {
+    const AnatomyCurves curves = makeAnatomyCurves(setup, sweep.geometry);
+    const std::vector<int> shared = findSharedMuscles(curves.muscles, targets);
+    std::vector<TargetScore> out;
     for (const AnatomyTarget& t : targets) {
-        const bool inRange = !std::isfinite(t.flexionDeg) || (t.flexionDeg >= minFlexion && t.flexionDeg <= maxFlexion);
-        if (!inRange) continue;
-        if (t.kind == TargetKind::ForearmMvc || t.kind == TargetKind::PostureRatio) {
-            if (!isScoredForearmTarget(setup, t)) continue;
-            const MvcGeometry& g = sweep.byRotation.at(t.rotationDeg);
-            const std::size_t a = std::lower_bound(g.flexionDeg.begin(), g.flexionDeg.end(), t.flexionDeg) - g.flexionDeg.begin();
-            if (t.kind == TargetKind::ForearmMvc) {
-                const SteadyMvcCurve c = calcSteadyMvcCurve(setup.muscles, g, t.forearmEffort, setup.effort);
-                add(t, "", std::abs(c.totalForearmTorque[a]));
-            } else {
-                const double at = calcSteadyMvcCurve(setup.muscles, g, MuscleGroup::Flexor, setup.effort).totalTorque[a];
-                const double ref =
-                    calcSteadyMvcCurve(setup.muscles, sweep.byRotation.at(0.0), MuscleGroup::Flexor, setup.effort).totalTorque[a];
-                add(t, "", ref > 0 ? at / ref : NAN);
-            }
+        if (!isInRange(t, curves.minFlexionDeg, curves.maxFlexionDeg)) continue;
+        if (t.kind != TargetKind::ForearmMvc && t.kind != TargetKind::PostureRatio) {
+            scoreCurveTarget(curves, t, shared, out);
             continue;
         }
-        if (t.kind == TargetKind::Mvc) {
-            const SteadyMvcCurve& c = t.direction == MuscleGroup::Flexor ? flexion : extension;
-            add(t, "", std::abs(c.totalTorque[indexOf(t.flexionDeg)]));
-            continue;
+        if (!isScoredForearmTarget(setup, t)) continue;
+        const MvcGeometry& g = sweep.byRotation.at(t.rotationDeg);
+        const std::size_t a = std::lower_bound(g.flexionDeg.begin(), g.flexionDeg.end(), t.flexionDeg) - g.flexionDeg.begin();
+        TargetScore s;
+        s.target = t;
+        if (t.kind == TargetKind::ForearmMvc) {
+            s.value = std::abs(calcSteadyMvcCurve(setup.muscles, g, t.forearmEffort, setup.effort).totalForearmTorque[a]);
+        } else {
+            const double at = calcSteadyMvcCurve(setup.muscles, g, MuscleGroup::Flexor, setup.effort).totalTorque[a];
+            const double ref =
+                calcSteadyMvcCurve(setup.muscles, sweep.byRotation.at(0.0), MuscleGroup::Flexor, setup.effort).totalTorque[a];
+            s.value = ref > 0 ? at / ref : NAN;
         }
-        const std::vector<int> covered = findCovered(setup, t.muscle);
-        if (covered.empty()) continue;
-        switch (t.kind) {
-        case TargetKind::MomentArm:
-            for (int m : covered) add(t, setup.muscles[m].params.name, geometry.momentArm[indexOf(t.flexionDeg)][m]);
-            break;
-        case TargetKind::OptimumAngle:
-            for (int m : covered)
-                add(t, setup.muscles[m].params.name, findOptimumAngle(full, m), extrapolateOptimumAngle(full, m));
-            break;
-        case TargetKind::Volume: {
-            double v = 0;
-            for (int m : covered) v += setup.muscles[m].params.mass / setup.muscles[m].params.coefficients.density;
-            add(t, t.muscle, v);
-            break;
-        }
-        case TargetKind::Share: {
-            // Like-for-like with share sources (Kawakami 1994's three add up to 1): the family's flexion
-            // torque over that of every muscle a share target names.
-            const int a = indexOf(t.flexionDeg);
-            double part = 0, whole = 0;
-            for (int m : covered) part += std::max(0.0, flexion.points[a][m].torque);
-            for (int m : sharedMuscles) whole += std::max(0.0, flexion.points[a][m].torque);
-            add(t, t.muscle, whole > 0 ? part / whole : NAN);
-            break;
-        }
-        case TargetKind::Mvc:
-        case TargetKind::ForearmMvc:
-        case TargetKind::PostureRatio: break;
-        }
+        s.fitValue = s.value;
+        s.pass = std::isfinite(s.value) && s.value >= t.lower - t.tolerance && s.value <= t.upper + t.tolerance;
+        out.push_back(s);
     }
     return out;
 }

@@ -64,13 +64,35 @@ struct TargetScore {
     bool pass = false;            ///< value within [lower - tolerance, upper + tolerance]
 };
 
+/// A model as scoring sees it: its muscles' names and volumes, and at sorted flexion angles (0 =
+/// extended) their moment arms and steady MVC curves. armsim models (calcAnatomyCurves) and OpenSim
+/// models (model/osim_anatomy.h) are scored through it.
+struct AnatomyCurves {
+    std::vector<std::string> muscles;
+    std::vector<double> volume;                    ///< per muscle [m^3]; NaN: not known (volume targets not scored)
+    double minFlexionDeg = 0, maxFlexionDeg = 0;   ///< the elbow's range [deg]
+    std::vector<double> flexionDeg;                ///< sorted, unique [deg]
+    std::vector<std::vector<double>> momentArm;    ///< [angle][muscle] h, + = flexes [m]
+    SteadyMvcCurve flexion, extension;             ///< the MVC curves at the model's effort
+    SteadyMvcCurve full;                           ///< flexion at full activation without co-contraction
+};
+/// The curves of an armsim model at flexionDeg (sorted, unique, within the elbow's range).
+AnatomyCurves calcAnatomyCurves(const ArmSetup& setup, const std::vector<double>& flexionDeg);
+/// The angles a scoring needs: each target's within [minDeg, maxDeg], and every 1 deg of the range when
+/// an optimum_angle target needs the fibre-length crossing.
+std::vector<double> findAnatomyAngles(const std::vector<AnatomyTarget>& targets, double minDeg, double maxDeg);
+/// Scores the curves against the moment-arm, MVC, volume, share and optimum-angle targets as
+/// scoreAnatomy does (forearm targets need an armsim model's forearm: not scored here). The curves must
+/// hold every angle findAnatomyAngles gives.
+std::vector<TargetScore> scoreAnatomyCurves(const AnatomyCurves& curves, const std::vector<AnatomyTarget>& targets);
+
 /// Scores `setup` against every target. Moment arms from virtual work at the angle, MVC torque from the
 /// steady MVC curve at the model's subject effort (the magnitude for extension), forearm_mvc the
 /// magnitude of the steady forearm torque of a supination or pronation MVC at the angle and posture,
 /// posture_ratio the flexion MVC at the posture over that in neutral (both skipped for a model without a
 /// forearm rotation), volume = mass / density,
 /// share = the family's part of the flexion torque of the muscles all share targets name (as the
-/// sources, whose shares add up to 1) at a flexion MVC, optimum angle = the flexion angle
+/// sources, whose shares add up to 1) at a flexion MVC, not scored when a family they name has no muscle, optimum angle = the flexion angle
 /// where the muscle's steady fibre length at a full flexion MVC crosses L0 (NaN: it does not within the
 /// elbow's range). Targets naming no model muscle are skipped.
 std::vector<TargetScore> scoreAnatomy(const ArmSetup& setup, const std::vector<AnatomyTarget>& targets);

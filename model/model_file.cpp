@@ -378,8 +378,9 @@ ArmSetup loadModel(const std::string& nameOrFile) {
     std::string file = nameOrFile;
     const bool looksLikeName = nameOrFile.find('/') == std::string::npos &&
                                nameOrFile.find(".yaml") == std::string::npos;
-    const std::string osimNote = "an OpenSim model: `armsim forward`, `armsim trial`, `armsim model show`, `armsim render` and Python's "
-                                 "armsim.forward, armsim.isometric_trial and armsim.free_movement take .osim files; "
+    const std::string osimNote = "an OpenSim model: `armsim forward`, `armsim trial`, `armsim model show`, `armsim model check`, "
+                                 "`armsim render`, torque protocols (subject.model) and Python's armsim.forward, "
+                                 "armsim.isometric_trial, armsim.free_movement and run_protocol take .osim files; "
                                  "this command takes an armsim model file (.yaml) yet";
     if (looksLikeName) {
         const std::string asset = getAssetDirectory() + "/models/" + nameOrFile + ".yaml";

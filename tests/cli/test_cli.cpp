@@ -774,6 +774,35 @@ TEST(Cli, AnOverviewThatCannotBeWrittenIsAnError) {
     EXPECT_TRUE(fs::exists(d / "out" / "index.html" / "mine.txt"));
 }
 
+// `armsim model check` scores an OpenSim model against the same target file as the twin (its coordinate as
+// the elbow): moment arms, MVCs and optimum angles scored, volumes and forearm targets said not to be;
+// --coordinate is refused for an armsim model.
+TEST(Cli, ModelCheckScoresAnOsimModel) {
+    const fs::path d = freshDir("osim_check");
+    const CommandResult r = runArmsim("model check --model arm26 --coordinate r_elbow_flex --out " + (d / "c").string());
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    EXPECT_NE(r.output.find("model arm26 (OpenSim) against"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("no muscle masses for volumes"), std::string::npos) << r.output;
+    std::ifstream card(d / "c" / "scorecard.csv");
+    std::string line;
+    std::getline(card, line);   // header
+    int momentArms = 0, mvcs = 0;
+    while (std::getline(card, line)) {
+        const std::string kind = armsim::splitCsvRecord(line).at(0);
+        EXPECT_NE(kind, "volume");
+        EXPECT_NE(kind, "forearm_mvc");
+        momentArms += kind == "moment_arm";
+        mvcs += kind == "mvc";
+    }
+    EXPECT_EQ(momentArms, 48);   // BIC x2 heads, BRA, TRI x3 heads at 8 angles (arm26 has no BRD)
+    EXPECT_EQ(mvcs, 26);
+    for (const char* f : {"score_summary.csv", "check_moment_arms.png", "check_mvc.png"}) EXPECT_TRUE(fs::exists(d / "c" / f)) << f;
+    const CommandResult bad = runArmsim("model check --model thesis --coordinate r_elbow_flex --out " + (d / "t").string());
+    EXPECT_EQ(bad.exitCode, 2) << bad.output;
+    EXPECT_NE(bad.output.find("--coordinate 'r_elbow_flex': only for OpenSim models"), std::string::npos) << bad.output;
+    EXPECT_FALSE(fs::exists(d / "t"));
+}
+
 // The overview shows what the command printed (its results and key numbers) byte for byte as standard
 // output got it, and a full standard output is still named with its reason.
 TEST(Cli, TheOverviewShowsWhatTheCommandPrinted) {
