@@ -240,7 +240,8 @@ void addMuscleCommands(CLI::App& app) {
             runNamingOptions({{"duration", "--duration"}, {"sample_rate", "--rate"}, {"accuracy", "--accuracy"}},
                              [&] { settings->integration.validate(); checkField("duration", settings->duration,
                                                                                Bound::positive("s"));
-                                   checkField("sample_rate", settings->sampleRate, Bound::positive("Hz")); });
+                                   checkField("sample_rate", settings->sampleRate, Bound::positive("Hz"));
+                                   calcNumSamples(settings->duration, settings->sampleRate); });
             OutputFiles files;  // both appear at the end, or neither
             opts->declareInputs(files);
             files.addInput("--activation-trace", *trace);

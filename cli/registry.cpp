@@ -3,6 +3,7 @@
 #include "basics/format.h"
 #include "basics/output_folder.h"
 #include "cli/commands.h"
+#include "numerics/stiff_ode.h"
 
 #include <fmt/format.h>
 #include <malloc.h>
@@ -150,6 +151,18 @@ CLI::Option* addNameListOption(CLI::App& app, const std::string& name, std::vect
 void runNamingOptions(const std::map<std::string, std::string>& optionOfField, const std::function<void()>& f) {
     try {
         f();
+    } catch (const SampleCountError& e) {
+        // The run's length and rate as the options that set them: --duration, or --rest + --rise + --hold.
+        const auto rate = optionOfField.find("sample_rate");
+        std::string duration;
+        if (const auto d = optionOfField.find("duration"); d != optionOfField.end()) duration = d->second;
+        else
+            for (const char* part : {"rest", "rise", "hold"})
+                if (const auto p = optionOfField.find(part); p != optionOfField.end())
+                    duration += (duration.empty() ? "" : " + ") + p->second;
+        if (rate == optionOfField.end() || duration.empty()) throw;
+        throw InputError(duration + " = " + formatNumber(e.getDuration()) + " s x " + rate->second + " " +
+                         formatNumber(e.getSampleRate()) + " Hz " + e.getDetail());
     } catch (const FieldError& e) {
         const auto it = optionOfField.find(e.getField());
         if (it == optionOfField.end()) throw;

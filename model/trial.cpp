@@ -628,6 +628,21 @@ Table runFreeMovement(const ArmSetup& setup, const FreeMovementSettings& setting
 
 // ---- Settings files -----------------------------------------------------------------------------
 
+namespace {
+
+// s.validate(arm) with the file's lines, the sample count in the file's keys (durationKeys, sample_rate).
+template <class Settings>
+void validateSettingsFile(const ParamNode& n, const Settings& s, const ArmParameters& arm, const std::string& durationKeys) {
+    try {
+        n.rethrowWithLocation([&] { s.validate(arm); });
+    } catch (const SampleCountError& e) {
+        throw InputError(n.where("sample_rate") + ": " + durationKeys + " = " + formatNumber(e.getDuration()) + " s x sample_rate " +
+                         formatNumber(e.getSampleRate()) + " Hz " + e.getDetail());
+    }
+}
+
+}  // namespace
+
 IsometricTrialSettings readIsometricTrialSettings(const ParamNode& n, const ArmParameters& arm) {
     IsometricTrialSettings s;
     const Bound any = Bound::any();
@@ -642,7 +657,7 @@ IsometricTrialSettings readIsometricTrialSettings(const ParamNode& n, const ArmP
     s.averagingWindow = n.getNumber("averaging_window", any, std::min(s.averagingWindow, s.holdDuration));
     s.integration.accuracy = n.getNumber("accuracy", any, s.integration.accuracy);
     n.finish();
-    n.rethrowWithLocation([&] { s.validate(arm); });
+    validateSettingsFile(n, s, arm, "rest + rise + hold");
     return s;
 }
 
@@ -660,7 +675,7 @@ FreeMovementSettings readFreeMovementSettings(const ParamNode& n, const ArmParam
     s.sampleRate = n.getNumber("sample_rate", any, s.sampleRate);
     s.integration.accuracy = n.getNumber("accuracy", any, s.integration.accuracy);
     n.finish();
-    n.rethrowWithLocation([&] { s.validate(arm); });
+    validateSettingsFile(n, s, arm, "duration");
     return s;
 }
 

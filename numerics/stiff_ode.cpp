@@ -33,17 +33,21 @@ std::string shortNumber(double v) {   // 3 significant digits, for a message
 }
 }  // namespace
 
+SampleCountError::SampleCountError(double duration, double sampleRate, std::string detail)
+    : InputError("duration " + formatNumber(duration) + " s x sample_rate " + formatNumber(sampleRate) + " Hz " + detail),
+      duration_(duration), sampleRate_(sampleRate), detail_(std::move(detail)) {}
+
 long calcNumSamples(double duration, double sampleRate) {
     const double n = std::round(duration * sampleRate) + 1;
     if (duration > 0 && duration * sampleRate < 1 - 1e-9)   // no sample after the start: its end silently dropped
-        throw InputError("duration " + formatNumber(duration) + " s x sample_rate " + formatNumber(sampleRate) +
-                         " Hz = " + formatNumber(std::stod(shortNumber(duration * sampleRate))) +
-                         " samples after the start: expected at least one (raise the sample rate to " +
-                         shortNumber(1 / duration) + " Hz or more)");
+        throw SampleCountError(duration, sampleRate,
+                               "= " + formatNumber(std::stod(shortNumber(duration * sampleRate))) +
+                                   " samples after the start: expected at least one (raise the sample rate to " +
+                                   shortNumber(1 / duration) + " Hz or more)");
     if (!(n <= kMaxSamples))
-        throw InputError("duration " + formatNumber(duration) + " s x sample_rate " + formatNumber(sampleRate) +
-                         " Hz = " + formatNumber(n) + " samples: expected at most " + formatNumber(kMaxSamples) +
-                         " (lower the sample rate or the duration)");
+        throw SampleCountError(duration, sampleRate,
+                               "= " + formatNumber(n) + " samples: expected at most " + formatNumber(kMaxSamples) +
+                                   " (lower the sample rate or the duration)");
     return long(n);
 }
 

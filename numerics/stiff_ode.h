@@ -13,6 +13,8 @@
 // (numerics/cpodes_c.h), so no SimTK::Vector temporaries are made.
 #pragma once
 
+#include "basics/errors.h"
+
 #include <functional>
 #include <vector>
 
@@ -31,9 +33,24 @@ struct IntegrationSettings {
 /// Most samples one sampled run records (10 million rows; a 33-column arm trial table is then 2.6 GB).
 constexpr double kMaxSamples = 1e7;
 
-/// Samples of a sampled run of `duration` at `sampleRate`: round(duration x rate) + 1. InputError
+/// calcNumSamples' error: an InputError that keeps the duration and rate, so a command can say it in
+/// the options the user typed (cli's runNamingOptions).
+class SampleCountError : public InputError {
+public:
+    SampleCountError(double duration, double sampleRate, std::string detail);
+    double getDuration() const { return duration_; }
+    double getSampleRate() const { return sampleRate_; }
+    /// "= 5000000501 samples: expected at most 1e+07 (...)", after "duration x rate".
+    const std::string& getDetail() const { return detail_; }
+
+private:
+    double duration_, sampleRate_;
+    std::string detail_;
+};
+
+/// Samples of a sampled run of `duration` at `sampleRate`: round(duration x rate) + 1. SampleCountError
 /// naming both values and the count when it exceeds kMaxSamples (a typo like --rate 1e12 would
-/// otherwise exhaust memory or run for days).
+/// otherwise exhaust memory or run for days), or when no sample follows the start.
 long calcNumSamples(double duration, double sampleRate);
 
 /// What an integration cost.
