@@ -298,14 +298,15 @@ void ParamNode::throwLocated(const FieldError& e) const {
         for (auto it = n.begin(); it != n.end(); ++it)
             if (it->first.as<std::string>() == part) {
                 line = it->first.Mark().line;
-                n = it->second;
+                n.reset(it->second);   // rebind the handle (operator= would overwrite the document's node)
                 found = true;
                 break;
             }
         if (!found) break;
         if (index != std::string::npos) {
             if (!n.IsSequence() || index >= n.size()) break;
-            n = YAML::Node(n[index]);
+            const YAML::Node entry = n[index];
+            n.reset(entry);
             line = n.Mark().line;
         }
     }

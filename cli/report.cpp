@@ -102,27 +102,34 @@ Captured& getCaptured() {
 }
 
 // The stdout stream's writer: every byte to file descriptor 1 (a failure is the stream's error, as
-// for the real stdout), and a copy into the buffer.
-ssize_t writeTee(void*, const char* data, std::size_t size) {
+// for the real stdout), and a copy into the buffer. As fopencookie(3) asks: the bytes written, 0 on an
+// error (never negative), and nothing thrown through the C library.
+ssize_t writeTee(void*, const char* data, std::size_t size) noexcept {
     std::size_t done = 0;
     while (done < size) {
         const ssize_t n = ::write(STDOUT_FILENO, data + done, size - done);
         if (n < 0) {
             if (errno == EINTR) continue;
             const int error = errno;
-            Captured& c = getCaptured();
-            std::lock_guard<std::mutex> lock(c.mutex);
-            if (!c.writeError) c.writeError = error;
+            try {
+                Captured& c = getCaptured();
+                std::lock_guard<std::mutex> lock(c.mutex);
+                if (!c.writeError) c.writeError = error;
+            } catch (...) {
+            }
             errno = error;
-            return -1;
+            return 0;
         }
         done += std::size_t(n);
     }
-    Captured& c = getCaptured();
-    std::lock_guard<std::mutex> lock(c.mutex);
-    const std::size_t room = kMaxCapturedStdout - std::min(kMaxCapturedStdout, c.text.size());
-    c.text.append(data, std::min(room, size));
-    if (size > room) c.cut = true;
+    try {
+        Captured& c = getCaptured();
+        std::lock_guard<std::mutex> lock(c.mutex);
+        const std::size_t room = kMaxCapturedStdout - std::min(kMaxCapturedStdout, c.text.size());
+        c.text.append(data, std::min(room, size));
+        if (size > room) c.cut = true;
+    } catch (...) {   // the copy is for the report only: standard output got every byte
+    }
     return ssize_t(size);
 }
 

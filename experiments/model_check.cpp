@@ -119,7 +119,7 @@ ModelCheckResult writeModelCheck(const ArmSetup& setup, const std::vector<Anatom
 
 ModelCheckResult writeOsimModelCheck(const OsimModel& model, const std::string& coordinate, const std::string& muscleModel,
                                      const std::vector<AnatomyTarget>& targets, const std::string& outDir) {
-    const std::array<double, 2> range = getOsimCoordinateRangeDeg(model, coordinate);
+    const std::array<double, 2> range = getOsimCoordinateRangeDeg(model, coordinate, muscleModel);
     const AnatomyCurves scored =
         calcOsimAnatomyCurves(model, coordinate, findAnatomyAngles(targets, range[0], range[1]), muscleModel);
     std::vector<double> angles;

@@ -196,7 +196,8 @@ TorqueProtocol readTorqueProtocol(const std::string& path) {
             p.subjectIndex = s.getInt("index", 0, 1000000, 0);
         } else {
             p.model = s.getString("model", p.model);
-            if (isOsimModel(p.model) && p.model.find('/') != std::string::npos) {
+            if (isOsimModel(p.model) && (p.model.find('/') != std::string::npos ||
+                                         (p.model.size() > 5 && p.model.compare(p.model.size() - 5, 5, ".osim") == 0))) {
                 // A file next to the protocol, or as given.
                 const std::string relative = root.getDirectory().empty() ? p.model : root.getDirectory() + "/" + p.model;
                 if (doesPathExist(relative)) p.model = relative;
@@ -406,6 +407,9 @@ OsimModel loadOsimProtocolModel(const TorqueProtocol& protocol) {
     for (std::size_t k = 0; k < protocol.conditions.size(); ++k) {
         try {
             makeOsimTrial(protocol, protocol.conditions[k]).validate(arm);
+        } catch (const SampleCountError& e) {
+            throw FieldError("trial.sample_rate", "= " + formatNumber(e.getSampleRate()) + " Hz over trial.rest + trial.hold = " +
+                                                      formatNumber(e.getDuration()) + " s " + e.getDetail());
         } catch (const FieldError& e) {
             if (e.getField() == "coordinate") throw FieldError("subject.coordinate", e.getDetail());
             if (e.getField() == "angle_deg")

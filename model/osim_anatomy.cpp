@@ -5,6 +5,7 @@
 #include "model/osim_arm.h"
 #include "model/osim_trial.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace armsim {
@@ -20,20 +21,20 @@ double roundDeg(double rad) { return std::round(rad / kDeg * 1e6) / 1e6; }
 int findOsimSweptCoordinate(const OsimArm& arm, const std::string& name) {
     std::string names;
     for (int i = 0; i < arm.getNumCoordinates(); ++i) names += (i ? ", " : "") + arm.getCoordinate(i).name;
-    if (name.empty()) {
-        if (arm.getNumCoordinates() == 1) return 0;
+    if (name.empty() && arm.getNumCoordinates() != 1) {
         throw InputError("--coordinate: model " + arm.getModel().name + " has " + std::to_string(arm.getNumCoordinates()) +
                          " coordinates (" + names + "): name the one to sweep");
     }
-    const int i = arm.findCoordinate(name);
+    const int i = name.empty() ? 0 : arm.findCoordinate(name);
     if (i < 0) throw InputError("--coordinate '" + name + "': not a coordinate of " + arm.getModel().name + " (" + names + ")");
     if (!arm.getCoordinate(i).rotational)
-        throw InputError("--coordinate '" + name + "': translational; expected a rotational coordinate");
+        throw InputError("--coordinate '" + arm.getCoordinate(i).name + "': translational; expected a rotational coordinate");
     return i;
 }
 
-std::array<double, 2> getOsimCoordinateRangeDeg(const OsimModel& model, const std::string& coordinate) {
-    const OsimArm arm(model);
+std::array<double, 2> getOsimCoordinateRangeDeg(const OsimModel& model, const std::string& coordinate,
+                                                const std::string& muscleModel) {
+    const OsimArm arm(model, {}, muscleModel);
     const auto range = arm.getCoordinate(findOsimSweptCoordinate(arm, coordinate)).range;
     return {roundDeg(range[0]), roundDeg(range[1])};
 }
@@ -59,10 +60,11 @@ AnatomyCurves calcOsimAnatomyCurves(const OsimModel& model, const std::string& c
     }
     SimTK::State s = arm.getDefaultState();
     for (double deg : flexionDeg) {
-        if (!(deg >= c.minFlexionDeg && deg <= c.maxFlexionDeg))
+        constexpr double kGridSlack = 1e-9;   // deg: a grid's last step may land a rounding error past the end
+        if (!(deg >= c.minFlexionDeg - kGridSlack && deg <= c.maxFlexionDeg + kGridSlack))
             throw InputError("angle " + formatNumber(deg) + " deg: outside " + arm.getCoordinate(j).name + "'s range [" +
                              formatNumber(c.minFlexionDeg) + ", " + formatNumber(c.maxFlexionDeg) + "] deg");
-        arm.setCoordinateValue(s, j, deg * kDeg);
+        arm.setCoordinateValue(s, j, std::clamp(deg, c.minFlexionDeg, c.maxFlexionDeg) * kDeg);
         arm.getSystem().realize(s, SimTK::Stage::Position);
         std::vector<double> R(n), P(n);
         for (int i = 0; i < n; ++i) R[i] = arm.calcMomentArm(s, i, j), P[i] = arm.calcPathLength(s, i);

@@ -26,7 +26,9 @@ int findOsimSweptCoordinate(const OsimArm& arm, const std::string& name);
 AnatomyCurves calcOsimAnatomyCurves(const OsimModel& model, const std::string& coordinate,
                                     const std::vector<double>& flexionDeg, const std::string& muscleModel = "");
 
-/// The coordinate's range [deg] (rounded to 1e-6 deg: a file's 2.26893 rad reads 130 deg).
-std::array<double, 2> getOsimCoordinateRangeDeg(const OsimModel& model, const std::string& coordinate);
+/// The coordinate's range [deg] (rounded to 1e-6 deg: a file's 2.26893 rad reads 130 deg); muscleModel
+/// as OsimArm's (the model is built to find the coordinate).
+std::array<double, 2> getOsimCoordinateRangeDeg(const OsimModel& model, const std::string& coordinate,
+                                                const std::string& muscleModel = "");
 
 }  // namespace armsim

@@ -369,18 +369,18 @@ OsimArm::OsimArm(OsimModel model, const std::map<std::string, ActivationProfile>
 
 void OsimArm::setMovingLocation(const OsimModel& m, const OsimPathPoint& pp, PathElement& e) const {
     const std::string at = where(m, pp.line, "<MovingPathPoint name=\"" + pp.name + "\">");
-    // One coordinate drives the point, as OpenSim requires; a component without one is its function at 0.
-    std::string name;
+    // One coordinate drives x, y and z, as OpenSim 4 requires (MovingPathPoint::extendConnectToModel); with
+    // none the point is its functions at 0.
     static const char* kAxis[] = {"x", "y", "z"};
+    const std::string name = pp.locationCoordinates[0];
     std::array<bool, 3> driven{};
     for (int k = 0; k < 3; ++k) {
         const std::string& c = pp.locationCoordinates[k];
         driven[k] = !c.empty();
-        if (c.empty()) continue;
-        if (!name.empty() && c != name)
-            throw OsimError(at + "its " + kAxis[k] + " location follows '" + c + "' and another follows '" + name +
-                            "': expected one coordinate for x, y and z (as OpenSim requires)");
-        name = c;
+        if (c != name)
+            throw OsimError(at + "its x location follows " + (name.empty() ? "no coordinate" : "'" + name + "'") + " and its " +
+                            kAxis[k] + " location " + (c.empty() ? "none" : "'" + c + "'") +
+                            ": expected one coordinate for x, y and z (as OpenSim requires)");
     }
     std::array<OsimFunctionEvaluator, 3> f;
     for (int k = 0; k < 3; ++k) f[k] = OsimFunctionEvaluator(pp.locationFunctions[k]);

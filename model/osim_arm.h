@@ -15,7 +15,8 @@
 //   - Path points on their bodies; a ConditionalPathPoint is a via point active while its coordinate is
 //     within its range. A MovingPathPoint sits at its x, y and z functions (model/osim_function.h) of one
 //     coordinate clamped to that coordinate's range; its tension also drives the coordinate with the
-//     generalized force f . dp/dq, as OpenSim's GeometryPath adds it.
+//     generalized force f . dp/dq, as OpenSim's GeometryPath adds it, except beyond the range, where dp/dq
+//     is 0 as the clamped location says (OpenSim's getdPointdQ takes the slope at the unclamped value).
 //   - Wrap objects: WrapCylinder (its z axis; no wrap when both tangent points lie beyond its length,
 //     as OpenSim), WrapSphere and WrapEllipsoid, with the quadrant as the side the path passes (all: the
 //     shorter way); as in OpenSim a wrap is off while a neighbouring path point lies inside its object,

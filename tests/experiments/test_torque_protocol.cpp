@@ -305,6 +305,9 @@ TEST(TorqueProtocol, OsimProtocolRefusesWhatItsModelCannotDoAtItsLine) {
          "armsim_osim_torque.yaml:3: field 'subject.coordinate' 'elbow': not a coordinate of arm26"},
         {"name: t\nkind: torque\nsubject: {model: twin, coordinate: r_elbow_flex}\nconditions:\n", "  - {flexion_deg: 90}\n",
          "only an OpenSim model"},
+        {"name: t\nkind: torque\ntrial: {hold: 100, sample_rate: 1e6}\nsubject: {model: arm26, coordinate: r_elbow_flex}\n"
+         "conditions:\n", "  - {flexion_deg: 90}\n",
+         "armsim_osim_torque.yaml:3: field 'trial.sample_rate' = 1e+06 Hz over trial.rest + trial.hold = 100.5 s = 100500001 samples: expected at most 1e+07"},
     };
     for (const Case& c : cases) {
         const std::string e = read(c.body, c.header);

@@ -79,9 +79,11 @@ TEST(OsimAnatomy, ScoresEqualASecondMethodAndWhatTheFileCannotSayIsNotScored) {
     EXPECT_EQ(at.muscles[4], "BICshort");
 }
 
-// Outside the coordinate's range an angle is refused, naming the range; an unknown coordinate names the
-// model's.
+// Outside the coordinate's range an angle is refused, naming the range (a grid's rounding error past the
+// end is the end); an unknown coordinate names the model's.
 TEST(OsimAnatomy, BadAnglesAndCoordinatesAreNamed) {
+    const AnatomyCurves end = calcOsimAnatomyCurves(arm26(), "r_elbow_flex", {130 + 5e-10});
+    EXPECT_EQ(end.flexion.totalTorque[0], calcOsimAnatomyCurves(arm26(), "r_elbow_flex", {130}).flexion.totalTorque[0]);
     try {
         calcOsimAnatomyCurves(arm26(), "r_elbow_flex", {140});
         ADD_FAILURE() << "accepted 140 deg";

@@ -147,9 +147,10 @@ TEST(OsimArm, UnsupportedJointsAndPointsNameTheirLine) {
 
 namespace {
 
-// arm26 with the brachialis inserting on a MovingPathPoint: x and y follow the elbow (SimmSpline,
-// NaturalCubicSpline), z is a Constant; `yCoordinate` drives y.
-std::string arm26WithMovingBrachialis(const std::string& yCoordinate = "/jointset/r_elbow/r_elbow_flex") {
+// arm26 with the brachialis inserting on a MovingPathPoint of the elbow: x a SimmSpline, y a
+// NaturalCubicSpline, z a Constant; `yCoordinate` drives y and `zCoordinate` z ("": no socket).
+std::string arm26WithMovingBrachialis(const std::string& yCoordinate = "/jointset/r_elbow/r_elbow_flex",
+                                      const std::string& zCoordinate = "/jointset/r_elbow/r_elbow_flex") {
     std::string text = readFileText(std::string(ARMSIM_ASSET_DIR) + "/models/arm26.osim");
     const std::size_t begin = text.find("<PathPoint name=\"BRA-P2\">");
     const std::size_t end = text.find("</PathPoint>", begin) + std::string("</PathPoint>").size();
@@ -160,7 +161,8 @@ std::string arm26WithMovingBrachialis(const std::string& yCoordinate = "/jointse
         "<y_location><NaturalCubicSpline><x>0 1.2 2.4</x><y>-0.0239 -0.03 -0.026</y></NaturalCubicSpline></y_location>"
         "<z_location><Constant><value>0.0009</value></Constant></z_location>"
         "<socket_x_coordinate>/jointset/r_elbow/r_elbow_flex</socket_x_coordinate>"
-        "<socket_y_coordinate>" + yCoordinate + "</socket_y_coordinate>"
+        "<socket_y_coordinate>" + yCoordinate + "</socket_y_coordinate>" +
+        (zCoordinate.empty() ? std::string() : "<socket_z_coordinate>" + zCoordinate + "</socket_z_coordinate>") +
         "</MovingPathPoint>";
     text.replace(begin, end - begin, moving);
     return text;
@@ -229,13 +231,17 @@ TEST(OsimArm, MovingPathPointMomentArmsIncludeItsGeneralizedForce) {
     EXPECT_NEAR(mobility[arm.getCoordinateBody(elbow).getFirstUIndex(s)], tension * term, 1e-12 * tension);
 }
 
-// OpenSim requires one coordinate for x, y and z: two are named with the line.
+// OpenSim 4 requires one coordinate for x, y and z (or none): two, or one left without, are named with
+// the line.
 TEST(OsimArm, MovingPathPointWithTwoCoordinatesIsRefused) {
-    try {
-        OsimArm arm(readOsimText(arm26WithMovingBrachialis("/jointset/r_shoulder/r_shoulder_elev"), "two.osim"));
-        ADD_FAILURE() << "built";
-    } catch (const OsimError& e) {
-        EXPECT_NE(std::string(e.what()).find("expected one coordinate for x, y and z"), std::string::npos) << e.what();
-        EXPECT_TRUE(std::regex_search(std::string(e.what()), std::regex("two\\.osim:[0-9]+: <MovingPathPoint name=\"BRA-P2\">"))) << e.what();
+    for (const auto& [y, z] : std::vector<std::pair<std::string, std::string>>{
+             {"/jointset/r_shoulder/r_shoulder_elev", "/jointset/r_elbow/r_elbow_flex"}, {"/jointset/r_elbow/r_elbow_flex", ""}}) {
+        try {
+            OsimArm arm(readOsimText(arm26WithMovingBrachialis(y, z), "two.osim"));
+            ADD_FAILURE() << "built with y " << y << ", z " << z;
+        } catch (const OsimError& e) {
+            EXPECT_NE(std::string(e.what()).find("expected one coordinate for x, y and z"), std::string::npos) << e.what();
+            EXPECT_TRUE(std::regex_search(std::string(e.what()), std::regex("two\\.osim:[0-9]+: <MovingPathPoint name=\"BRA-P2\">"))) << e.what();
+        }
     }
 }
