@@ -807,8 +807,10 @@ TEST(Cli, ModelCheckScoresAnOsimModel) {
 // output got it, and a full standard output is still named with its reason.
 TEST(Cli, TheOverviewShowsWhatTheCommandPrinted) {
     const fs::path d = freshDir("overview_printed");
-    const CommandResult r = armsim::testing::runCommand(std::string(ARMSIM_EXE) + " model show --model twin --out " +
-                                                        (d / "out").string() + " > " + (d / "stdout.txt").string());
+    // Standard error apart (a sanitizer's report goes there).
+    const CommandResult r = armsim::testing::runCommand("( " + std::string(ARMSIM_EXE) + " model show --model twin --out " +
+                                                        (d / "out").string() + " > " + (d / "stdout.txt").string() + " 2> " +
+                                                        (d / "stderr.txt").string() + " )");
     ASSERT_EQ(r.exitCode, 0) << r.output;
     auto read = [](const fs::path& p) {
         std::ifstream in(p);
