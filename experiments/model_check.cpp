@@ -7,6 +7,7 @@
 #include "basics/plot.h"
 #include "model/mvc_curve.h"
 #include "model/osim_anatomy.h"
+#include "model/osim_arm.h"
 
 #include <algorithm>
 #include <cmath>
@@ -119,12 +120,13 @@ ModelCheckResult writeModelCheck(const ArmSetup& setup, const std::vector<Anatom
 
 ModelCheckResult writeOsimModelCheck(const OsimModel& model, const std::string& coordinate, const std::string& muscleModel,
                                      const std::vector<AnatomyTarget>& targets, const std::string& outDir) {
-    const std::array<double, 2> range = getOsimCoordinateRangeDeg(model, coordinate, muscleModel);
-    const AnatomyCurves scored =
-        calcOsimAnatomyCurves(model, coordinate, findAnatomyAngles(targets, range[0], range[1]), muscleModel);
+    const OsimArm arm(model, {}, muscleModel);
+    const int j = findOsimSweptCoordinate(arm, coordinate);
+    const auto [lo, hi] = getOsimCoordinateRangeDeg(arm, j);
+    const AnatomyCurves scored = calcOsimAnatomyCurves(arm, j, findAnatomyAngles(targets, lo, hi));
     std::vector<double> angles;
-    for (double d = range[0]; d <= range[1] + 1e-9; d += 2) angles.push_back(d);
-    const AnatomyCurves drawn = calcOsimAnatomyCurves(model, coordinate, angles, muscleModel);
+    for (double d = lo; d <= hi + 1e-9; d += 2) angles.push_back(std::min(d, hi));
+    const AnatomyCurves drawn = calcOsimAnatomyCurves(arm, j, angles);
     return writeCheckFiles(scoreAnatomyCurves(scored, targets), drawn,
                            (coordinate.empty() ? std::string("the coordinate") : coordinate) + " (deg, as elbow flexion)", outDir);
 }

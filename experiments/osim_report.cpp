@@ -9,7 +9,6 @@
 #include "basics/plot.h"
 #include "basics/table.h"
 #include "model/osim_arm.h"
-#include "model/osim_trial.h"
 
 #include <cmath>
 
@@ -52,31 +51,19 @@ OsimReportFiles writeOsimModelReport(const OsimModel& model, const OsimReportSet
     for (int i = 0; i < n; ++i) mvcCols.push_back("torque_" + arm.getMuscleName(i) + "_Nm");
     for (int i = 0; i < n; ++i) mvcCols.push_back("fibre_length_" + arm.getMuscleName(i));
     Table arms(armCols), positive(mvcCols), negative(mvcCols);
-    SimTK::State s = arm.getDefaultState();
-    for (double deg : anglesDeg) {
-        arm.setCoordinateValue(s, j, deg * kDeg);
-        arm.getSystem().realize(s, SimTK::Stage::Position);
-        std::vector<double> row = {deg}, P(n), R(n);
-        for (int i = 0; i < n; ++i) R[i] = arm.calcMomentArm(s, i, j), P[i] = arm.calcPathLength(s, i);
-        row.insert(row.end(), R.begin(), R.end());
-        row.insert(row.end(), P.begin(), P.end());
+    const AnatomyCurves curves = calcOsimAnatomyCurves(arm, j, anglesDeg);   // each direction's agonists fully excited
+    for (std::size_t a = 0; a < anglesDeg.size(); ++a) {
+        const double deg = anglesDeg[a];
+        std::vector<double> row = {deg};
+        for (int i = 0; i < n; ++i) row.push_back(curves.flexion.points[a][i].momentArm);
+        for (int i = 0; i < n; ++i) row.push_back(curves.flexion.points[a][i].pathLength);
         arms.appendRow(row);
         for (int direction : {1, -1}) {
-            std::vector<double> torque(n), fibre(n);
-            double total = 0;
-            for (int i = 0; i < n; ++i) {
-                const MuscleModel& m = arm.getMuscleForce(i).getMuscle();
-                const SteadyState ss = m.calcSteadyState(P[i], isOsimAgonist(direction, R[i]) ? 1.0 : 0.0);
-                if (!ss.converged)
-                    throw SimulationError("muscle " + arm.getMuscleName(i) + " at " + r.coordinate + " = " + formatNumber(deg) +
-                                          " deg: " + ss.message);
-                torque[i] = ss.force * R[i];
-                fibre[i] = ss.fascicleLength / m.getOptimalFascicleLength();
-                total += torque[i];
-            }
+            const SteadyMvcCurve& c = direction > 0 ? curves.flexion : curves.extension;
+            const double total = c.totalTorque[a];
             std::vector<double> mvc = {deg, total};
-            mvc.insert(mvc.end(), torque.begin(), torque.end());
-            mvc.insert(mvc.end(), fibre.begin(), fibre.end());
+            for (int i = 0; i < n; ++i) mvc.push_back(c.points[a][i].torque);
+            for (int i = 0; i < n; ++i) mvc.push_back(c.points[a][i].fibreLength);
             (direction > 0 ? positive : negative).appendRow(mvc);
             if (direction > 0 && total > r.peakPositive) r.peakPositive = total, r.peakPositiveDeg = deg;
             if (direction < 0 && -total > r.peakNegative) r.peakNegative = -total, r.peakNegativeDeg = deg;

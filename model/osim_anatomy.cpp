@@ -32,25 +32,26 @@ int findOsimSweptCoordinate(const OsimArm& arm, const std::string& name) {
     return i;
 }
 
-std::array<double, 2> getOsimCoordinateRangeDeg(const OsimModel& model, const std::string& coordinate,
-                                                const std::string& muscleModel) {
-    const OsimArm arm(model, {}, muscleModel);
-    const auto range = arm.getCoordinate(findOsimSweptCoordinate(arm, coordinate)).range;
+std::array<double, 2> getOsimCoordinateRangeDeg(const OsimArm& arm, int j) {
+    const auto range = arm.getCoordinate(j).range;
     return {roundDeg(range[0]), roundDeg(range[1])};
 }
 
-AnatomyCurves calcOsimAnatomyCurves(const OsimModel& model, const std::string& coordinate,
-                                    const std::vector<double>& flexionDeg, const std::string& muscleModel) {
+std::array<double, 2> getOsimCoordinateRangeDeg(const OsimModel& model, const std::string& coordinate,
+                                                const std::string& muscleModel) {
     const OsimArm arm(model, {}, muscleModel);
-    const int j = findOsimSweptCoordinate(arm, coordinate);
+    return getOsimCoordinateRangeDeg(arm, findOsimSweptCoordinate(arm, coordinate));
+}
+
+AnatomyCurves calcOsimAnatomyCurves(const OsimArm& arm, int j, const std::vector<double>& flexionDeg) {
     const int n = arm.getNumMuscles();
-    if (n == 0) throw InputError("model " + model.name + " (" + model.file + ") has no muscles to score");
+    if (n == 0) throw InputError("model " + arm.getModel().name + " (" + arm.getModel().file + ") has no muscles");
     AnatomyCurves c;
     for (int i = 0; i < n; ++i) c.muscles.push_back(arm.getMuscleName(i));
     c.volume.assign(n, kNaN);
-    const auto range = arm.getCoordinate(j).range;
-    c.minFlexionDeg = roundDeg(range[0]);
-    c.maxFlexionDeg = roundDeg(range[1]);
+    const auto [lo, hi] = getOsimCoordinateRangeDeg(arm, j);
+    c.minFlexionDeg = lo;
+    c.maxFlexionDeg = hi;
     c.flexionDeg = flexionDeg;
     SteadyMvcCurve* curves[2] = {&c.flexion, &c.extension};
     for (int k = 0; k < 2; ++k) {
@@ -60,11 +61,7 @@ AnatomyCurves calcOsimAnatomyCurves(const OsimModel& model, const std::string& c
     }
     SimTK::State s = arm.getDefaultState();
     for (double deg : flexionDeg) {
-        constexpr double kGridSlack = 1e-9;   // deg: a grid's last step may land a rounding error past the end
-        if (!(deg >= c.minFlexionDeg - kGridSlack && deg <= c.maxFlexionDeg + kGridSlack))
-            throw InputError("angle " + formatNumber(deg) + " deg: outside " + arm.getCoordinate(j).name + "'s range [" +
-                             formatNumber(c.minFlexionDeg) + ", " + formatNumber(c.maxFlexionDeg) + "] deg");
-        arm.setCoordinateValue(s, j, std::clamp(deg, c.minFlexionDeg, c.maxFlexionDeg) * kDeg);
+        arm.setCoordinateValue(s, j, deg * kDeg);
         arm.getSystem().realize(s, SimTK::Stage::Position);
         std::vector<double> R(n), P(n);
         for (int i = 0; i < n; ++i) R[i] = arm.calcMomentArm(s, i, j), P[i] = arm.calcPathLength(s, i);
@@ -89,6 +86,25 @@ AnatomyCurves calcOsimAnatomyCurves(const OsimModel& model, const std::string& c
         }
     }
     c.full = c.flexion;   // the flexion MVC is already at full excitation
+    return c;
+}
+
+AnatomyCurves calcOsimAnatomyCurves(const OsimModel& model, const std::string& coordinate,
+                                    const std::vector<double>& flexionDeg, const std::string& muscleModel) {
+    const OsimArm arm(model, {}, muscleModel);
+    const int j = findOsimSweptCoordinate(arm, coordinate);
+    const auto [lo, hi] = getOsimCoordinateRangeDeg(arm, j);
+    std::vector<double> angles;
+    for (double deg : flexionDeg) {
+        constexpr double kGridSlack = 1e-9;   // deg: a grid's last step may land a rounding error past the end
+        if (!(deg >= lo - kGridSlack && deg <= hi + kGridSlack))
+            throw InputError("angle " + formatNumber(deg) + " deg: outside " + arm.getCoordinate(j).name + "'s range [" +
+                             formatNumber(lo) + ", " + formatNumber(hi) + "] deg");
+        angles.push_back(std::clamp(deg, lo, hi));
+    }
+    AnatomyCurves c = calcOsimAnatomyCurves(arm, j, angles);
+    c.flexionDeg = flexionDeg;
+    c.flexion.flexionDeg = c.extension.flexionDeg = c.full.flexionDeg = flexionDeg;
     return c;
 }
 

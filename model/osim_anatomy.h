@@ -21,12 +21,18 @@ class OsimArm;
 /// model's coordinates otherwise, or for a translational one.
 int findOsimSweptCoordinate(const OsimArm& arm, const std::string& name);
 
+/// The curves of a built model about its coordinate j at flexionDeg (the coordinate's values [deg],
+/// taken as given). minFlexionDeg and maxFlexionDeg are the coordinate's range [deg].
+AnatomyCurves calcOsimAnatomyCurves(const OsimArm& arm, int j, const std::vector<double>& flexionDeg);
+
 /// The model's curves at flexionDeg (the coordinate's values [deg], within its range); muscleModel as
 /// OsimArm's. minFlexionDeg and maxFlexionDeg are the coordinate's range [deg].
 AnatomyCurves calcOsimAnatomyCurves(const OsimModel& model, const std::string& coordinate,
                                     const std::vector<double>& flexionDeg, const std::string& muscleModel = "");
 
-/// The coordinate's range [deg] (rounded to 1e-6 deg: a file's 2.26893 rad reads 130 deg); muscleModel
+/// Coordinate j's range [deg], rounded to 1e-6 deg (a file's 2.26893 rad reads 130 deg).
+std::array<double, 2> getOsimCoordinateRangeDeg(const OsimArm& arm, int j);
+/// The same for a coordinate named as findOsimSweptCoordinate takes it; muscleModel
 /// as OsimArm's (the model is built to find the coordinate).
 std::array<double, 2> getOsimCoordinateRangeDeg(const OsimModel& model, const std::string& coordinate,
                                                 const std::string& muscleModel = "");

@@ -1,5 +1,7 @@
 #include "model/osim_trial.h"
 
+#include "model/osim_anatomy.h"
+
 #include "basics/bound.h"
 #include "basics/errors.h"
 #include "basics/format.h"
@@ -53,10 +55,8 @@ double mean(const std::vector<double>& v, std::size_t first) {
 
 void OsimIsometricTrialSettings::validate(const OsimArm& arm) const {
     const int j = findTrialCoordinate(arm, coordinate);
-    const auto range = arm.getCoordinate(j).range;
-    // The range in degrees rounded to 1e-6 deg (a file's 2.26893 rad reads 130 deg, not 130.00000014).
-    checkField("angle_deg", angleDeg,
-               Bound::closed(std::round(range[0] / kDeg * 1e6) / 1e6, std::round(range[1] / kDeg * 1e6) / 1e6, "deg"));
+    const auto [lo, hi] = getOsimCoordinateRangeDeg(arm, j);
+    checkField("angle_deg", angleDeg, Bound::closed(lo, hi, "deg"));
     if (direction != 1 && direction != -1)
         throw FieldError("direction", "= " + std::to_string(direction) + ": expected +1 or -1");
     checkIsometricEffort(activation, antagonistActivation, restDuration, riseTime, holdDuration, sampleRate, averagingWindow);
@@ -161,10 +161,8 @@ void OsimFreeMovementSettings::validate(const OsimArm& arm) const {
     if (c.locked)
         throw FieldError("coordinate", "'" + c.name + "' is locked in " + arm.getModel().file + " (line " + std::to_string(c.line) +
                                            "): a free movement needs it free (an isometric trial holds it at an angle)");
-    const auto range = c.range;
-    if (!std::isnan(initialAngleDeg))
-        checkField("initial_angle_deg", initialAngleDeg,
-                   Bound::closed(std::round(range[0] / kDeg * 1e6) / 1e6, std::round(range[1] / kDeg * 1e6) / 1e6, "deg"));
+    const auto [lo, hi] = getOsimCoordinateRangeDeg(arm, j);
+    if (!std::isnan(initialAngleDeg)) checkField("initial_angle_deg", initialAngleDeg, Bound::closed(lo, hi, "deg"));
     checkField("initial_velocity_degps", initialVelocityDegps, Bound::closed(-2000, 2000, "deg/s"));
     if (direction != 1 && direction != -1)
         throw FieldError("direction", "= " + std::to_string(direction) + ": expected +1 or -1");
