@@ -32,6 +32,29 @@ struct MapCost {
     }
 };
 
+// The same cost with the data rows' Jacobian from MapProblem::jacobian and the prior rows' L^{-1}.
+class AnalyticMapCost final : public ceres::CostFunction {
+public:
+    explicit AnalyticMapCost(const MapCost& cost) : cost_(cost) {
+        mutable_parameter_block_sizes()->push_back(int(cost.mean.size()));
+        set_num_residuals(cost.problem->numResiduals + int(cost.mean.size()));
+    }
+    bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
+        if (jacobians == nullptr || jacobians[0] == nullptr) return cost_(parameters, residuals);
+        const int n = int(cost_.mean.size()), m = cost_.problem->numResiduals;
+        const double* x = parameters[0];
+        if (!cost_.problem->jacobian(x, residuals, jacobians[0])) return false;
+        const Eigen::VectorXd d = Eigen::Map<const Eigen::VectorXd>(x, n) - cost_.mean;
+        Eigen::Map<Eigen::VectorXd>(residuals + m, n) = cost_.priorL.triangularView<Eigen::Lower>().solve(d);
+        Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(jacobians[0] + std::size_t(m) * n, n, n) =
+            cost_.priorL.triangularView<Eigen::Lower>().solve(Eigen::MatrixXd::Identity(n, n));
+        return true;
+    }
+
+private:
+    MapCost cost_;
+};
+
 constexpr double kSmoothStep = 1e-3;  // on x: ln scales and activations
 
 // Stops the solve at the next iteration after Ctrl-C (requestInterruption); the caller then throws.
@@ -101,7 +124,8 @@ MapResult calcMapEstimate(const MapProblem& problem) {
     MapCost functor{&problem, Eigen::Map<const Eigen::VectorXd>(problem.priorMean.data(), n), llt.matrixL()};
     MapResult result;
     result.x = problem.start.empty() ? problem.priorMean : problem.start;
-    auto* cost = new SteppingNumericDiffCost<MapCost>(new MapCost(functor), n, problem.numResiduals + n);
+    ceres::CostFunction* cost = problem.jacobian ? static_cast<ceres::CostFunction*>(new AnalyticMapCost(functor))
+                                                 : new SteppingNumericDiffCost<MapCost>(new MapCost(functor), n, problem.numResiduals + n);
     ceres::Problem pr;
     pr.AddResidualBlock(cost, nullptr, result.x.data());
     std::vector<int> fixed;

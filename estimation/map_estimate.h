@@ -18,8 +18,14 @@ namespace armsim {
 /// solver then rejects the step).
 using ResidualFunction = std::function<bool(const double* x, double* residuals)>;
 
+/// r(x) and its Jacobian dr/dx, row-major (jacobian[i * n + j] = d r_i / d x_j); false as ResidualFunction.
+using ResidualJacobianFunction = std::function<bool(const double* x, double* residuals, double* jacobian)>;
+
 struct MapProblem {
     ResidualFunction residuals;
+    /// Optional: the data residuals' Jacobian in closed form; empty: central differences of residuals
+    /// (Ceres's steps). The smoothed covariance's fallback (a wider step) always differences.
+    ResidualJacobianFunction jacobian;
     int numResiduals = 0;
     std::vector<double> priorMean;                   ///< mu
     std::vector<std::vector<double>> priorCovariance;  ///< Sigma (symmetric positive definite)

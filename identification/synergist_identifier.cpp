@@ -13,6 +13,8 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <array>
+#include <limits>
 #include <tuple>
 
 namespace armsim {
@@ -30,11 +32,11 @@ double sumTaredTorque(const SteadyMvcCurve& active, const SteadyMvcCurve& relaxe
     return t;
 }
 
-// Every muscle at rest (U = 0), with an optional cache (SteadyCurveCache).
+// Every muscle at rest (U = 0), with an optional cache (SteadyCurveCache) and sensitivities.
 SteadyMvcCurve calcRelaxedCurve(const std::vector<MuscleSpec>& muscles, const MvcGeometry& g,
-                                SteadyCurveCache* cache = nullptr) {
+                                SteadyCurveCache* cache = nullptr, bool sensitivities = false) {
     const std::vector<std::vector<bool>> any(g.flexionDeg.size(), std::vector<bool>(muscles.size(), true));
-    return calcSteadyMvcCurve(muscles, g, Effort::Flexion, any, SubjectEffort{0, 0}, cache);
+    return calcSteadyMvcCurve(muscles, g, Effort::Flexion, any, SubjectEffort{0, 0}, cache, sensitivities);
 }
 
 // The effort of a condition at level l: agonists l VA, antagonists l CC.
@@ -412,52 +414,243 @@ void SynergistModel::calcPredictions(const double* x, std::vector<double>& torqu
     calcPredictions(x, nullptr, torques, forearmTorques, channels);
 }
 
-void SynergistModel::calcPredictions(const double* x, const std::vector<MuscleDeviation>* deviations,
-                                     std::vector<double>& torques, std::vector<double>& forearmTorques,
-                                     std::vector<double>& channels, PredictionCache* cache) const {
+struct SynergistModel::Evaluation {
+    std::vector<MuscleSpec> muscles;
+    SteadyMvcCurve relaxed;
+    std::vector<SteadyMvcCurve> active;   // per effort kind
+    double va = 0, cc = 0, g = 1;
+};
+
+SynergistModel::Evaluation SynergistModel::evaluate(const double* x, const std::vector<MuscleDeviation>* deviations,
+                                                    PredictionCache* cache, bool sensitivities) const {
+    Evaluation e;
     // Guard: the bounds keep difference probes inside [0, 1].
-    const double va = std::clamp(x[kActivation], 0.0, 1.0), cc = std::clamp(x[kCoContraction], 0.0, 1.0);
-    const std::vector<MuscleSpec> muscles = makeMuscles(x, deviations);
-    const double g = std::exp(x[kSize]);
+    e.va = std::clamp(x[kActivation], 0.0, 1.0);
+    e.cc = std::clamp(x[kCoContraction], 0.0, 1.0);
+    e.muscles = makeMuscles(x, deviations);
+    e.g = std::exp(x[kSize]);
     MvcGeometry scaled;
-    if (g != 1) {  // every length scales by g: paths and moment arms too
+    if (e.g != 1) {  // every length scales by g: paths and moment arms too
         scaled = geometry_;
         for (auto* table : {&scaled.pathLength, &scaled.momentArm, &scaled.forearmMomentArm})
             for (std::vector<double>& row : *table)
-                for (double& v : row) v *= g;
+                for (double& v : row) v *= e.g;
     }
-    const MvcGeometry& geometry = g != 1 ? scaled : geometry_;
+    const MvcGeometry& geometry = e.g != 1 ? scaled : geometry_;
     if (cache) cache->active.resize(kinds_.size());
-    const SteadyMvcCurve relaxed = calcRelaxedCurve(muscles, geometry, cache ? &cache->relaxed : nullptr);
-    std::vector<SteadyMvcCurve> active;
+    e.relaxed = calcRelaxedCurve(e.muscles, geometry, cache ? &cache->relaxed : nullptr, sensitivities);
     for (std::size_t j = 0; j < kinds_.size(); ++j)
-        active.push_back(calcSteadyMvcCurve(muscles, geometry, kinds_[j].effort, agonists_[j],
-                                            makeEffort(kinds_[j].level, va, cc), cache ? &cache->active[j] : nullptr));
+        e.active.push_back(calcSteadyMvcCurve(e.muscles, geometry, kinds_[j].effort, agonists_[j],
+                                              makeEffort(kinds_[j].level, e.va, e.cc),
+                                              cache ? &cache->active[j] : nullptr, sensitivities));
+    return e;
+}
+
+void SynergistModel::readPredictions(const Evaluation& e, std::vector<double>& torques,
+                                     std::vector<double>& forearmTorques, std::vector<double>& channels) const {
     torques.clear();
     forearmTorques.clear();
     for (std::size_t c = 0; c < angleOf_.size(); ++c) {
-        torques.push_back(sumTaredTorque(active[kindOf_[c]], relaxed, std::size_t(angleOf_[c]), leftOut_));
-        forearmTorques.push_back(sumTaredTorque(active[kindOf_[c]], relaxed, std::size_t(angleOf_[c]), leftOut_,
+        torques.push_back(sumTaredTorque(e.active[kindOf_[c]], e.relaxed, std::size_t(angleOf_[c]), leftOut_));
+        forearmTorques.push_back(sumTaredTorque(e.active[kindOf_[c]], e.relaxed, std::size_t(angleOf_[c]), leftOut_,
                                                 &SteadyMusclePoint::forearmTorque));
     }
     channels.clear();
     for (std::size_t k = 0; k < channels_.size(); ++k) {
         const ChannelObservation& o = channels_[k];
         const int m = channelMuscle_[k];
+        const MuscleParameters& q = e.muscles[std::size_t(std::max(m, 0))].params;
         double v = 0;
         if (o.channel == "fascicle_length") {
-            const SteadyMvcCurve& curve = channelKind_[k] < 0 ? relaxed : active[channelKind_[k]];
-            v = curve.points[channelAngle_[k]][m].fibreLength * muscles[m].params.optimalFascicleLength;
+            const SteadyMvcCurve& curve = channelKind_[k] < 0 ? e.relaxed : e.active[channelKind_[k]];
+            v = curve.points[channelAngle_[k]][m].fibreLength * q.optimalFascicleLength;
         } else if (o.channel == "volume") {
-            v = muscles[m].params.mass / muscles[m].params.coefficients.density;
+            v = q.mass / q.coefficients.density;
         } else if (o.channel == "emg") {
-            const bool agonist = isAgonistOf(o.effort, muscles[m].group, 0.0);
-            const double own = o.level * (agonist ? va : cc), other = o.level * (agonist ? cc : va);
-            v = (own + emgCrosstalk_ * other) / (va + emgCrosstalk_ * cc);
+            const bool agonist = isAgonistOf(o.effort, e.muscles[m].group, 0.0);
+            const double own = o.level * (agonist ? e.va : e.cc), other = o.level * (agonist ? e.cc : e.va);
+            v = (own + emgCrosstalk_ * other) / (e.va + emgCrosstalk_ * e.cc);
         } else {  // upper_arm_length
-            v = base_->arm.upperArmLength * g;
+            v = base_->arm.upperArmLength * e.g;
         }
         channels.push_back(v);
+    }
+}
+
+void SynergistModel::calcPredictions(const double* x, const std::vector<MuscleDeviation>* deviations,
+                                     std::vector<double>& torques, std::vector<double>& forearmTorques,
+                                     std::vector<double>& channels, PredictionCache* cache) const {
+    readPredictions(evaluate(x, deviations, cache, false), torques, forearmTorques, channels);
+}
+
+namespace {
+
+// d F / d x_j and d L / d x_j of one muscle at one steady point: the chain rule through the point's
+// sensitivity, its inputs' log-derivatives d (row j of SynergistModel::InputDerivatives) and the drive's
+// derivatives by VA and CC.
+void differentiatePoint(const SteadyMusclePoint& p, double F0, const SynergistModel::InputDerivatives& d, int va,
+                        int cc, double dUdVa, double dUdCc, std::vector<double>& dForce, std::vector<double>& dFibre) {
+    using S = SteadySensitivity;
+    using I = SynergistModel::Input;
+    const S& s = p.sensitivity;
+    const int n = int(d.size());
+    dForce.resize(n);
+    dFibre.resize(n);
+    for (int j = 0; j < n; ++j) {
+        const double dU = (j == va ? dUdVa : 0.0) + (j == cc ? dUdCc : 0.0);
+        double dFn = s.dFn[S::kInput] * dU, dL = s.dL[S::kInput] * dU;
+        for (int k = 0; k < S::kInput; ++k) {
+            dFn += s.dFn[k] * d[j][k];
+            dL += s.dL[k] * d[j][k];
+        }
+        // F = F0 Fn with F0 = sigma M / (rho L0).
+        dForce[j] = p.force * (d[j][I::kLnMass] + d[j][I::kLnTension] - d[j][I::kLnL0]) + F0 * dFn;
+        dFibre[j] = dL;
+    }
+}
+
+bool haveSensitivities(const SteadyMvcCurve& curve) {
+    for (const auto& row : curve.points)
+        for (const SteadyMusclePoint& p : row)
+            if (!p.sensitivity.valid) return false;
+    return true;
+}
+
+}  // namespace
+
+std::vector<SynergistModel::InputDerivatives> SynergistModel::calcInputDerivatives() const {
+    const int n = getNumParameters();
+    const std::size_t nm = base_->muscles.size();
+    std::vector<InputDerivatives> d(nm, InputDerivatives(std::size_t(n), std::array<double, Input::kNumInputs>{}));
+    for (std::size_t i = 0; i < nm; ++i) {
+        d[i][kSize] = {1, 1, 1, 1, 0, 0, 1};   // every length
+        d[i][kSigma][Input::kLnTension] = 1;
+        const int mass = findMassIndex(int(i));
+        if (mass >= 0) d[i][mass][Input::kLnMass] = 1;
+    }
+    for (int i : extensors_) d[i][kExtensorMass][Input::kLnMass] = 1;
+    for (const auto& [group, tendon, fascicle] : {std::tuple{&biceps_, kTendon, kFascicle},
+                                                  std::tuple{&synergists_, kSynergistTendon, kSynergistFascicle}})
+        for (int i : *group) {
+            d[i][tendon][Input::kLnL0T] = 1;
+            d[i][fascicle][Input::kLnL0] = 1;
+        }
+    return d;
+}
+
+void SynergistModel::addTorqueDerivatives(const Evaluation& e, const double* x, std::vector<double>& dTorques,
+                                          std::vector<double>& dForearmTorques) const {
+    const int n = getNumParameters();
+    const std::vector<InputDerivatives> d = calcInputDerivatives();
+    const int va = x[kActivation] > 0 && x[kActivation] < 1 ? kActivation : -1;   // clamped outside
+    const int cc = x[kCoContraction] > 0 && x[kCoContraction] < 1 ? kCoContraction : -1;
+    std::vector<double> dForce, dFibre, dRelaxed(n), dRelaxedForearm(n);
+    for (std::size_t a = 0; a < geometry_.flexionDeg.size(); ++a)
+        for (std::size_t i = 0; i < e.muscles.size(); ++i) {
+            if (std::find(leftOut_.begin(), leftOut_.end(), int(i)) != leftOut_.end()) continue;
+            const double F0 = calcMaxIsometricForce(e.muscles[i].params);
+            // The relaxed point, subtracted from every condition at this pose; torque = h F, h ~ g.
+            const SteadyMusclePoint& r = e.relaxed.points[a][i];
+            differentiatePoint(r, F0, d[i], va, cc, 0, 0, dForce, dFibre);
+            for (int j = 0; j < n; ++j) {
+                const double dF = dForce[j] + r.force * d[i][j][Input::kLnArm];
+                dRelaxed[j] = r.momentArm * dF;
+                dRelaxedForearm[j] = r.forearmMomentArm * dF;
+            }
+            for (std::size_t kind = 0; kind < kinds_.size(); ++kind) {
+                const SteadyMusclePoint& p = e.active[kind].points[a][i];
+                const double level = kinds_[kind].level;
+                const bool agonist = agonists_[kind][a][i];
+                bool differentiated = false;
+                for (std::size_t c = 0; c < angleOf_.size(); ++c) {
+                    if (angleOf_[c] != int(a) || kindOf_[c] != int(kind)) continue;
+                    if (!differentiated) differentiatePoint(p, F0, d[i], va, cc, agonist ? level : 0.0, agonist ? 0.0 : level, dForce, dFibre);
+                    differentiated = true;
+                    for (int j = 0; j < n; ++j) {
+                        const double dF = dForce[j] + p.force * d[i][j][Input::kLnArm];
+                        dTorques[c * n + j] += p.momentArm * dF - dRelaxed[j];
+                        dForearmTorques[c * n + j] += p.forearmMomentArm * dF - dRelaxedForearm[j];
+                    }
+                }
+            }
+        }
+}
+
+void SynergistModel::calcChannelDerivatives(const Evaluation& e, const double* x, const std::vector<double>& channels,
+                                            std::vector<double>& dChannels) const {
+    const int n = getNumParameters();
+    const std::vector<InputDerivatives> d = calcInputDerivatives();
+    const int va = x[kActivation] > 0 && x[kActivation] < 1 ? kActivation : -1;
+    const int cc = x[kCoContraction] > 0 && x[kCoContraction] < 1 ? kCoContraction : -1;
+    std::vector<double> dForce, dFibre;
+    for (std::size_t k = 0; k < channels_.size(); ++k) {
+        const ChannelObservation& o = channels_[k];
+        const int m = channelMuscle_[k];
+        double* row = &dChannels[k * n];
+        if (o.channel == "fascicle_length") {   // L L0
+            const int kind = channelKind_[k];
+            const SteadyMusclePoint& p = (kind < 0 ? e.relaxed : e.active[kind]).points[channelAngle_[k]][m];
+            const bool agonist = kind >= 0 && agonists_[kind][channelAngle_[k]][m];
+            const double level = kind < 0 ? 0.0 : kinds_[kind].level;
+            differentiatePoint(p, calcMaxIsometricForce(e.muscles[m].params), d[m], va, cc, agonist ? level : 0.0,
+                               agonist || kind < 0 ? 0.0 : level, dForce, dFibre);
+            const double L0 = e.muscles[m].params.optimalFascicleLength;
+            for (int j = 0; j < n; ++j) row[j] = L0 * dFibre[j] + channels[k] * d[m][j][Input::kLnL0];
+        } else if (o.channel == "volume") {   // M / rho
+            for (int j = 0; j < n; ++j) row[j] = channels[k] * d[m][j][Input::kLnMass];
+        } else if (o.channel == "emg") {   // (own + c other) / (VA + c CC)
+            const bool agonist = isAgonistOf(o.effort, e.muscles[m].group, 0.0);
+            const double c = emgCrosstalk_, D = e.va + c * e.cc;
+            const double N = o.level * (agonist ? e.va + c * e.cc : e.cc + c * e.va);
+            if (va >= 0) row[va] = (o.level * (agonist ? 1.0 : c) * D - N) / (D * D);
+            if (cc >= 0) row[cc] = (o.level * (agonist ? c : 1.0) * D - N * c) / (D * D);
+        } else {  // upper_arm_length, ~ g
+            row[kSize] = channels[k];
+        }
+    }
+}
+
+void SynergistModel::calcPredictionJacobian(const double* x, std::vector<double>& torques,
+                                            std::vector<double>& forearmTorques, std::vector<double>& channels,
+                                            std::vector<double>& dTorques, std::vector<double>& dForearmTorques,
+                                            std::vector<double>& dChannels, PredictionCache* cache) const {
+    const int n = getNumParameters();
+    const Evaluation e = evaluate(x, nullptr, cache, true);
+    readPredictions(e, torques, forearmTorques, channels);
+    const std::size_t nc = torques.size(), nk = channels.size();
+    dTorques.assign(nc * n, 0.0);
+    dForearmTorques.assign(nc * n, 0.0);
+    dChannels.assign(nk * n, 0.0);
+    bool analytic = haveSensitivities(e.relaxed);
+    for (const SteadyMvcCurve& curve : e.active) analytic = analytic && haveSensitivities(curve);
+    if (analytic) {
+        addTorqueDerivatives(e, x, dTorques, dForearmTorques);
+        calcChannelDerivatives(e, x, channels, dChannels);
+    }
+    // Columns by central differences (Ceres's steps): the slow-fraction shifts when free, or every
+    // column when a muscle has no steady sensitivity.
+    std::vector<double> xp(x, x + n), t, f, ch, plus, minus;
+    auto flatten = [&](std::vector<double>& out) {
+        out.assign(t.begin(), t.end());
+        out.insert(out.end(), f.begin(), f.end());
+        out.insert(out.end(), ch.begin(), ch.end());
+    };
+    for (int j = 0; j < n; ++j) {
+        if (analytic && !((j == kBicepsSlow || j == kSynergistSlow) && lower_[j] < upper_[j])) continue;
+        const double delta = std::max(std::sqrt(std::numeric_limits<double>::epsilon()), std::abs(x[j]) * 1e-6);
+        xp[j] = x[j] + delta;
+        calcPredictions(xp.data(), nullptr, t, f, ch, cache);
+        flatten(plus);
+        xp[j] = x[j] - delta;
+        calcPredictions(xp.data(), nullptr, t, f, ch, cache);
+        flatten(minus);
+        xp[j] = x[j];
+        for (std::size_t r = 0; r < plus.size(); ++r) {
+            const double v = (plus[r] - minus[r]) / (2 * delta);
+            if (r < nc) dTorques[r * n + j] = v;
+            else if (r < 2 * nc) dForearmTorques[(r - nc) * n + j] = v;
+            else dChannels[(r - 2 * nc) * n + j] = v;
+        }
     }
 }
 
@@ -727,6 +920,46 @@ MuscleEstimate identifySynergistAware(const Population& prior, const std::vector
         }
         return true;
     };
+    // The same residuals with their Jacobian through the steady states (calcPredictionJacobian).
+    // Ceres asks twice at an accepted point: the last answer is kept.
+    const int n = model.getNumParameters();
+    struct {
+        std::vector<double> x, r, J;
+    } last;
+    map.jacobian = [&](const double* x, double* r, double* J) {
+        const std::size_t R = std::size_t(map.numResiduals);
+        if (last.x.size() == std::size_t(n) && std::equal(last.x.begin(), last.x.end(), x)) {
+            std::copy(last.r.begin(), last.r.end(), r);
+            std::copy(last.J.begin(), last.J.end(), J);
+            return true;
+        }
+        last.x.clear();
+        std::vector<double> t, f, c, dt, df, dc;
+        try {
+            model.calcPredictionJacobian(x, t, f, c, dt, df, dc, &cache);
+        } catch (const std::exception&) {
+            return false;
+        }
+        std::fill(J, J + R * n, 0.0);
+        for (std::size_t k = 0; k < nt; ++k) {
+            const Row& row = rows[k];
+            r[k] = ((row.forearm ? f : t)[row.observation] - torque[k]) / sd[k];
+            const double* d = &(row.forearm ? df : dt)[row.observation * n];
+            for (int j = 0; j < n; ++j) J[k * n + j] = d[j] / sd[k];
+        }
+        for (std::size_t k = 0; k < nc; ++k) {
+            r[nt + k] = (c[k] - channels[k].value) / channels[k].sd;
+            for (int j = 0; j < n; ++j) J[(nt + k) * n + j] = dc[k * n + j] / channels[k].sd;
+        }
+        if (measured) {
+            r[nt + nc] = (x[P::kActivation] - options.measuredActivation) / options.activationSd;
+            J[(nt + nc) * n + P::kActivation] = 1 / options.activationSd;
+        }
+        last.x.assign(x, x + n);
+        last.r.assign(r, r + R);
+        last.J.assign(J, J + R * n);
+        return true;
+    };
     const MapResult m = calcMapEstimate(map);
     const std::vector<double>& x = m.x;
     est.converged = m.converged;
@@ -833,17 +1066,19 @@ MuscleEstimate identifySynergistAware(const Population& prior, const std::vector
             return v;
         };
         // The whitened data residuals' Jacobian at the estimate over every parameter (free and held) and
-        // every consider parameter, by central differences: for the free parameters a tangent (step
-        // 1e-5); for the held and considered ones a secant over +/- half their prior sd, the spread the
-        // truth has (muscle forces step with motor-unit recruitment: a tangent there can be any size).
+        // every consider parameter: for the free parameters the tangent (map.jacobian); for the held and
+        // considered ones a central secant over +/- half their prior sd, the spread the truth has (muscle
+        // forces step with motor-unit recruitment: a tangent there can be any size).
         const std::vector<P::ConsiderParameter> considered = model.getConsiderParameters();
         const int nk = int(considered.size());
         std::vector<std::vector<double>> J(R, std::vector<double>(n + nk, 0.0));
         std::vector<double> steps = model.getSecantSteps();
+        std::vector<double> r0(R), J0(std::size_t(R) * n);
+        bool haveJacobian = map.jacobian(x.data(), r0.data(), J0.data());
         for (int j = 0; j < n; ++j)
-            if (!(map.lower[j] >= map.upper[j])) steps[j] = 1e-5;
-        bool haveJacobian = true;
-        {
+            if (!(map.lower[j] >= map.upper[j]))
+                for (int k = 0; k < R; ++k) J[k][j] = J0[std::size_t(k) * n + j];
+        if (haveJacobian) {
             std::vector<double> xp = x, rp(R), rm(R);
             std::vector<P::MuscleDeviation> deviations(base.muscles.size());
             auto shift = [&](int j, double by) {

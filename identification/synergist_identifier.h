@@ -23,6 +23,7 @@
 #include "identification/torque_estimate.h"
 #include "model/mvc_curve.h"
 
+#include <array>
 #include <string>
 #include <utility>
 #include <vector>
@@ -127,6 +128,21 @@ public:
     void calcPredictions(const double* x, const std::vector<MuscleDeviation>* deviations, std::vector<double>& torques,
                          std::vector<double>& forearmTorques, std::vector<double>& channels,
                          PredictionCache* cache = nullptr) const;
+    /// The predictions (as calcPredictions without deviations) and their derivatives by x, row-major with
+    /// getNumParameters() columns (dTorques[c * n + j] = d torques[c] / d x_j): through every muscle's
+    /// steady state by the implicit function theorem (MuscleModel::calcSteadySensitivity) and the chain
+    /// rule through x's scales. Columns that move the slow-fibre fractions (when free), and every column
+    /// when a muscle's model has no steady sensitivity, by central differences with Ceres's steps.
+    void calcPredictionJacobian(const double* x, std::vector<double>& torques, std::vector<double>& forearmTorques,
+                                std::vector<double>& channels, std::vector<double>& dTorques,
+                                std::vector<double>& dForearmTorques, std::vector<double>& dChannels,
+                                PredictionCache* cache = nullptr) const;
+    /// What calcPredictionJacobian's chain rule reads: d ln(input) / d x_j of one muscle's steady
+    /// inputs (SteadySensitivity's first four, then mass, specific tension and moment arm), [j][input].
+    struct Input {
+        enum { kLnP = 0, kLnL0, kLnL0T, kLnPmax, kLnMass, kLnTension, kLnArm, kNumInputs };
+    };
+    using InputDerivatives = std::vector<std::array<double, Input::kNumInputs>>;
     /// The population's model with x's muscles (and each muscle's deviation, when given).
     std::vector<MuscleSpec> makeMuscles(const double* x, const std::vector<MuscleDeviation>* deviations = nullptr) const;
 
@@ -194,6 +210,17 @@ private:
     std::vector<int> channelMuscle_, channelAngle_, channelKind_;  // kind -1: relaxed
     double emgCrosstalk_ = 0;
     int findKind(Effort effort, double level);
+    /// x's muscles and every steady curve the predictions read (the relaxed one and one per effort kind).
+    struct Evaluation;
+    Evaluation evaluate(const double* x, const std::vector<MuscleDeviation>* deviations, PredictionCache* cache,
+                        bool sensitivities) const;
+    void readPredictions(const Evaluation& e, std::vector<double>& torques, std::vector<double>& forearmTorques,
+                         std::vector<double>& channels) const;
+    std::vector<InputDerivatives> calcInputDerivatives() const;   // [muscle]
+    void addTorqueDerivatives(const Evaluation& e, const double* x, std::vector<double>& dTorques,
+                              std::vector<double>& dForearmTorques) const;
+    void calcChannelDerivatives(const Evaluation& e, const double* x, const std::vector<double>& channels,
+                                std::vector<double>& dChannels) const;
     /// Frees the rotators' scales within the mass scales' bounds (the data read the forearm axis).
     void freeRotatorMass();
     /// Index of the pose (flexion, forearm rotation; NaN = the model's posture, kept as +inf), added if new.

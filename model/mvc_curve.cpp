@@ -73,7 +73,8 @@ namespace {
 // from the cache where their inputs are unchanged.
 template <class IsAgonist>
 SteadyMvcCurve calcSteadyCurve(const std::vector<MuscleSpec>& muscles, const MvcGeometry& geometry,
-                               const SubjectEffort& subject, IsAgonist isAgonist, SteadyCurveCache* cache) {
+                               const SubjectEffort& subject, IsAgonist isAgonist, SteadyCurveCache* cache,
+                               bool sensitivities = false) {
     checkField("voluntary activation", subject.voluntaryActivation, Bound::closed(0, 1));
     checkField("co-contraction", subject.coContraction, Bound::closed(0, 1));
     const std::size_t nm = muscles.size(), na = geometry.flexionDeg.size();
@@ -119,7 +120,15 @@ SteadyMvcCurve calcSteadyCurve(const std::vector<MuscleSpec>& muscles, const Mvc
                 if (!st.converged)
                     throw SimulationError("muscle '" + curve.muscles[i] + "' at " + formatNumber(geometry.flexionDeg[a]) +
                                           " deg flexion: " + st.message);
-                q = {true, p.pathLength, p.activation, st.L, st.normalizedForce};
+                q = {true, p.pathLength, p.activation, st.L, st.normalizedForce, false, {}};
+            }
+            if (sensitivities) {
+                if (!q.haveSensitivity) {
+                    if (!model[i]) build(i);
+                    q.sensitivity = model[i]->calcSteadySensitivity(p.pathLength, p.activation, q.L);
+                    q.haveSensitivity = true;
+                }
+                p.sensitivity = q.sensitivity;
             }
             if (cache) SteadyCurveCacheAccess::count(*cache, reuse);
             p.fibreLength = q.L;
@@ -164,11 +173,12 @@ std::vector<std::vector<bool>> findAgonists(const std::vector<MuscleSpec>& muscl
 
 SteadyMvcCurve calcSteadyMvcCurve(const std::vector<MuscleSpec>& muscles, const MvcGeometry& geometry, Effort effort,
                                   const std::vector<std::vector<bool>>& agonists, const SubjectEffort& subject,
-                                  SteadyCurveCache* cache) {
+                                  SteadyCurveCache* cache, bool sensitivities) {
     if (agonists.size() != geometry.flexionDeg.size())
         throw std::logic_error("calcSteadyMvcCurve: one agonist row per angle expected");
     SteadyMvcCurve c = calcSteadyCurve(muscles, geometry, subject,
-                                       [&](std::size_t a, std::size_t i) { return bool(agonists[a].at(i)); }, cache);
+                                       [&](std::size_t a, std::size_t i) { return bool(agonists[a].at(i)); }, cache,
+                                       sensitivities);
     c.effort = effort;
     return c;
 }

@@ -5,6 +5,7 @@
 #include "basics/numbers.h"
 
 #include "model/model_file.h"
+#include "muscles/muscle_model.h"
 
 #include <string>
 #include <vector>
@@ -21,6 +22,9 @@ struct SteadyMusclePoint {
     double torque = 0;       ///< h Fse, + = flexion [N m]
     double forearmMomentArm = 0;  ///< about the forearm rotation axis, + = supinates [m] (0 without one)
     double forearmTorque = 0;     ///< forearmMomentArm Fse, + = supination [N m]
+    /// How the steady state moves with its inputs (MuscleModel::calcSteadySensitivity); filled only
+    /// when the curve is asked for it, else valid = false.
+    SteadySensitivity sensitivity;
 };
 
 /// The steady MVC torque-angle curve of a model: rows = angles, columns = muscles.
@@ -68,6 +72,8 @@ private:
     struct Point {
         bool valid = false;
         double pathLength = 0, activation = 0, L = 0, normalizedForce = 0;
+        bool haveSensitivity = false;
+        SteadySensitivity sensitivity;
     };
     struct Muscle {
         bool valid = false;
@@ -88,10 +94,11 @@ std::vector<std::vector<bool>> findAgonists(const std::vector<MuscleSpec>& muscl
                                             Effort effort);
 /// The curve with the agonists given per angle (findAgonists, perhaps of another geometry: a fit that
 /// scales the moment arms keeps its agonists).
-/// `cache` (optional) holds this curve's earlier states (SteadyCurveCache).
+/// `cache` (optional) holds this curve's earlier states (SteadyCurveCache); `sensitivities`: fill each
+/// point's sensitivity (SteadyMusclePoint::sensitivity).
 SteadyMvcCurve calcSteadyMvcCurve(const std::vector<MuscleSpec>& muscles, const MvcGeometry& geometry, Effort effort,
                                   const std::vector<std::vector<bool>>& agonists, const SubjectEffort& subject,
-                                  SteadyCurveCache* cache = nullptr);
+                                  SteadyCurveCache* cache = nullptr, bool sensitivities = false);
 /// The same with the agonists of a muscle group: Flexor a flexion effort, Extensor an extension effort.
 SteadyMvcCurve calcSteadyMvcCurve(const std::vector<MuscleSpec>& muscles, const MvcGeometry& geometry,
                                   MuscleGroup effort, const SubjectEffort& subject);

@@ -77,7 +77,7 @@ AnatomyCurves calcOsimAnatomyCurves(const OsimArm& arm, int j, const std::vector
                 if (!ss.converged)
                     throw SimulationError("muscle " + arm.getMuscleName(i) + " at " + arm.getCoordinate(j).name + " = " +
                                           formatNumber(deg) + " deg: " + ss.message);
-                row[i] = {P[i], R[i], u, ss.fascicleLength / m.getOptimalFascicleLength(), ss.force, ss.force * R[i], 0, 0};
+                row[i] = {P[i], R[i], u, ss.fascicleLength / m.getOptimalFascicleLength(), ss.force, ss.force * R[i], 0, 0, {}};
                 total += row[i].torque;
             }
             curves[k]->points.push_back(row);

@@ -38,6 +38,18 @@ struct SteadyState {
     std::vector<double> states;  ///< full state vector, ready for a time integration
 };
 
+/// How a steady state moves with its inputs, by the implicit function theorem on the steady balance
+/// (d L / d theta = -(dR/d theta) / (dR/d L), R the model's steady imbalance): the derivatives of the
+/// normalized force F / F0 and of the normalized fascicle length L with respect to ln P (path), ln L0
+/// (optimal fascicle length), ln L0T (the tendon's reference length), ln P_max (the longest path) and U.
+/// F0's own dependence on L0 is not included (F = F0 Fn: the caller adds it).
+struct SteadySensitivity {
+    enum Input { kLnPath = 0, kLnFascicle, kLnTendon, kLnMaxPath, kInput, kNumInputs };
+    bool valid = false;          ///< false: not available (the caller takes difference quotients)
+    double dFn[kNumInputs] = {}; ///< d (F / F0) / d input [1]
+    double dL[kNumInputs] = {};  ///< d L / d input [1]
+};
+
 /// A built muscle model: immutable, cheap to share between threads.
 class MuscleModel {
 public:
@@ -92,6 +104,12 @@ public:
     /// Steady isometric state at path P and input U. Never throws for a missing equilibrium: returns
     /// converged = false with the reason.
     virtual SteadyState calcSteadyState(double pathLength, double U) const = 0;
+    /// Sensitivity of the steady state L (calcSteadyState's, at the same P and U) to its inputs. The
+    /// default: not available (valid = false).
+    virtual SteadySensitivity calcSteadySensitivity(double pathLength, double U, double L) const {
+        (void)pathLength, (void)U, (void)L;
+        return {};
+    }
     /// Fascicle length [m] of state y at path P.
     virtual double calcFascicleLength(double pathLength, const double* y) const = 0;
     /// Fascicle velocity [m/s] (+ = lengthening) of state y at path P, input U.

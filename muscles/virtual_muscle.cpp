@@ -513,8 +513,12 @@ void VirtualMuscle::checkStates(double t, const double* y) const {
 }
 
 double VirtualMuscle::calcSteadyImbalance(double P, double U, double L) const {
-    const auto& c = params_.coefficients;
     const double LT = (P - params_.optimalFascicleLength * L) / params_.optimalTendonLength;
+    return calcSeriesElastic(params_.coefficients, LT) - calcSteadyFibreForce(U, L, Lmax_);
+}
+
+double VirtualMuscle::calcSteadyFibreForce(double U, double L, double Lmax) const {
+    const auto& c = params_.coefficients;
     const double fpe2 = calcPassiveCompression(c, L);
     const double nfS = calcNf(params_.slow, L), nfF = calcNf(params_.fast, L);
     double sumS = 0, sumF = 0;
@@ -524,10 +528,40 @@ double VirtualMuscle::calcSteadyImbalance(double P, double U, double L) const {
         const double S = t.hasSag() ? (fenv < 0.1 ? t.aS1 : t.aS2) : 1.0;
         (mu.slow ? sumS : sumF) += calcActivationFrequency(t, S * fenv, mu.slow ? nfS : nfF) * mu.fraction;
     }
-    double fce = calcPassiveStretch(c, L, 0.0, Lmax_);
+    double fce = calcPassiveStretch(c, L, 0.0, Lmax);
     if (sumS > 0) fce += sumS * (calcForceLength(params_.slow, L) + fpe2);
     if (sumF > 0) fce += sumF * (calcForceLength(params_.fast, L) + fpe2);
-    return calcSeriesElastic(c, LT) - std::max(0.0, fce);
+    return std::max(0.0, fce);
+}
+
+SteadySensitivity VirtualMuscle::calcSteadySensitivity(double P, double U, double L) const {
+    using S = SteadySensitivity;
+    const auto& c = params_.coefficients;
+    const double L0 = params_.optimalFascicleLength, L0T = params_.optimalTendonLength;
+    const double LT = (P - L0 * L) / L0T;
+    constexpr double h = 1e-7;
+    const double dFse = (calcSeriesElastic(c, LT + h) - calcSeriesElastic(c, LT - h)) / (2 * h);
+    const double dFceL = (calcSteadyFibreForce(U, L + h, Lmax_) - calcSteadyFibreForce(U, L - h, Lmax_)) / (2 * h);
+    const double Uhi = std::min(U + h, 1.0), Ulo = std::max(U - h, 0.0);
+    const double dFceU = (calcSteadyFibreForce(Uhi, L, Lmax_) - calcSteadyFibreForce(Ulo, L, Lmax_)) / (Uhi - Ulo);
+    // Lmax enters through the passive stretch only, and only while the fibre side is positive.
+    const double hm = h * Lmax_;
+    const double dFceLmax = calcSteadyFibreForce(U, L, Lmax_) > 0
+        ? (calcPassiveStretch(c, L, 0.0, Lmax_ + hm) - calcPassiveStretch(c, L, 0.0, Lmax_ - hm)) / (2 * hm) : 0.0;
+    // LT = (P - L0 L) / L0T and Lmax = (Pmax - LT* L0T) / L0: their partials by each input.
+    double dLT[S::kNumInputs] = {P / L0T, -L0 * L / L0T, -LT, 0.0, 0.0};
+    double dLmax[S::kNumInputs] = {0.0, -Lmax_, -calcTendonLengthAtLimit(c) * L0T / L0, params_.maxPathLength / L0, 0.0};
+    const double dLTdL = -L0 / L0T;
+    const double RL = dFse * dLTdL - dFceL;
+    SteadySensitivity s;
+    if (!(RL != 0) || !std::isfinite(RL)) return s;
+    for (int k = 0; k < S::kNumInputs; ++k) {
+        const double Rk = dFse * dLT[k] - dFceLmax * dLmax[k] - (k == S::kInput ? dFceU : 0.0);
+        s.dL[k] = -Rk / RL;
+        s.dFn[k] = dFse * (dLT[k] + dLTdL * s.dL[k]);
+    }
+    s.valid = std::all_of(std::begin(s.dFn), std::end(s.dFn), [](double v) { return std::isfinite(v); });
+    return s;
 }
 
 SteadyState VirtualMuscle::calcSteadyState(double P, double U) const {

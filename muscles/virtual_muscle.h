@@ -230,10 +230,15 @@ public:
     /// Steady isometric state at path P and activation U: solves Fse(L) = Fce(L, V = 0).
     /// Never throws for a missing equilibrium: returns converged = false with the reason.
     SteadyState calcSteadyState(double pathLength, double U) const override;
+    /// The steady state's sensitivity by the implicit function theorem on calcSteadyImbalance; the
+    /// partial derivatives of the balance's two sides by central differences (steps 1e-7).
+    SteadySensitivity calcSteadySensitivity(double pathLength, double U, double L) const override;
 
 private:
     /// (Fse - Fce) / F0 in the steady state at fascicle length L (V = 0, feff = fenv, Y = 1).
     double calcSteadyImbalance(double pathLength, double U, double L) const;
+    /// Its fibre side Fce / F0 at L, U and normalized longest fascicle Lmax.
+    double calcSteadyFibreForce(double U, double L, double Lmax) const;
     MuscleParameters params_;
     std::vector<MotorUnit> units_;
     double F0_ = 0, Lmax_ = 0, nfLimit_ = 0;

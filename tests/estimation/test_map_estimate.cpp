@@ -55,6 +55,50 @@ TEST(MapEstimate, LinearGaussianPosteriorMatchesTheClosedFormAndCovers95Percent)
     for (int j = 0; j < 2; ++j) EXPECT_NEAR(covered[j] / double(kDraws), 0.95, tolerance) << j;
 }
 
+// The same posterior with the data rows' Jacobian given in closed form (MapProblem::jacobian): the
+// estimate and the covariance equal the closed form, and the covariance is built from that Jacobian
+// (a Jacobian twice too large gives the posterior of noise half as large).
+TEST(MapEstimate, AClosedFormJacobianGivesTheClosedFormPosterior) {
+    constexpr double kNoiseSd = 0.3;
+    Eigen::MatrixXd A(3, 2);
+    A << 1, 0.5, 1, 2.0, 0.5, -1.0;
+    const Eigen::Vector2d mu(1.0, -0.5);
+    Eigen::Matrix2d Sigma;
+    Sigma << 0.5, 0.2, 0.2, 0.3;
+    const Eigen::Vector3d y(1.2, 0.3, 1.1);
+    for (double scale : {1.0, 2.0}) {
+        MapProblem m;
+        m.numResiduals = 3;
+        m.residuals = [&](const double* x, double* r) {
+            const Eigen::VectorXd pred = A * Eigen::Vector2d(x[0], x[1]);
+            for (int k = 0; k < 3; ++k) r[k] = (pred[k] - y[k]) / kNoiseSd;
+            return true;
+        };
+        int calls = 0;
+        m.jacobian = [&](const double* x, double* r, double* J) {
+            ++calls;
+            m.residuals(x, r);
+            for (int k = 0; k < 3; ++k)
+                for (int j = 0; j < 2; ++j) J[k * 2 + j] = scale * A(k, j) / kNoiseSd;
+            return true;
+        };
+        m.priorMean = {mu[0], mu[1]};
+        m.functionTolerance = 1e-14;
+        m.priorCovariance = {{Sigma(0, 0), Sigma(0, 1)}, {Sigma(1, 0), Sigma(1, 1)}};
+        const MapResult r = calcMapEstimate(m);
+        ASSERT_EQ(r.covariance.size(), 2u) << r.message;
+        EXPECT_GT(calls, 0);
+        const Eigen::Matrix2d P = (A.transpose() * A / (kNoiseSd * kNoiseSd) + Sigma.inverse()).inverse();
+        const Eigen::Matrix2d Pj = (scale * scale * A.transpose() * A / (kNoiseSd * kNoiseSd) + Sigma.inverse()).inverse();
+        if (scale == 1) {
+            const Eigen::Vector2d mean = P * (A.transpose() * y / (kNoiseSd * kNoiseSd) + Sigma.inverse() * mu);
+            for (int j = 0; j < 2; ++j) EXPECT_NEAR(r.x[j], mean[j], 1e-7);   // the solver's tolerances
+        }
+        for (int j = 0; j < 2; ++j)
+            for (int k = 0; k < 2; ++k) EXPECT_NEAR(r.covariance[j][k], Pj(j, k), 1e-9 * P(j, j)) << "scale " << scale;
+    }
+}
+
 // A model with a step (a motor unit's recruitment) where the estimate sits: Ceres's Jacobian, with
 // steps of 1e-6, sees a slope of ~1e9 there and its covariance is near singular; the smoothed
 // Jacobian's (step 1e-3) is not. The smooth coordinate keeps its closed-form variance: y = x1 + e with

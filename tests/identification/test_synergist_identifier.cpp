@@ -405,6 +405,83 @@ TEST(ElbowIdentification, CachedPredictionsEqualUncachedOnesBitForBit) {
     EXPECT_EQ(solvedBy(SynergistModel::getSizeIndex()), long(prior.base.muscles.size()) * poses * curves);
 }
 
+// The predictions' Jacobian through the steady states (implicit function theorem and the chain rule
+// through x's scales) against central differences of the predictions, over every parameter: both axes
+// of flexion, extension, supination and submaximal efforts in three postures, and every channel kind;
+// the slow-fraction shifts free (their columns are differenced inside, the rest analytic).
+TEST(ElbowIdentification, PredictionJacobianEqualsDifferencesOfPredictions) {
+    constexpr double kStep = 1e-6;   // central differences, on x (ln scales and activations)
+    constexpr double kTol = 2e-5;    // of the row's largest derivative: differences of 1e-13-bracketed solves
+    const Population& prior = population();
+    const ArmSetup& base = prior.base;
+    std::vector<TorqueCondition> conditions = {{30, Effort::Flexion, 1.0, 1}, {90, Effort::Flexion, 1.0, 1},
+                                               {90, Effort::Extension, 1.0, 1}, {90, Effort::Supination, 1.0, 1},
+                                               {120, Effort::Flexion, 0.5, 1}, {60, Effort::Pronation, 1.0, 1}};
+    conditions[3].rotationDeg = -60;
+    conditions[4].rotationDeg = 45;
+    SynergistOptions options;
+    options.freeSlowFraction = true;
+    const std::string head = base.muscles[base.primary].params.name;
+    for (double level : {0.0, 1.0}) {
+        ChannelObservation o;
+        o.channel = "fascicle_length";
+        o.muscle = head;
+        o.flexionDeg = 90;
+        o.level = level;
+        options.channels.push_back(o);
+    }
+    ChannelObservation emg, volume, arm;
+    emg.channel = "emg";
+    emg.muscle = base.muscles[base.surfaceEmg.back()].params.name;
+    emg.flexionDeg = 90;
+    emg.level = 1;
+    volume.channel = "volume";
+    volume.muscle = head;
+    arm.channel = "upper_arm_length";
+    for (const ChannelObservation& o : {emg, volume, arm}) options.channels.push_back(o);
+    for (ChannelObservation& o : options.channels) o.sd = 1;
+    const SynergistModel model(prior, options, conditions);
+    const int n = model.getNumParameters();
+    std::vector<double> x = model.getPriorMean();
+    for (int j = 0; j < n; ++j)   // away from the prior's mean, inside the bounds
+        if (model.getLower()[j] < model.getUpper()[j])
+            x[j] = std::clamp(x[j] + 0.03 * ((j * 7) % 5 - 2), model.getLower()[j] + 1e-3, model.getUpper()[j] - 1e-3);
+    std::vector<double> t, f, c, dt, df, dc;
+    SynergistModel::PredictionCache cache;
+    model.calcPredictionJacobian(x.data(), t, f, c, dt, df, dc, &cache);
+    std::vector<double> t0, f0, c0;
+    model.calcPredictions(x.data(), nullptr, t0, f0, c0);
+    ASSERT_EQ(t, t0);   // the same values as calcPredictions
+    ASSERT_EQ(f, f0);
+    ASSERT_EQ(c, c0);
+    const std::size_t nc = t.size(), nk = c.size();
+    std::vector<std::vector<double>> fd(2 * nc + nk, std::vector<double>(n));
+    for (int j = 0; j < n; ++j) {
+        std::vector<double> xp = x, xm = x, tp, fp, cp, tm, fm, cm;
+        xp[j] += kStep;
+        xm[j] -= kStep;
+        model.calcPredictions(xp.data(), nullptr, tp, fp, cp);
+        model.calcPredictions(xm.data(), nullptr, tm, fm, cm);
+        for (std::size_t k = 0; k < nc; ++k) {
+            fd[k][j] = (tp[k] - tm[k]) / (2 * kStep);
+            fd[nc + k][j] = (fp[k] - fm[k]) / (2 * kStep);
+        }
+        for (std::size_t k = 0; k < nk; ++k) fd[2 * nc + k][j] = (cp[k] - cm[k]) / (2 * kStep);
+    }
+    const std::vector<std::string> names = model.getParameterNames();
+    int nonzero = 0;
+    for (std::size_t r = 0; r < fd.size(); ++r) {
+        const double* row = r < nc ? &dt[r * n] : r < 2 * nc ? &df[(r - nc) * n] : &dc[(r - 2 * nc) * n];
+        double largest = 1e-9;
+        for (int j = 0; j < n; ++j) largest = std::max(largest, std::abs(fd[r][j]));
+        for (int j = 0; j < n; ++j) {
+            EXPECT_NEAR(row[j], fd[r][j], kTol * largest) << "row " << r << ", d / d " << names[j];
+            nonzero += row[j] != 0;
+        }
+    }
+    EXPECT_GT(nonzero, int(fd.size()) * 3);   // not an empty matrix
+}
+
 // The forearm axis identifies: torque data of both axes made by the identifier's own model at a known x
 // (biceps long head 20 % heavier, supinator 15 % stronger than the prior's mean; no noise, 2 % assumed)
 // are fitted within their noise, with the mass inside its interval and the supinator's scale moved from

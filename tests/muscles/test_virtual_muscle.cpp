@@ -226,3 +226,47 @@ TEST(VirtualMuscle, AnalyticJacobianEqualsDifferenceQuotients) {
     EXPECT_EQ(checkedStates, 12);
     EXPECT_GT(nonzero, 12 * 3 * n);   // not an empty matrix: every unit couples to L, V and its own states
 }
+
+// The steady state's sensitivity (implicit function theorem) against central differences of steady
+// states solved afresh (bracket 1e-13) with each input moved: the path, U, and muscles rebuilt with
+// L0, L0T and P_max scaled; over the ascending and descending limbs and three drives.
+TEST(VirtualMuscle, SteadySensitivityEqualsDifferencesOfSolvedStates) {
+    using S = SteadySensitivity;
+    constexpr double kStep = 1e-5;   // on ln inputs and on U
+    constexpr double kTol = 2e-6;    // absolute, on derivatives of order 0.1-10: truncation ~kStep^2
+    const MuscleParameters base = bicepsLongHead();
+    const VirtualMuscle m(base);
+    int checked = 0;
+    double largest = 0;
+    for (double fraction : {0.8, 0.88, 0.96})
+        for (double U : {0.3, 0.7, 0.98}) {
+            const double P = fraction * m.getMaxPathLength();
+            const SteadyState st = m.calcSteadyState(P, U);
+            ASSERT_TRUE(st.converged) << st.message;
+            const S s = m.calcSteadySensitivity(P, U, st.L);
+            ASSERT_TRUE(s.valid);
+            for (int k = 0; k < S::kNumInputs; ++k) {
+                auto solve = [&](double by) {
+                    MuscleParameters q = base;
+                    double path = P, u = U;
+                    if (k == S::kLnPath) path *= std::exp(by);
+                    if (k == S::kLnFascicle) q.optimalFascicleLength *= std::exp(by);
+                    if (k == S::kLnTendon) q.optimalTendonLength *= std::exp(by);
+                    if (k == S::kLnMaxPath) q.maxPathLength *= std::exp(by);
+                    if (k == S::kInput) u += by;
+                    const SteadyState r = VirtualMuscle(q).calcSteadyState(path, u);
+                    EXPECT_TRUE(r.converged) << r.message;
+                    return r;
+                };
+                const SteadyState hi = solve(kStep), lo = solve(-kStep);
+                const double dFn = (hi.normalizedForce - lo.normalizedForce) / (2 * kStep);
+                const double dL = (hi.L - lo.L) / (2 * kStep);
+                EXPECT_NEAR(s.dFn[k], dFn, kTol) << "d Fn / d input " << k << " at P " << P << ", U " << U;
+                EXPECT_NEAR(s.dL[k], dL, kTol) << "d L / d input " << k << " at P " << P << ", U " << U;
+                largest = std::max(largest, std::abs(dFn));
+                ++checked;
+            }
+        }
+    EXPECT_EQ(checked, 9 * S::kNumInputs);
+    EXPECT_GT(largest, 0.5);   // not all zero
+}
