@@ -155,7 +155,15 @@ SynergistModel::SynergistModel(const Population& prior, const SynergistOptions& 
         channelAngle_.push_back(angle);
         channelKind_.push_back(kind);
     }
-    // The geometry of every pose, one calcMvcGeometry per posture, rows in pose order.
+    setGeometry(poses);
+    setPrior(prior, options, conditions);
+    prepareConsidered();
+}
+
+// The geometry of every pose, one calcMvcGeometry per posture, rows in pose order, and each effort
+// kind's agonists in it.
+void SynergistModel::setGeometry(const std::vector<std::pair<double, double>>& poses) {
+    const ArmSetup& base = *base_;
     std::map<double, std::vector<int>> byRotation;
     for (std::size_t k = 0; k < poses.size(); ++k) byRotation[poses[k].second].push_back(int(k));
     geometry_.flexionDeg.assign(poses.size(), 0);
@@ -177,6 +185,11 @@ SynergistModel::SynergistModel(const Population& prior, const SynergistOptions& 
     // scale moves a moment arm across kForearmAgonistMomentArm (the residuals stay smooth in x).
     for (const EffortKind& k : kinds_) agonists_.push_back(findAgonists(base.muscles, geometry_, k.effort));
 
+}
+
+// The prior's mean and covariance of x and its bounds (SynergistModel's class comment).
+void SynergistModel::setPrior(const Population& prior, const SynergistOptions& options,
+                              const std::vector<TorqueCondition>& conditions) {
     const int n = getNumParameters();
     const double s2 = prior.strengthSubjectSd * prior.strengthSubjectSd;
     const double m2 = prior.strengthMuscleSd * prior.strengthMuscleSd;
@@ -237,7 +250,6 @@ SynergistModel::SynergistModel(const Population& prior, const SynergistOptions& 
     if (options.readsForearmTorque ||
         std::any_of(conditions.begin(), conditions.end(), [](const TorqueCondition& c) { return isForearmEffort(c.effort); }))
         freeRotatorMass();
-    prepareConsidered();
 }
 
 std::vector<std::string> SynergistModel::getParameterNames() const {
@@ -825,21 +837,71 @@ std::vector<double> SynergistModel::getSecantSteps() const {
     return steps;
 }
 
-MuscleEstimate identifySynergistAware(const Population& prior, const std::vector<TorqueObservation>& data,
-                                      const SynergistOptions& options) {
-    if (data.empty()) throw InputError("synergist-aware identifier: no observations");
-    const bool measured = std::isfinite(options.measuredActivation);
-    if (measured) {
-        checkField("measured voluntary activation", options.measuredActivation, Bound{0, 1, true, false, "fraction of full drive"});
-        checkField("activation sd", options.activationSd, Bound::positive());
+// One synergist-aware fit, in named steps: the data's rows and their sds, the residuals and their
+// Jacobian, the MAP estimate, each channel's judgement and the intervals.
+class SynergistFit {
+public:
+    using P = SynergistModel;
+    SynergistFit(const Population& prior, const std::vector<TorqueObservation>& data, const SynergistOptions& options)
+        : prior_(prior), data_(data), options_(options), channels_(options.channels),
+          measured_(std::isfinite(options.measuredActivation)), model_(prior, checkInputs(), conditions_) {
+        n_ = model_.getNumParameters();
+        for (const ChannelObservation& o : channels_)
+            if (!(o.sd > 0) || !std::isfinite(o.value))
+                throw InputError("synergist-aware identifier: " + o.channel + " measurement" +
+                                 (o.line > 0 ? " on line " + std::to_string(o.line) : std::string()) +
+                                 " has value " + formatNumber(o.value) + " and sd " + formatNumber(o.sd) +
+                                 ": expected a finite value and sd > 0");
     }
-    // One condition per observation: the model computes each distinct angle and effort kind once.
-    std::vector<TorqueCondition> conditions;
+    MuscleEstimate run();
+
+private:
+    struct Row {   // a transducer reading: observation and axis
+        std::size_t observation;
+        bool forearm;
+    };
+    const Population& prior_;
+    const std::vector<TorqueObservation>& data_;
+    const SynergistOptions& options_;
+    const std::vector<ChannelObservation>& channels_;
+    const bool measured_;
+    std::vector<TorqueCondition> conditions_;
+    SynergistOptions modelOptions_;
+    std::vector<Row> rows_;
+    std::size_t nFlexion_ = 0;
+    const SynergistModel model_;
+    int n_ = 0;
+    std::vector<double> torque_, sd_;   // per row
+    P::PredictionCache cache_;          // the fit, its covariance and the consider Jacobian run on this thread
+    struct {
+        std::vector<double> x, r, J;
+    } last_;                            // the last Jacobian (Ceres asks twice at an accepted point)
+
+    const SynergistOptions& checkInputs();
+    void setNoise(MuscleEstimate& est);
+    int getNumResiduals() const { return int(rows_.size() + channels_.size()) + (measured_ ? 1 : 0); }
+    std::vector<double> calcResiduals(const double* x, double* r, const std::vector<P::MuscleDeviation>* deviations = nullptr);
+    bool calcResidualJacobian(const double* x, double* r, double* J);
+    MapProblem makeProblem();
+    void setParameters(MuscleEstimate& est, const std::vector<double>& x) const;
+    void judgeChannels(MuscleEstimate& est, const std::vector<double>& r) const;
+    bool calcConsiderJacobian(const std::vector<double>& x, std::vector<std::vector<double>>& J);
+    void setIntervals(MuscleEstimate& est, const MapResult& m);
+};
+
+// Checks the options, builds one condition per observation (the model computes each distinct angle and
+// effort kind once) and the transducer's rows; returns the model's options.
+const SynergistOptions& SynergistFit::checkInputs() {
+    if (data_.empty()) throw InputError("synergist-aware identifier: no observations");
+    if (measured_) {
+        checkField("measured voluntary activation", options_.measuredActivation, Bound{0, 1, true, false, "fraction of full drive"});
+        checkField("activation sd", options_.activationSd, Bound::positive());
+    }
     bool readsForearm = false;
-    for (const TorqueObservation& o : data) {
+    for (const TorqueObservation& o : data_) {
         TorqueCondition c{o.flexionDeg, o.effort, o.level, 1};
         c.rotationDeg = o.rotationDeg;
-        conditions.push_back(c);
+        conditions_.push_back(c);
         readsForearm = readsForearm || std::isfinite(o.forearmTorque);
         if (isForearmEffort(o.effort) && !std::isfinite(o.forearmTorque))
             throw InputError(std::string("synergist-aware identifier: a ") + getEffortName(o.effort) + " effort at " +
@@ -849,70 +911,91 @@ MuscleEstimate identifySynergistAware(const Population& prior, const std::vector
     // axis wherever it was read. A rotation effort's flexion axis is left out: it is the flexors'
     // co-contraction, whose motor-unit recruitment steps (a unit starts at its minimum firing rate)
     // make the steady prediction jump at the low activations that carry it.
-    struct Row {
-        std::size_t observation;
-        bool forearm;
-    };
-    std::vector<Row> rows;
-    for (std::size_t k = 0; k < data.size(); ++k)
-        if (!isForearmEffort(data[k].effort)) rows.push_back({k, false});
-    const std::size_t nFlexion = rows.size();
-    for (std::size_t k = 0; k < data.size(); ++k)
-        if (std::isfinite(data[k].forearmTorque)) rows.push_back({k, true});
-    SynergistOptions modelOptions = options;
-    modelOptions.readsForearmTorque = options.readsForearmTorque || readsForearm;
-    const SynergistModel model(prior, modelOptions, conditions);
-    const std::vector<ChannelObservation>& channels = options.channels;
-    for (const ChannelObservation& o : channels)
-        if (!(o.sd > 0) || !std::isfinite(o.value))
-            throw InputError("synergist-aware identifier: " + o.channel + " measurement" +
-                             (o.line > 0 ? " on line " + std::to_string(o.line) : std::string()) +
-                             " has value " + formatNumber(o.value) + " and sd " + formatNumber(o.sd) +
-                             ": expected a finite value and sd > 0");
+    for (std::size_t k = 0; k < data_.size(); ++k)
+        if (!isForearmEffort(data_[k].effort)) rows_.push_back({k, false});
+    nFlexion_ = rows_.size();
+    for (std::size_t k = 0; k < data_.size(); ++k)
+        if (std::isfinite(data_[k].forearmTorque)) rows_.push_back({k, true});
+    modelOptions_ = options_;
+    modelOptions_.readsForearmTorque = options_.readsForearmTorque || readsForearm;
+    return modelOptions_;
+}
 
-    MuscleEstimate est;
-    est.method = !channels.empty() ? "channels" : measured ? "synergist-va" : "synergist";
-    est.predictedTorque.assign(data.size(), NAN);   // whole even when the fit fails
-    std::tie(est.noiseLevel, est.noiseDegreesOfFreedom) = estimateNoiseLevel(data);
-    if (std::isfinite(options.noiseLevel)) {
-        checkField("noise level", options.noiseLevel, Bound{0, 0.5, true, true, "relative sd"});
-        est.noiseLevel = options.noiseLevel;
+// The relative noise level (given, estimated from the repetitions or the population's transducer
+// noise) and each row's sd: the level times the transducer's load (1 N m at least).
+void SynergistFit::setNoise(MuscleEstimate& est) {
+    std::tie(est.noiseLevel, est.noiseDegreesOfFreedom) = estimateNoiseLevel(data_);
+    if (std::isfinite(options_.noiseLevel)) {
+        checkField("noise level", options_.noiseLevel, Bound{0, 0.5, true, true, "relative sd"});
+        est.noiseLevel = options_.noiseLevel;
         est.noiseDegreesOfFreedom = 0;
     } else if (!std::isfinite(est.noiseLevel)) {
-        est.noiseLevel = prior.transducerNoise;
+        est.noiseLevel = prior_.transducerNoise;
         est.noiseDegreesOfFreedom = 0;
     }
     est.noiseLevel = std::max(est.noiseLevel, 0.002);  // floor: the scatter of few repetitions can be ~0
-    // Each axis's sd: the noise level times the transducer's load (1 N m at least; TorqueObservation::getLoad).
-    std::vector<double> torque, sd;
-    for (const Row& row : rows) {
-        const TorqueObservation& o = data[row.observation];
-        torque.push_back(row.forearm ? o.forearmTorque : o.torque);
-        sd.push_back(est.noiseLevel * std::max(o.getLoad(), 1.0));
+    for (const Row& row : rows_) {
+        const TorqueObservation& o = data_[row.observation];
+        torque_.push_back(row.forearm ? o.forearmTorque : o.torque);
+        sd_.push_back(est.noiseLevel * std::max(o.getLoad(), 1.0));
     }
+}
 
-    using P = SynergistModel;
-    const std::size_t nt = rows.size(), nc = channels.size();
+// Residuals: torques, then channels, then the measured activation; returns the flexion-axis torques.
+std::vector<double> SynergistFit::calcResiduals(const double* x, double* r, const std::vector<P::MuscleDeviation>* deviations) {
+    const std::size_t nt = rows_.size(), nc = channels_.size();
+    std::vector<double> t, f, c;
+    model_.calcPredictions(x, deviations, t, f, c, &cache_);
+    for (std::size_t k = 0; k < nt; ++k) r[k] = ((rows_[k].forearm ? f : t)[rows_[k].observation] - torque_[k]) / sd_[k];
+    for (std::size_t k = 0; k < nc; ++k) r[nt + k] = (c[k] - channels_[k].value) / channels_[k].sd;
+    if (measured_) r[nt + nc] = (x[P::kActivation] - options_.measuredActivation) / options_.activationSd;
+    return t;
+}
+
+// The same residuals with their Jacobian through the steady states (calcPredictionJacobian).
+bool SynergistFit::calcResidualJacobian(const double* x, double* r, double* J) {
+    const std::size_t R = std::size_t(getNumResiduals()), nt = rows_.size(), nc = channels_.size(), n = std::size_t(n_);
+    if (last_.x.size() == n && std::equal(last_.x.begin(), last_.x.end(), x)) {
+        std::copy(last_.r.begin(), last_.r.end(), r);
+        std::copy(last_.J.begin(), last_.J.end(), J);
+        return true;
+    }
+    last_.x.clear();
+    std::vector<double> t, f, c, dt, df, dc;
+    try {
+        model_.calcPredictionJacobian(x, t, f, c, dt, df, dc, &cache_);
+    } catch (const std::exception&) {
+        return false;
+    }
+    std::fill(J, J + R * n, 0.0);
+    for (std::size_t k = 0; k < nt; ++k) {
+        const Row& row = rows_[k];
+        r[k] = ((row.forearm ? f : t)[row.observation] - torque_[k]) / sd_[k];
+        const double* d = &(row.forearm ? df : dt)[row.observation * n];
+        for (std::size_t j = 0; j < n; ++j) J[k * n + j] = d[j] / sd_[k];
+    }
+    for (std::size_t k = 0; k < nc; ++k) {
+        r[nt + k] = (c[k] - channels_[k].value) / channels_[k].sd;
+        for (std::size_t j = 0; j < n; ++j) J[(nt + k) * n + j] = dc[k * n + j] / channels_[k].sd;
+    }
+    if (measured_) {
+        r[nt + nc] = (x[P::kActivation] - options_.measuredActivation) / options_.activationSd;
+        J[(nt + nc) * n + P::kActivation] = 1 / options_.activationSd;
+    }
+    last_.x.assign(x, x + n);
+    last_.r.assign(r, r + R);
+    last_.J.assign(J, J + R * n);
+    return true;
+}
+
+MapProblem SynergistFit::makeProblem() {
     MapProblem map;
-    map.priorMean = model.getPriorMean();
-    map.priorCovariance = model.getPriorCovariance();
-    map.lower = model.getLower();
-    map.upper = model.getUpper();
-    map.numResiduals = int(nt + nc) + (measured ? 1 : 0);
-    // Residuals: torques, then channels, then the measured activation.
-    P::PredictionCache cache;   // the fit, its covariance and the consider Jacobian run on this thread
-    auto calcResiduals = [&](const double* x, double* r, const std::vector<P::MuscleDeviation>* deviations = nullptr) {
-        std::vector<double> t, f, c;
-        model.calcPredictions(x, deviations, t, f, c, &cache);
-        for (std::size_t k = 0; k < nt; ++k) {
-            const Row& row = rows[k];
-            r[k] = ((row.forearm ? f : t)[row.observation] - torque[k]) / sd[k];
-        }
-        for (std::size_t k = 0; k < nc; ++k) r[nt + k] = (c[k] - channels[k].value) / channels[k].sd;
-        if (measured) r[nt + nc] = (x[P::kActivation] - options.measuredActivation) / options.activationSd;
-        return t;
-    };
-    map.residuals = [&](const double* x, double* r) {
+    map.priorMean = model_.getPriorMean();
+    map.priorCovariance = model_.getPriorCovariance();
+    map.lower = model_.getLower();
+    map.upper = model_.getUpper();
+    map.numResiduals = getNumResiduals();
+    map.residuals = [this](const double* x, double* r) {
         try {
             calcResiduals(x, r);
         } catch (const std::exception&) {
@@ -920,102 +1003,47 @@ MuscleEstimate identifySynergistAware(const Population& prior, const std::vector
         }
         return true;
     };
-    // The same residuals with their Jacobian through the steady states (calcPredictionJacobian).
-    // Ceres asks twice at an accepted point: the last answer is kept.
-    const int n = model.getNumParameters();
-    struct {
-        std::vector<double> x, r, J;
-    } last;
-    map.jacobian = [&](const double* x, double* r, double* J) {
-        const std::size_t R = std::size_t(map.numResiduals);
-        if (last.x.size() == std::size_t(n) && std::equal(last.x.begin(), last.x.end(), x)) {
-            std::copy(last.r.begin(), last.r.end(), r);
-            std::copy(last.J.begin(), last.J.end(), J);
-            return true;
-        }
-        last.x.clear();
-        std::vector<double> t, f, c, dt, df, dc;
-        try {
-            model.calcPredictionJacobian(x, t, f, c, dt, df, dc, &cache);
-        } catch (const std::exception&) {
-            return false;
-        }
-        std::fill(J, J + R * n, 0.0);
-        for (std::size_t k = 0; k < nt; ++k) {
-            const Row& row = rows[k];
-            r[k] = ((row.forearm ? f : t)[row.observation] - torque[k]) / sd[k];
-            const double* d = &(row.forearm ? df : dt)[row.observation * n];
-            for (int j = 0; j < n; ++j) J[k * n + j] = d[j] / sd[k];
-        }
-        for (std::size_t k = 0; k < nc; ++k) {
-            r[nt + k] = (c[k] - channels[k].value) / channels[k].sd;
-            for (int j = 0; j < n; ++j) J[(nt + k) * n + j] = dc[k * n + j] / channels[k].sd;
-        }
-        if (measured) {
-            r[nt + nc] = (x[P::kActivation] - options.measuredActivation) / options.activationSd;
-            J[(nt + nc) * n + P::kActivation] = 1 / options.activationSd;
-        }
-        last.x.assign(x, x + n);
-        last.r.assign(r, r + R);
-        last.J.assign(J, J + R * n);
-        return true;
-    };
-    const MapResult m = calcMapEstimate(map);
-    const std::vector<double>& x = m.x;
-    est.converged = m.converged;
-    est.message = m.message;
-    est.iterations = m.iterations;
-    if (m.failed) {  // no estimate: mass and tendon length stay NaN
-        est.converged = false;
-        return est;
-    }
+    map.jacobian = [this](const double* x, double* r, double* J) { return calcResidualJacobian(x, r, J); };
+    return map;
+}
 
-    const ArmSetup& base = prior.base;
+// Mass, tendon length, F0, specific tension and the nuisance parameters at the estimate x.
+void SynergistFit::setParameters(MuscleEstimate& est, const std::vector<double>& x) const {
+    const ArmSetup& base = prior_.base;
     const MuscleParameters& b = base.muscles[base.primary].params;
-    const int im = model.getMassIndex();
-    est.numParameters = model.getNumParameters();
-    est.mass = b.mass * std::exp(x[im]);
+    est.numParameters = n_;
+    est.mass = b.mass * std::exp(x[model_.getMassIndex()]);
     est.tendonLength = b.optimalTendonLength * std::exp(x[P::kTendon] + x[P::kSize]);
     est.nuisanceNames = {"voluntary_activation", "co_contraction", "biceps_fascicle_scale", "synergist_tendon_scale",
                          "synergist_fascicle_scale", "extensor_mass_scale"};
     est.nuisance = {x[P::kActivation], x[P::kCoContraction], std::exp(x[P::kFascicle]),
                     std::exp(x[P::kSynergistTendon]), std::exp(x[P::kSynergistFascicle]), std::exp(x[P::kExtensorMass])};
-    if (options.freeSlowFraction) {
+    if (options_.freeSlowFraction) {
         est.nuisanceNames.insert(est.nuisanceNames.end(), {"biceps_slow_fraction_shift", "synergist_slow_fraction_shift"});
         est.nuisance.insert(est.nuisance.end(), {x[P::kBicepsSlow], x[P::kSynergistSlow]});
     }
-    if (prior.specificTensionSd > 0) {
+    if (prior_.specificTensionSd > 0) {
         est.nuisanceNames.push_back("specific_tension_scale");
         est.nuisance.push_back(std::exp(x[P::kSigma]));
     }
-    if (prior.geometryScaleSd > 0) {
+    if (prior_.geometryScaleSd > 0) {
         est.nuisanceNames.push_back("size_scale");
         est.nuisance.push_back(std::exp(x[P::kSize]));
     }
     for (int i = 0; i < base.getNumMuscles(); ++i) {
-        const int k = model.findMassIndex(i);
-        if (k < 0 || i == base.primary || model.getLower()[k] == model.getUpper()[k]) continue;  // held: a rotator
+        const int k = model_.findMassIndex(i);
+        if (k < 0 || i == base.primary || model_.getLower()[k] == model_.getUpper()[k]) continue;  // held: a rotator
         est.nuisanceNames.push_back(base.muscles[i].params.name + "_mass_scale");
         est.nuisance.push_back(std::exp(x[k]));
     }
-    const MuscleParameters q = model.makeMuscles(x.data())[base.primary].params;
+    const MuscleParameters q = model_.makeMuscles(x.data())[base.primary].params;
     est.specificTension = q.coefficients.sigma;
     est.maxForce = q.coefficients.sigma * q.mass / (q.coefficients.density * q.optimalFascicleLength);
-    std::vector<double> r(map.numResiduals);
-    try {
-        const std::vector<double> t = calcResiduals(x.data(), r.data());
-        double ss = 0;
-        for (std::size_t k = 0; k < nFlexion; ++k) ss += std::pow(t[rows[k].observation] - torque[k], 2);
-        est.predictedTorque = t;  // the flexion axis; NaN where it is not fitted (rotation efforts)
-        for (std::size_t k = 0; k < data.size(); ++k)
-            if (isForearmEffort(data[k].effort)) est.predictedTorque[k] = NAN;
-        est.rmsResidual = std::sqrt(ss / double(std::max<std::size_t>(nFlexion, 1)));
-    } catch (const std::exception& e) {
-        est.converged = false;
-        est.message += "; no steady state at the estimate: " + std::string(e.what());
-        return est;
-    }
-    // Per channel: chi-square of its residuals and the worst measurement.
+}
+
+// Per channel: chi-square of its residuals r and the worst measurement.
+void SynergistFit::judgeChannels(MuscleEstimate& est, const std::vector<double>& r) const {
+    const std::size_t nt = rows_.size(), nc = channels_.size();
     auto addFit = [&](const std::string& channel, std::size_t k, const std::string& what) {
         auto it = std::find_if(est.channelFits.begin(), est.channelFits.end(),
                                [&](const ChannelFit& f) { return f.channel == channel; });
@@ -1041,109 +1069,152 @@ MuscleEstimate identifySynergistAware(const Population& prior, const std::vector
         return std::isnan(o.rotationDeg) ? std::string() : ", forearm at " + formatNumber(o.rotationDeg) + " deg";
     };
     for (std::size_t k = 0; k < nt; ++k) {
-        const TorqueObservation& o = data[rows[k].observation];
-        addFit(rows[k].forearm ? "forearm_torque" : "torque", k, describe(o.flexionDeg, o.effort, o.level) + posture(o));
+        const TorqueObservation& o = data_[rows_[k].observation];
+        addFit(rows_[k].forearm ? "forearm_torque" : "torque", k, describe(o.flexionDeg, o.effort, o.level) + posture(o));
     }
     for (std::size_t k = 0; k < nc; ++k) {
-        const ChannelObservation& o = channels[k];
+        const ChannelObservation& o = channels_[k];
         addFit(o.channel, nt + k,
                o.muscle + (std::isfinite(o.flexionDeg) ? ", " + describe(o.flexionDeg, o.effort, o.level) : std::string()));
     }
-    if (measured) addFit("activation", nt + nc, "twitch interpolation");
+    if (measured_) addFit("activation", nt + nc, "twitch interpolation");
     for (ChannelFit& f : est.channelFits) f.p = calcChiSquareSurvival(f.chiSquare, f.n);
-    if (!m.covariance.empty()) {
-        const int n = int(m.covariance.size()), R = map.numResiduals;
-        const int it = P::kTendon, ig = P::kSize;
-        // Reported quantities as linear combinations of x: ln M; ln L0T = ln t_b + ln g; ln F0.
-        std::vector<double> gm(n, 0.0), gt(n, 0.0), gf = model.getLnMaxForceWeights();
-        gm[im] = 1;
-        gt[it] += 1, gt[ig] += 1;
-        auto quadratic = [&](const std::vector<double>& a, const std::vector<std::vector<double>>& M,
-                             const std::vector<double>& b) {
-            double v = 0;
-            for (int i = 0; i < n; ++i)
-                for (int j = 0; j < n; ++j) v += a[i] * M[i][j] * b[j];
-            return v;
-        };
-        // The whitened data residuals' Jacobian at the estimate over every parameter (free and held) and
-        // every consider parameter: for the free parameters the tangent (map.jacobian); for the held and
-        // considered ones a central secant over +/- half their prior sd, the spread the truth has (muscle
-        // forces step with motor-unit recruitment: a tangent there can be any size).
-        const std::vector<P::ConsiderParameter> considered = model.getConsiderParameters();
-        const int nk = int(considered.size());
-        std::vector<std::vector<double>> J(R, std::vector<double>(n + nk, 0.0));
-        std::vector<double> steps = model.getSecantSteps();
-        std::vector<double> r0(R), J0(std::size_t(R) * n);
-        bool haveJacobian = map.jacobian(x.data(), r0.data(), J0.data());
-        for (int j = 0; j < n; ++j)
-            if (!(map.lower[j] >= map.upper[j]))
-                for (int k = 0; k < R; ++k) J[k][j] = J0[std::size_t(k) * n + j];
-        if (haveJacobian) {
-            std::vector<double> xp = x, rp(R), rm(R);
-            std::vector<P::MuscleDeviation> deviations(base.muscles.size());
-            auto shift = [&](int j, double by) {
-                if (j < n) return void(xp[j] = x[j] + by);
-                P::setDeviation(deviations, considered[j - n], by);
-            };
-            try {
-                for (int j = 0; j < n + nk; ++j) {
-                    if (!(steps[j] > 0)) continue;  // the prior does not vary it
-                    shift(j, steps[j]);
-                    calcResiduals(xp.data(), rp.data(), &deviations);
-                    shift(j, -steps[j]);
-                    calcResiduals(xp.data(), rm.data(), &deviations);
-                    shift(j, 0);
-                    for (int k = 0; k < R; ++k) J[k][j] = (rp[k] - rm[k]) / (2 * steps[j]);
-                }
-            } catch (const std::exception&) {
-                haveJacobian = false;  // keep the Laplace covariance and the conservative quantile of nu
-            }
+}
+
+// The whitened data residuals' Jacobian at the estimate over every parameter (free and held) and every
+// consider parameter: for the free parameters the tangent (calcResidualJacobian); for the held and
+// considered ones a central secant over +/- half their prior sd, the spread the truth has (muscle forces
+// step with motor-unit recruitment: a tangent there can be any size). false where a probe has no steady state.
+bool SynergistFit::calcConsiderJacobian(const std::vector<double>& x, std::vector<std::vector<double>>& J) {
+    const std::vector<P::ConsiderParameter> considered = model_.getConsiderParameters();
+    const int n = n_, nk = int(considered.size()), R = getNumResiduals();
+    J.assign(R, std::vector<double>(n + nk, 0.0));
+    const std::vector<double> steps = model_.getSecantSteps();
+    std::vector<double> r0(R), J0(std::size_t(R) * n);
+    if (!calcResidualJacobian(x.data(), r0.data(), J0.data())) return false;
+    for (int j = 0; j < n; ++j)
+        if (model_.getLower()[j] < model_.getUpper()[j])
+            for (int k = 0; k < R; ++k) J[k][j] = J0[std::size_t(k) * n + j];
+    std::vector<double> xp = x, rp(R), rm(R);
+    std::vector<P::MuscleDeviation> deviations(prior_.base.muscles.size());
+    auto shift = [&](int j, double by) {
+        if (j < n) return void(xp[j] = x[j] + by);
+        P::setDeviation(deviations, considered[j - n], by);
+    };
+    try {
+        for (int j = 0; j < n + nk; ++j) {
+            if (!(steps[j] > 0)) continue;  // free (a tangent), or the prior does not vary it
+            shift(j, steps[j]);
+            calcResiduals(xp.data(), rp.data(), &deviations);
+            shift(j, -steps[j]);
+            calcResiduals(xp.data(), rm.data(), &deviations);
+            shift(j, 0);
+            for (int k = 0; k < R; ++k) J[k][j] = (rp[k] - rm[k]) / (2 * steps[j]);
         }
-        // C0: the Laplace covariance; C: the estimate's error covariance with the consider parameters.
-        std::vector<std::vector<double>> C0 = m.covariance, C = m.covariance;
-        if (haveJacobian) {
-            model.calcConsideredCovariance(J, C0, C);
-            const ChannelFit check = model.calcPriorCheck(J, x);
-            if (check.n > 0) est.channelFits.push_back(check);
-        }
-        // Degrees of freedom of each interval. The torque rows' sd is the noise level estimated with nu
-        // dof; a quantity whose error variance owes the fraction f = g'C0 Ht C0 g / g'C g to the torque
-        // rows (Ht = Jt'Jt, their whitened Jacobian) has that variance estimated with about nu / f^2 dof
-        // (Satterthwaite); the channels' and the prior's sds are known. Torque alone: f near 1, the
-        // Student-t of nu; a volume measured: f small, near the normal quantile.
-        std::vector<double> fraction(3, 1.0);
-        const int nu = est.noiseDegreesOfFreedom;
-        if (nu > 0 && haveJacobian) {
-            std::vector<std::vector<double>> ht(n, std::vector<double>(n, 0.0));
-            for (std::size_t k = 0; k < nt; ++k)
-                for (int a = 0; a < n; ++a)
-                    if (J[k][a] != 0)
-                        for (int b = 0; b < n; ++b) ht[a][b] += J[k][a] * J[k][b];
-            int q = 0;
-            for (const std::vector<double>* g : {&gm, &gt, &gf}) {
-                std::vector<double> cg(n, 0.0);  // C0 g
-                for (int a = 0; a < n; ++a)
-                    for (int b = 0; b < n; ++b) cg[a] += C0[a][b] * (*g)[b];
-                const double v = quadratic(*g, C, *g);
-                fraction[q++] = v > 0 ? std::clamp(quadratic(cg, ht, cg) / v, 0.0, 1.0) : 1.0;
-            }
-        }
-        auto quantileOf = [&](double f) {
-            if (nu <= 0 || f <= 0) return calcNormalQuantile(0.975);
-            return calcStudentTQuantile(0.975, std::min(double(nu) / (f * f), 1e6));
-        };
-        const double sm = std::sqrt(std::max(quadratic(gm, C, gm), 0.0)), st = std::sqrt(std::max(quadratic(gt, C, gt), 0.0)),
-                     sf = std::sqrt(std::max(quadratic(gf, C, gf), 0.0));
-        const double qm = quantileOf(fraction[0]), qt = quantileOf(fraction[1]), qf = quantileOf(fraction[2]);
-        est.massLower = est.mass * std::exp(-qm * sm);
-        est.massUpper = est.mass * std::exp(qm * sm);
-        est.tendonLower = est.tendonLength * std::exp(-qt * st);
-        est.tendonUpper = est.tendonLength * std::exp(qt * st);
-        est.maxForceLower = est.maxForce * std::exp(-qf * sf);
-        est.maxForceUpper = est.maxForce * std::exp(qf * sf);
-        est.massTendonCorrelation = quadratic(gm, C, gt) / (sm * st);
+    } catch (const std::exception&) {
+        return false;
     }
+    return true;
+}
+
+// The 95 % intervals of M, L0T and F0 from the estimate's error covariance with the consider parameters
+// (the Laplace covariance where the consider Jacobian has no value), and the prior's check.
+void SynergistFit::setIntervals(MuscleEstimate& est, const MapResult& m) {
+    const std::vector<double>& x = m.x;
+    const int n = n_;
+    // Reported quantities as linear combinations of x: ln M; ln L0T = ln t_b + ln g; ln F0.
+    std::vector<double> gm(n, 0.0), gt(n, 0.0), gf = model_.getLnMaxForceWeights();
+    gm[model_.getMassIndex()] = 1;
+    gt[P::kTendon] += 1, gt[P::kSize] += 1;
+    auto quadratic = [&](const std::vector<double>& a, const std::vector<std::vector<double>>& M, const std::vector<double>& b) {
+        double v = 0;
+        for (int i = 0; i < n; ++i)
+            for (int j = 0; j < n; ++j) v += a[i] * M[i][j] * b[j];
+        return v;
+    };
+    std::vector<std::vector<double>> J;
+    const bool haveJacobian = calcConsiderJacobian(x, J);   // else the Laplace covariance and the conservative quantile
+    // C0: the Laplace covariance; C: the estimate's error covariance with the consider parameters.
+    std::vector<std::vector<double>> C0 = m.covariance, C = m.covariance;
+    if (haveJacobian) {
+        model_.calcConsideredCovariance(J, C0, C);
+        const ChannelFit check = model_.calcPriorCheck(J, x);
+        if (check.n > 0) est.channelFits.push_back(check);
+    }
+    // Degrees of freedom of each interval. The torque rows' sd is the noise level estimated with nu
+    // dof; a quantity whose error variance owes the fraction f = g'C0 Ht C0 g / g'C g to the torque
+    // rows (Ht = Jt'Jt, their whitened Jacobian) has that variance estimated with about nu / f^2 dof
+    // (Satterthwaite); the channels' and the prior's sds are known. Torque alone: f near 1, the
+    // Student-t of nu; a volume measured: f small, near the normal quantile.
+    std::vector<double> fraction(3, 1.0);
+    const int nu = est.noiseDegreesOfFreedom;
+    if (nu > 0 && haveJacobian) {
+        std::vector<std::vector<double>> ht(n, std::vector<double>(n, 0.0));
+        for (std::size_t k = 0; k < rows_.size(); ++k)
+            for (int a = 0; a < n; ++a)
+                if (J[k][a] != 0)
+                    for (int b = 0; b < n; ++b) ht[a][b] += J[k][a] * J[k][b];
+        int q = 0;
+        for (const std::vector<double>* g : {&gm, &gt, &gf}) {
+            std::vector<double> cg(n, 0.0);  // C0 g
+            for (int a = 0; a < n; ++a)
+                for (int b = 0; b < n; ++b) cg[a] += C0[a][b] * (*g)[b];
+            const double v = quadratic(*g, C, *g);
+            fraction[q++] = v > 0 ? std::clamp(quadratic(cg, ht, cg) / v, 0.0, 1.0) : 1.0;
+        }
+    }
+    auto quantileOf = [&](double f) {
+        if (nu <= 0 || f <= 0) return calcNormalQuantile(0.975);
+        return calcStudentTQuantile(0.975, std::min(double(nu) / (f * f), 1e6));
+    };
+    const double sm = std::sqrt(std::max(quadratic(gm, C, gm), 0.0)), st = std::sqrt(std::max(quadratic(gt, C, gt), 0.0)),
+                 sf = std::sqrt(std::max(quadratic(gf, C, gf), 0.0));
+    const double qm = quantileOf(fraction[0]), qt = quantileOf(fraction[1]), qf = quantileOf(fraction[2]);
+    est.massLower = est.mass * std::exp(-qm * sm);
+    est.massUpper = est.mass * std::exp(qm * sm);
+    est.tendonLower = est.tendonLength * std::exp(-qt * st);
+    est.tendonUpper = est.tendonLength * std::exp(qt * st);
+    est.maxForceLower = est.maxForce * std::exp(-qf * sf);
+    est.maxForceUpper = est.maxForce * std::exp(qf * sf);
+    est.massTendonCorrelation = quadratic(gm, C, gt) / (sm * st);
+}
+
+MuscleEstimate SynergistFit::run() {
+    MuscleEstimate est;
+    est.method = !channels_.empty() ? "channels" : measured_ ? "synergist-va" : "synergist";
+    est.predictedTorque.assign(data_.size(), NAN);   // whole even when the fit fails
+    setNoise(est);
+    const MapResult m = calcMapEstimate(makeProblem());
+    est.converged = m.converged;
+    est.message = m.message;
+    est.iterations = m.iterations;
+    if (m.failed) {  // no estimate: mass and tendon length stay NaN
+        est.converged = false;
+        return est;
+    }
+    setParameters(est, m.x);
+    std::vector<double> r(static_cast<std::size_t>(getNumResiduals()));
+    try {
+        const std::vector<double> t = calcResiduals(m.x.data(), r.data());
+        double ss = 0;
+        for (std::size_t k = 0; k < nFlexion_; ++k) ss += std::pow(t[rows_[k].observation] - torque_[k], 2);
+        est.predictedTorque = t;  // the flexion axis; NaN where it is not fitted (rotation efforts)
+        for (std::size_t k = 0; k < data_.size(); ++k)
+            if (isForearmEffort(data_[k].effort)) est.predictedTorque[k] = NAN;
+        est.rmsResidual = std::sqrt(ss / double(std::max<std::size_t>(nFlexion_, 1)));
+    } catch (const std::exception& e) {
+        est.converged = false;
+        est.message += "; no steady state at the estimate: " + std::string(e.what());
+        return est;
+    }
+    judgeChannels(est, r);
+    if (!m.covariance.empty()) setIntervals(est, m);
     return est;
+}
+
+MuscleEstimate identifySynergistAware(const Population& prior, const std::vector<TorqueObservation>& data,
+                                      const SynergistOptions& options) {
+    return SynergistFit(prior, data, options).run();
 }
 
 double measureVoluntaryActivation(const std::vector<TorqueObservation>& data, double sd, unsigned seed) {

@@ -58,6 +58,8 @@ struct SynergistOptions {
     bool readsForearmTorque = false;
 };
 
+class SynergistFit;
+
 /// The synergist-aware identifier's model: its parameters x, their prior and bounds, and the tared
 /// steady torque it predicts for a list of effort conditions (also used by experiment design).
 /// x = [ln t_b, VA, CC, ln f_b, ln t_s, ln f_s, ln s_e, d_b, d_s, ln sigma, ln g, then ln s_m for every
@@ -234,9 +236,10 @@ private:
     std::vector<int> free_, held_;
     std::vector<std::vector<double>> freePrecision_, truthCovariance_;
     void prepareConsidered();
+    void setGeometry(const std::vector<std::pair<double, double>>& poses);
+    void setPrior(const Population& prior, const SynergistOptions& options, const std::vector<TorqueCondition>& conditions);
     std::vector<std::vector<double>> coupledCovariance_;  // with the rotators coupled (freeRotatorMass)
-    friend MuscleEstimate identifySynergistAware(const Population&, const std::vector<TorqueObservation>&,
-                                                 const SynergistOptions&);
+    friend class SynergistFit;   // identifySynergistAware's steps
 };
 
 /// The synergist-aware MAP identifier with the population as prior.
