@@ -22,7 +22,7 @@ namespace {
 
 constexpr double kMassGoal = 0.10;     // the design goal: mass RMSE <= 10 %
 constexpr double kTendonGoal = 0.010;  // the design goal: tendon-length RMSE <= 1 cm [m]
-constexpr double kStep = 1e-4;         // central-difference step in x (ln scales and activations)
+constexpr double kMargin = 2e-4;       // prior draws stay this far inside the bounds (ln scales and activations)
 constexpr unsigned kMaxRedraws = 100;  // prior draws tried again for one without a steady state
 
 Eigen::MatrixXd toMatrix(const std::vector<std::vector<double>>& rows) {
@@ -81,7 +81,7 @@ std::vector<std::vector<double>> drawFromPrior(const SynergistModel& model, unsi
     // which held parameters the model carries.
     std::vector<int> free;
     for (int j = 0; j < n; ++j)
-        if (model.getLower()[j] + 2 * kStep < model.getUpper()[j] - 2 * kStep) free.push_back(j);
+        if (model.getLower()[j] + kMargin < model.getUpper()[j] - kMargin) free.push_back(j);
     const Eigen::MatrixXd sigma = toMatrix(model.getPriorCovariance());
     Eigen::MatrixXd freeSigma(free.size(), free.size());
     for (std::size_t a = 0; a < free.size(); ++a)
@@ -101,7 +101,7 @@ std::vector<std::vector<double>> drawFromPrior(const SynergistModel& model, unsi
             std::vector<double> x = model.getPriorMean();
             for (std::size_t k = 0; k < free.size(); ++k) {
                 const int j = free[k];  // kept inside the bounds by more than the difference step
-                x[j] = std::clamp(x[j] + v(k), model.getLower()[j] + 2 * kStep, model.getUpper()[j] - 2 * kStep);
+                x[j] = std::clamp(x[j] + v(k), model.getLower()[j] + kMargin, model.getUpper()[j] - kMargin);
             }
             try {
                 model.calcTorques(x.data());
@@ -192,20 +192,17 @@ Sensitivities calcSensitivities(const Population& prior, const std::vector<Torqu
         try {
             SynergistModel::PredictionCache cache;   // this draw's probes, on this thread
             std::vector<double> x = xs[d];
-            out.prediction = predict(x.data(), &cache);
+            // The predictions and their tangents through the steady states (held parameters: zero).
+            std::vector<double> t, f, c, dt, df, dc;
+            model.calcPredictionJacobian(x.data(), t, f, c, dt, df, dc, &cache);
+            out.prediction = t;
+            out.prediction.insert(out.prediction.end(), c.begin(), c.end());
+            if (forearm) out.prediction.insert(out.prediction.end(), f.begin(), f.end());
             out.jacobian.resize(rows, n);
-            for (int j = 0; j < n; ++j) {
-                const double x0 = x[j];
-                if (model.getLower()[j] == model.getUpper()[j]) {  // held fixed
-                    out.jacobian.col(j).setZero();
-                    continue;
-                }
-                x[j] = x0 + kStep;
-                const std::vector<double> up = predict(x.data(), &cache);
-                x[j] = x0 - kStep;
-                const std::vector<double> down = predict(x.data(), &cache);
-                x[j] = x0;
-                for (int r = 0; r < rows; ++r) out.jacobian(r, j) = (up[r] - down[r]) / (2 * kStep);
+            for (int r = 0; r < rows; ++r) {
+                const double* g = r < nt ? &dt[std::size_t(r) * n] : r < nt + nch ? &dc[std::size_t(r - nt) * n]
+                                                                                   : &df[std::size_t(r - nt - nch) * n];
+                for (int j = 0; j < n; ++j) out.jacobian(r, j) = model.getLower()[j] == model.getUpper()[j] ? 0.0 : g[j];
             }
             // The held and consider parameters' secants: what the truth varies and the fit does not. A
             // secant without a steady state leaves the draw without them (its own widths still count).
