@@ -383,6 +383,41 @@ void calcForceVelocitySlopes(const FibreType& t, double V, double L, double& dV,
 
 }  // namespace
 
+namespace {
+
+// calcStateJacobian's per fibre type: active = FL FV + Fpe2 and its slopes; nf; Y; the sum of Af x
+// fraction and its slopes (filled unit by unit). Writes the type's yield rows.
+struct JacobianFibreType {
+    double active = 0, dActiveL = 0, dActiveV = 0, nf = 0, dNfL = 0, Y = 1;
+    int yieldIndex = -1;
+    double sum = 0, dSumL = 0, dSumY = 0;
+};
+
+JacobianFibreType makeJacobianFibreType(const FibreType& t, const double* y, double L, double V, double fpe2,
+                                        double dFpe2, int yieldIndex, double* J, int n) {
+    JacobianFibreType k;
+    const double Ls = std::max(L, kLFloor), dLs = L > kLFloor ? 1.0 : 0.0;
+    const double fl = calcForceLength(t, L), fv = calcForceVelocity(t, V, L);
+    double dFvV = 0, dFvL = 0;
+    calcForceVelocitySlopes(t, V, L, dFvV, dFvL);
+    k.active = fl * fv + fpe2;
+    k.dActiveL = calcForceLengthSlope(t, L) * fv + fl * dFvL + dFpe2;
+    k.dActiveV = fl * dFvV;
+    const double nfRaw = calcNf(t, Ls);
+    k.nf = std::max(nfRaw, kNfFloor);
+    k.dNfL = nfRaw > kNfFloor ? -t.nf1 / (Ls * Ls) * dLs : 0.0;
+    k.yieldIndex = yieldIndex;
+    if (yieldIndex >= 0) {
+        k.Y = y[yieldIndex];
+        J[std::size_t(yieldIndex) * n + yieldIndex] = -1.0 / t.TY;
+        const double e = std::exp(-std::abs(V) / t.VY);
+        J[std::size_t(yieldIndex) * n + VirtualMuscle::kV] = -t.cY * e * (V > 0 ? 1.0 : V < 0 ? -1.0 : 0.0) / (t.VY * t.TY);
+    }
+    return k;
+}
+
+}  // namespace
+
 bool VirtualMuscle::calcStateJacobian(double P, double U, const double* y, double* J) const {
     const auto& c = params_.coefficients;
     const int n = numStates_;
@@ -396,33 +431,8 @@ bool VirtualMuscle::calcStateJacobian(double P, double U, const double* y, doubl
     const double e2 = c.c2 * (std::exp(c.k2 * (L - c.Lr2)) - 1.0);
     const double fpe2 = std::min(0.0, e2), dFpe2 = e2 < 0 ? c.c2 * c.k2 * std::exp(c.k2 * (L - c.Lr2)) : 0.0;
 
-    // Per fibre type: active = FL FV + Fpe2 and its slopes; nf; Y; sum of Af x fraction and its slopes.
-    struct Type {
-        double active = 0, dActiveL = 0, dActiveV = 0, nf = 0, dNfL = 0, Y = 1;
-        int yieldIndex = -1;
-        double sum = 0, dSumL = 0, dSumY = 0;
-    };
-    auto makeType = [&](const FibreType& t, int yieldIndex) {
-        Type k;
-        const double fl = calcForceLength(t, L), fv = calcForceVelocity(t, V, L);
-        double dFvV = 0, dFvL = 0;
-        calcForceVelocitySlopes(t, V, L, dFvV, dFvL);
-        k.active = fl * fv + fpe2;
-        k.dActiveL = calcForceLengthSlope(t, L) * fv + fl * dFvL + dFpe2;
-        k.dActiveV = fl * dFvV;
-        const double nfRaw = calcNf(t, Ls);
-        k.nf = std::max(nfRaw, kNfFloor);
-        k.dNfL = nfRaw > kNfFloor ? -t.nf1 / (Ls * Ls) * dLs : 0.0;
-        k.yieldIndex = yieldIndex;
-        if (yieldIndex >= 0) {
-            k.Y = y[yieldIndex];
-            at(yieldIndex, yieldIndex) = -1.0 / t.TY;
-            const double e = std::exp(-std::abs(V) / t.VY);
-            at(yieldIndex, kV) = -t.cY * e * (V > 0 ? 1.0 : V < 0 ? -1.0 : 0.0) / (t.VY * t.TY);
-        }
-        return k;
-    };
-    Type slow = makeType(params_.slow, yieldSlow_), fast = makeType(params_.fast, yieldFast_);
+    JacobianFibreType slow = makeJacobianFibreType(params_.slow, y, L, V, fpe2, dFpe2, yieldSlow_, J, n);
+    JacobianFibreType fast = makeJacobianFibreType(params_.fast, y, L, V, fpe2, dFpe2, yieldFast_, J, n);
 
     // Row V = K (dFse - dFce) collects -K d fce / d(unit states) as it goes: fce = stretch + sum_s
     // active_s + sum_f active_f (each unit's feff and sag are columns of their own).
@@ -430,7 +440,7 @@ bool VirtualMuscle::calcStateJacobian(double P, double U, const double* y, doubl
     for (int u = 0; u < getNumUnits(); ++u) {
         const MotorUnit& mu = units_[u];
         const FibreType& t = mu.slow ? params_.slow : params_.fast;
-        Type& k = mu.slow ? slow : fast;
+        JacobianFibreType& k = mu.slow ? slow : fast;
         const double fenv = calcEnvelopeFrequency(c, mu.threshold, U);
         const int fi = getFintIndex(u), fe = getFeffIndex(u), si = sagIndex_[u];
         const double fint = y[fi], feff = y[fe], S = si >= 0 ? y[si] : 1.0;
