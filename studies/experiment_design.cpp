@@ -133,6 +133,83 @@ double calcRowSd(const Sensitivities& s, int r, double v) {
     return s.noise.upperArmLength;
 }
 
+// One prior draw x: the predictions of every row, their whitened tangents (through the steady states;
+// held parameters zero) and the held and consider parameters' secants (what the truth varies and the
+// fit does not). Throws SimulationError where x has no steady state.
+DrawSensitivity calcDrawSensitivity(const Sensitivities& s, const std::vector<TorqueCondition>& conditions,
+                                    std::vector<double> x) {
+    const SynergistModel& model = *s.model;
+    const int n = model.getNumParameters(), nt = int(conditions.size()), nch = int(s.channels.size());
+    const int rows = nt + nch + (s.forearm ? nt : 0);
+    const std::vector<SynergistModel::ConsiderParameter> considered = model.getConsiderParameters();
+    const std::vector<double> secant = model.getSecantSteps();
+    const int nk = int(considered.size());
+    SynergistModel::PredictionCache cache;   // this draw's probes, on this thread
+    auto predict = [&](const std::vector<SynergistModel::MuscleDeviation>* deviations = nullptr) {
+        std::vector<double> t, f, c;
+        model.calcPredictions(x.data(), deviations, t, f, c, &cache);
+        t.insert(t.end(), c.begin(), c.end());
+        if (s.forearm) t.insert(t.end(), f.begin(), f.end());
+        return t;
+    };
+    DrawSensitivity out;
+    std::vector<double> t, f, c, dt, df, dc;
+    model.calcPredictionJacobian(x.data(), t, f, c, dt, df, dc, &cache);
+    out.prediction = t;
+    out.prediction.insert(out.prediction.end(), c.begin(), c.end());
+    if (s.forearm) out.prediction.insert(out.prediction.end(), f.begin(), f.end());
+    out.jacobian.resize(rows, n);
+    for (int r = 0; r < rows; ++r) {
+        const double* g = r < nt ? &dt[std::size_t(r) * n] : r < nt + nch ? &dc[std::size_t(r - nt) * n]
+                                                                           : &df[std::size_t(r - nt - nch) * n];
+        for (int j = 0; j < n; ++j) out.jacobian(r, j) = model.getLower()[j] == model.getUpper()[j] ? 0.0 : g[j];
+    }
+    // A secant without a steady state leaves the draw without them (its own widths still count).
+    out.considerJacobian = Eigen::MatrixXd::Zero(rows, n + nk);
+    out.considerJacobian.leftCols(n) = out.jacobian;
+    std::vector<SynergistModel::MuscleDeviation> deviations(model.makeMuscles(x.data()).size());
+    try {
+        for (int j = 0; j < n + nk; ++j) {
+            if (!(secant[j] > 0)) continue;
+            std::vector<double> up, down;
+            if (j < n) {
+                const double x0 = x[j];
+                x[j] = x0 + secant[j];
+                up = predict();
+                x[j] = x0 - secant[j];
+                down = predict();
+                x[j] = x0;
+            } else {
+                SynergistModel::setDeviation(deviations, considered[j - n], secant[j]);
+                up = predict(&deviations);
+                SynergistModel::setDeviation(deviations, considered[j - n], -secant[j]);
+                down = predict(&deviations);
+                SynergistModel::setDeviation(deviations, considered[j - n], 0);
+            }
+            for (int r = 0; r < rows; ++r) out.considerJacobian(r, j) = (up[r] - down[r]) / (2 * secant[j]);
+        }
+    } catch (const SimulationError&) {
+        out.considerJacobian.resize(0, 0);
+    }
+    // Transducer rows as the identifier weights them: sd relative to the trial's load (both axes when
+    // the forearm axis is read); a rotation effort's flexion axis is not fitted.
+    for (int r = 0; r < rows; ++r) {
+        const bool axis = r < nt || r >= nt + nch;
+        const int k = r < nt ? r : r - nt - nch;
+        double v = out.prediction[r];
+        if (axis && s.forearm) v = std::hypot(out.prediction[k], out.prediction[nt + nch + k]);
+        const double sd = calcRowSd(s, r, v);
+        out.jacobian.row(r) /= sd;
+        if (out.considerJacobian.size() > 0) out.considerJacobian.row(r) /= sd;
+        if (r < nt && isForearmEffort(conditions[k].effort)) {
+            out.jacobian.row(r).setZero();
+            if (out.considerJacobian.size() > 0) out.considerJacobian.row(r).setZero();
+        }
+    }
+    out.ok = true;
+    return out;
+}
+
 Sensitivities calcSensitivities(const Population& prior, const std::vector<TorqueCondition>& conditions,
                                 const DesignSettings& settings, const std::function<void(int, int)>& progress,
                                 const std::vector<ChannelObservation>& channels = {}, const ChannelNoise& noise = {},
@@ -173,83 +250,12 @@ Sensitivities calcSensitivities(const Population& prior, const std::vector<Torqu
     s.consideredCriterion = !settings.ownModelCriterion;
 
     const std::vector<std::vector<double>> xs = drawFromPrior(model, settings.seed, settings.draws);
-    const int nt = int(conditions.size()), nch = int(channels.size());
-    const int rows = nt + nch + (forearm ? nt : 0);
-    const std::vector<SynergistModel::ConsiderParameter> considered = model.getConsiderParameters();
-    const std::vector<double> secant = model.getSecantSteps();
-    const int nk = int(considered.size());
-    auto predict = [&](const double* x, SynergistModel::PredictionCache* cache,
-                       const std::vector<SynergistModel::MuscleDeviation>* deviations = nullptr) {
-        std::vector<double> t, f, c;
-        model.calcPredictions(x, deviations, t, f, c, cache);
-        t.insert(t.end(), c.begin(), c.end());
-        if (forearm) t.insert(t.end(), f.begin(), f.end());
-        return t;
-    };
     s.draws.resize(xs.size());
     runParallel(int(xs.size()), settings.jobs, [&](int d) {
-        DrawSensitivity& out = s.draws[d];
         try {
-            SynergistModel::PredictionCache cache;   // this draw's probes, on this thread
-            std::vector<double> x = xs[d];
-            // The predictions and their tangents through the steady states (held parameters: zero).
-            std::vector<double> t, f, c, dt, df, dc;
-            model.calcPredictionJacobian(x.data(), t, f, c, dt, df, dc, &cache);
-            out.prediction = t;
-            out.prediction.insert(out.prediction.end(), c.begin(), c.end());
-            if (forearm) out.prediction.insert(out.prediction.end(), f.begin(), f.end());
-            out.jacobian.resize(rows, n);
-            for (int r = 0; r < rows; ++r) {
-                const double* g = r < nt ? &dt[std::size_t(r) * n] : r < nt + nch ? &dc[std::size_t(r - nt) * n]
-                                                                                   : &df[std::size_t(r - nt - nch) * n];
-                for (int j = 0; j < n; ++j) out.jacobian(r, j) = model.getLower()[j] == model.getUpper()[j] ? 0.0 : g[j];
-            }
-            // The held and consider parameters' secants: what the truth varies and the fit does not. A
-            // secant without a steady state leaves the draw without them (its own widths still count).
-            out.considerJacobian = Eigen::MatrixXd::Zero(rows, n + nk);
-            out.considerJacobian.leftCols(n) = out.jacobian;
-            std::vector<SynergistModel::MuscleDeviation> deviations(prior.base.muscles.size());
-            try {
-            for (int j = 0; j < n + nk; ++j) {
-                if (!(secant[j] > 0)) continue;
-                std::vector<double> up, down;
-                if (j < n) {
-                    const double x0 = x[j];
-                    x[j] = x0 + secant[j];
-                    up = predict(x.data(), &cache);
-                    x[j] = x0 - secant[j];
-                    down = predict(x.data(), &cache);
-                    x[j] = x0;
-                } else {
-                    SynergistModel::setDeviation(deviations, considered[j - n], secant[j]);
-                    up = predict(x.data(), &cache, &deviations);
-                    SynergistModel::setDeviation(deviations, considered[j - n], -secant[j]);
-                    down = predict(x.data(), &cache, &deviations);
-                    SynergistModel::setDeviation(deviations, considered[j - n], 0);
-                }
-                for (int r = 0; r < rows; ++r) out.considerJacobian(r, j) = (up[r] - down[r]) / (2 * secant[j]);
-            }
-            } catch (const SimulationError&) {
-                out.considerJacobian.resize(0, 0);
-            }
-            // Transducer rows as the identifier weights them: sd relative to the trial's load (both axes
-            // when the forearm axis is read); a rotation effort's flexion axis is not fitted.
-            for (int r = 0; r < rows; ++r) {
-                const bool axis = r < nt || r >= nt + nch;
-                const int c = r < nt ? r : r - nt - nch;
-                double v = out.prediction[r];
-                if (axis && forearm) v = std::hypot(out.prediction[c], out.prediction[nt + nch + c]);
-                const double sd = calcRowSd(s, r, v);
-                out.jacobian.row(r) /= sd;
-                out.considerJacobian.row(r) /= sd;
-                if (r < nt && isForearmEffort(conditions[c].effort)) {
-                    out.jacobian.row(r).setZero();
-                    out.considerJacobian.row(r).setZero();
-                }
-            }
-            out.ok = true;
+            s.draws[d] = calcDrawSensitivity(s, conditions, xs[d]);
         } catch (const SimulationError&) {
-            out.ok = false;  // no steady state for this draw: left out of the averages
+            s.draws[d].ok = false;  // no steady state for this draw: left out of the averages
         }
     }, progress);
     return s;
