@@ -96,9 +96,11 @@ struct Captured {
     bool cut = false;
     int writeError = 0;   // errno of the first failed write
 };
+// Never destroyed: stdio flushes the stream at exit after the static destructors have run, and a
+// command that returns early (an error) leaves its printed lines in the buffer until then.
 Captured& getCaptured() {
-    static Captured c;
-    return c;
+    static Captured* c = new Captured;
+    return *c;
 }
 
 // The stdout stream's writer: every byte to file descriptor 1 (a failure is the stream's error, as

@@ -508,6 +508,100 @@ double LabCosts::calcMinutes(const TorqueProtocol& p) const {
     return minutes + (emg ? emgSetup : 0) + volumeScan * double(p.volumeScan.size()) + (p.anthropometry ? anthropometry : 0);
 }
 
+namespace {
+
+// The design's measurement rows beside the candidates' torques (row numbers count from nc, the number
+// of candidates): per candidate its fascicle and EMG rows, the volume candidates (the flexors surface
+// electrodes reach: superficial, so a panoramic scan reaches them too) and the arm.
+struct ChannelRows {
+    std::vector<ChannelObservation> rows;
+    std::vector<std::vector<int>> ultrasound, emg;          // [candidate] row numbers
+    std::vector<std::pair<std::string, int>> volume;        // (muscle, row)
+    int arm = 0;
+};
+
+ChannelRows makeChannelRows(const ArmSetup& base, const std::vector<TorqueCondition>& candidates) {
+    const int nc = int(candidates.size());
+    ChannelRows r;
+    r.ultrasound.resize(nc);
+    r.emg.resize(nc);
+    for (int c = 0; c < nc; ++c) {
+        if (!takesChannels(candidates[c])) continue;
+        for (const ChannelObservation& o : makeConditionRows(base, candidates[c], true, false)) {
+            r.ultrasound[c].push_back(nc + int(r.rows.size()));
+            r.rows.push_back(o);
+        }
+        for (const ChannelObservation& o : makeConditionRows(base, candidates[c], false, true)) {
+            r.emg[c].push_back(nc + int(r.rows.size()));
+            r.rows.push_back(o);
+        }
+    }
+    for (int m : base.surfaceEmg)
+        if (base.muscles[m].group == MuscleGroup::Flexor) {
+            r.volume.push_back({base.muscles[m].params.name, nc + int(r.rows.size())});
+            r.rows.push_back(makeRow("volume", base.muscles[m].params.name, kNaN, Effort::Flexion, 0));
+        }
+    r.arm = nc + int(r.rows.size());
+    r.rows.push_back(makeRow("upper_arm_length", "", kNaN, Effort::Flexion, 0));
+    return r;
+}
+
+// What the design has chosen: MVC repetitions per candidate, ultrasound per candidate, EMG (every picked
+// block), a volume scan per muscle, anthropometry.
+struct Choice {
+    std::vector<int> torque;
+    std::vector<bool> ultrasound;
+    bool emg = false, arm = false;
+    std::vector<bool> volume;
+    // Trials (measurements) of every row: torques, the channel rows, then the forearm axis of the same trials.
+    std::vector<int> toCounts(const ChannelRows& r, bool forearm) const {
+        const int nc = int(torque.size());
+        std::vector<int> counts(nc + r.rows.size() + (forearm ? nc : 0), 0);
+        for (int c = 0; c < nc; ++c) {
+            counts[c] = torque[c];
+            if (forearm) counts[nc + r.rows.size() + c] = torque[c];
+            if (ultrasound[c]) for (int k : r.ultrasound[c]) counts[k] = torque[c];
+            if (emg) for (int k : r.emg[c]) counts[k] = torque[c];
+        }
+        for (std::size_t v = 0; v < r.volume.size(); ++v) counts[r.volume[v].second] = volume[v] ? 1 : 0;
+        counts[r.arm] = arm ? 1 : 0;
+        return counts;
+    }
+};
+
+// The protocol of a choice: its MVC blocks with their channels, the scans and the noise model.
+TorqueProtocol makeDesignedProtocol(const std::vector<TorqueCondition>& candidates, const ChannelRows& r,
+                                    const Choice& chosen, bool forearm, const ChannelNoise& noise) {
+    TorqueProtocol p;
+    p.name = "designed";
+    p.conditions.clear();   // not the default protocol's
+    for (std::size_t c = 0; c < candidates.size(); ++c)
+        if (chosen.torque[c] > 0) {
+            TorqueCondition tc = candidates[c];
+            tc.repetitions = chosen.torque[c];
+            tc.ultrasound = chosen.ultrasound[c];
+            tc.emg = chosen.emg && takesChannels(tc);
+            p.conditions.push_back(tc);
+        }
+    p.forearmTorque = forearm;
+    for (std::size_t v = 0; v < r.volume.size(); ++v)
+        if (chosen.volume[v]) p.volumeScan.push_back(r.volume[v].first);
+    p.anthropometry = chosen.arm;
+    p.channelNoise = noise;
+    return p;
+}
+
+std::string describeDesign(const DesignSettings& settings, const TorqueProtocol& p, const ProtocolPrediction& predicted) {
+    return fmt::format(
+        "designed by armsim design --budget {}: {:.0f} lab minutes ({} trials), {} prior draws (seed {}); predicted "
+        "sd of ln M {:.1f} %, of L0T {:.1f} mm with what the fit shares ({:.1f} %, {:.1f} mm for its own model)",
+        formatNumber(settings.budgetMinutes), settings.costs.calcMinutes(p), predicted.trials, settings.draws,
+        settings.seed, 100 * predicted.massSdConsidered, 1000 * predicted.tendonSdConsidered,
+        100 * predicted.massSd, 1000 * predicted.tendonSd);
+}
+
+}  // namespace
+
 DesignResult designChannelProtocol(const Population& prior, const DesignSettings& settings,
                                    const TorqueProtocol& reference, const std::function<void(int, int)>& progress) {
     reference.validate();
@@ -518,69 +612,29 @@ DesignResult designChannelProtocol(const Population& prior, const DesignSettings
     const LabCosts& cost = settings.costs;
     DesignResult result;
     result.candidates = makeCandidates(settings);
-    // Rows: candidate torques, then per candidate its fascicle and EMG rows, the volume candidates
-    // (flexors surface electrodes reach: superficial, so a panoramic scan reaches them too) and the arm.
     const int nc = int(result.candidates.size());
-    std::vector<ChannelObservation> rows;
-    std::vector<std::vector<int>> ultrasoundRows(nc), emgRows(nc);
     const bool forearm = !settings.postures.empty();
     if (forearm && !base.arm.forearmRotation.enabled)
         throw InputError("design: postures need a model whose forearm rotates; the prior's model '" + base.name +
                          "' has none");
     checkPosturesBesideTheModels(settings, base.arm);
-    for (int c = 0; c < nc; ++c) {
-        if (!takesChannels(result.candidates[c])) continue;
-        for (const ChannelObservation& o : makeConditionRows(base, result.candidates[c], true, false)) {
-            ultrasoundRows[c].push_back(nc + int(rows.size()));
-            rows.push_back(o);
-        }
-        for (const ChannelObservation& o : makeConditionRows(base, result.candidates[c], false, true)) {
-            emgRows[c].push_back(nc + int(rows.size()));
-            rows.push_back(o);
-        }
-    }
-    std::vector<std::pair<std::string, int>> volumeRows;
-    for (int m : base.surfaceEmg)
-        if (base.muscles[m].group == MuscleGroup::Flexor) {
-            volumeRows.push_back({base.muscles[m].params.name, nc + int(rows.size())});
-            rows.push_back(makeRow("volume", base.muscles[m].params.name, kNaN, Effort::Flexion, 0));
-        }
-    const int armRow = nc + int(rows.size());
-    rows.push_back(makeRow("upper_arm_length", "", kNaN, Effort::Flexion, 0));
+    const ChannelRows rows = makeChannelRows(base, result.candidates);
     const ChannelNoise noise = reference.channelNoise;
     const int total = 2 * settings.draws + 1;
     Sensitivities s = calcSensitivities(prior, result.candidates, settings, [&](int done, int) {
         if (progress) progress(done, total);
-    }, rows, noise, forearm);
+    }, rows.rows, noise, forearm);
     Sensitivities r = calcSensitivities(prior, reference.conditions, settings, [&](int done, int) {
         if (progress) progress(settings.draws + done, total);
     });
     for (std::size_t d = 0; d < s.draws.size(); ++d) s.draws[d].ok = r.draws[d].ok = s.draws[d].ok && r.draws[d].ok;
     result.reference = evaluate(r, countTrials(reference.conditions), reference.name, true);
 
-    // Items: a block of MVCs at a candidate (repeatable), ultrasound at a picked candidate, EMG (once,
-    // every picked block), a volume scan per muscle, anthropometry. Greedy by criterion drop per minute.
-    struct Choice {
-        std::vector<int> torque;        // repetitions per candidate
-        std::vector<bool> ultrasound;
-        bool emg = false, arm = false;
-        std::vector<bool> volume;
-    } chosen{std::vector<int>(nc, 0), std::vector<bool>(nc, false), false, false, std::vector<bool>(volumeRows.size(), false)};
-    auto toCounts = [&](const Choice& ch) {
-        std::vector<int> counts(nc + rows.size() + (forearm ? nc : 0), 0);
-        for (int c = 0; c < nc; ++c) {
-            counts[c] = ch.torque[c];
-            if (forearm) counts[nc + rows.size() + c] = ch.torque[c];   // the forearm axis of the same trials
-            if (ch.ultrasound[c]) for (int k : ultrasoundRows[c]) counts[k] = ch.torque[c];
-            if (ch.emg) for (int k : emgRows[c]) counts[k] = ch.torque[c];
-        }
-        for (std::size_t v = 0; v < volumeRows.size(); ++v) counts[volumeRows[v].second] = ch.volume[v] ? 1 : 0;
-        counts[armRow] = ch.arm ? 1 : 0;
-        return counts;
-    };
+    // Greedy by criterion drop per minute.
+    Choice chosen{std::vector<int>(nc, 0), std::vector<bool>(nc, false), false, false, std::vector<bool>(rows.volume.size(), false)};
     const int reps = settings.repetitions;
     const double block = cost.mvcBlock * double(reps) / 3;
-    double spent = 0, current = evaluate(s, toCounts(chosen), "").criterion;
+    double spent = 0, current = evaluate(s, chosen.toCounts(rows, forearm), "").criterion;
     for (;;) {
         double bestScore = 0, bestMinutes = 0, bestCriterion = current;
         Choice best;
@@ -589,7 +643,7 @@ DesignResult designChannelProtocol(const Population& prior, const DesignSettings
         auto consider = [&](const Choice& ch, double minutes, const std::string& item, const TorqueCondition& c) {
             if (spent + minutes > settings.budgetMinutes + 1e-9) return;
             checkInterruption();
-            const double v = evaluate(s, toCounts(ch), "").criterion;
+            const double v = evaluate(s, ch.toCounts(rows, forearm), "").criterion;
             const double score = (current - v) / minutes;
             if (score > bestScore) bestScore = score, best = ch, bestMinutes = minutes, bestItem = item, bestCriterion = v,
                                    bestCondition = c;
@@ -612,11 +666,11 @@ DesignResult designChannelProtocol(const Population& prior, const DesignSettings
             ch.emg = true;
             consider(ch, cost.emgSetup, "emg", none);
         }
-        for (std::size_t v = 0; v < volumeRows.size(); ++v)
+        for (std::size_t v = 0; v < rows.volume.size(); ++v)
             if (!chosen.volume[v]) {
                 Choice ch = chosen;
                 ch.volume[v] = true;
-                consider(ch, cost.volumeScan, "volume " + volumeRows[v].first, none);
+                consider(ch, cost.volumeScan, "volume " + rows.volume[v].first, none);
             }
         if (!chosen.arm) {
             Choice ch = chosen;
@@ -640,30 +694,10 @@ DesignResult designChannelProtocol(const Population& prior, const DesignSettings
     if (std::none_of(chosen.torque.begin(), chosen.torque.end(), [](int n) { return n > 0; }))
         throw InputError("design --budget " + formatNumber(settings.budgetMinutes) + " min: no MVC block (" +
                          formatNumber(block) + " min) fits: expected a larger budget");
-
+    result.protocol = makeDesignedProtocol(result.candidates, rows, chosen, forearm, noise);
     TorqueProtocol& p = result.protocol;
-    p.name = "designed";
-    p.conditions.clear();
-    for (int c = 0; c < nc; ++c)
-        if (chosen.torque[c] > 0) {
-            TorqueCondition tc = result.candidates[c];
-            tc.repetitions = chosen.torque[c];
-            tc.ultrasound = chosen.ultrasound[c];
-            tc.emg = chosen.emg && takesChannels(tc);
-            p.conditions.push_back(tc);
-        }
-    p.forearmTorque = forearm;
-    for (std::size_t v = 0; v < volumeRows.size(); ++v)
-        if (chosen.volume[v]) p.volumeScan.push_back(volumeRows[v].first);
-    p.anthropometry = chosen.arm;
-    p.channelNoise = noise;
-    result.predicted = evaluate(s, toCounts(chosen), p.name, true);
-    p.description = fmt::format(
-        "designed by armsim design --budget {}: {:.0f} lab minutes ({} trials), {} prior draws (seed {}); predicted "
-        "sd of ln M {:.1f} %, of L0T {:.1f} mm with what the fit shares ({:.1f} %, {:.1f} mm for its own model)",
-        formatNumber(settings.budgetMinutes), cost.calcMinutes(p), result.predicted.trials, settings.draws,
-        settings.seed, 100 * result.predicted.massSdConsidered, 1000 * result.predicted.tendonSdConsidered,
-        100 * result.predicted.massSd, 1000 * result.predicted.tendonSd);
+    result.predicted = evaluate(s, chosen.toCounts(rows, forearm), p.name, true);
+    p.description = describeDesign(settings, p, result.predicted);
     return result;
 }
 
