@@ -181,16 +181,13 @@ double calcCost(const std::vector<double>& r) {
 
 }  // namespace detail
 
-IdentificationReport identify(const IdentificationProblem& problem, const ForceModel& model,
-                              const IdentificationOptions& options) {
-    const auto t0 = std::chrono::steady_clock::now();
-    validateOptions(options);
-    const ObservationSet& data = problem.data;
-    if (data.points.empty()) throw InputError(data.source + ": no observations");
-    validateObservations(data);
-    const ParameterMap map(problem.base, problem.unknowns);
-    const int p = map.size(), n = int(data.points.size());
+namespace {
 
+// The data against the unknowns and the method: paths within P_max, positive forces for relative
+// noise, enough distinct points, and what each method needs (thesis 4.5.1, 7.1).
+void checkProblem(const IdentificationProblem& problem, const ParameterMap& map, const IdentificationOptions& options) {
+    const ObservationSet& data = problem.data;
+    const int p = map.size(), n = int(data.points.size());
     // P_max: fixed, or an unknown whose lower bound must admit every path.
     double maxPath = 0;
     int maxPathIndex = 0;
@@ -257,33 +254,13 @@ IdentificationReport identify(const IdentificationProblem& problem, const ForceM
             break;
     }
 
-    detail::SolverContext ctx(map, model, data.points, options);
-    IdentificationReport report;
-    report.method = getMethodName(options.method);
-    report.forceModel = model.getName();
-    report.dataSource = data.source;
-    report.observations = data.points;
+}
 
-    detail::SolverOutcome out;
-    switch (options.method) {
-        case Method::FalsePosition: out = detail::solveFalsePosition(ctx); break;
-        case Method::LevenbergMarquardt: out = detail::solveLeastSquares(ctx, report); break;
-        default: out = detail::solveIlc(ctx); break;
-    }
-
-    report.stopReason = out.reason;
-    report.message = out.message;
-    report.iterations = out.iterations;
-    report.muscle = map.toMuscle(out.x);
-    report.residuals = out.r;
-    report.modelForces.assign(n, std::numeric_limits<double>::quiet_NaN());
-    if (int(out.r.size()) == n)
-        for (int k = 0; k < n; ++k) report.modelForces[k] = data.points[k].force + out.r[k];
-    else
-        report.residuals.assign(n, std::numeric_limits<double>::quiet_NaN());
-    report.cost = detail::calcCost(report.residuals);
-    report.rmsResidual = std::sqrt(2.0 * report.cost / n);
-
+// Each unknown's estimate, interval and bound flag; a bound the data push against is the stop reason.
+void setParameterEstimates(IdentificationReport& report, const ParameterMap& map, const detail::SolverOutcome& out,
+                           const detail::SolverContext& ctx) {
+    const auto& unknowns = map.getUnknowns();
+    const int p = map.size();
     std::string atBound;
     for (int j = 0; j < p; ++j) {
         const Unknown& u = unknowns[j];
@@ -314,6 +291,50 @@ IdentificationReport identify(const IdentificationProblem& problem, const ForceM
             report.message += " (note: " + atBound + ")";
         }
     }
+}
+
+}  // namespace
+
+IdentificationReport identify(const IdentificationProblem& problem, const ForceModel& model,
+                              const IdentificationOptions& options) {
+    const auto t0 = std::chrono::steady_clock::now();
+    validateOptions(options);
+    const ObservationSet& data = problem.data;
+    if (data.points.empty()) throw InputError(data.source + ": no observations");
+    validateObservations(data);
+    const ParameterMap map(problem.base, problem.unknowns);
+    const int n = int(data.points.size());
+
+    checkProblem(problem, map, options);
+
+    detail::SolverContext ctx(map, model, data.points, options);
+    IdentificationReport report;
+    report.method = getMethodName(options.method);
+    report.forceModel = model.getName();
+    report.dataSource = data.source;
+    report.observations = data.points;
+
+    detail::SolverOutcome out;
+    switch (options.method) {
+        case Method::FalsePosition: out = detail::solveFalsePosition(ctx); break;
+        case Method::LevenbergMarquardt: out = detail::solveLeastSquares(ctx, report); break;
+        default: out = detail::solveIlc(ctx); break;
+    }
+
+    report.stopReason = out.reason;
+    report.message = out.message;
+    report.iterations = out.iterations;
+    report.muscle = map.toMuscle(out.x);
+    report.residuals = out.r;
+    report.modelForces.assign(n, std::numeric_limits<double>::quiet_NaN());
+    if (int(out.r.size()) == n)
+        for (int k = 0; k < n; ++k) report.modelForces[k] = data.points[k].force + out.r[k];
+    else
+        report.residuals.assign(n, std::numeric_limits<double>::quiet_NaN());
+    report.cost = detail::calcCost(report.residuals);
+    report.rmsResidual = std::sqrt(2.0 * report.cost / n);
+
+    setParameterEstimates(report, map, out, ctx);
     report.forwardEvaluations = ctx.getEvaluations();
     if (report.history.empty()) report.history = ctx.takeHistory();
     report.wallTime = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
