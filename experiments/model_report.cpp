@@ -200,6 +200,52 @@ MvcCurveSummary summarizeMvcCurve(const SteadyMvcCurve& curve) {
     return s;
 }
 
+namespace {
+
+// The steady MVC curve of an effort (g's agonists): the net torque, each agonist's and the published
+// means +/- sd, the effort's torque positive.
+PlotSpec makeMvcPlot(const ArmSetup& setup, const SteadyMvcCurve& curve, const Table& t, MuscleGroup g,
+                     const ElbowReference& reference) {
+    const bool flexion = g == MuscleGroup::Flexor;
+    const std::string name = flexion ? "flexion" : "extension";
+    const double sign = flexion ? 1.0 : -1.0;
+    PlotSpec plot;
+    plot.title = "Steady " + name + " MVC, model " + setup.name + " (agonists U " +
+                 formatNumber(setup.effort.voluntaryActivation) + ", antagonists " +
+                 formatNumber(setup.effort.coContraction) + ")";
+    plot.xLabel = "flexion angle (deg, 0 = extended)";
+    plot.yLabel = name + " torque (N m)";
+    PlotSeries total;
+    total.label = "net (all muscles)";
+    total.x = curve.flexionDeg;
+    for (double v : curve.totalTorque) total.y.push_back(sign * v);
+    plot.series.push_back(total);
+    int color = 1;
+    for (int i = 0; i < setup.getNumMuscles(); ++i) {
+        if (setup.muscles[i].group != g) continue;
+        PlotSeries m;
+        m.label = curve.muscles[i];
+        m.x = curve.flexionDeg;
+        for (double v : t.getColumn("torque_" + curve.muscles[i] + "_Nm")) m.y.push_back(sign * v);
+        m.color = color++ % 7;
+        plot.series.push_back(m);
+    }
+    PlotSeries pub;
+    pub.label = "published mean, +/- SD";
+    pub.markers = true;
+    pub.color = 7;
+    for (const MvcTorqueReference& r : flexion ? reference.mvcFlexion : reference.mvcExtension)
+        for (double v : {r.torque - r.sd, r.torque, r.torque + r.sd}) {
+            pub.x.push_back(r.flexionDeg);
+            pub.y.push_back(sign * v);
+        }
+    if (!pub.x.empty()) plot.series.push_back(pub);
+    plot.yMin = 0;
+    return plot;
+}
+
+}  // namespace
+
 ModelReportFiles writeModelReport(const ArmSetup& setup, const std::string& outDir, double stepDeg,
                                   const ElbowReference& reference) {
     namespace fs = std::filesystem;
@@ -264,7 +310,6 @@ ModelReportFiles writeModelReport(const ArmSetup& setup, const std::string& outD
     for (MuscleGroup g : {MuscleGroup::Flexor, MuscleGroup::Extensor}) {
         const bool flexion = g == MuscleGroup::Flexor;
         const std::string name = flexion ? "flexion" : "extension";
-        const double sign = flexion ? 1.0 : -1.0;  // plot the effort's torque as positive
         const SteadyMvcCurve curve = calcSteadyMvcCurve(setup, g, setup.effort, angles);
         const Table t = formatMvcCurve(setup, curve);
         folder.write("mvc_" + name + ".csv", t.toCsv());
@@ -273,38 +318,7 @@ ModelReportFiles writeModelReport(const ArmSetup& setup, const std::string& outD
         if (flexion)
             out.primaryShareAt90 = interpolate(t.getColumn("flexion_deg"), t.getColumn("primary_share"), 90.0);
 
-        PlotSpec plot;
-        plot.title = "Steady " + name + " MVC, model " + setup.name + " (agonists U " +
-                     formatNumber(setup.effort.voluntaryActivation) + ", antagonists " +
-                     formatNumber(setup.effort.coContraction) + ")";
-        plot.xLabel = "flexion angle (deg, 0 = extended)";
-        plot.yLabel = name + " torque (N m)";
-        PlotSeries total;
-        total.label = "net (all muscles)";
-        total.x = curve.flexionDeg;
-        for (double v : curve.totalTorque) total.y.push_back(sign * v);
-        plot.series.push_back(total);
-        int color = 1;
-        for (int i = 0; i < setup.getNumMuscles(); ++i) {
-            if (setup.muscles[i].group != g) continue;
-            PlotSeries m;
-            m.label = curve.muscles[i];
-            m.x = curve.flexionDeg;
-            for (double v : t.getColumn("torque_" + curve.muscles[i] + "_Nm")) m.y.push_back(sign * v);
-            m.color = color++ % 7;
-            plot.series.push_back(m);
-        }
-        PlotSeries pub;
-        pub.label = "published mean, +/- SD";
-        pub.markers = true;
-        pub.color = 7;
-        for (const MvcTorqueReference& r : flexion ? reference.mvcFlexion : reference.mvcExtension)
-            for (double v : {r.torque - r.sd, r.torque, r.torque + r.sd}) {
-                pub.x.push_back(r.flexionDeg);
-                pub.y.push_back(sign * v);
-            }
-        if (!pub.x.empty()) plot.series.push_back(pub);
-        plot.yMin = 0;
+        const PlotSpec plot = makeMvcPlot(setup, curve, t, g, reference);
         folder.writeWith("mvc_" + name + ".png", [&](const std::string& p) { writePlotPng(p, plot); });
         out.files.push_back(path("mvc_" + name + ".png"));
     }
