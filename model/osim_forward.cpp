@@ -79,12 +79,11 @@ void OsimForwardSettings::validate() const {
     integration.validate();
 }
 
-OsimForwardResult runOsimForward(const OsimModel& model, const OsimStorage& controls, const OsimStorage* initial,
-                                 const OsimForwardSettings& settings) {
-    settings.validate();
-    OsimForwardResult result;
+namespace {
+
+// The controls' times: finite and not decreasing (a row repeating a time replaces the earlier one).
+void checkControlTimes(const OsimStorage& controls) {
     const Table& c = controls.table;
-    // Times: finite and not decreasing (a row repeating a time replaces the earlier one).
     for (int r = 0; r < c.getNumRows(); ++r) {
         const double t = c.get(r, 0);
         if (!std::isfinite(t) || std::abs(t) > 1e9)
@@ -94,34 +93,14 @@ OsimForwardResult runOsimForward(const OsimModel& model, const OsimStorage& cont
             throw InputError(controls.file + ": row " + std::to_string(r + 1) + ": time " + formatNumber(t) + " s is before the "
                              "previous row's " + formatNumber(c.get(r - 1, 0)) + " s: expected times in increasing order");
     }
-    double t0 = std::isfinite(settings.initialTime) ? settings.initialTime : c.get(0, 0);
-    // Initial states: the row at or before t0, or the first row when t0 is before it; the run starts at
-    // that row's time (the Forward tool's rule). Else defaults and equilibrium.
-    std::map<std::string, double> given;
-    if (initial) {
-        const Table& st = initial->table;
-        int row = 0;
-        for (int r = 0; r < st.getNumRows(); ++r)
-            if (st.get(r, 0) <= t0 + 1e-12) row = r;
-        if (st.get(row, 0) != t0)
-            result.notes.push_back(initial->file + ": the run starts at its row's time " + formatNumber(st.get(row, 0)) +
-                                   " s (asked: " + formatNumber(t0) + " s), as OpenSim's Forward tool does");
-        t0 = st.get(row, 0);
-        for (int k = 1; k < st.getNumColumns(); ++k) given[st.getColumnNames()[k]] = st.get(row, k);
-    }
-    if (!(settings.finalTime > t0))
-        throw InputError("final time " + formatNumber(settings.finalTime) + " s: expected after the initial time " +
-                         formatNumber(t0) + " s" + (initial ? " (from " + initial->file + ")" : std::string()));
-    if (settings.integration.maxStepSize > 0 && (settings.finalTime - t0) / settings.integration.maxStepSize > kMaxSamples)
-        throw FieldError("maximum_integrator_step_size",
-                         "= " + formatNumber(settings.integration.maxStepSize) + " s: " +
-                             formatNumber((settings.finalTime - t0) / settings.integration.maxStepSize, 3) + " steps over " +
-                             formatNumber(settings.finalTime - t0) + " s: expected at most " + formatNumber(kMaxSamples) +
-                             " steps (a larger step limit)");
+}
 
-    // Excitations as OpenSim's ControlLinear: linear between the rows (a row repeating a time replaces the
-    // earlier one), extrapolated linearly beyond the first and last rows and clamped to [0, 1] (the
-    // muscles' min and max control).
+// Excitations as OpenSim's ControlLinear: linear between the rows (a row repeating a time replaces the
+// earlier one), extrapolated linearly beyond the first and last rows and clamped to [0, 1] (the
+// muscles' min and max control); notes for extrapolation and muscles without a column.
+std::map<std::string, ActivationProfile> makeExcitations(const OsimModel& model, const OsimStorage& controls, double t0,
+                                                         double finalTime, std::vector<std::string>& notes) {
+    const Table& c = controls.table;
     std::vector<int> rows;  // the rows kept, by time
     for (int r = 0; r < c.getNumRows(); ++r) {
         if (!rows.empty() && c.get(rows.back(), 0) == c.get(r, 0)) rows.back() = r;
@@ -152,25 +131,32 @@ OsimForwardResult runOsimForward(const OsimModel& model, const OsimStorage& cont
             times.insert(times.begin(), t0);
             values.insert(values.begin(), v);
         }
-        if (settings.finalTime > times.back()) {
+        if (finalTime > times.back()) {
             const std::size_t m = times.size();
-            const double v = n > 1 ? extrapolate(m - 2, m - 1, settings.finalTime) : values.back();
-            times.push_back(settings.finalTime);
+            const double v = n > 1 ? extrapolate(m - 2, m - 1, finalTime) : values.back();
+            times.push_back(finalTime);
             values.push_back(v);
         }
         excitations[muscle] = ActivationProfile(times, values, "controls column " + muscle);
     }
-    if (settings.finalTime > c.get(c.getNumRows() - 1, 0) || t0 < c.get(0, 0))
-        result.notes.push_back(controls.file + ": controls from " + formatNumber(c.get(0, 0)) + " to " +
+    if (finalTime > c.get(c.getNumRows() - 1, 0) || t0 < c.get(0, 0))
+        notes.push_back(controls.file + ": controls from " + formatNumber(c.get(0, 0)) + " to " +
                                formatNumber(c.get(c.getNumRows() - 1, 0)) +
                                " s, extrapolated linearly beyond (OpenSim's ControlLinear), clamped to [0, 1]");
     for (const OsimMuscle& m : model.muscles)
-        if (!excitations.count(m.name)) result.notes.push_back("muscle " + m.name + " has no control column: excitation 0");
+        if (!excitations.count(m.name)) notes.push_back("muscle " + m.name + " has no control column: excitation 0");
 
-    const OsimArm arm(model, excitations, settings.muscleModel);
-    SimTK::State s = arm.getDefaultState();
-    s.setTime(t0);
+    return excitations;
+}
 
+// The initial state from the initial-states row `given` (coordinates in the file's unit, muscle states
+// in OpenSim's), each value checked; muscles without every state start at equilibrium. Notes the
+// columns nothing reads (a misspelt column would otherwise leave its state at the default).
+void setInitialStates(const OsimModel& model, const OsimArm& arm, const OsimStorage* initial,
+                      const std::map<std::string, double>& given, double t0,
+                      const std::vector<std::vector<std::string>>& stateNames,
+                      const std::vector<std::vector<double>>& stateScales, SimTK::State& s,
+                      std::vector<std::string>& notes) {
     std::map<std::string, std::string> jointOf;  // coordinate -> joint, for 4.x column names
     for (const OsimJoint& j : model.joints)
         for (const OsimCoordinate& k : j.coordinates) jointOf[k.name] = j.name;
@@ -198,15 +184,6 @@ OsimForwardResult runOsimForward(const OsimModel& model, const OsimStorage& cont
         if (take({n + "_u", path + "/speed"}, v)) arm.setCoordinateSpeed(s, i, v * (arm.getCoordinate(i).rotational ? degree : 1));
     }
     arm.getSystem().realize(s, SimTK::Stage::Velocity);
-    // Each muscle state's names and its storage unit per state unit (OpenSim writes fibre lengths in
-    // metres, armsim's Hill states hold them over l0).
-    std::vector<std::vector<std::string>> stateNames(arm.getNumMuscles());
-    std::vector<std::vector<double>> stateScales(arm.getNumMuscles());
-    for (int i = 0; i < arm.getNumMuscles(); ++i) {
-        const MuscleModel& m = arm.getMuscleForce(i).getMuscle();
-        stateNames[i] = m.getStateNames();
-        for (const std::string& n : stateNames[i]) stateScales[i].push_back(n == "fiber_length" ? m.getOptimalFascicleLength() : 1.0);
-    }
     for (int i = 0; i < arm.getNumMuscles(); ++i) {
         const MuscleForce& f = arm.getMuscleForce(i);
         const std::vector<std::string>& names = stateNames[i];
@@ -234,8 +211,59 @@ OsimForwardResult runOsimForward(const OsimModel& model, const OsimStorage& cont
         for (const auto& [name, value] : given)
             if (!used.count(name)) unused += (unused.empty() ? "" : ", ") + name;
         if (!unused.empty())
-            result.notes.push_back(initial->file + ": columns not used (no state of " + model.name + " by that name): " + unused);
+            notes.push_back(initial->file + ": columns not used (no state of " + model.name + " by that name): " + unused);
     }
+
+}
+
+}  // namespace
+
+OsimForwardResult runOsimForward(const OsimModel& model, const OsimStorage& controls, const OsimStorage* initial,
+                                 const OsimForwardSettings& settings) {
+    settings.validate();
+    OsimForwardResult result;
+    const Table& c = controls.table;
+    checkControlTimes(controls);
+    double t0 = std::isfinite(settings.initialTime) ? settings.initialTime : c.get(0, 0);
+    // Initial states: the row at or before t0, or the first row when t0 is before it; the run starts at
+    // that row's time (the Forward tool's rule). Else defaults and equilibrium.
+    std::map<std::string, double> given;
+    if (initial) {
+        const Table& st = initial->table;
+        int row = 0;
+        for (int r = 0; r < st.getNumRows(); ++r)
+            if (st.get(r, 0) <= t0 + 1e-12) row = r;
+        if (st.get(row, 0) != t0)
+            result.notes.push_back(initial->file + ": the run starts at its row's time " + formatNumber(st.get(row, 0)) +
+                                   " s (asked: " + formatNumber(t0) + " s), as OpenSim's Forward tool does");
+        t0 = st.get(row, 0);
+        for (int k = 1; k < st.getNumColumns(); ++k) given[st.getColumnNames()[k]] = st.get(row, k);
+    }
+    if (!(settings.finalTime > t0))
+        throw InputError("final time " + formatNumber(settings.finalTime) + " s: expected after the initial time " +
+                         formatNumber(t0) + " s" + (initial ? " (from " + initial->file + ")" : std::string()));
+    if (settings.integration.maxStepSize > 0 && (settings.finalTime - t0) / settings.integration.maxStepSize > kMaxSamples)
+        throw FieldError("maximum_integrator_step_size",
+                         "= " + formatNumber(settings.integration.maxStepSize) + " s: " +
+                             formatNumber((settings.finalTime - t0) / settings.integration.maxStepSize, 3) + " steps over " +
+                             formatNumber(settings.finalTime - t0) + " s: expected at most " + formatNumber(kMaxSamples) +
+                             " steps (a larger step limit)");
+
+    const std::map<std::string, ActivationProfile> excitations = makeExcitations(model, controls, t0, settings.finalTime, result.notes);
+    const OsimArm arm(model, excitations, settings.muscleModel);
+    SimTK::State s = arm.getDefaultState();
+    s.setTime(t0);
+
+    // Each muscle state's names and its storage unit per state unit (OpenSim writes fibre lengths in
+    // metres, armsim's Hill states hold them over l0).
+    std::vector<std::vector<std::string>> stateNames(arm.getNumMuscles());
+    std::vector<std::vector<double>> stateScales(arm.getNumMuscles());
+    for (int i = 0; i < arm.getNumMuscles(); ++i) {
+        const MuscleModel& m = arm.getMuscleForce(i).getMuscle();
+        stateNames[i] = m.getStateNames();
+        for (const std::string& n : stateNames[i]) stateScales[i].push_back(n == "fiber_length" ? m.getOptimalFascicleLength() : 1.0);
+    }
+    setInitialStates(model, arm, initial, given, t0, stateNames, stateScales, s, result.notes);
 
     // The states table.
     std::vector<std::string> columns = {"time"};
