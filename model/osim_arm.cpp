@@ -175,16 +175,9 @@ std::shared_ptr<const MuscleModel> buildOsimMuscleModel(const OsimModel& model, 
                     " cannot be simulated yet: expected Thelen2003Muscle or DeGrooteFregly2016Muscle");
 }
 
-OsimArm::OsimArm(OsimModel model, const std::map<std::string, ActivationProfile>& excitations,
-                 const std::string& muscleModel)
-    : model_(std::move(model)), matter_(system_), forces_subsystem_(system_) {
+std::map<std::string, MobilizedBody> OsimArm::buildBodies() {
     const OsimModel& m = model_;
-    for (const auto& excitation : excitations) {
-        const std::string& name = excitation.first;
-        if (std::none_of(m.muscles.begin(), m.muscles.end(), [&name](const OsimMuscle& x) { return x.name == name; }))
-            throw InputError(m.file + ": no muscle '" + name + "' to excite");
-    }
-    // Bodies: ground, then each joint's child once its parent exists (any file order).
+    // Ground, then each joint's child once its parent exists (any file order).
     std::map<std::string, MobilizedBody> bodies = {{"ground", matter_.updGround()}};
     std::vector<bool> built(m.joints.size(), false);
     for (std::size_t pass = 0, done = 0; done < m.joints.size(); ++pass) {
@@ -232,44 +225,57 @@ OsimArm::OsimArm(OsimModel model, const std::map<std::string, ActivationProfile>
     const Vec3 g = toVec3(m.gravity);
     if (g.norm() > 0) Force::Gravity(forces_subsystem_, matter_, UnitVec3(g), g.norm());
 
-    // Wrap objects as path surfaces on their bodies.
-    auto surfaceOf = [&](const OsimWrapObject& o) {
-        if (!bodies.count(o.body))
-            throw OsimError(where(m, o.line, std::string("<") + wrapElementName(o.kind) + " name=\"" + o.name + "\">") + "its body '" + o.body +
-                            "' has no joint to ground: not built");
-        PathElement e;
-        e.body = bodies.at(o.body);
-        e.location = toVec3(o.translation);
-        e.label = o.name;
-        e.passWhenInside = true;  // OpenSim: a path point inside a wrap object turns the wrap off
-        const Rotation R_BW(BodyRotationSequence, o.xyzBodyRotation[0], XAxis, o.xyzBodyRotation[1], YAxis,
-                            o.xyzBodyRotation[2], ZAxis);
-        if (o.quadrant != "all") {
-            Vec3 side(0);
-            side[o.quadrant.back() - 'x'] = o.quadrant[0] == '-' ? -1 : 1;
-            e.side = R_BW * side;
-        }
-        switch (o.kind) {
-            case OsimWrapObject::Kind::Cylinder:
-                e.kind = PathElement::Kind::Cylinder;
-                e.axis = UnitVec3(R_BW * Vec3(0, 0, 1));
-                e.radius = o.radius;
-                e.length = o.length;
-                break;
-            case OsimWrapObject::Kind::Sphere:
-                e.kind = PathElement::Kind::Sphere;
-                e.radius = o.radius;
-                e.onlyWhenCut = true;
-                break;
-            case OsimWrapObject::Kind::Ellipsoid:
-                e.kind = PathElement::Kind::Ellipsoid;
-                e.onlyWhenCut = true;
-                e.radii = toVec3(o.dimensions);
-                e.orientation = R_BW;
-                break;
-        }
-        return e;
-    };
+    return bodies;
+}
+
+namespace {
+
+// A wrap object as a path surface on its body.
+PathElement makeWrapSurface(const OsimModel& m, const std::map<std::string, MobilizedBody>& bodies,
+                            const OsimWrapObject& o) {
+    if (!bodies.count(o.body))
+        throw OsimError(where(m, o.line, std::string("<") + wrapElementName(o.kind) + " name=\"" + o.name + "\">") + "its body '" + o.body +
+                        "' has no joint to ground: not built");
+    PathElement e;
+    e.body = bodies.at(o.body);
+    e.location = toVec3(o.translation);
+    e.label = o.name;
+    e.passWhenInside = true;  // OpenSim: a path point inside a wrap object turns the wrap off
+    const Rotation R_BW(BodyRotationSequence, o.xyzBodyRotation[0], XAxis, o.xyzBodyRotation[1], YAxis,
+                        o.xyzBodyRotation[2], ZAxis);
+    if (o.quadrant != "all") {
+        Vec3 side(0);
+        side[o.quadrant.back() - 'x'] = o.quadrant[0] == '-' ? -1 : 1;
+        e.side = R_BW * side;
+    }
+    switch (o.kind) {
+        case OsimWrapObject::Kind::Cylinder:
+            e.kind = PathElement::Kind::Cylinder;
+            e.axis = UnitVec3(R_BW * Vec3(0, 0, 1));
+            e.radius = o.radius;
+            e.length = o.length;
+            break;
+        case OsimWrapObject::Kind::Sphere:
+            e.kind = PathElement::Kind::Sphere;
+            e.radius = o.radius;
+            e.onlyWhenCut = true;
+            break;
+        case OsimWrapObject::Kind::Ellipsoid:
+            e.kind = PathElement::Kind::Ellipsoid;
+            e.onlyWhenCut = true;
+            e.radii = toVec3(o.dimensions);
+            e.orientation = R_BW;
+            break;
+    }
+    return e;
+
+}
+
+}  // namespace
+
+MusclePath OsimArm::buildMusclePath(const OsimMuscle& mu, const std::map<std::string, MobilizedBody>& bodies,
+                                    const State& pose) const {
+    const OsimModel& m = model_;
     auto findWrap = [&](const std::string& name) -> const OsimWrapObject* {
         for (const OsimWrapObject& o : m.wrapObjects)
             if (o.name == name) return &o;
@@ -281,78 +287,93 @@ OsimArm::OsimArm(OsimModel model, const std::map<std::string, ActivationProfile>
         throw OsimError(where(m, line, element) + "coordinate '" + name + "' does not move a built joint");
     };
 
+    const std::string element = "<" + mu.type + " name=\"" + mu.name + "\">";
+    std::vector<PathElement> points;
+    for (const OsimPathPoint& pp : mu.path) {
+        const std::string at = where(m, pp.line, "<PathPoint name=\"" + pp.name + "\">");
+        if (!bodies.count(pp.body)) throw OsimError(at + "body '" + pp.body + "' is not built");
+        PathElement e;
+        e.body = bodies.at(pp.body);
+        e.location = toVec3(pp.location);
+        e.label = pp.name;
+        if (pp.kind == OsimPathPoint::Kind::Moving) setMovingLocation(m, pp, e);
+        if (pp.kind == OsimPathPoint::Kind::Conditional) {
+            e.joint = coordinateBody(pp.coordinate, pp.line, "<ConditionalPathPoint name=\"" + pp.name + "\">");
+            e.activeMin = pp.range[0];
+            e.activeMax = pp.range[1];
+        }
+        points.push_back(e);
+    }
+    if (points.size() < 2) throw OsimError(where(m, mu.line, element) + "a path needs two points");
+    // Each wrap on one segment [k, k+1] of its range: the one whose straight line passes nearest the
+    // surface's centre (relative to its size) in the default pose.
+    // Surfaces after point k, ordered along the segment by where its line passes nearest them.
+    std::vector<std::vector<std::pair<double, PathElement>>> wrapAfter(points.size());
+    for (const OsimPathWrap& w : mu.wraps) {
+        const OsimWrapObject* o = findWrap(w.wrapObject);
+        const std::string at = where(m, w.line, "<PathWrap>") + "muscle '" + mu.name + "': ";
+        if (!o) throw OsimError(at + "wrap object '" + w.wrapObject + "' does not exist");
+        if (!o->active) continue;
+        const int n = int(points.size());
+        const int first = w.range[0] < 1 ? 0 : w.range[0] - 1;
+        const int last = w.range[1] < 1 ? n - 1 : w.range[1] - 1;
+        if (first >= last || last >= n)
+            throw OsimError(at + "range " + std::to_string(w.range[0]) + " " + std::to_string(w.range[1]) +
+                            ": expected two path points 1.." + std::to_string(n) + " in order");
+        const PathElement surface = makeWrapSurface(m, bodies, *o);
+        const Vec3 c = surface.body.getBodyTransform(pose) * surface.location;
+        const double size = surface.kind == PathElement::Kind::Ellipsoid
+                                ? std::max({surface.radii[0], surface.radii[1], surface.radii[2]})
+                                : surface.radius;
+        int best = -1;
+        double bestDistance = std::numeric_limits<double>::infinity(), bestT = 0;
+        for (int k = first; k < last; ++k) {
+            if (points[k].isConditional() || points[k + 1].isConditional()) continue;
+            const Vec3 a = points[k].body.getBodyTransform(pose) * points[k].findLocation(pose);
+            const Vec3 b = points[k + 1].body.getBodyTransform(pose) * points[k + 1].findLocation(pose);
+            const Vec3 d = b - a;
+            const double t = d.normSqr() > 0 ? std::clamp(dot(c - a, d) / d.normSqr(), 0.0, 1.0) : 0.0;
+            const double distance = (a + t * d - c).norm() / size;
+            if (distance < bestDistance) bestDistance = distance, best = k, bestT = t;
+        }
+        if (best < 0) throw OsimError(at + "no segment between fixed points in its range");
+        wrapAfter[best].emplace_back(bestT, surface);
+    }
+    std::vector<PathElement> elements;
+    for (std::size_t k = 0; k < points.size(); ++k) {
+        elements.push_back(points[k]);
+        std::stable_sort(wrapAfter[k].begin(), wrapAfter[k].end(),
+                         [](const auto& x, const auto& y) { return x.first < y.first; });
+        for (const auto& [t, surface] : wrapAfter[k]) elements.push_back(surface);
+    }
+    MusclePath path = [&] {
+        try {
+            return MusclePath(elements);
+        } catch (const std::exception& e) {
+            throw OsimError(where(m, mu.line, element) + e.what());
+        }
+    }();
+    return path;
+}
+
+OsimArm::OsimArm(OsimModel model, const std::map<std::string, ActivationProfile>& excitations,
+                 const std::string& muscleModel)
+    : model_(std::move(model)), matter_(system_), forces_subsystem_(system_) {
+    const OsimModel& m = model_;
+    for (const auto& excitation : excitations) {
+        const std::string& name = excitation.first;
+        if (std::none_of(m.muscles.begin(), m.muscles.end(), [&name](const OsimMuscle& x) { return x.name == name; }))
+            throw InputError(m.file + ": no muscle '" + name + "' to excite");
+    }
+    const std::map<std::string, MobilizedBody> bodies = buildBodies();
+
     // The default pose, to place each wrap on its segment.
     State pose = system_.realizeTopology();
     for (const Coordinate& c : coordinates_) c.body.setOneQ(pose, 0, c.spec.defaultValue);
     system_.realize(pose, Stage::Position);
 
     for (const OsimMuscle& mu : m.muscles) {
-        const std::string element = "<" + mu.type + " name=\"" + mu.name + "\">";
-        std::vector<PathElement> points;
-        for (const OsimPathPoint& pp : mu.path) {
-            const std::string at = where(m, pp.line, "<PathPoint name=\"" + pp.name + "\">");
-            if (!bodies.count(pp.body)) throw OsimError(at + "body '" + pp.body + "' is not built");
-            PathElement e;
-            e.body = bodies.at(pp.body);
-            e.location = toVec3(pp.location);
-            e.label = pp.name;
-            if (pp.kind == OsimPathPoint::Kind::Moving) setMovingLocation(m, pp, e);
-            if (pp.kind == OsimPathPoint::Kind::Conditional) {
-                e.joint = coordinateBody(pp.coordinate, pp.line, "<ConditionalPathPoint name=\"" + pp.name + "\">");
-                e.activeMin = pp.range[0];
-                e.activeMax = pp.range[1];
-            }
-            points.push_back(e);
-        }
-        if (points.size() < 2) throw OsimError(where(m, mu.line, element) + "a path needs two points");
-        // Each wrap on one segment [k, k+1] of its range: the one whose straight line passes nearest the
-        // surface's centre (relative to its size) in the default pose.
-        // Surfaces after point k, ordered along the segment by where its line passes nearest them.
-        std::vector<std::vector<std::pair<double, PathElement>>> wrapAfter(points.size());
-        for (const OsimPathWrap& w : mu.wraps) {
-            const OsimWrapObject* o = findWrap(w.wrapObject);
-            const std::string at = where(m, w.line, "<PathWrap>") + "muscle '" + mu.name + "': ";
-            if (!o) throw OsimError(at + "wrap object '" + w.wrapObject + "' does not exist");
-            if (!o->active) continue;
-            const int n = int(points.size());
-            const int first = w.range[0] < 1 ? 0 : w.range[0] - 1;
-            const int last = w.range[1] < 1 ? n - 1 : w.range[1] - 1;
-            if (first >= last || last >= n)
-                throw OsimError(at + "range " + std::to_string(w.range[0]) + " " + std::to_string(w.range[1]) +
-                                ": expected two path points 1.." + std::to_string(n) + " in order");
-            const PathElement surface = surfaceOf(*o);
-            const Vec3 c = surface.body.getBodyTransform(pose) * surface.location;
-            const double size = surface.kind == PathElement::Kind::Ellipsoid
-                                    ? std::max({surface.radii[0], surface.radii[1], surface.radii[2]})
-                                    : surface.radius;
-            int best = -1;
-            double bestDistance = std::numeric_limits<double>::infinity(), bestT = 0;
-            for (int k = first; k < last; ++k) {
-                if (points[k].isConditional() || points[k + 1].isConditional()) continue;
-                const Vec3 a = points[k].body.getBodyTransform(pose) * points[k].findLocation(pose);
-                const Vec3 b = points[k + 1].body.getBodyTransform(pose) * points[k + 1].findLocation(pose);
-                const Vec3 d = b - a;
-                const double t = d.normSqr() > 0 ? std::clamp(dot(c - a, d) / d.normSqr(), 0.0, 1.0) : 0.0;
-                const double distance = (a + t * d - c).norm() / size;
-                if (distance < bestDistance) bestDistance = distance, best = k, bestT = t;
-            }
-            if (best < 0) throw OsimError(at + "no segment between fixed points in its range");
-            wrapAfter[best].emplace_back(bestT, surface);
-        }
-        std::vector<PathElement> elements;
-        for (std::size_t k = 0; k < points.size(); ++k) {
-            elements.push_back(points[k]);
-            std::stable_sort(wrapAfter[k].begin(), wrapAfter[k].end(),
-                             [](const auto& x, const auto& y) { return x.first < y.first; });
-            for (const auto& [t, surface] : wrapAfter[k]) elements.push_back(surface);
-        }
-        MusclePath path = [&] {
-            try {
-                return MusclePath(elements);
-            } catch (const std::exception& e) {
-                throw OsimError(where(m, mu.line, element) + e.what());
-            }
-        }();
+        MusclePath path = buildMusclePath(mu, bodies, pose);
         const auto ex = excitations.find(mu.name);
         forces_.emplace_back(forces_subsystem_, buildOsimMuscleModel(m, mu, muscleModel), std::move(path),
                              ex == excitations.end() ? ActivationProfile() : ex->second);

@@ -96,6 +96,12 @@ public:
 private:
     // A MovingPathPoint's location function and the mobilizer of its coordinate (OsimError otherwise).
     void setMovingLocation(const OsimModel& m, const OsimPathPoint& pp, PathElement& e) const;
+    // Every body on its joint (coordinates_ filled) and gravity.
+    std::map<std::string, SimTK::MobilizedBody> buildBodies();
+    // A muscle's path: its points and each active wrap on the segment of its range that passes nearest
+    // the surface in `pose` (the default pose).
+    MusclePath buildMusclePath(const OsimMuscle& mu, const std::map<std::string, SimTK::MobilizedBody>& bodies,
+                               const SimTK::State& pose) const;
 
     struct Coordinate {
         OsimCoordinate spec;
