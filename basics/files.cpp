@@ -2,10 +2,13 @@
 
 #include "basics/errors.h"
 
+#include <algorithm>
 #include <cstdio>
+#include <iterator>
 #include <filesystem>
 #include <fstream>
 #include <mutex>
+#include <set>
 #include <sstream>
 #include <stdexcept>
 #include <unistd.h>
@@ -14,6 +17,64 @@ namespace armsim {
 
 namespace {
 thread_local FileReadRecorder* tInnermostRecorder = nullptr;
+
+std::mutex inputMutex;
+bool inputProtection = false;   // guarded by inputMutex
+std::set<std::string>& getInputs() {   // canonical paths; never destroyed (writers may run at exit)
+    static auto* inputs = new std::set<std::string>;
+    return *inputs;
+}
+
+std::string canonicalPath(const std::string& path) {
+    std::error_code ec;
+    const std::filesystem::path p = std::filesystem::weakly_canonical(path, ec);
+    return ec ? std::filesystem::absolute(path, ec).lexically_normal().string() : p.string();
+}
+
+bool haveSameBytes(const std::string& a, const std::string& b) {
+    std::error_code ec;
+    if (std::filesystem::file_size(a, ec) != std::filesystem::file_size(b, ec) || ec) return false;
+    std::ifstream x(a, std::ios::binary), y(b, std::ios::binary);
+    return x && y && std::equal(std::istreambuf_iterator<char>(x), std::istreambuf_iterator<char>(),
+                                std::istreambuf_iterator<char>(y), std::istreambuf_iterator<char>());
+}
+}  // namespace
+
+void setInputProtection(bool on) {
+    std::lock_guard<std::mutex> lock(inputMutex);
+    inputProtection = on;
+    if (!on) getInputs().clear();
+}
+
+void noteInputFile(const std::string& path) {
+    {
+        std::lock_guard<std::mutex> lock(inputMutex);
+        if (!inputProtection) return;
+    }
+    const std::string c = canonicalPath(path);
+    std::lock_guard<std::mutex> lock(inputMutex);
+    getInputs().insert(c);
+}
+
+void checkNotReplacingInput(const std::string& target, const std::string& replacement, const std::string& what) {
+    const std::string c = canonicalPath(target);
+    {
+        std::lock_guard<std::mutex> lock(inputMutex);
+        if (!getInputs().count(c)) return;
+    }
+    if (!replacement.empty() && haveSameBytes(target, replacement)) return;
+    throw InputError(what + " would " + (replacement.empty() ? "delete " : "replace ") + target +
+                     ", which this command read as input (nothing was written): expected an output apart from the inputs");
+}
+
+std::vector<std::string> findInputsInside(const std::string& folder) {
+    std::string prefix = canonicalPath(folder);
+    if (prefix.empty() || prefix.back() != '/') prefix += '/';
+    std::vector<std::string> out;
+    std::lock_guard<std::mutex> lock(inputMutex);
+    for (const std::string& p : getInputs())
+        if (p.rfind(prefix, 0) == 0) out.push_back(p);
+    return out;
 }
 
 bool doesPathExist(const std::string& path) {
@@ -37,6 +98,7 @@ void createFolder(const std::string& path) {
 }
 
 void checkInputFile(const std::string& path, std::uintmax_t maxBytes) {
+    noteInputFile(path);
     std::error_code ec;
     if (std::filesystem::exists(path, ec) && !std::filesystem::is_regular_file(path, ec))
         throw InputError(path + ": not a regular file (a folder, device or pipe): expected a file");
@@ -115,12 +177,18 @@ void writeFileAtomically(const std::string& path, const std::string& text) {
     out.commit();
 }
 
-AtomicFileWriter::AtomicFileWriter(const std::string& path) : path_(path) {
+AtomicFileWriter::AtomicFileWriter(const std::string& path) : path_(path), target_(path) {
     namespace fs = std::filesystem;
-    const fs::path target(path);
     std::error_code ec;
+    if (fs::is_symlink(path, ec)) {   // written through: the link stays, its target is replaced
+        target_ = fs::weakly_canonical(path, ec).string();
+        if (ec || (fs::exists(target_, ec) && !fs::is_regular_file(target_, ec)))
+            throw InputError(path + ": a link to " + (target_.empty() ? std::string("nothing that can be resolved") : target_) +
+                             ", which is not a regular file: expected a file to write");
+    }
+    const fs::path target(target_);
     if (target.has_parent_path()) fs::create_directories(target.parent_path(), ec);
-    tmp_ = path + ".tmp." + std::to_string(::getpid());
+    tmp_ = target_ + ".tmp." + std::to_string(::getpid());
     file_ = std::fopen(tmp_.c_str(), "wb");
     if (!file_) throw InputError(path + ": cannot write (is the directory writable?)");
 }
@@ -150,8 +218,14 @@ void AtomicFileWriter::commit() {
         std::remove(tmp_.c_str());
         throw InputError(path_ + ": write failed (disk full?)");
     }
+    try {
+        checkNotReplacingInput(target_, tmp_, path_);
+    } catch (...) {
+        std::remove(tmp_.c_str());
+        throw;
+    }
     std::error_code ec;
-    std::filesystem::rename(tmp_, path_, ec);
+    std::filesystem::rename(tmp_, target_, ec);
     if (ec) {
         std::remove(tmp_.c_str());
         throw InputError(path_ + ": cannot replace file: " + ec.message());

@@ -21,8 +21,22 @@ void createFolder(const std::string& path);
 /// The whole file as bytes. Throws InputError naming the path when it cannot be read.
 std::string readFileText(const std::string& path);
 /// InputError unless `path` (when it exists) is a regular file of at most maxBytes (a folder, a device
-/// such as /dev/zero or a pipe would make a reader block or grow without bound).
+/// such as /dev/zero or a pipe would make a reader block or grow without bound). Notes the file as an
+/// input of this process (noteInputFile).
 void checkInputFile(const std::string& path, std::uintmax_t maxBytes);
+
+/// Turns the protection of inputs on or off for this process (off by default; the armsim command turns
+/// it on): while on, every file a reader opens is noted (noteInputFile) and an output that would
+/// replace or delete it with other bytes is refused (checkNotReplacingInput), so a command never
+/// overwrites or deletes what it read. Turning it off forgets the noted files.
+void setInputProtection(bool on);
+/// Notes `path` as an input of this process (every reader does, through checkInputFile). Thread-safe.
+void noteInputFile(const std::string& path);
+/// InputError when `target` (a file about to be replaced by `replacement`, or "" for a removal) is a
+/// noted input and the replacement is not byte for byte the same. `what` names the output in the message.
+void checkNotReplacingInput(const std::string& target, const std::string& replacement, const std::string& what);
+/// The noted inputs inside the folder `folder` (for an output that replaces the folder whole).
+std::vector<std::string> findInputsInside(const std::string& folder);
 
 /// One file as readFileText read it, or a lookup as doesPathExist answered it.
 struct FileSnapshot {
@@ -71,7 +85,9 @@ public:
 std::string showPath(const std::string& path);
 
 /// Writes text to path atomically: to a temporary beside it, then rename. Throws InputError naming
-/// the path when it cannot be written. Parent directories are created.
+/// the path when it cannot be written. Parent directories are created. A path that is a symbolic link
+/// is written through: its target is replaced (InputError when the target exists and is not a regular
+/// file, such as /dev/stdout on a pipe); an input of the command is not replaced by other bytes.
 void writeFileAtomically(const std::string& path, const std::string& text);
 
 /// A file written piece by piece and put in place whole: the pieces go to a temporary beside the
@@ -87,7 +103,7 @@ public:
     void commit();
 
 private:
-    std::string path_, tmp_;
+    std::string path_, target_, tmp_;   // as given; where it goes (a link's target); the temporary
     std::FILE* file_ = nullptr;
 };
 

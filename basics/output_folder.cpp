@@ -1,6 +1,7 @@
 #include "basics/output_folder.h"
 
 #include "basics/errors.h"
+#include "basics/files.h"
 
 #include <signal.h>
 #include <unistd.h>
@@ -63,6 +64,29 @@ void placeAllOrNone(const std::vector<Placement>& placements) {
         fs::rename(p.from, p.to, ec);
         if (ec) fail(p.name + ": cannot move the file into place: " + ec.message());
         moved.push_back({p.from, p.to});
+    }
+}
+
+// A folder holding `marker` as armsim writes it: a manifest whose text names armsim's version (a
+// stranger's manifest.json does not make a folder an armsim run).
+bool holdsMarker(const fs::path& dir, const std::string& marker) {
+    std::error_code ec;
+    if (marker.empty() || !fs::is_regular_file(dir / marker, ec)) return false;
+    std::ifstream in(dir / marker);
+    std::string head(4096, '\0');
+    in.read(head.data(), std::streamsize(head.size()));
+    head.resize(std::size_t(in.gcount()));
+    return head.find("\"armsim_version\"") != std::string::npos;
+}
+
+// The inputs of this command inside `target` (a folder about to be replaced whole by `staged`): each
+// must come back byte for byte in the staged folder, or the replacement would lose it.
+void checkInputsKept(const fs::path& target, const fs::path& staged) {
+    std::error_code ec;
+    const fs::path base = fs::weakly_canonical(target, ec);
+    for (const std::string& input : findInputsInside(target.string())) {
+        const fs::path twin = staged / fs::path(input).lexically_relative(base);
+        checkNotReplacingInput(input, fs::is_regular_file(twin, ec) ? twin.string() : std::string(), target.string());
     }
 }
 
@@ -169,6 +193,7 @@ void OutputFolder::commit() {
     std::error_code ec;
     const bool exists = fs::exists(target_, ec);
     if (mode_ == Mode::AddFiles && exists) return commitInto();
+    if (exists) checkInputsKept(target_, temp_);
     if (exists) {
         fs::rename(target_, old_, ec);
         if (ec) throw InputError(target_.string() + ": cannot move the earlier run aside: " + ec.message());
@@ -203,11 +228,14 @@ void OutputFolder::commitInto() {
     for (const std::string& f : files) {
         const fs::path to = target_ / f;
         if (runs.count(f)) {
-            if (fs::exists(to, ec) && !(fs::is_directory(to, ec) && fs::exists(to / marker_, ec)))
+            if (fs::exists(to, ec) && !(fs::is_directory(to, ec) && holdsMarker(to, marker_)))
                 throw InputError(to.string() + ": exists and is not an armsim run (no " + marker_ +
-                                 "): cannot replace it with the output folder");
+                                 " of armsim's): cannot replace it with the output folder");
+            if (fs::exists(to, ec)) checkInputsKept(to, temp_ / f);
         } else if (fs::exists(to, ec) && !fs::is_regular_file(to, ec)) {
             throw InputError(to.string() + ": exists and is not a file: cannot replace it with the output file");
+        } else if (fs::exists(to, ec)) {
+            checkNotReplacingInput(to.string(), (temp_ / f).string(), target_.string());
         }
     }
     std::vector<Placement> placements;
@@ -255,9 +283,9 @@ void OutputFolder::checkReplaceable() const {
         if (isFolder) return;
         throw InputError(target_.string() + ": exists and is not a folder: expected a folder for the output files");
     }
-    if (isFolder && (fs::is_empty(target_, ec) || (!marker_.empty() && fs::exists(target_ / marker_, ec)))) return;
+    if (isFolder && (fs::is_empty(target_, ec) || holdsMarker(target_, marker_))) return;
     throw InputError(target_.string() + ": exists and is not an armsim run (no " + marker_ +
-                     "): refusing to replace it; choose another output folder");
+                     " of armsim's): refusing to replace it; choose another output folder");
 }
 
 namespace {
@@ -321,8 +349,15 @@ std::string OutputFiles::add(const std::string& option, const std::string& path,
     if (path.empty()) return "";
     if (committed_) throw std::logic_error("OutputFiles::add after commit");
     checkNotInput(option, path);
-    const fs::path target = fs::path(path).lexically_normal();
+    fs::path target = fs::path(path).lexically_normal();
     std::error_code ec;
+    if (fs::is_symlink(target, ec)) {   // written through: the link stays, its target gets the file
+        const fs::path resolved = fs::weakly_canonical(target, ec);
+        if (ec || (fs::exists(resolved, ec) && !fs::is_regular_file(resolved, ec)))
+            throw InputError(option + " '" + path + "': a link to '" + resolved.string() +
+                             "', which is not a regular file: expected a file path");
+        target = resolved;
+    }
     const fs::path absolute = fs::absolute(target, ec).lexically_normal();
     for (const Entry& e : entries_)
         if (fs::absolute(e.target, ec).lexically_normal() == absolute)
@@ -378,6 +413,7 @@ void OutputFiles::commit() {
         if (!fs::exists(e.staging, ec)) continue;
         if (fs::exists(e.target, ec) && !fs::is_regular_file(e.target, ec))
             throw InputError(e.option + " '" + e.target + "': exists and is not a file: cannot replace it");
+        if (fs::exists(e.target, ec)) checkNotReplacingInput(e.target, e.staging, e.option + " '" + e.target + "'");
         placements.push_back({e.staging, e.target, e.staging + ".old", e.option + " '" + e.target + "'"});
     }
     placeAllOrNone(placements);

@@ -26,7 +26,8 @@ public:
 
     /// How commit() treats a target that exists.
     enum class Mode {
-        /// The folder is one run: an earlier run (an empty folder or one holding `marker`) is replaced
+        /// The folder is one run: an earlier run (an empty folder or one holding `marker` as armsim writes
+        /// it: a manifest whose text names "armsim_version") is replaced
         /// as a whole by one rename; any other existing folder or file is refused (InputError).
         ReplaceRun,
         /// The files join the folder: each replaces a file of the same name by a rename; other files in

@@ -65,7 +65,12 @@ ParamNode ParamNode::loadString(const std::string& text, const std::string& sour
     auto impl = std::make_shared<Impl>();
     impl->source = sourceName;
     try {
-        impl->node = YAML::Load(text);
+        const std::vector<YAML::Node> documents = YAML::LoadAll(text);
+        if (!documents.empty()) impl->node = documents.front();
+        for (std::size_t k = 1; k < documents.size(); ++k)   // a second '---' document: never read, so refused
+            if (!documents[k].IsNull())
+                throw InputError(sourceName + ":" + std::to_string(documents[k].Mark().line + 1) +
+                                 ": a second YAML document (after '---'): expected one document per file");
     } catch (const YAML::DeepRecursion& e) {  // yaml-cpp says only "bad file"
         throw InputError(sourceName + ":" + std::to_string(e.mark.line + 1) + ": nested deeper than " +
                          std::to_string(e.depth()) + " levels: expected a parameter file");

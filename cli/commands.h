@@ -59,9 +59,11 @@ struct MainJobContext {
     MuscleOptions muscle;        ///< the subject's biceps
 };
 
-/// A step of `armsim run`; steps run in ascending order.
+/// A step of `armsim run`; steps run in ascending order. `check` (optional) runs before any step does
+/// work: what the step needs that could be missing (an InputError then stops the job before it starts).
 struct MainJobStepRegistrar {
-    MainJobStepRegistrar(int order, std::string name, std::function<void(const MainJobContext&)> run);
+    MainJobStepRegistrar(int order, std::string name, std::function<void(const MainJobContext&)> run,
+                         std::function<void()> check = {});
 };
 
 /// Adds every registered command to app (called by main).

@@ -4,6 +4,7 @@
 // that cannot go on, 4 an internal error, 128 + signal when stopped by SIGINT, SIGTERM or SIGHUP (after
 // removing the partial output of the run in progress).
 #include "basics/errors.h"
+#include "basics/files.h"
 #include "estimation/ceres_logging.h"
 #include "cli/commands.h"
 #include "cli/report.h"
@@ -102,10 +103,24 @@ std::string explainConversion(const CLI::App& app, const std::string& what) {
     return what;
 }
 
+// What went to standard output must have arrived (a full disk, /dev/full, a closed pipe): `status`
+// when it did, else 2 with a message.
+int finishStdout(int status) {
+    errno = 0;
+    std::cout.flush();
+    const bool flushed = std::fflush(stdout) == 0 && !std::ferror(stdout) && std::cout.good();
+    if (flushed) return status;
+    const int error = errno ? errno : armsim::cli::getStdoutWriteError();
+    std::cerr << "armsim: error: cannot write to standard output" << (error ? std::string(": ") + std::strerror(error) : "")
+              << " (the results printed there are incomplete)\n";
+    return status == 0 ? 2 : status;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
     armsim::cli::startStdoutCapture();   // the report shows what the command printed
+    armsim::setInputProtection(true);     // no output replaces or deletes a file the command read
     startSignalThread();
     armsim::quietCeresLogging();  // once, before any thread: armsim reports what Ceres would log
     CLI::App app{"armsim: a Simbody elbow with a Virtual Muscle biceps (simulate, identify, render)"};
@@ -128,11 +143,11 @@ int main(int argc, char** argv) {
             return 2;
         }
     } catch (const CLI::CallForHelp& e) {
-        return app.exit(e);
+        return finishStdout(app.exit(e));
     } catch (const CLI::CallForAllHelp& e) {
-        return app.exit(e);
+        return finishStdout(app.exit(e));
     } catch (const CLI::CallForVersion& e) {
-        return app.exit(e);
+        return finishStdout(app.exit(e));
     } catch (const CLI::ConversionError& e) {
         std::cerr << "armsim: error: " << explainConversion(app, e.what()) << " (armsim COMMAND --help lists its options)\n";
         return 2;
@@ -164,15 +179,5 @@ int main(int argc, char** argv) {
         std::cerr << "armsim: internal error: " << e.what() << "\n";
         return 4;
     }
-    // What went to standard output must have arrived (a full disk, /dev/full, a closed pipe).
-    errno = 0;
-    std::cout.flush();
-    const bool flushed = std::fflush(stdout) == 0 && !std::ferror(stdout) && std::cout.good();
-    if (!flushed) {
-        const int error = errno ? errno : armsim::cli::getStdoutWriteError();
-        std::cerr << "armsim: error: cannot write to standard output" << (error ? std::string(": ") + std::strerror(error) : "")
-                  << " (the results printed there are incomplete)\n";
-        return 2;
-    }
-    return 0;
+    return finishStdout(0);
 }

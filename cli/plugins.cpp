@@ -11,6 +11,7 @@
 #include <dlfcn.h>
 
 #include <filesystem>
+#include <algorithm>
 #include <mutex>
 #include <vector>
 
@@ -38,6 +39,12 @@ void addInterruptionSink(void (*sink)(int)) {
     if (gForwarded) sink(gForwarded);
 }
 
+// Where a plugin file may be: beside the executable (the build tree), or <prefix>/lib/armsim/ for
+// <prefix>/bin/armsim (installed).
+std::vector<std::string> findPluginCandidates(const std::string& folder, const char* file) {
+    return {folder + "/" + file, folder + "/../lib/armsim/" + file};
+}
+
 /// dlopen(file beside the executable, else ARMSIM_PLUGIN_DIR/file) and dlsym(symbol); the entry
 /// point's result, or nullptr with `why` set. The entry point is called through its own type
 /// (`const Api* (*)()`): calling it through another function type is undefined behaviour.
@@ -51,8 +58,7 @@ const Api* loadPluginApi(const char* file, const char* symbol, std::string& why)
         why = "the executable's folder is unknown (/proc/self/exe unreadable)";
         return nullptr;
     }
-    // Beside the executable (the build tree), or <prefix>/lib/armsim/ for <prefix>/bin/armsim (installed).
-    const std::vector<std::string> candidates = {folder + "/" + file, folder + "/../lib/armsim/" + file};
+    const std::vector<std::string> candidates = findPluginCandidates(folder, file);
     for (const std::string& path : candidates) {
         if (!doesPathExist(path)) continue;
         void* handle = dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);
@@ -78,6 +84,18 @@ void forwardInterruption(int sig) {
     const std::lock_guard<std::mutex> lock(gMutex);
     gForwarded = sig;
     for (void (*sink)(int) : gInterruptionSinks) sink(sig);
+}
+
+void checkRenderPluginFile(const std::string& option) {
+#ifdef ARMSIM_WITH_RENDER
+    const std::string folder = findExecutableFolder();
+    const std::vector<std::string> candidates = findPluginCandidates(folder, kRenderPluginFile);
+    if (!folder.empty() && std::none_of(candidates.begin(), candidates.end(), [](const std::string& p) { return doesPathExist(p); }))
+        throw InputError(option + ": the renderer plugin is missing: " + kRenderPluginFile + " not found beside the executable (" +
+                         candidates[0] + ")");
+#else
+    throw InputError(option + ": this armsim was built without the renderer (-DARMSIM_RENDER=OFF)");
+#endif
 }
 
 const RenderPlugin& getRenderPlugin(const std::string& option) {

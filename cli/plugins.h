@@ -14,6 +14,9 @@ namespace armsim::cli {
 /// The renderer (render/render_plugin.h). InputError naming `option` when it cannot be loaded (built
 /// with -DARMSIM_RENDER=OFF, or the plugin file missing beside the executable).
 const RenderPlugin& getRenderPlugin(const std::string& option);
+/// The same InputError when the renderer plugin's file is not where getRenderPlugin looks, without
+/// loading it (its libraries stay mapped once loaded: the main job loads it last).
+void checkRenderPluginFile(const std::string& option);
 
 /// Passes an interruption (SIGINT/SIGTERM) on to every plugin loaded now or later: each holds its own
 /// copy of the interruption flag.

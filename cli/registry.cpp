@@ -33,6 +33,7 @@ struct Step {
     int order;
     std::string name;
     std::function<void(const MainJobContext&)> run;
+    std::function<void()> check;
 };
 
 std::vector<Command>& commands() {
@@ -51,8 +52,8 @@ CommandRegistrar::CommandRegistrar(int order, std::function<void(CLI::App&)> add
 }
 
 MainJobStepRegistrar::MainJobStepRegistrar(int order, std::string name,
-                                           std::function<void(const MainJobContext&)> run) {
-    steps().push_back({order, std::move(name), std::move(run)});
+                                           std::function<void(const MainJobContext&)> run, std::function<void()> check) {
+    steps().push_back({order, std::move(name), std::move(run), std::move(check)});
 }
 
 double parseNumber(const std::string& option, const std::string& text) {
@@ -315,6 +316,8 @@ void addRegisteredCommands(CLI::App& app) {
         // error, an interruption) none of them does and the staging folder is removed.
         checkOutputFolder("--out", ctx->outDir);
         ctx->muscle.loadSetup();   // the model and its options checked before any step prints or writes
+        for (const auto& step : s)
+            if (step.check) step.check();   // what a step needs (the renderer's plugin), before any work
         OutputFolder folder(ctx->outDir, OutputFolder::Mode::AddFiles, "manifest.json");  // protocol runs whole
         MainJobContext staged = *ctx;
         staged.outDir = folder.getStagingPath();

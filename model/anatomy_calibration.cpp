@@ -109,6 +109,7 @@ struct AnatomyProblem {
     }
 
     bool operator()(double const* const* x, double* r) const {
+        if (getInterruption()) return false;   // a stop: every evaluation fails at once, the callback ends the solve
         try {
             const ArmSetup s = applyCalibration(*setup, calcCalibration(x[0]));
             const std::vector<TargetScore> scores = scoreAnatomy(s, *targets, *sweep);
@@ -199,7 +200,14 @@ AnatomyCalibrationResult calibrateToAnatomy(const ArmSetup& setup, const std::ve
         so.max_num_iterations = options.maxIterations;
         so.function_tolerance = 1e-8;
         so.parameter_tolerance = 1e-8;
+        struct StopOnInterruption : ceres::IterationCallback {
+            ceres::CallbackReturnType operator()(const ceres::IterationSummary&) override {
+                return getInterruption() ? ceres::SOLVER_ABORT : ceres::SOLVER_CONTINUE;
+            }
+        } stop;
+        so.callbacks.push_back(&stop);
         ceres::Solve(so, &pr, &summary);
+        checkInterruption();
         iterations += int(summary.iterations.size());
         allConverged = allConverged && summary.termination_type == ceres::CONVERGENCE;
         if (summary.termination_type != ceres::CONVERGENCE)

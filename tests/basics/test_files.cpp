@@ -8,6 +8,9 @@
 
 #include <filesystem>
 #include <memory>
+#include <fstream>
+#include <iterator>
+#include <sys/stat.h>
 
 using namespace armsim;
 
@@ -118,4 +121,50 @@ TEST(Files, CreateFolderNamesThePathWhenItCannot) {
         }
     }
     std::filesystem::remove_all(dir);
+}
+
+// A path that is a symbolic link is written through: the link stays and its target gets the bytes; a
+// link to something that is not a regular file (a pipe, as /dev/stdout often is) is refused with the
+// path, and nothing is written.
+TEST(Files, WritingALinkReplacesItsTargetAndKeepsTheLink) {
+    namespace fs = std::filesystem;
+    const fs::path d = armsim::testing::makeFreshDir("files", "link");
+    std::ofstream(d / "target.csv") << "old\n";
+    fs::create_symlink("target.csv", d / "link.csv");
+    writeFileAtomically((d / "link.csv").string(), "new\n");
+    EXPECT_TRUE(fs::is_symlink(d / "link.csv"));
+    EXPECT_EQ(armsim::testing::readFileText(d / "target.csv"), "new\n");
+    ASSERT_EQ(::mkfifo((d / "pipe").c_str(), 0600), 0);
+    fs::create_symlink("pipe", d / "to_pipe.csv");
+    const std::string message = armsim::testing::getInputErrorOf([&] { writeFileAtomically((d / "to_pipe.csv").string(), "x"); });
+    EXPECT_NE(message.find("to_pipe.csv"), std::string::npos) << message;
+    EXPECT_NE(message.find("not a regular file"), std::string::npos) << message;
+    EXPECT_TRUE(fs::is_symlink(d / "to_pipe.csv"));
+    fs::remove_all(d);
+}
+
+// With input protection on (the armsim command), a file a reader opened is never replaced by other
+// bytes: the write is refused naming the file and the file keeps its bytes; the same bytes pass (a
+// run that copies its input); with protection off nothing is checked.
+TEST(Files, AnInputIsNotReplacedByOtherBytes) {
+    namespace fs = std::filesystem;
+    struct Protection {
+        Protection() { setInputProtection(true); }
+        ~Protection() { setInputProtection(false); }
+    };
+    const fs::path d = armsim::testing::makeFreshDir("files", "input");
+    const std::string input = (d / "data.csv").string();
+    std::ofstream(input) << "a,b\n1,2\n";
+    {
+        Protection on;
+        EXPECT_EQ(readFileText(input), "a,b\n1,2\n");
+        const std::string message = armsim::testing::getInputErrorOf([&] { writeFileAtomically(input, "results\n"); });
+        EXPECT_NE(message.find("data.csv"), std::string::npos) << message;
+        EXPECT_NE(message.find("read as input"), std::string::npos) << message;
+        EXPECT_EQ(armsim::testing::readFileText(input), "a,b\n1,2\n");
+        EXPECT_NO_THROW(writeFileAtomically(input, "a,b\n1,2\n"));   // the same bytes
+        EXPECT_EQ(std::distance(fs::directory_iterator(d), fs::directory_iterator()), 1);   // no temporary left
+    }
+    EXPECT_NO_THROW(writeFileAtomically(input, "results\n"));   // protection off
+    fs::remove_all(d);
 }

@@ -10,6 +10,8 @@
 
 using namespace armsim;
 namespace fs = std::filesystem;
+// A manifest as armsim writes it (the marker names armsim's version).
+constexpr const char* kManifest = "{\"armsim_version\": \"0.1.0\"}";
 
 namespace {
 
@@ -43,13 +45,13 @@ TEST_F(OutputFolderTest, ReplaceRunSwapsTheWholeFolderAndRefusesAForeignOne) {
     {
         OutputFolder out(target.string(), OutputFolder::Mode::ReplaceRun, "manifest.json");
         out.write("old_only.csv", "x");
-        out.write("manifest.json", "{}");
+        out.write("manifest.json", kManifest);
         out.commit();
     }
     {
         OutputFolder out(target.string(), OutputFolder::Mode::ReplaceRun, "manifest.json");
         out.write("trials/t.csv", "y");
-        out.write("manifest.json", "{}");
+        out.write("manifest.json", kManifest);
         EXPECT_EQ(out.getFiles(), (std::vector<std::string>{"manifest.json", "trials/t.csv"}));
         out.commit();
     }
@@ -59,6 +61,9 @@ TEST_F(OutputFolderTest, ReplaceRunSwapsTheWholeFolderAndRefusesAForeignOne) {
     const fs::path foreign = root / "mine";
     fs::create_directories(foreign);
     std::ofstream(foreign / "notes.txt") << "keep";
+    EXPECT_THROW(OutputFolder(foreign.string(), OutputFolder::Mode::ReplaceRun, "manifest.json"), InputError);
+    EXPECT_TRUE(fs::exists(foreign / "notes.txt"));
+    std::ofstream(foreign / "manifest.json") << "{}";   // someone else's manifest: still not an armsim run
     EXPECT_THROW(OutputFolder(foreign.string(), OutputFolder::Mode::ReplaceRun, "manifest.json"), InputError);
     EXPECT_TRUE(fs::exists(foreign / "notes.txt"));
 }
@@ -88,7 +93,7 @@ TEST_F(OutputFolderTest, LeftoversOfDeadProcessesAreCleanedAndTheEarlierRunResto
     // pid 999999999 exceeds pid_max, so no process has it.
     fs::create_directories(root / ".run.partial.999999999");
     fs::create_directories(root / ".run.old.999999999");
-    std::ofstream(root / ".run.old.999999999" / "manifest.json") << "{}";
+    std::ofstream(root / ".run.old.999999999" / "manifest.json") << kManifest;
     {
         OutputFolder out(target.string(), OutputFolder::Mode::ReplaceRun, "manifest.json");
         EXPECT_FALSE(fs::exists(root / ".run.partial.999999999"));
@@ -243,12 +248,12 @@ TEST_F(OutputFolderTest, OutputFilesCommitFailingPartWayPutsBackWhatWasThere) {
 TEST_F(OutputFolderTest, AddFilesReplacesARunInsideWhole) {
     const fs::path target = root / "out";
     fs::create_directories(target / "run");
-    std::ofstream(target / "run" / "manifest.json") << "{}\n";
+    std::ofstream(target / "run" / "manifest.json") << kManifest;
     std::ofstream(target / "run" / "stale.csv") << "an earlier run's file\n";
     std::ofstream(target / "mine.txt") << "a user's file\n";
     {
         OutputFolder out(target.string(), OutputFolder::Mode::AddFiles, "manifest.json");
-        out.write("run/manifest.json", "{\"new\": 1}\n");
+        out.write("run/manifest.json", std::string(kManifest) + "\n");
         out.write("run/a.csv", "1\n");
         out.write("top.csv", "2\n");
         out.commit();
@@ -262,7 +267,7 @@ TEST_F(OutputFolderTest, AddFilesReplacesARunInsideWhole) {
     fs::remove(target / "run" / "manifest.json");  // now a folder that is not a run
     {
         OutputFolder out(target.string(), OutputFolder::Mode::AddFiles, "manifest.json");
-        out.write("run/manifest.json", "{}\n");
+        out.write("run/manifest.json", kManifest);
         out.write("top.csv", "3\n");
         EXPECT_THROW(out.commit(), InputError);
     }
@@ -293,4 +298,43 @@ TEST_F(OutputFolderTest, FoldersMadeForAnOutputThatNeverAppearsAreRemoved) {
     }
     EXPECT_TRUE(fs::exists(root / "c" / "keep.txt"));
     EXPECT_FALSE(fs::exists(root / "c" / "d"));
+}
+
+// With input protection on (the armsim command): an earlier run replaced whole must not take an input
+// of this command with it (a protocol file kept in the run's folder), and a file added to a folder must
+// not replace an input by other bytes; both commits are refused and leave every file as it was. An
+// input that comes back byte for byte passes.
+TEST_F(OutputFolderTest, AnInputInsideTheTargetIsNeitherDeletedNorReplaced) {
+    struct Protection {
+        Protection() { setInputProtection(true); }
+        ~Protection() { setInputProtection(false); }
+    } on;
+    const fs::path run = root / "run";
+    fs::create_directories(run);
+    std::ofstream(run / "manifest.json") << kManifest;
+    std::ofstream(run / "my_edit.yaml") << "edited\n";
+    EXPECT_EQ(readFileText((run / "my_edit.yaml").string()), "edited\n");   // read: an input now
+    {
+        OutputFolder out(run.string(), OutputFolder::Mode::ReplaceRun, "manifest.json");
+        out.write("manifest.json", kManifest);
+        EXPECT_THROW(out.commit(), InputError);
+    }
+    EXPECT_EQ(readAll(run / "my_edit.yaml"), "edited\n");
+    {
+        OutputFolder out(run.string(), OutputFolder::Mode::ReplaceRun, "manifest.json");
+        out.write("manifest.json", kManifest);
+        out.write("my_edit.yaml", "edited\n");   // the run copies its input: nothing is lost
+        EXPECT_NO_THROW(out.commit());
+    }
+    const fs::path results = root / "results";
+    fs::create_directories(results);
+    std::ofstream(results / "data.csv") << "1\n";
+    EXPECT_EQ(readFileText((results / "data.csv").string()), "1\n");
+    {
+        OutputFolder out(results.string(), OutputFolder::Mode::AddFiles);
+        out.write("data.csv", "estimates\n");
+        EXPECT_THROW(out.commit(), InputError);
+    }
+    EXPECT_EQ(readAll(results / "data.csv"), "1\n");
+    EXPECT_EQ(countEntries(root), 2);   // run/ and results/: nothing staged or moved aside left
 }

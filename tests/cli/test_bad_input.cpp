@@ -67,6 +67,17 @@ std::vector<BadInput> makeCatalogue() {
     return {
         // ---- command line -----------------------------------------------------------------------
         {"UnknownCommand", {}, "nosuch", {"unknown command 'nosuch'", "expected one of", "muscle"}},
+        // An output never replaces a file the command read (the input here sits where --out writes).
+        {"IdentifyOutputWouldReplaceItsInput",
+         {{"identification_history.csv", armsim::readFileText(armsim::getAssetDirectory() + "/measured/thesis_measured.csv")}},
+         "identify IN/identification_history.csv --out IN", {"would replace", "identification_history.csv", "read as input"}},
+        // A second YAML document would never be read.
+        {"SettingsWithASecondYamlDocument", {{"y.yaml", "type: isometric\nhold: 0.2\n---\ntype: free\n"}},
+         "trial --settings IN/y.yaml --out OUT/t.csv", {"y.yaml:4", "a second YAML document"}},
+        // A folder with someone else's manifest.json is not an armsim run to replace.
+        {"ProtocolOverAForeignManifest", {{"manifest.json", "{}"}, {"precious.txt", "keep"}},
+         "protocol " + armsim::getAssetDirectory() + "/protocols/force_length.yaml --out IN",
+         {"not an armsim run", "manifest.json"}},
         {"UnknownOption", {}, "muscle steady --foo 1", {"--foo"}},
         {"NotANumber", {}, "muscle steady --path abc", {"--path", "abc"}},
         {"MissingOptionValue", {}, "muscle steady --path", {"--path"}},

@@ -444,6 +444,12 @@ TEST(Cli, AStandardOutputThatCannotBeWrittenIsAnError) {
     const armsim::testing::CommandResult full = armsim::testing::runCommand("( " + std::string(ARMSIM_EXE) + " model list >/dev/full )");
     EXPECT_EQ(full.exitCode, 2) << full.output;
     EXPECT_NE(full.output.find("cannot write to standard output: No space left on device"), std::string::npos) << full.output;
+    for (const char* args : {"--version", "--help", "muscle --help"}) {   // help and version too
+        const armsim::testing::CommandResult r =
+            armsim::testing::runCommand("( " + std::string(ARMSIM_EXE) + " " + args + " >/dev/full )");
+        EXPECT_EQ(r.exitCode, 2) << args << "\n" << r.output;
+        EXPECT_NE(r.output.find("cannot write to standard output"), std::string::npos) << args << "\n" << r.output;
+    }
 }
 
 // Issue 15: Ctrl-C (SIGINT) stops a protocol run at its next trial, removes its temporary folder and
@@ -478,7 +484,7 @@ TEST(Cli, AnInterruptedProtocolLeavesNothingAndTheNextRunCleansUpAfterAKilledOne
     const std::string tag = std::to_string(dead);
     fs::create_directories(d / (".quick.partial." + tag) / "trials");
     fs::create_directories(d / (".quick.old." + tag));
-    std::ofstream(d / (".quick.old." + tag) / "manifest.json") << "{}";  // an earlier run, moved aside
+    std::ofstream(d / (".quick.old." + tag) / "manifest.json") << "{\"armsim_version\": \"0.1.0\"}";  // an earlier run, moved aside
     const armsim::testing::CommandResult q =
         runArmsim("protocol protocols/mvc_force_angle.yaml --jobs 2 --out " + (d / "quick").string());
     ASSERT_EQ(q.exitCode, 0) << q.output;
