@@ -33,6 +33,8 @@ constexpr Bound kMuscleMass{0, 10, true, false, "kg"};  ///< a muscle's mass (10
 constexpr Bound kTendonLength{0, 2, true, false, "m"};  ///< a muscle's optimal tendon length L0T
 constexpr Bound kMotorUnits{0, 1000, false, false, ""}; ///< motor units of one fibre type
 constexpr Bound kMaxIsometricForce{0, 1e5, true, false, "N"};  ///< a muscle's F0 (the strongest ~10 kN)
+/// An integrator's relative accuracy: CPodes refuses much below 1e-12 ("too much accuracy requested").
+constexpr Bound kAccuracy{1e-12, 0.1, false, false, ""};
 }  // namespace bounds
 
 /// Throws FieldError naming field, value and bound unless value is finite and inside bound.

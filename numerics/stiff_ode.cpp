@@ -19,7 +19,7 @@
 namespace armsim {
 
 void IntegrationSettings::validate() const {
-    checkField("accuracy", accuracy, Bound::open(0, 1));
+    checkField("accuracy", accuracy, bounds::kAccuracy);
     checkField("max_step", maxStepSize, Bound::nonNegative("s"));
     if (maxStepSize > 0 && maxStepSize < kMinStepSize)
         checkField("max_step", maxStepSize, Bound{kMinStepSize, 1e300, false, false, "s, 0 or at least the 1e-12 s minimum step"});

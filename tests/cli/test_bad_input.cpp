@@ -400,7 +400,7 @@ std::vector<BadInput> makeCatalogue() {
         // options named as typed, in the units typed, checked before any work
         {"TrialAngleNan", {}, "trial --angle nan --out OUT/t.csv", {"--angle = nan", "[40, 180] (deg)"}},
         {"TrialRestNegative", {}, "trial --rest -1 --out OUT/t.csv", {"--rest = -1", "> 0 (s)"}},
-        {"TrialAccuracyOne", {}, "trial --accuracy 1 --out OUT/t.csv", {"--accuracy = 1", "(0, 1)"}},
+        {"TrialAccuracyOne", {}, "trial --accuracy 1 --out OUT/t.csv", {"--accuracy = 1", "[1e-12, 0.1]"}},
         {"FreeTrialInitialAngle", {}, "trial --type free --initial-angle 10 --out OUT/f.csv", {"--initial-angle = 10", "[40, 180] (deg)"}},
         {"FreeTrialLoadHuge", {}, "trial --type free --load 1e6 --out OUT/f.csv", {"--load = 1e+06", "[0, 50] (kg)"}},
         {"ValidateSeedsNegative", {}, "validate --seeds -1 --out OUT/v", {"--seeds = -1", "[0, 1e+06]"}},
@@ -582,6 +582,8 @@ TEST(BoundsTable, EveryEntryPointRefusesOutsideTheSameBound) {
          "muscle steady --muscle IN/m.yaml"},
         {"motor units", armsim::bounds::kMotorUnits, "muscle steady --slow-units 1001",
          {"m.yaml", replaceAll(muscle, "slow: 3", "slow: 1001")}, "muscle steady --muscle IN/m.yaml"},
+        {"integrator accuracy", armsim::bounds::kAccuracy, "trial --hold 0.2 --accuracy 1e-30 --out OUT/t.csv",
+         {"s.yaml", "hold: 0.2\naccuracy: 1e-30\n"}, "trial --settings IN/s.yaml --out OUT/t.csv"},
     };
     for (const Entry& e : table) {
         const fs::path d = armsim::testing::makeFreshDir("bounds_table", replaceAll(e.name, " ", "_"));
