@@ -550,10 +550,9 @@ std::vector<SynergistModel::InputDerivatives> SynergistModel::calcInputDerivativ
     return d;
 }
 
-void SynergistModel::addTorqueDerivatives(const Evaluation& e, const double* x, std::vector<double>& dTorques,
-                                          std::vector<double>& dForearmTorques) const {
+void SynergistModel::addTorqueDerivatives(const Evaluation& e, const std::vector<InputDerivatives>& d, const double* x,
+                                          std::vector<double>& dTorques, std::vector<double>& dForearmTorques) const {
     const int n = getNumParameters();
-    const std::vector<InputDerivatives> d = calcInputDerivatives();
     const int va = x[kActivation] > 0 && x[kActivation] < 1 ? kActivation : -1;   // clamped outside
     const int cc = x[kCoContraction] > 0 && x[kCoContraction] < 1 ? kCoContraction : -1;
     std::vector<double> dForce, dFibre, dRelaxed(n), dRelaxedForearm(n);
@@ -588,10 +587,9 @@ void SynergistModel::addTorqueDerivatives(const Evaluation& e, const double* x, 
         }
 }
 
-void SynergistModel::calcChannelDerivatives(const Evaluation& e, const double* x, const std::vector<double>& channels,
-                                            std::vector<double>& dChannels) const {
+void SynergistModel::calcChannelDerivatives(const Evaluation& e, const std::vector<InputDerivatives>& d, const double* x,
+                                            const std::vector<double>& channels, std::vector<double>& dChannels) const {
     const int n = getNumParameters();
-    const std::vector<InputDerivatives> d = calcInputDerivatives();
     const int va = x[kActivation] > 0 && x[kActivation] < 1 ? kActivation : -1;
     const int cc = x[kCoContraction] > 0 && x[kCoContraction] < 1 ? kCoContraction : -1;
     std::vector<double> dForce, dFibre;
@@ -636,8 +634,9 @@ void SynergistModel::calcPredictionJacobian(const double* x, std::vector<double>
     bool analytic = haveSensitivities(e.relaxed);
     for (const SteadyMvcCurve& curve : e.active) analytic = analytic && haveSensitivities(curve);
     if (analytic) {
-        addTorqueDerivatives(e, x, dTorques, dForearmTorques);
-        calcChannelDerivatives(e, x, channels, dChannels);
+        const std::vector<InputDerivatives> d = calcInputDerivatives();   // once for both
+        addTorqueDerivatives(e, d, x, dTorques, dForearmTorques);
+        calcChannelDerivatives(e, d, x, channels, dChannels);
     }
     // Columns by central differences (Ceres's steps): the slow-fraction shifts when free, or every
     // column when a muscle has no steady sensitivity.

@@ -219,10 +219,10 @@ private:
     void readPredictions(const Evaluation& e, std::vector<double>& torques, std::vector<double>& forearmTorques,
                          std::vector<double>& channels) const;
     std::vector<InputDerivatives> calcInputDerivatives() const;   // [muscle]
-    void addTorqueDerivatives(const Evaluation& e, const double* x, std::vector<double>& dTorques,
-                              std::vector<double>& dForearmTorques) const;
-    void calcChannelDerivatives(const Evaluation& e, const double* x, const std::vector<double>& channels,
-                                std::vector<double>& dChannels) const;
+    void addTorqueDerivatives(const Evaluation& e, const std::vector<InputDerivatives>& d, const double* x,
+                              std::vector<double>& dTorques, std::vector<double>& dForearmTorques) const;
+    void calcChannelDerivatives(const Evaluation& e, const std::vector<InputDerivatives>& d, const double* x,
+                                const std::vector<double>& channels, std::vector<double>& dChannels) const;
     /// Frees the rotators' scales within the mass scales' bounds (the data read the forearm axis).
     void freeRotatorMass();
     /// Index of the pose (flexion, forearm rotation; NaN = the model's posture, kept as +inf), added if new.
