@@ -3,6 +3,7 @@
 #include "basics/files.h"
 
 #include <yaml-cpp/depthguard.h>
+#include <yaml-cpp/eventhandler.h>
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
@@ -59,18 +60,58 @@ void checkKeysAndSize(const YAML::Node& n, const std::string& source, int depth,
     }
 }
 
+/// Notes whether a parsed document holds anything but a null (a bare '---' or a trailing one holds nothing).
+class ContentFinder : public YAML::EventHandler {
+public:
+    bool hasContent = false;
+    YAML::Mark start;     ///< where the document starts ('---' or its first token)
+    YAML::Mark content;   ///< where its first value starts
+    void OnDocumentStart(const YAML::Mark& mark) override { start = mark; }
+    void OnDocumentEnd() override {}
+    void OnNull(const YAML::Mark&, YAML::anchor_t) override {}
+    void OnAlias(const YAML::Mark& mark, YAML::anchor_t) override { noteContent(mark); }
+    void OnScalar(const YAML::Mark& mark, const std::string&, YAML::anchor_t, const std::string&) override {
+        noteContent(mark);
+    }
+    void OnSequenceStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t,
+                         YAML::EmitterStyle::value) override {
+        noteContent(mark);
+    }
+    void OnSequenceEnd() override {}
+    void OnMapStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t, YAML::EmitterStyle::value) override {
+        noteContent(mark);
+    }
+    void OnMapEnd() override {}
+
+private:
+    void noteContent(const YAML::Mark& mark) {
+        if (!hasContent) content = mark;
+        hasContent = true;
+    }
+};
+
+/// Refuses a second document with content. yaml-cpp 0.7's LoadAll never ends on some malformed input (a
+/// token no node starts with is never consumed; jbeder/yaml-cpp#1319), so the parser is asked for two
+/// documents only, and a document that did not move past the first one's start is not a second one.
+void checkSingleDocument(const std::string& text, const std::string& sourceName) {
+    std::istringstream in(text);
+    YAML::Parser parser(in);
+    ContentFinder first;
+    if (!parser.HandleNextDocument(first)) return;
+    ContentFinder second;
+    if (!parser.HandleNextDocument(second) || !second.hasContent || second.start.pos <= first.start.pos) return;
+    throw InputError(sourceName + ":" + std::to_string(second.content.line + 1) +
+                     ": a second YAML document (after '---'): expected one document per file");
+}
+
 }  // namespace
 
 ParamNode ParamNode::loadString(const std::string& text, const std::string& sourceName) {
     auto impl = std::make_shared<Impl>();
     impl->source = sourceName;
     try {
-        const std::vector<YAML::Node> documents = YAML::LoadAll(text);
-        if (!documents.empty()) impl->node = documents.front();
-        for (std::size_t k = 1; k < documents.size(); ++k)   // a second '---' document: never read, so refused
-            if (!documents[k].IsNull())
-                throw InputError(sourceName + ":" + std::to_string(documents[k].Mark().line + 1) +
-                                 ": a second YAML document (after '---'): expected one document per file");
+        impl->node = YAML::Load(text);
+        checkSingleDocument(text, sourceName);   // a second '---' document would never be read
     } catch (const YAML::DeepRecursion& e) {  // yaml-cpp says only "bad file"
         throw InputError(sourceName + ":" + std::to_string(e.mark.line + 1) + ": nested deeper than " +
                          std::to_string(e.depth()) + " levels: expected a parameter file");

@@ -2,7 +2,6 @@
 #include "basics/numbers.h"
 
 #include "basics/bound.h"
-#include "basics/csv.h"
 #include "estimation/statistics.h"
 
 #include <algorithm>
@@ -50,35 +49,76 @@ MuscleEstimate identifyElbowMethod(const ElbowMethod& method, const Population& 
     return e;
 }
 
+#define ARMSIM_AT(member) [](auto& r) -> auto& { return r.member; }
+
+const FieldTable<TorqueEstimateRow>& getTorqueEstimateFields() {
+    using R = TorqueEstimateRow;
+    static const FieldTable<R> fields({
+        textField<R>("method", ARMSIM_AT(estimate.method)),
+        boolField<R>("converged", ARMSIM_AT(estimate.converged)),
+        numberField<R>("mass_kg", "kg", ARMSIM_AT(estimate.mass)),
+        numberField<R>("mass_lower_kg", "kg", ARMSIM_AT(estimate.massLower)),
+        numberField<R>("mass_upper_kg", "kg", ARMSIM_AT(estimate.massUpper)),
+        numberField<R>("tendon_length_m", "m", ARMSIM_AT(estimate.tendonLength)),
+        numberField<R>("tendon_lower_m", "m", ARMSIM_AT(estimate.tendonLower)),
+        numberField<R>("tendon_upper_m", "m", ARMSIM_AT(estimate.tendonUpper)),
+        numberField<R>("rms_residual_Nm", "N m", ARMSIM_AT(check.rms)),
+        numberField<R>("chi_square", "1", ARMSIM_AT(check.chiSquare)),
+        integerField<R>("dof", "", ARMSIM_AT(check.dof)),
+        numberField<R>("p_value", "1", ARMSIM_AT(check.p)),
+        numberField<R>("noise_level", "1", ARMSIM_AT(noiseLevel)),
+        numberField<R>("max_force_N", "N", ARMSIM_AT(estimate.maxForce)),
+        numberField<R>("max_force_lower_N", "N", ARMSIM_AT(estimate.maxForceLower)),
+        numberField<R>("max_force_upper_N", "N", ARMSIM_AT(estimate.maxForceUpper)),
+        numberField<R>("specific_tension_N_per_m2", "N/m^2", ARMSIM_AT(estimate.specificTension)),
+    });
+    return fields;
+}
+
+namespace {
+
+/// A channel fit's verdict: the prior's check holds or conflicts; a data channel is within its noise or
+/// a misfit (p < 0.05).
+std::string getChannelVerdict(const ChannelFit& f) {
+    const bool prior = f.channel == "prior";
+    return f.p >= 0.05 ? (prior ? "holds" : "noise") : (prior ? "conflict" : "misfit");
+}
+
+}  // namespace
+
+const FieldTable<ChannelFitRow>& getChannelFitFields() {
+    using R = ChannelFitRow;
+    Field<R> verdict{"verdict", "", [](const R& r, CsvRow& row) { row.addText(getChannelVerdict(r.fit)); },
+                     nullptr,   // follows from p: not read back
+                     [](const R& r) { return nlohmann::json(getChannelVerdict(r.fit)); }, "verdict",
+                     [](const R& r) { return nlohmann::json(getChannelVerdict(r.fit)); }};
+    static const FieldTable<R> fields({
+        textField<R>("method", ARMSIM_AT(method)),
+        textField<R>("channel", ARMSIM_AT(fit.channel)),
+        integerField<R>("n", "", ARMSIM_AT(fit.n)),
+        numberField<R>("chi_square", "1", ARMSIM_AT(fit.chiSquare)),
+        numberField<R>("p_value", "1", ARMSIM_AT(fit.p)),
+        verdict,
+        textField<R>("worst", ARMSIM_AT(fit.worst)),
+        numberField<R>("worst_residual_sd", "1", ARMSIM_AT(fit.worstResidual)),
+    });
+    return fields;
+}
+
+#undef ARMSIM_AT
+
 std::string formatTorqueEstimatesCsv(const std::vector<TorqueObservation>& data,
                                      const std::vector<MuscleEstimate>& estimates, double noiseLevel) {
-    CsvText csv({"method", "converged", "mass_kg", "mass_lower_kg", "mass_upper_kg", "tendon_length_m",
-                 "tendon_lower_m", "tendon_upper_m", "rms_residual_Nm", "chi_square", "dof", "p_value", "noise_level",
-                 "max_force_N", "max_force_lower_N", "max_force_upper_N", "specific_tension_N_per_m2"});
-    for (const MuscleEstimate& e : estimates) {
-        const TorqueResidualCheck c = checkTorqueResiduals(data, e, noiseLevel);
-        CsvRow row;
-        row.addText(e.method).addInteger(e.converged ? 1 : 0).addNumber(e.mass).addNumber(e.massLower);
-        row.addNumber(e.massUpper).addNumber(e.tendonLength).addNumber(e.tendonLower).addNumber(e.tendonUpper);
-        row.addNumber(c.rms).addNumber(c.chiSquare).addInteger(c.dof).addNumber(c.p).addNumber(noiseLevel);
-        row.addNumber(e.maxForce).addNumber(e.maxForceLower).addNumber(e.maxForceUpper).addNumber(e.specificTension);
-        csv.addRow(row);
-    }
-    return csv.getText();
+    std::vector<TorqueEstimateRow> rows;
+    for (const MuscleEstimate& e : estimates) rows.push_back({e, checkTorqueResiduals(data, e, noiseLevel), noiseLevel});
+    return getTorqueEstimateFields().formatCsv(rows);
 }
 
 std::string formatChannelFitsCsv(const std::vector<MuscleEstimate>& estimates) {
-    CsvText csv({"method", "channel", "n", "chi_square", "p_value", "verdict", "worst", "worst_residual_sd"});
+    std::vector<ChannelFitRow> rows;
     for (const MuscleEstimate& e : estimates)
-        for (const ChannelFit& f : e.channelFits) {
-            CsvRow row;
-            row.addText(e.method).addText(f.channel).addInteger(f.n).addNumber(f.chiSquare).addNumber(f.p);
-            const bool prior = f.channel == "prior";  // the prior's check: the person fits the population or not
-            row.addText(f.p >= 0.05 ? (prior ? "holds" : "noise") : (prior ? "conflict" : "misfit"));
-            row.addText(f.worst).addNumber(f.worstResidual);
-            csv.addRow(row);
-        }
-    return csv.getText();
+        for (const ChannelFit& f : e.channelFits) rows.push_back({e.method, f});
+    return getChannelFitFields().formatCsv(rows);
 }
 
 std::string formatTorquePredictionsCsv(const std::vector<TorqueObservation>& data,

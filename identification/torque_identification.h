@@ -2,6 +2,8 @@
 // studies): the identifiers by name, the set run on a lab's data, residual checks and the CSV tables.
 #pragma once
 
+#include "basics/fields.h"
+
 #include "basics/numbers.h"
 
 #include "identification/synergist_identifier.h"
@@ -45,6 +47,19 @@ struct TorqueResidualCheck {
 };
 TorqueResidualCheck checkTorqueResiduals(const std::vector<TorqueObservation>& data, const MuscleEstimate& estimate,
                                          double noiseLevel);
+/// One row of torque_estimates.csv: an estimate, its residual check and the noise level it was judged at.
+struct TorqueEstimateRow {
+    MuscleEstimate estimate;
+    TorqueResidualCheck check;
+    double noiseLevel = kNaN;   ///< relative torque sd [1]
+};
+const FieldTable<TorqueEstimateRow>& getTorqueEstimateFields();
+/// One row of channel_fits.csv: an estimate's method and one of its channel fits.
+struct ChannelFitRow {
+    std::string method;
+    ChannelFit fit;
+};
+const FieldTable<ChannelFitRow>& getChannelFitFields();
 /// torque_estimates.csv of `armsim identify-torque`: per estimate its interval, its residual check against
 /// noiseLevel (checkTorqueResiduals) and the noise level.
 std::string formatTorqueEstimatesCsv(const std::vector<TorqueObservation>& data,

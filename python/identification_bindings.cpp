@@ -241,25 +241,6 @@ double optionalNumber(const std::optional<double>& v, const char* argument) {
     return *v;
 }
 
-/// A list of rows as columns: numbers become float64 arrays, strings lists.
-struct Columns {
-    py::dict d;
-    void add(const char* name, double v) { column(name).append(v); }
-    void add(const char* name, const std::string& v) { column(name).append(v); }
-    py::list column(const char* name) {
-        if (!d.contains(name)) d[name] = py::list();
-        return d[name].cast<py::list>();
-    }
-    py::dict finish() {
-        py::dict out;
-        for (auto item : d) {
-            py::list l = item.second.cast<py::list>();
-            out[item.first] = l.size() && py::isinstance<py::str>(l[0]) ? py::object(l)
-                                                                       : py::object(py::array_t<double>(l));
-        }
-        return out;
-    }
-};
 
 py::dict toDict(const TorqueCondition& c) {
     py::dict d;
@@ -421,25 +402,7 @@ py::dict validatePy(const Model& m, int seeds, unsigned seed, const std::vector<
     runInterruptible([&] {
         rows = runValidation(m.setup.arm, m.setup.calcBicepsParameters(), s);
     });
-    Columns c;
-    for (const ValidationRow& r : rows) {
-        c.add("truth", r.truth);
-        c.add("noise", r.noise);
-        c.add("method", r.method);
-        c.add("true_mass_kg", r.trueMass);
-        c.add("true_tendon_length_m", r.trueTendonLength);
-        c.add("mass_kg", r.mass);
-        c.add("tendon_length_m", r.tendonLength);
-        c.add("mass_error", r.massError);
-        c.add("tendon_length_error_m", r.tendonLengthError);
-        c.add("mass_covered", r.massCovered);
-        c.add("tendon_length_covered", r.tendonLengthCovered);
-        c.add("stop_reason", r.stopReason);
-        c.add("iterations", r.iterations);
-        c.add("evaluations", r.evaluations);
-        c.add("wall_time_s", r.wallTime);
-    }
-    return c.finish();
+    return toFieldColumns(getValidationFields(), rows);
 }
 
 py::tuple validateElbowPy(const py::object& population, int subjects, unsigned seed,
@@ -473,48 +436,10 @@ py::tuple validateElbowPy(const py::object& population, int subjects, unsigned s
     runInterruptible([&] {
         rows = runElbowValidation(pop, priorPop, s);
     });
-    Columns c;
-    for (const ElbowValidationRow& r : rows) {
-        c.add("subject", r.subject);
-        c.add("noise", r.noise);
-        c.add("method", r.method);
-        c.add("true_mass_kg", r.trueMass);
-        c.add("true_tendon_length_m", r.trueTendonLength);
-        c.add("mass_kg", r.estimate.mass);
-        c.add("tendon_length_m", r.estimate.tendonLength);
-        c.add("mass_lower_kg", r.estimate.massLower);
-        c.add("mass_upper_kg", r.estimate.massUpper);
-        c.add("tendon_lower_m", r.estimate.tendonLower);
-        c.add("tendon_upper_m", r.estimate.tendonUpper);
-        c.add("converged", r.estimate.converged);
-        c.add("mass_error", r.massError);
-        c.add("tendon_error_m", r.tendonError);
-        c.add("mass_covered", r.massCovered);
-        c.add("tendon_covered", r.tendonCovered);
-        c.add("voluntary_activation", r.voluntaryActivation);
-        c.add("co_contraction", r.coContraction);
-        c.add("strength_level", r.strengthLevel);
-        c.add("biceps_short_scale", r.bicepsShortScale);
-        c.add("synergist_scale", r.synergistScale);
-    }
     py::list summary;
-    for (const ElbowValidationSummary& x : summarizeElbowValidation(rows)) {
-        py::dict d;
-        d["method"] = x.method;
-        d["noise"] = x.noise;
-        d["subjects"] = x.subjects;
-        d["converged"] = x.converged;
-        d["mass_bias"] = x.massBias;
-        d["mass_rmse"] = x.massRmse;
-        d["tendon_bias_m"] = x.tendonBias;
-        d["tendon_rmse_m"] = x.tendonRmse;
-        d["mass_coverage"] = x.massCoverage;
-        d["tendon_coverage"] = x.tendonCoverage;
-        d["mass_interval_width"] = x.massIntervalWidth;
-        d["tendon_interval_width_m"] = x.tendonIntervalWidth;
-        summary.append(d);
-    }
-    return py::make_tuple(c.finish(), summary);
+    for (const ElbowValidationSummary& x : summarizeElbowValidation(rows))
+        summary.append(toFieldDict(getElbowValidationSummaryFields(), x));
+    return py::make_tuple(toFieldColumns(getElbowValidationFields(), rows), summary);
 }
 
 py::dict designPy(const py::object& population, const std::vector<double>& angles,

@@ -4,6 +4,7 @@
 #pragma once
 
 #include "basics/errors.h"
+#include "basics/fields.h"
 #include "basics/table.h"
 #include "model/model_file.h"
 
@@ -11,10 +12,8 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
-#include <string>
+#include <cmath>
 #include <map>
-#include <vector>
-
 #include <string>
 #include <type_traits>
 #include <utility>
@@ -48,6 +47,42 @@ Table toTable(const py::dict& columns, const std::string& what);
 py::array_t<double> toArray(const std::vector<double>& values);
 /// Rows (equal lengths) as an (n, m) float64 array.
 py::array_t<double> toArray(const std::vector<std::vector<double>>& rows);
+
+/// Result rows as columns under their fields' SI names (basics/fields.h): text fields as lists of str,
+/// every other field (numbers, counts, yes/no, flags -1/0/1) as a float64 array, missing numbers NaN.
+template <class T>
+py::dict toFieldColumns(const FieldTable<T>& table, const std::vector<T>& rows) {
+    py::dict out;
+    for (const Field<T>& f : table.getFields()) {
+        py::list text;
+        std::vector<double> numbers;
+        for (const T& r : rows) {
+            const nlohmann::json v = f.toSi(r);
+            if (v.is_string()) text.append(v.template get<std::string>());
+            else numbers.push_back(v.is_null() ? std::nan("") : v.is_boolean() ? double(v.template get<bool>())
+                                                                              : v.template get<double>());
+        }
+        if (!text.empty()) out[py::str(f.siName)] = text;
+        else out[py::str(f.siName)] = toArray(numbers);
+    }
+    return out;
+}
+
+/// One result as a dict under its fields' SI names: numbers as float (NaN when missing), counts as
+/// int, yes/no as bool, flags -1/0/1, text as str.
+template <class T>
+py::dict toFieldDict(const FieldTable<T>& table, const T& r) {
+    py::dict d;
+    for (const Field<T>& f : table.getFields()) {
+        const nlohmann::json v = f.toSi(r);
+        if (v.is_null()) d[py::str(f.siName)] = std::nan("");
+        else if (v.is_string()) d[py::str(f.siName)] = v.template get<std::string>();
+        else if (v.is_boolean()) d[py::str(f.siName)] = v.template get<bool>();
+        else if (v.is_number_integer()) d[py::str(f.siName)] = v.template get<long long>();
+        else d[py::str(f.siName)] = v.template get<double>();
+    }
+    return d;
+}
 
 /// A str or os.PathLike argument as a path string; TypeError naming the argument and the type given
 /// otherwise.

@@ -1,4 +1,5 @@
 #include "studies/study.h"
+
 #include "basics/numbers.h"
 
 #include "basics/format.h"
@@ -35,22 +36,6 @@ std::uint64_t hashFnv1a(const std::string& text, std::uint64_t h = 1469598103934
 }
 
 std::string toHex(std::uint64_t v) { return fmt::format("{:016x}", v); }
-
-bool parseDouble(const std::string& s, double& v) {
-    if (s.empty()) {
-        v = kNaN;
-        return true;
-    }
-    const char* b = s.data();
-    const auto r = std::from_chars(b, b + s.size(), v);
-    return r.ec == std::errc() && r.ptr == b + s.size();
-}
-
-bool parseLong(const std::string& s, long& v) {
-    const char* b = s.data();
-    const auto r = std::from_chars(b, b + s.size(), v);
-    return !s.empty() && r.ec == std::errc() && r.ptr == b + s.size();
-}
 
 // Strict UTF-8: no overlong forms, surrogates or code points past U+10FFFF.
 bool isValidUtf8(const std::string& text) {
@@ -383,88 +368,53 @@ std::vector<StudyResult> runStudyGroup(const Study& study, long group, const std
 
 namespace {
 
-// results.csv's columns, each with how a result is written to its cell and read back from it: the one
-// description of a result that results.csv's header, its rows and the journal's lines all follow.
-struct ResultField {
-    const char* name;
-    std::function<std::string(const StudyResult&)> write;
-    std::function<bool(const std::string&, StudyResult&)> read;
-};
-
-// Fields by kind; `at` is a generic lambda giving the member of a (const or not) StudyResult.
-template <class At>
-ResultField numberField(const char* name, At at) {
-    return {name, [at](const StudyResult& r) { return CsvRow().addNumber(at(r)).getText(); },
-            [at](const std::string& s, StudyResult& r) { return parseDouble(s, at(r)); }};
-}
-template <class At>
-ResultField integerField(const char* name, At at) {
-    return {name, [at](const StudyResult& r) { return std::to_string(at(r)); },
-            [at](const std::string& s, StudyResult& r) {
-                long v = 0;
-                if (!parseLong(s, v)) return false;
-                at(r) = static_cast<std::remove_reference_t<decltype(at(r))>>(v);
-                return true;
-            }};
-}
-template <class At>
-ResultField textField(const char* name, At at) {
-    return {name, [at](const StudyResult& r) { return CsvRow().addText(at(r)).getText(); },
-            [at](const std::string& s, StudyResult& r) { return at(r) = s, true; }};
-}
-// 1/0: covered or not; empty: no interval (-1).
-template <class At>
-ResultField flagField(const char* name, At at) {
-    return {name, [at](const StudyResult& r) { return at(r) < 0 ? std::string() : std::to_string(at(r)); },
-            [at](const std::string& s, StudyResult& r) {
-                if (s.empty()) return at(r) = -1, true;
-                if (s != "0" && s != "1") return false;
-                return at(r) = s == "1", true;
-            }};
-}
-
+// results.csv's columns: the one description of a result that results.csv's header, its rows and the
+// journal's lines all follow.
 #define ARMSIM_AT(member) [](auto& r) -> auto& { return r.member; }
 
-const std::vector<ResultField>& getResultFields() {
-    static const std::vector<ResultField> fields = {
-        integerField("task", ARMSIM_AT(task)),
-        textField("truth", ARMSIM_AT(truth)),
-        integerField("subject", ARMSIM_AT(row.subject)),
-        textField("protocol", ARMSIM_AT(protocol)),
-        {"method", [](const StudyResult& r) { return CsvRow().addText(r.row.method).getText(); },
-         [](const std::string& s, StudyResult& r) { return r.row.method = r.row.estimate.method = s, true; }},
-        numberField("noise", ARMSIM_AT(row.noise)),
-        textField("status", ARMSIM_AT(status)),
-        numberField("true_mass_kg", ARMSIM_AT(row.trueMass)),
-        numberField("mass_kg", ARMSIM_AT(row.estimate.mass)),
-        numberField("mass_lower_kg", ARMSIM_AT(row.estimate.massLower)),
-        numberField("mass_upper_kg", ARMSIM_AT(row.estimate.massUpper)),
-        numberField("mass_error", ARMSIM_AT(row.massError)),
-        flagField("mass_covered", ARMSIM_AT(row.massCovered)),
-        numberField("true_tendon_length_m", ARMSIM_AT(row.trueTendonLength)),
-        numberField("tendon_length_m", ARMSIM_AT(row.estimate.tendonLength)),
-        numberField("tendon_lower_m", ARMSIM_AT(row.estimate.tendonLower)),
-        numberField("tendon_upper_m", ARMSIM_AT(row.estimate.tendonUpper)),
-        numberField("tendon_error_m", ARMSIM_AT(row.tendonError)),
-        flagField("tendon_covered", ARMSIM_AT(row.tendonCovered)),
-        numberField("true_max_force_N", ARMSIM_AT(row.trueMaxForce)),
-        numberField("max_force_N", ARMSIM_AT(row.estimate.maxForce)),
-        numberField("max_force_lower_N", ARMSIM_AT(row.estimate.maxForceLower)),
-        numberField("max_force_upper_N", ARMSIM_AT(row.estimate.maxForceUpper)),
-        numberField("max_force_error", ARMSIM_AT(row.maxForceError)),
-        flagField("max_force_covered", ARMSIM_AT(row.maxForceCovered)),
-        numberField("noise_estimate", ARMSIM_AT(row.estimate.noiseLevel)),
-        numberField("rms_residual_Nm", ARMSIM_AT(row.estimate.rmsResidual)),
-        integerField("iterations", ARMSIM_AT(row.estimate.iterations)),
-        integerField("parameters", ARMSIM_AT(row.estimate.numParameters)),
-        numberField("mass_tendon_correlation", ARMSIM_AT(row.estimate.massTendonCorrelation)),
-        numberField("voluntary_activation", ARMSIM_AT(row.voluntaryActivation)),
-        numberField("co_contraction", ARMSIM_AT(row.coContraction)),
-        numberField("strength_level", ARMSIM_AT(row.strengthLevel)),
-        numberField("biceps_short_scale", ARMSIM_AT(row.bicepsShortScale)),
-        numberField("synergist_scale", ARMSIM_AT(row.synergistScale)),
-        textField("reason", ARMSIM_AT(reason)),
-    };
+const FieldTable<StudyResult>& getResultFields() {
+    using R = StudyResult;
+    static const FieldTable<R> fields({
+        integerField<R>("task", "", ARMSIM_AT(task)),
+        textField<R>("truth", ARMSIM_AT(truth)),
+        integerField<R>("subject", "", ARMSIM_AT(row.subject)),
+        textField<R>("protocol", ARMSIM_AT(protocol)),
+        {"method", "", [](const R& r, CsvRow& row) { row.addText(r.row.method); },
+         [](const std::string& s, R& r) { return r.row.method = r.row.estimate.method = s, true; },
+         [](const R& r) { return nlohmann::json(r.row.method); }, "method",
+         [](const R& r) { return nlohmann::json(r.row.method); }},
+        numberField<R>("noise", "1", ARMSIM_AT(row.noise)),
+        textField<R>("status", ARMSIM_AT(status)),
+        numberField<R>("true_mass_kg", "kg", ARMSIM_AT(row.trueMass)),
+        numberField<R>("mass_kg", "kg", ARMSIM_AT(row.estimate.mass)),
+        numberField<R>("mass_lower_kg", "kg", ARMSIM_AT(row.estimate.massLower)),
+        numberField<R>("mass_upper_kg", "kg", ARMSIM_AT(row.estimate.massUpper)),
+        numberField<R>("mass_error", "1", ARMSIM_AT(row.massError)),
+        flagField<R>("mass_covered", ARMSIM_AT(row.massCovered)),
+        numberField<R>("true_tendon_length_m", "m", ARMSIM_AT(row.trueTendonLength)),
+        numberField<R>("tendon_length_m", "m", ARMSIM_AT(row.estimate.tendonLength)),
+        numberField<R>("tendon_lower_m", "m", ARMSIM_AT(row.estimate.tendonLower)),
+        numberField<R>("tendon_upper_m", "m", ARMSIM_AT(row.estimate.tendonUpper)),
+        numberField<R>("tendon_error_m", "m", ARMSIM_AT(row.tendonError)),
+        flagField<R>("tendon_covered", ARMSIM_AT(row.tendonCovered)),
+        numberField<R>("true_max_force_N", "N", ARMSIM_AT(row.trueMaxForce)),
+        numberField<R>("max_force_N", "N", ARMSIM_AT(row.estimate.maxForce)),
+        numberField<R>("max_force_lower_N", "N", ARMSIM_AT(row.estimate.maxForceLower)),
+        numberField<R>("max_force_upper_N", "N", ARMSIM_AT(row.estimate.maxForceUpper)),
+        numberField<R>("max_force_error", "1", ARMSIM_AT(row.maxForceError)),
+        flagField<R>("max_force_covered", ARMSIM_AT(row.maxForceCovered)),
+        numberField<R>("noise_estimate", "1", ARMSIM_AT(row.estimate.noiseLevel)),
+        numberField<R>("rms_residual_Nm", "N m", ARMSIM_AT(row.estimate.rmsResidual)),
+        integerField<R>("iterations", "", ARMSIM_AT(row.estimate.iterations)),
+        integerField<R>("parameters", "", ARMSIM_AT(row.estimate.numParameters)),
+        numberField<R>("mass_tendon_correlation", "1", ARMSIM_AT(row.estimate.massTendonCorrelation)),
+        numberField<R>("voluntary_activation", "1", ARMSIM_AT(row.voluntaryActivation)),
+        numberField<R>("co_contraction", "1", ARMSIM_AT(row.coContraction)),
+        numberField<R>("strength_level", "1", ARMSIM_AT(row.strengthLevel)),
+        numberField<R>("biceps_short_scale", "1", ARMSIM_AT(row.bicepsShortScale)),
+        numberField<R>("synergist_scale", "1", ARMSIM_AT(row.synergistScale)),
+        textField<R>("reason", ARMSIM_AT(reason)),
+    });
     return fields;
 }
 
@@ -472,18 +422,11 @@ const std::vector<ResultField>& getResultFields() {
 
 }  // namespace
 
-std::string getStudyResultsHeader() {
-    std::string header;
-    for (const ResultField& f : getResultFields()) header += (header.empty() ? "" : ",") + std::string(f.name);
-    return header;
-}
+const FieldTable<StudyResult>& getStudyResultFields() { return getResultFields(); }
 
-std::string formatStudyResult(const StudyResult& r) {
-    const std::vector<ResultField>& fields = getResultFields();
-    std::string line;
-    for (std::size_t i = 0; i < fields.size(); ++i) line += (i ? "," : "") + fields[i].write(r);
-    return line;
-}
+std::string getStudyResultsHeader() { return getResultFields().getHeader(); }
+
+std::string formatStudyResult(const StudyResult& r) { return getResultFields().formatRow(r).getText(); }
 
 std::string formatStudyJournalLine(const StudyResult& r) {
     const std::string body = formatStudyResult(r) + '\t' + formatNumber(r.synthesisTime) + ',' +
@@ -499,13 +442,11 @@ bool parseStudyJournalLine(const std::string& line, StudyResult& r) {
     if (tab == std::string::npos) return false;
     const std::vector<std::string> c = splitCsvRecord(body.substr(0, tab)),
                                    timing = splitCsvRecord(body.substr(tab + 1));
-    const std::vector<ResultField>& fields = getResultFields();
-    if (c.size() != fields.size() || timing.size() != 3) return false;
+    if (timing.size() != 3) return false;
     r = StudyResult();
-    for (std::size_t i = 0; i < fields.size(); ++i)
-        if (!fields[i].read(c[i], r)) return false;
+    if (!getResultFields().parseRow(c, r)) return false;
     long rank = 0;
-    if (!parseDouble(timing[0], r.synthesisTime) || !parseDouble(timing[1], r.identificationTime) || !parseLong(timing[2], rank))
+    if (!parseCsvNumber(timing[0], r.synthesisTime) || !parseCsvNumber(timing[1], r.identificationTime) || !parseCsvInteger(timing[2], rank))
         return false;
     r.rank = int(rank);
     r.row.estimate.converged = r.status == "ok";
@@ -516,7 +457,7 @@ long peekStudyJournalTask(const std::string& line) {
     long task = -1;
     if (line.size() > 17 && line[16] == ' ') {
         const std::size_t comma = line.find(',', 17);
-        if (!parseLong(line.substr(17, comma == std::string::npos ? std::string::npos : comma - 17), task)) task = -1;
+        if (!parseCsvInteger(line.substr(17, comma == std::string::npos ? std::string::npos : comma - 17), task)) task = -1;
     }
     return task;
 }

@@ -28,6 +28,8 @@
 // never stops the study.
 #pragma once
 
+#include "basics/fields.h"
+
 #include "studies/torque_validation.h"
 
 #include <cstdint>
@@ -129,6 +131,8 @@ struct StudyResult {
 /// identification error is that task's "failed" result with the message.
 std::vector<StudyResult> runStudyGroup(const Study& study, long group, const std::vector<long>& tasks, int rank = 0);
 
+/// results.csv's fields (basics/fields.h): its header, rows and the journal's lines are made from them.
+const FieldTable<StudyResult>& getStudyResultFields();
 /// Column names of results.csv.
 std::string getStudyResultsHeader();
 /// One results.csv line (no newline); every number in shortest round-trip form.

@@ -227,50 +227,84 @@ std::vector<ElbowValidationSummary> ElbowValidationAccumulator::getSummaries() c
     return out;
 }
 
+#define ARMSIM_AT(member) [](auto& r) -> auto& { return r.member; }
+
+const FieldTable<ElbowValidationRow>& getElbowValidationFields() {
+    using R = ElbowValidationRow;
+    static const FieldTable<R> fields({
+        integerField<R>("subject", "", ARMSIM_AT(subject)),
+        numberField<R>("noise", "1", ARMSIM_AT(noise)),
+        textField<R>("method", ARMSIM_AT(method)),
+        boolField<R>("converged", ARMSIM_AT(estimate.converged)),
+        numberField<R>("true_mass_kg", "kg", ARMSIM_AT(trueMass)),
+        numberField<R>("mass_kg", "kg", ARMSIM_AT(estimate.mass)),
+        numberField<R>("mass_lower_kg", "kg", ARMSIM_AT(estimate.massLower)),
+        numberField<R>("mass_upper_kg", "kg", ARMSIM_AT(estimate.massUpper)),
+        numberField<R>("mass_error_pct", "%", ARMSIM_AT(massError), 100),
+        flagField<R>("mass_covered", ARMSIM_AT(massCovered)),
+        numberField<R>("true_tendon_length_m", "m", ARMSIM_AT(trueTendonLength)),
+        numberField<R>("tendon_length_m", "m", ARMSIM_AT(estimate.tendonLength)),
+        numberField<R>("tendon_lower_m", "m", ARMSIM_AT(estimate.tendonLower)),
+        numberField<R>("tendon_upper_m", "m", ARMSIM_AT(estimate.tendonUpper)),
+        numberField<R>("tendon_error_mm", "mm", ARMSIM_AT(tendonError), 1000),
+        flagField<R>("tendon_covered", ARMSIM_AT(tendonCovered)),
+        numberField<R>("voluntary_activation", "1", ARMSIM_AT(voluntaryActivation)),
+        numberField<R>("co_contraction", "1", ARMSIM_AT(coContraction)),
+        numberField<R>("strength_level", "1", ARMSIM_AT(strengthLevel)),
+        numberField<R>("biceps_short_scale", "1", ARMSIM_AT(bicepsShortScale)),
+        numberField<R>("synergist_scale", "1", ARMSIM_AT(synergistScale)),
+        numberField<R>("noise_level_used", "1", ARMSIM_AT(estimate.noiseLevel)),
+        numberField<R>("rms_residual_Nm", "N m", ARMSIM_AT(estimate.rmsResidual)),
+        numberField<R>("true_max_force_N", "N", ARMSIM_AT(trueMaxForce)),
+        numberField<R>("max_force_N", "N", ARMSIM_AT(estimate.maxForce)),
+        numberField<R>("max_force_lower_N", "N", ARMSIM_AT(estimate.maxForceLower)),
+        numberField<R>("max_force_upper_N", "N", ARMSIM_AT(estimate.maxForceUpper)),
+        numberField<R>("max_force_error_pct", "%", ARMSIM_AT(maxForceError), 100),
+        flagField<R>("max_force_covered", ARMSIM_AT(maxForceCovered)),
+        numberField<R>("prior_check_p", "1", ARMSIM_AT(priorCheckP)),
+    });
+    return fields;
+}
+
+const FieldTable<ElbowValidationSummary>& getElbowValidationSummaryFields() {
+    using S = ElbowValidationSummary;
+    static const FieldTable<S> fields({
+        textField<S>("method", ARMSIM_AT(method)),
+        numberField<S>("noise", "1", ARMSIM_AT(noise)),
+        integerField<S>("subjects", "", ARMSIM_AT(subjects)),
+        integerField<S>("converged", "", ARMSIM_AT(converged)),
+        numberField<S>("mass_bias_pct", "%", ARMSIM_AT(massBias), 100),
+        numberField<S>("mass_rmse_pct", "%", ARMSIM_AT(massRmse), 100),
+        numberField<S>("mass_coverage", "1", ARMSIM_AT(massCoverage)),
+        numberField<S>("tendon_bias_mm", "mm", ARMSIM_AT(tendonBias), 1000),
+        numberField<S>("tendon_rmse_mm", "mm", ARMSIM_AT(tendonRmse), 1000),
+        numberField<S>("tendon_coverage", "1", ARMSIM_AT(tendonCoverage)),
+        numberField<S>("mass_bias_se_pct", "%", ARMSIM_AT(massBiasSe), 100),
+        numberField<S>("mass_rmse_se_pct", "%", ARMSIM_AT(massRmseSe), 100),
+        numberField<S>("mass_coverage_se", "1", ARMSIM_AT(massCoverageSe)),
+        numberField<S>("tendon_bias_se_mm", "mm", ARMSIM_AT(tendonBiasSe), 1000),
+        numberField<S>("tendon_rmse_se_mm", "mm", ARMSIM_AT(tendonRmseSe), 1000),
+        numberField<S>("tendon_coverage_se", "1", ARMSIM_AT(tendonCoverageSe)),
+        numberField<S>("max_force_bias_pct", "%", ARMSIM_AT(maxForceBias), 100),
+        numberField<S>("max_force_rmse_pct", "%", ARMSIM_AT(maxForceRmse), 100),
+        numberField<S>("max_force_coverage", "1", ARMSIM_AT(maxForceCoverage)),
+        numberField<S>("prior_flagged", "1", ARMSIM_AT(priorFlagged)),
+        numberField<S>("mass_coverage_prior_passed", "1", ARMSIM_AT(massCoveragePassed)),
+        numberField<S>("tendon_coverage_prior_passed", "1", ARMSIM_AT(tendonCoveragePassed)),
+        numberField<S>("mass_interval_width", "1", ARMSIM_AT(massIntervalWidth)),
+        numberField<S>("tendon_interval_width_mm", "mm", ARMSIM_AT(tendonIntervalWidth), 1000),
+    });
+    return fields;
+}
+
+#undef ARMSIM_AT
+
 std::string formatElbowValidationCsv(const std::vector<ElbowValidationRow>& rows) {
-    CsvText csv({"subject", "noise", "method", "converged", "true_mass_kg", "mass_kg", "mass_lower_kg", "mass_upper_kg",
-                 "mass_error_pct", "mass_covered", "true_tendon_length_m", "tendon_length_m", "tendon_lower_m",
-                 "tendon_upper_m", "tendon_error_mm", "tendon_covered", "voluntary_activation", "co_contraction",
-                 "strength_level", "biceps_short_scale", "synergist_scale", "noise_level_used", "rms_residual",
-                 "true_max_force_N", "max_force_N", "max_force_lower_N", "max_force_upper_N", "max_force_error_pct",
-                 "max_force_covered", "prior_check_p"});
-    auto flag = [](CsvRow& row, int c) -> CsvRow& { return c < 0 ? row.addEmpty() : row.addInteger(c); };
-    for (const ElbowValidationRow& r : rows) {
-        const MuscleEstimate& e = r.estimate;
-        CsvRow row;
-        row.addInteger(r.subject).addNumber(r.noise).addText(r.method).addInteger(e.converged ? 1 : 0);
-        row.addNumber(r.trueMass).addNumber(e.mass).addNumber(e.massLower).addNumber(e.massUpper);
-        flag(row.addNumber(100 * r.massError), r.massCovered);
-        row.addNumber(r.trueTendonLength).addNumber(e.tendonLength).addNumber(e.tendonLower).addNumber(e.tendonUpper);
-        flag(row.addNumber(1000 * r.tendonError), r.tendonCovered);
-        row.addNumber(r.voluntaryActivation).addNumber(r.coContraction).addNumber(r.strengthLevel);
-        row.addNumber(r.bicepsShortScale).addNumber(r.synergistScale).addNumber(e.noiseLevel).addNumber(e.rmsResidual);
-        row.addNumber(r.trueMaxForce).addNumber(e.maxForce).addNumber(e.maxForceLower).addNumber(e.maxForceUpper);
-        flag(row.addNumber(100 * r.maxForceError), r.maxForceCovered);
-        row.addNumber(r.priorCheckP);
-        csv.addRow(row);
-    }
-    return csv.getText();
+    return getElbowValidationFields().formatCsv(rows);
 }
 
 std::string formatElbowValidationSummaryCsv(const std::vector<ElbowValidationSummary>& summaries) {
-    CsvText csv({"method", "noise", "subjects", "converged", "mass_bias_pct", "mass_rmse_pct", "mass_coverage",
-                 "tendon_bias_mm", "tendon_rmse_mm", "tendon_coverage", "mass_bias_se_pct", "mass_rmse_se_pct",
-                 "mass_coverage_se", "tendon_bias_se_mm", "tendon_rmse_se_mm", "tendon_coverage_se",
-                 "max_force_bias_pct", "max_force_rmse_pct", "max_force_coverage", "prior_flagged",
-                 "mass_coverage_prior_passed", "tendon_coverage_prior_passed"});
-    for (const ElbowValidationSummary& s : summaries) {
-        CsvRow row;
-        row.addText(s.method).addNumber(s.noise).addInteger(s.subjects).addInteger(s.converged);
-        row.addNumber(100 * s.massBias).addNumber(100 * s.massRmse).addNumber(s.massCoverage);
-        row.addNumber(1000 * s.tendonBias).addNumber(1000 * s.tendonRmse).addNumber(s.tendonCoverage);
-        row.addNumber(100 * s.massBiasSe).addNumber(100 * s.massRmseSe).addNumber(s.massCoverageSe);
-        row.addNumber(1000 * s.tendonBiasSe).addNumber(1000 * s.tendonRmseSe).addNumber(s.tendonCoverageSe);
-        row.addNumber(100 * s.maxForceBias).addNumber(100 * s.maxForceRmse).addNumber(s.maxForceCoverage);
-        row.addNumber(s.priorFlagged).addNumber(s.massCoveragePassed).addNumber(s.tendonCoveragePassed);
-        csv.addRow(row);
-    }
-    return csv.getText();
+    return getElbowValidationSummaryFields().formatCsv(summaries);
 }
 
 

@@ -2,6 +2,8 @@
 // its data synthesized through a protocol, identified with every method, truth beside estimate.
 #pragma once
 
+#include "basics/fields.h"
+
 #include "basics/numbers.h"
 
 #include "identification/torque_identification.h"
@@ -123,6 +125,9 @@ private:
     };
     std::vector<Cell> cells_;
 };
+/// The fields of a validation row and of a summary (basics/fields.h): their CSV files are made from them.
+const FieldTable<ElbowValidationRow>& getElbowValidationFields();
+const FieldTable<ElbowValidationSummary>& getElbowValidationSummaryFields();
 /// One CSV line per row: truth, estimate, 95 % interval, coverage, nuisance truths (SI units, errors in %).
 std::string formatElbowValidationCsv(const std::vector<ElbowValidationRow>& rows);
 /// Per method and noise level: bias, RMSE, coverage, then their standard errors (CSV).

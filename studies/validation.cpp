@@ -154,22 +154,31 @@ std::vector<ValidationRow> runValidation(const ArmParameters& arm, const MuscleP
     return rows;
 }
 
-std::string formatValidationCsv(const std::vector<ValidationRow>& rows) {
-    CsvText csv({"truth", "noise_pct", "method", "true_mass_kg", "true_tendon_length_m", "mass_kg", "tendon_length_m",
-                 "mass_error_pct", "tendon_length_error_pct", "mass_covered", "tendon_length_covered", "stop_reason",
-                 "iterations", "evaluations", "wall_time_s"});
-    auto flag = [](CsvRow& row, int c) -> CsvRow& { return c < 0 ? row.addEmpty() : row.addInteger(c); };
-    for (const ValidationRow& r : rows) {
-        CsvRow row;
-        row.addText(r.truth).addNumber(100 * r.noise, 10).addText(r.method).addNumber(r.trueMass, 10);
-        row.addNumber(r.trueTendonLength, 10).addNumber(r.mass, 10).addNumber(r.tendonLength, 10);
-        row.addNumber(100 * r.massError, 10).addNumber(100 * r.tendonLengthError, 10);
-        flag(flag(row, r.massCovered), r.tendonLengthCovered).addText(r.stopReason).addInteger(r.iterations);
-        row.addInteger(r.evaluations).addNumber(r.wallTime, 4);
-        csv.addRow(row);
-    }
-    return csv.getText();
+const FieldTable<ValidationRow>& getValidationFields() {
+#define ARMSIM_AT(member) [](auto& r) -> auto& { return r.member; }
+    using R = ValidationRow;
+    static const FieldTable<R> fields({
+        textField<R>("truth", ARMSIM_AT(truth)),
+        numberField<R>("noise_pct", "%", ARMSIM_AT(noise), 100, 10),
+        textField<R>("method", ARMSIM_AT(method)),
+        numberField<R>("true_mass_kg", "kg", ARMSIM_AT(trueMass), 1, 10),
+        numberField<R>("true_tendon_length_m", "m", ARMSIM_AT(trueTendonLength), 1, 10),
+        numberField<R>("mass_kg", "kg", ARMSIM_AT(mass), 1, 10),
+        numberField<R>("tendon_length_m", "m", ARMSIM_AT(tendonLength), 1, 10),
+        numberField<R>("mass_error_pct", "%", ARMSIM_AT(massError), 100, 10),
+        numberField<R>("tendon_length_error_pct", "%", ARMSIM_AT(tendonLengthError), 100, 10),
+        flagField<R>("mass_covered", ARMSIM_AT(massCovered)),
+        flagField<R>("tendon_length_covered", ARMSIM_AT(tendonLengthCovered)),
+        textField<R>("stop_reason", ARMSIM_AT(stopReason)),
+        integerField<R>("iterations", "", ARMSIM_AT(iterations)),
+        integerField<R>("evaluations", "", ARMSIM_AT(evaluations)),
+        numberField<R>("wall_time_s", "s", ARMSIM_AT(wallTime), 1, 4),
+    });
+#undef ARMSIM_AT
+    return fields;
 }
+
+std::string formatValidationCsv(const std::vector<ValidationRow>& rows) { return getValidationFields().formatCsv(rows); }
 
 std::string formatValidationTable(const std::vector<ValidationRow>& rows) {
     std::ostringstream s;

@@ -3,6 +3,8 @@
 // transducer noise, identified by every method; one row per (truth, noise level, method).
 #pragma once
 
+#include "basics/fields.h"
+
 #include "identification/faithful_model.h"
 #include "identification/identifier.h"
 #include "identification/thesis_cases.h"
@@ -75,6 +77,8 @@ std::vector<ValidationRow> runValidation(const ArmParameters& arm, const MuscleP
                                          const ValidationSettings& settings,
                                          const std::function<void(int, int)>& progress = {});
 
+/// A row's fields (basics/fields.h): validation.csv is made from them.
+const FieldTable<ValidationRow>& getValidationFields();
 /// CSV text (header + one line per row; errors in %, coverage 1/0/empty).
 std::string formatValidationCsv(const std::vector<ValidationRow>& rows);
 /// Fixed-width table for a terminal (g, cm, %), and per method and noise level the interval coverage

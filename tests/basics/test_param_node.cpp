@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <unistd.h>
 #include <functional>
@@ -80,6 +81,26 @@ TEST(ParamNode, BadYamlAndNonMappingsAreInputErrors) {
     EXPECT_TRUE(has(messageOf([] { ParamNode::loadString("- 1\n- 2\n", "list.yaml"); }), "expected a mapping"));
     EXPECT_TRUE(has(messageOf([] { ParamNode::loadString("a: x\n", "s.yaml").getNumber("a", Bound::any()); }),
                     "s.yaml:1"));
+}
+
+// One document per file: a second with content is refused at its line; an empty trailing '---' is fine.
+// A lone ',' made yaml-cpp 0.7's LoadAll loop for ever (found by fuzzing every YAML loader); the load runs
+// in a child process under an alarm, so a hang fails the test instead of stalling the suite.
+TEST(ParamNode, OneDocumentPerFileAndNoHangOnATokenNoNodeStartsWith) {
+    const std::string two = messageOf([] { ParamNode::loadString("a: 1\n---\nb: 2\n", "two.yaml"); });
+    EXPECT_TRUE(has(two, "two.yaml:3: a second YAML document")) << two;
+    EXPECT_NO_THROW(ParamNode::loadString("a: 1\n---\n", "trailing.yaml"));
+    EXPECT_NO_THROW(ParamNode::loadString("---\na: 1\n", "leading.yaml"));
+    for (const char* text : {",", ",\n", "a: 1\n,\n", "- ,\n"}) {
+        EXPECT_EXIT(
+            {
+                alarm(20);
+                const std::string msg = messageOf([&] { ParamNode::loadString(text, "comma.yaml"); });
+                std::exit(has(msg, "comma.yaml:") ? 0 : 1);
+            },
+            ::testing::ExitedWithCode(0), "")
+            << "input: '" << text << "'";
+    }
 }
 
 // Found by fuzzing the population loader: a key that is itself a mapping ('? sd: 0.05') ended in a

@@ -289,6 +289,9 @@ DIMENSIONLESS = {
     "prior_flexor_strength_sd", "max_force_sd", "prior_max_force_sd", "max_force_sd_considered", "parameter_names",
     "mass_correlation", "posterior_sd", "name", "trials", "draws_used", "criterion", "conditions", "protocol_yaml",
     "predicted", "reference", "steps", "repetitions", "coordinate", "muscles", "agonists", "excitation",
+    "tendon_length_error", "mass_bias_se", "mass_rmse_se", "mass_coverage_se", "tendon_coverage_se",
+    "mass_coverage_prior_passed", "tendon_coverage_prior_passed", "max_force_bias", "max_force_rmse",
+    "max_force_coverage", "max_force_error", "max_force_covered", "noise_level_used", "prior_check_p", "prior_flagged",
 }   # mass_sd and max_force_sd: of ln M and ln F0; posterior_sd: per parameter_names entry; *_scale: ratios
 
 

@@ -2,12 +2,15 @@
 // writes one row per method and noise level.
 #include "basics/errors.h"
 #include "muscles/muscle_file.h"
+#include "identification/torque_identification.h"
+#include "studies/study.h"
 #include "studies/torque_validation.h"
 #include "studies/validation.h"
 #include "tests/identification/test_support.h"
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <random>
 
 using namespace armsim;
@@ -290,4 +293,38 @@ TEST(Validation, OneSubjectAloneEqualsItsRowsOfTheWholeValidation) {
     EXPECT_EQ(one.torque.size(), 6u);
     EXPECT_TRUE(one.channels.empty());
     EXPECT_EQ(one.subject.index, 1);
+}
+
+namespace {
+
+/// A field's name must end in its unit as the house spells units in column names.
+template <class T>
+std::vector<std::string> findUnitlessNames(const FieldTable<T>& table) {
+    static const std::map<std::string, std::string> suffix = {
+        {"kg", "_kg"}, {"m", "_m"}, {"mm", "_mm"}, {"N", "_N"}, {"N m", "_Nm"}, {"s", "_s"}, {"%", "_pct"},
+        {"N/m^2", "_N_per_m2"}};
+    std::vector<std::string> bad;
+    for (const Field<T>& f : table.getFields()) {
+        if (f.unit.empty() || f.unit == "1") continue;
+        const auto it = suffix.find(f.unit);
+        const bool ok = it != suffix.end() && f.name.size() > it->second.size() &&
+                        f.name.compare(f.name.size() - it->second.size(), it->second.size(), it->second) == 0;
+        if (!ok) bad.push_back(f.name + " [" + f.unit + "]");
+    }
+    return bad;
+}
+
+}  // namespace
+
+// Every result table's columns carry their units in their names (the house's naming rule), and each
+// table's header is what its CSV writer writes.
+TEST(ResultFields, EveryColumnWithAUnitEndsInIt) {
+    EXPECT_EQ(findUnitlessNames(getStudyResultFields()), std::vector<std::string>{});
+    EXPECT_EQ(findUnitlessNames(getValidationFields()), std::vector<std::string>{});
+    EXPECT_EQ(findUnitlessNames(getElbowValidationFields()), std::vector<std::string>{});
+    EXPECT_EQ(findUnitlessNames(getElbowValidationSummaryFields()), std::vector<std::string>{});
+    EXPECT_EQ(findUnitlessNames(getTorqueEstimateFields()), std::vector<std::string>{});
+    EXPECT_EQ(findUnitlessNames(getChannelFitFields()), std::vector<std::string>{});
+    EXPECT_EQ(formatElbowValidationCsv({}), getElbowValidationFields().getHeader() + "\n");
+    EXPECT_EQ(getStudyResultsHeader(), getStudyResultFields().getHeader());
 }
