@@ -5,6 +5,7 @@
 #include "basics/plot.h"
 #include "cli/commands.h"
 #include "cli/plugins.h"
+#include "experiments/mvc_angles.h"
 #include "model/geometry.h"
 #include "model/osim_forward.h"
 #include "model/osim_trial.h"
@@ -404,114 +405,41 @@ void addTrialCommand(CLI::App& app) {
     });
 }
 
-/// Main job: MVC at the thesis's five angles, in parallel.
+const std::vector<double> kMainJobAnglesDeg{std::begin(kThesisMvcAnglesDeg), std::end(kThesisMvcAnglesDeg)};
+
+/// Main job: the thesis arm's MVC at the thesis's five angles, in parallel.
 void runMvcAngles(const MainJobContext& ctx) {
-    ArmSetup setup = ctx.muscle.loadSetup();
-    const auto& angles = kThesisMvcAnglesDeg;
-    std::vector<IsometricTrialSettings> settings;
-    for (double a : angles) {
-        IsometricTrialSettings s;
-        s.elbowAngle = degToRad(a);
-        settings.push_back(s);
-    }
-    const auto results = runIsometricTrials(setup, settings, ctx.jobs,
-                                            [](int d, int n) { printProgress("MVC trials", d, n); });
-    Table t({"elbow_angle_deg", "path_length_m", "moment_arm_m", "muscle_force_N", "strap_force_N",
-             "force_moment_arm_N", "force_fixed_ratio_N", "rest_force_N"});
-    PlotSpec spec;
-    spec.title = "MVC force vs elbow angle (3 s efforts, mean of the last second)";
-    spec.xLabel = "elbow angle (deg, 180 = extended)";
-    spec.yLabel = "force (N)";
-    PlotSeries truth{"true muscle force", {}, {}, true, 0}, fixed{"thesis fixed-ratio estimate", {}, {}, true, 1},
-        strap{"transducer (strap) force", {}, {}, true, 2};
+    const MvcAngleSweep sweep = runMvcAngleSweep(ctx.muscle.loadSetup(), kMainJobAnglesDeg, ctx.jobs,
+                                                 [](int d, int n) { printProgress("MVC trials", d, n); });
+    const Table& t = sweep.table;
     std::printf("  angle (deg)  path (cm)  muscle F (N)  strap (N)  est. moment arm (N)  est. fixed ratio (N)\n");
-    for (std::size_t k = 0; k < results.size(); ++k) {
-        const IsometricSummary& s = results[k].summary;
-        t.appendRow({angles[k], s.pathLength, s.momentArm, s.meanForce, s.meanStrapForce, s.meanForceMomentArm,
-                     s.meanForceFixedRatio, s.restForce});
-        std::printf("  %11.0f  %9.2f  %12.2f  %9.2f  %19.2f  %20.2f\n", angles[k], 100 * s.pathLength, s.meanForce,
-                    s.meanStrapForce, s.meanForceMomentArm, s.meanForceFixedRatio);
-        truth.x.push_back(angles[k]);
-        truth.y.push_back(s.meanForce);
-        fixed.x.push_back(angles[k]);
-        fixed.y.push_back(s.meanForceFixedRatio);
-        strap.x.push_back(angles[k]);
-        strap.y.push_back(s.meanStrapForce);
-    }
-    spec.series = {truth, fixed, strap};
+    for (int k = 0; k < t.getNumRows(); ++k)
+        std::printf("  %11.0f  %9.2f  %12.2f  %9.2f  %19.2f  %20.2f\n", t.get(k, "elbow_angle_deg"),
+                    100 * t.get(k, "path_length_m"), t.get(k, "muscle_force_N"), t.get(k, "strap_force_N"),
+                    t.get(k, "force_moment_arm_N"), t.get(k, "force_fixed_ratio_N"));
     t.writeCsv(ctx.outDir + "/mvc_angles.csv");
-    writePlotPng(ctx.outDir + "/mvc_angles.png", spec);
+    writePlotPng(ctx.outDir + "/mvc_angles.png", sweep.plot);
     std::printf("  (thesis measured 450-600 N, quadratic peak 603.3 N at 101.2 deg; see README on short paths)\n");
     std::printf("  wrote %s/mvc_angles.csv, mvc_angles.png\n", showPath(ctx.outDir).c_str());
 }
 
-/// Main job: the same five-angle MVC on the anatomical twin (the virtual subject: agonists at its
-/// voluntary activation, antagonists co-contracting), with the thesis's biceps-force estimate (tared
-/// torque over the biceps moment arm) beside every muscle's true force.
+/// Main job: the same five-angle MVC on the anatomical twin, with the thesis's biceps-force estimate
+/// beside every muscle's true force.
 void runSubjectMvcAngles(const MainJobContext& ctx) {
     const ArmSetup setup = loadModel(kDefaultSubjectModel);
-    const auto& angles = kThesisMvcAnglesDeg;
-    std::vector<IsometricTrialSettings> settings;
-    for (double a : angles) {
-        IsometricTrialSettings s;
-        s.elbowAngle = degToRad(a);
-        s.activation = setup.effort.voluntaryActivation;
-        s.antagonistActivation = setup.effort.coContraction;
-        settings.push_back(s);
-    }
-    const auto results = runIsometricTrials(setup, settings, ctx.jobs,
-                                            [](int d, int n) { printProgress("twin MVC trials", d, n); });
-    const int n = setup.getNumMuscles(), primary = setup.primary;
-    const std::string biceps = setup.muscles[primary].params.name;
-    // The thesis's one biceps is every head the model file names (roles.biceps).
-    const std::vector<int> heads = setup.getBicepsHeads();
-    std::vector<std::string> columns{"elbow_angle_deg", "flexion_deg", "tared_torque_Nm", "strap_force_N",
-                                     "primary_moment_arm_m", "primary_force_N", "biceps_both_heads_N",
-                                     "thesis_estimate_N", "estimate_error_vs_both_heads_pct"};
-    for (int i = 0; i < n; ++i) columns.push_back("force_" + setup.muscles[i].params.name + "_N");
-    for (int i = 0; i < n; ++i) columns.push_back("torque_" + setup.muscles[i].params.name + "_Nm");
-    Table t(columns);
-    PlotSpec spec;
-    spec.title = "Anatomical twin: MVC at the thesis's angles (VA " + formatNumber(setup.effort.voluntaryActivation) +
-                 ", co-contraction " + formatNumber(setup.effort.coContraction) + ")";
-    spec.xLabel = "elbow angle (deg, thesis convention: 180 = extended)";
-    spec.yLabel = "force (N)";
-    PlotSeries estimated{"thesis estimate of " + biceps + " (torque / moment arm)", {}, {}, false, 1};
-    std::vector<PlotSeries> forces;
-    for (int i = 0; i < n; ++i)
-        if (setup.muscles[i].group == MuscleGroup::Flexor)
-            forces.push_back({"true force " + setup.muscles[i].params.name, {}, {}, false, int(forces.size() + 2) % 8});
-    PlotSeries bothHeads{"true force, biceps (both heads)", {}, {}, false, 7};
+    const MvcAngleSweep sweep = runSubjectMvcAngleSweep(setup, kMainJobAnglesDeg, ctx.jobs,
+                                                        [](int d, int n) { printProgress("twin MVC trials", d, n); });
+    const Table& t = sweep.table;
+    const std::string biceps = setup.muscles[setup.primary].params.name;
     std::printf("  angle (deg)  flexion (deg)  torque (N m)  %s (N)  biceps, both heads (N)  thesis estimate (N)  "
                 "error\n", biceps.c_str());
-    for (std::size_t k = 0; k < results.size(); ++k) {
-        const IsometricSummary& s = results[k].summary;
-        const double F = s.meanForce, estimate = s.meanForceMomentArm;
-        double both = 0;
-        for (int i : heads) both += s.meanForces[i];
-        bothHeads.x.push_back(angles[k]);
-        bothHeads.y.push_back(both);
-        std::vector<double> row{angles[k], 180 - angles[k], s.meanMuscleTorque, s.meanStrapForce, s.momentArm, F,
-                                both, estimate, 100 * (estimate - both) / both};
-        for (int i = 0; i < n; ++i) row.push_back(s.meanForces[i]);
-        for (int i = 0; i < n; ++i) row.push_back(s.momentArms[i] * s.meanForces[i]);
-        t.appendRow(row);
-        std::printf("  %11.0f  %13.0f  %12.1f  %*.1f  %22.1f  %19.1f  %+5.0f %%\n", angles[k], 180 - angles[k],
-                    s.meanMuscleTorque, int(biceps.size()) + 4, F, both, estimate, 100 * (estimate - both) / both);
-        estimated.x.push_back(angles[k]);
-        estimated.y.push_back(estimate);
-        for (int i = 0, j = 0; i < n; ++i)
-            if (setup.muscles[i].group == MuscleGroup::Flexor) {
-                forces[j].x.push_back(angles[k]);
-                forces[j++].y.push_back(s.meanForces[i]);
-            }
-    }
-    spec.series = forces;
-    spec.series.push_back(bothHeads);
-    spec.series.push_back(estimated);
-    spec.yMin = 0;
+    for (int k = 0; k < t.getNumRows(); ++k)
+        std::printf("  %11.0f  %13.0f  %12.1f  %*.1f  %22.1f  %19.1f  %+5.0f %%\n", t.get(k, "elbow_angle_deg"),
+                    t.get(k, "flexion_deg"), t.get(k, "tared_torque_Nm"), int(biceps.size()) + 4,
+                    t.get(k, "primary_force_N"), t.get(k, "biceps_both_heads_N"), t.get(k, "thesis_estimate_N"),
+                    t.get(k, "estimate_error_vs_both_heads_pct"));
     t.writeCsv(ctx.outDir + "/mvc_angles_twin.csv");
-    writePlotPng(ctx.outDir + "/mvc_angles_twin.png", spec);
+    writePlotPng(ctx.outDir + "/mvc_angles_twin.png", sweep.plot);
     std::printf("  the estimate credits the biceps with the brachialis' and brachioradialis' torque, less the\n"
                 "  triceps' co-contraction; wrote %s/mvc_angles_twin.csv, mvc_angles_twin.png\n",
                 showPath(ctx.outDir).c_str());

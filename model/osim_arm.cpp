@@ -102,7 +102,7 @@ std::shared_ptr<const MuscleModel> makeMuscle(const OsimModel& model, const Osim
     try {
         return std::make_shared<Muscle>(p);
     } catch (const FieldError& e) {
-        // The model's field ("muscle 'BIClong': pennation_angle") as the file's element, at its line.
+        // The model's field ("muscle 'M': pennation_angle") as the file's element, at its line.
         static const std::map<std::string, std::string> kElement = {
             {"pennation_angle", "pennation_angle_at_optimal"}, {"vmax", "max_contraction_velocity"},
             {"fmax_tendon_strain", "FmaxTendonStrain"}, {"fmax_muscle_strain", "FmaxMuscleStrain"},

@@ -7,6 +7,7 @@
 #include "basics/files.h"
 #include "experiments/channels.h"
 #include "experiments/protocol.h"
+#include "experiments/protocol_files.h"
 #include "studies/torque_validation.h"
 #include "studies/experiment_design.h"
 #include "identification/forward_choice.h"
@@ -491,31 +492,24 @@ py::dict runProtocolPy(const py::object& file, const py::object& outArgument, in
     const std::string path = findFile(pathOf(file, "file"));
     const std::string out = outArgument.is_none() ? std::string() : pathOf(outArgument, "out");
     checkField("jobs", jobs, Bound::closed(1, 64));
+    ProtocolFileOptions options;
+    options.outDir = out;
+    options.write = !out.empty();
+    options.jobs = jobs;
+    ProtocolFileRun run;
+    runInterruptible([&] { run = runProtocolFile(path, options); });
     py::dict d;
-    if (isTorqueProtocolFile(path)) {
-        const TorqueProtocol protocol = readTorqueProtocol(path);
-        TorqueProtocolRun run;
-        std::vector<std::string> files;
-        runInterruptible([&] {
-            run = runTorqueProtocol(protocol, jobs);
-            if (!out.empty()) files = writeTorqueProtocolRun(out, protocol, run.data, run.channels);
-        });
-        d["name"] = protocol.name;
-        d["kind"] = "torque";
-        d["subject"] = run.subject;
-        d["data"] = toDict(run.data);
-        d["channels"] = toDict(run.channels);
-        d["files"] = files;
+    d["name"] = run.name;
+    d["kind"] = run.kind;
+    if (run.torqueRun) {
+        d["subject"] = run.torqueRun->subject;
+        d["data"] = toDict(run.torqueRun->data);
+        d["channels"] = toDict(run.torqueRun->channels);
+        d["files"] = run.files;
         return d;
     }
-    const Protocol protocol = readProtocol(path);
-    const ArmSetup subject = loadProtocolSubject(protocol);
-    ProtocolResult r;
-    runInterruptible([&] {
-        r = runProtocol(protocol, subject, {out, jobs, {}});
-    });
-    d["name"] = protocol.name;
-    d["kind"] = getProtocolKindName(protocol.kind);
+    const Protocol& protocol = *run.armProtocol;
+    ProtocolResult& r = *run.armResult;
     d["trials"] = toDict(std::move(r.trials));
     d["trial_ids"] = r.trialIds;
     d["summary"] = toDict(std::move(r.summary));
