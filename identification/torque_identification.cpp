@@ -10,8 +10,69 @@
 
 namespace armsim {
 
+namespace {
+
+using ElbowIdentifier = MuscleEstimate (*)(const ElbowMethod& method, const Population& population,
+                                           const std::vector<TorqueObservation>& data, unsigned seed, int subject,
+                                           const std::vector<ChannelObservation>& channels);
+
+MuscleEstimate identifyWithThesisMethod(const ElbowMethod&, const Population& population,
+                                        const std::vector<TorqueObservation>& data, unsigned, int,
+                                        const std::vector<ChannelObservation>&) {
+    return identifyThesisMethod(population.base, data);
+}
+
+MuscleEstimate identifyWithSynergists(const ElbowMethod& method, const Population& population,
+                                      const std::vector<TorqueObservation>& data, unsigned, int,
+                                      const std::vector<ChannelObservation>&) {
+    SynergistOptions o = method.options;
+    o.measuredActivation = kNaN;
+    return identifySynergistAware(population, data, o);
+}
+
+MuscleEstimate identifyWithMeasuredActivation(const ElbowMethod& method, const Population& population,
+                                              const std::vector<TorqueObservation>& data, unsigned seed, int subject,
+                                              const std::vector<ChannelObservation>&) {
+    SynergistOptions o = method.options;
+    checkField("activation_sd", o.activationSd, Bound{0, 0.5, true, false});
+    o.measuredActivation = measureVoluntaryActivation(data, o.activationSd, seed + 7919u * unsigned(subject));
+    return identifySynergistAware(population, data, o);
+}
+
+MuscleEstimate identifyWithChannels(const ElbowMethod& method, const Population& population,
+                                    const std::vector<TorqueObservation>& data, unsigned seed, int subject,
+                                    const std::vector<ChannelObservation>& channels) {
+    if (channels.empty())
+        throw InputError("identifier 'channels': the data hold no channel besides torque (the protocol records "
+                         "none: add ultrasound or emg to its conditions, or measurements)");
+    SynergistOptions o = method.options;
+    checkField("activation_sd", o.activationSd, Bound{0, 0.5, false, false});
+    o.measuredActivation = o.activationSd > 0
+                               ? measureVoluntaryActivation(data, o.activationSd, seed + 7919u * unsigned(subject))
+                               : kNaN;
+    o.channels = channels;
+    return identifySynergistAware(population, data, o);
+}
+
+/// The identifiers of torque data, one row each: a new identifier is a function and a row.
+const std::vector<std::pair<std::string, ElbowIdentifier>>& getElbowIdentifiers() {
+    static const std::vector<std::pair<std::string, ElbowIdentifier>> identifiers = {
+        {"thesis", identifyWithThesisMethod},
+        {"synergist", identifyWithSynergists},
+        {"synergist-va", identifyWithMeasuredActivation},
+        {"channels", identifyWithChannels},
+    };
+    return identifiers;
+}
+
+}  // namespace
+
 const std::vector<std::string>& getElbowMethodKinds() {
-    static const std::vector<std::string> kinds = {"thesis", "synergist", "synergist-va", "channels"};
+    static const std::vector<std::string> kinds = [] {
+        std::vector<std::string> k;
+        for (const auto& [name, identify] : getElbowIdentifiers()) k.push_back(name);
+        return k;
+    }();
     return kinds;
 }
 
@@ -19,34 +80,15 @@ MuscleEstimate identifyElbowMethod(const ElbowMethod& method, const Population& 
                                    const std::vector<TorqueObservation>& data, unsigned seed, int subject,
                                    const std::vector<ChannelObservation>& channels) {
     population.base.requireVirtualMuscles("the identifiers (prior population '" + population.name + "')");
-    MuscleEstimate e;
-    if (method.kind == "thesis") {
-        e = identifyThesisMethod(population.base, data);
-    } else if (method.kind == "synergist") {
-        SynergistOptions o = method.options;
-        o.measuredActivation = kNaN;
-        e = identifySynergistAware(population, data, o);
-    } else if (method.kind == "synergist-va") {
-        SynergistOptions o = method.options;
-        checkField("activation_sd", o.activationSd, Bound{0, 0.5, true, false});
-        o.measuredActivation = measureVoluntaryActivation(data, o.activationSd, seed + 7919u * unsigned(subject));
-        e = identifySynergistAware(population, data, o);
-    } else if (method.kind == "channels") {
-        if (channels.empty())
-            throw InputError("identifier 'channels': the data hold no channel besides torque (the protocol records "
-                             "none: add ultrasound or emg to its conditions, or measurements)");
-        SynergistOptions o = method.options;
-        checkField("activation_sd", o.activationSd, Bound{0, 0.5, false, false});
-        o.measuredActivation = o.activationSd > 0
-                                   ? measureVoluntaryActivation(data, o.activationSd, seed + 7919u * unsigned(subject))
-                                   : kNaN;
-        o.channels = channels;
-        e = identifySynergistAware(population, data, o);
-    } else {
-        throw InputError("identifier '" + method.kind + "': expected thesis, synergist, synergist-va or channels");
-    }
-    e.method = method.label.empty() ? method.kind : method.label;
-    return e;
+    for (const auto& [name, identify] : getElbowIdentifiers())
+        if (method.kind == name) {
+            MuscleEstimate e = identify(method, population, data, seed, subject, channels);
+            e.method = method.label.empty() ? method.kind : method.label;
+            return e;
+        }
+    std::string names;
+    for (const std::string& k : getElbowMethodKinds()) names += (names.empty() ? "" : ", ") + k;
+    throw InputError("identifier '" + method.kind + "': expected one of " + names);
 }
 
 #define ARMSIM_AT(member) [](auto& r) -> auto& { return r.member; }

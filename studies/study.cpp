@@ -141,8 +141,11 @@ void Study::validate() const {
     const auto& kinds = getElbowMethodKinds();
     for (std::size_t i = 0; i < methods.size(); ++i) {
         const std::string f = "methods[" + std::to_string(i) + "]";
-        if (std::find(kinds.begin(), kinds.end(), methods[i].kind) == kinds.end())
-            throw FieldError(f + ".method", "= '" + methods[i].kind + "': expected thesis, synergist, synergist-va or channels");
+        if (std::find(kinds.begin(), kinds.end(), methods[i].kind) == kinds.end()) {
+            std::string names;
+            for (const std::string& k : kinds) names += (names.empty() ? "" : ", ") + k;
+            throw FieldError(f + ".method", "= '" + methods[i].kind + "': expected one of " + names);
+        }
         if (methods[i].label.empty()) throw FieldError(f + ".label", "is empty: expected a name");
         for (std::size_t j = 0; j < i; ++j)
             if (methods[j].label == methods[i].label)
