@@ -237,7 +237,12 @@ void addDesignCommand(CLI::App& app) {
         ->capture_default_str()
         ->transform(inRange(0, 1000000));
     c->add_option("--out", o->out, "output directory")->capture_default_str();
-    c->callback([o] { runDesign(*o); });
+    c->callback([o, c] {
+        if (c->count("--budget") && c->count("--trials"))
+            throw InputError("--trials with --budget: a lab-minute budget sets how many trials fit, so --trials would "
+                             "be ignored; give one or the other");
+        runDesign(*o);
+    });
 }
 
 const CommandRegistrar registerDesign(57, addDesignCommand);

@@ -25,6 +25,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <set>
 #include <filesystem>
 #include <memory>
 
@@ -251,6 +252,22 @@ void addIdentifyCommand(CLI::App& app) {
             if (o->model.model == "steady" && c->count(option))
                 throw InputError(std::string(option) + " is an option of the faithful forward model: with --forward "
                                  "steady (the default) it would be ignored; add --forward faithful or corrected");
+        // Options of the least-squares fit would be ignored by the learning-control family.
+        for (const char* option : {"--force-sd", "--noise", "--multistart", "--seed"})
+            if (o->method != "lm" && c->count(option))
+                throw InputError(std::string(option) + " is an option of --method lm: --method " + o->method +
+                                 " would ignore it");
+        // One --bounds or --start per unknown: a second would silently win.
+        for (const auto& [option, list] : {std::pair<const char*, const std::vector<std::string>*>{"--bounds", &o->bounds},
+                                           {"--start", &o->starts}}) {
+            std::set<std::string> seen;
+            for (const std::string& item : *list) {
+                const std::string name = item.substr(0, item.find('='));
+                if (!seen.insert(name).second)
+                    throw InputError(std::string(option) + " " + item + ": '" + name + "' is given twice: expected one " +
+                                     option + " per unknown");
+            }
+        }
         runIdentify(*o);
     });
 }
@@ -489,6 +506,17 @@ void addValidateCommand(CLI::App& app) {
                                    "--angles", "--repetitions", "--protocol", "--free-slow-fraction"})
             if (o->truth != "elbow" && c->count(option))
                 throw InputError(std::string(option) + " needs --truth elbow");
+        // The truths set every muscle's mass and tendon length (thesis: Table 7.2's and drawn ones; elbow:
+        // the population's people), so these would be ignored.
+        for (const char* option : {"--mass", "--tendon-length"})
+            if (c->count(option))
+                throw InputError(std::string(option) + ": validate draws the true muscles (--seeds, or --truth elbow's "
+                                 "population), so a given value would be ignored");
+        if (o->truth == "elbow")
+            for (const char* option : {"--model", "--muscle", "--arm", "--slow-units", "--fast-units", "--max-path"})
+                if (c->count(option))
+                    throw InputError(std::string(option) + " with --truth elbow: the subjects come from the population "
+                                     "file (--population, --truth-population), so it would be ignored");
         if (o->truth == "elbow")
             for (const char* option : {"--seeds", "--methods", "--forward", "--estimate"})
                 if (c->count(option))

@@ -73,6 +73,11 @@ ArmSetup MuscleOptions::loadSetup() const {
             throw InputError(std::string("option ") + e.what());
         }
     };
+    const MuscleSpec& primary = s.muscles[s.primary];
+    if ((slowUnits || fastUnits) && primary.muscleModel != kDefaultMuscleModel)
+        throw InputError(std::string(slowUnits ? "--slow-units" : "--fast-units") + ": muscle '" + p.name + "' is a " +
+                         primary.muscleModel + " muscle (" + (muscleModel.empty() ? "model " + model : "--muscle-model") +
+                         "), which has no motor units: it would be ignored (motor units are Virtual Muscle's)");
     if (slowUnits) check("--slow-units", *slowUnits, bounds::kMotorUnits), p.numSlowUnits = *slowUnits;
     if (fastUnits) check("--fast-units", *fastUnits, bounds::kMotorUnits), p.numFastUnits = *fastUnits;
     if ((slowUnits || fastUnits) && p.numSlowUnits + p.numFastUnits == 0)

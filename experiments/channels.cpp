@@ -202,8 +202,14 @@ std::vector<ChannelObservation> readChannelData(const std::string& path) {
         if (rep != std::floor(rep) || rep < 0 || rep > 1e6) fail("repetition", formatNumber(rep), "an integer >= 0");
         o.repetition = int(rep);
         o.value = number("value", kNaN);
-        if (!std::isfinite(o.value) || (o.channel != "emg" && o.value <= 0))
-            fail("value", formatNumber(o.value), o.channel == "emg" ? "a finite number" : "> 0 (SI units)");
+        // Upper limits a typo (cm for m, mm^3 for m^3) or a unit slip passes: a fascicle or an upper arm
+        // of 1 m, a muscle of 10 L, EMG at 10 times its MVC amplitude.
+        const bool isEmg = o.channel == "emg";
+        const double limit = isEmg ? 10 : o.channel == "volume" ? 0.01 : 1;
+        if (!std::isfinite(o.value) || (!isEmg && o.value <= 0) || std::abs(o.value) > limit)
+            fail("value", formatNumber(o.value),
+                 isEmg ? "a fraction of the MVC amplitude in [-10, 10]"
+                       : "in (0, " + formatNumber(limit) + "] " + (o.channel == "volume" ? "m^3" : "m") + " (SI units)");
         o.sd = number("sd", kNaN);
         if (!(o.sd > 0)) fail("sd", formatNumber(o.sd), "> 0 (the measurement's sd, units of value)");
         o.cleanValue = number("clean_value", kNaN);

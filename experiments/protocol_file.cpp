@@ -168,7 +168,7 @@ void readProtocolSensors(const ParamNode& root, Protocol& p, bool armTrials) {
         const ParamNode s = root.child("sensors");
         if (s.has("transducer")) {
             const ParamNode t = s.child("transducer");
-            p.transducerNoiseRms = t.getNumber("noise_rms", Bound::nonNegative("N"), 0.0);
+            p.transducerNoiseRms = t.getNumber("noise_rms", Bound::closed(0, 1e4, "N"), 0.0);
             t.finish();
         }
         p.emg.acquisition.outputRate = p.trial.sampleRate;

@@ -28,8 +28,9 @@ void validateOptions(const IdentificationOptions& o) {
     checkField("options.lambda", o.lambda, {0, 1, true, false, ""});
     checkField("options.probe_step", o.probeStep, Bound::open(0, 1));
     checkField("options.stall_iterations", o.stallIterations, Bound::closed(1, 1e7));
-    if (!std::isnan(o.forceSd)) checkField("options.force_sd", o.forceSd, Bound::positive("N"));
-    if (!std::isnan(o.relativeForceSd)) checkField("options.relative_force_sd", o.relativeForceSd, Bound::positive());
+    if (!std::isnan(o.forceSd)) checkField("options.force_sd", o.forceSd, Bound{0, 1e5, true, false, "N"});
+    if (!std::isnan(o.relativeForceSd))   // a relative sd of 1 already spans zero force
+        checkField("options.relative_force_sd", o.relativeForceSd, Bound{0, 1, true, false, "fraction of the force"});
     checkField("options.confidence_level", o.confidenceLevel, Bound::open(0, 1));
     checkField("options.starts", o.starts, Bound::closed(1, 1e6));
     if (!std::isnan(o.differenceStep)) checkField("options.difference_step", o.differenceStep, Bound::open(0, 1));

@@ -6,18 +6,28 @@
 
 namespace armsim {
 
+namespace {
+
+// A person's size: the heaviest and tallest recorded people (about 635 kg, 2.72 m) inside, a typo's
+// factor of 1000 outside.
+constexpr Bound kBodyMass{0, 700, true, false, "kg, a person"};
+constexpr Bound kBodyHeight{0, 3, true, false, "m, a person"};
+constexpr Bound kSegmentLength{0, 1, true, false, "m, a human arm segment"};
+
+}  // namespace
+
 void ArmParameters::validate() const {
     const double reach = (forearmLength + handLength) / forearmLength;  // fingertip in forearm lengths
-    checkField("body.mass", bodyMass, Bound::positive("kg"));
-    checkField("body.height", bodyHeight, Bound::positive("m"));
+    checkField("body.mass", bodyMass, kBodyMass);
+    checkField("body.height", bodyHeight, kBodyHeight);
 
-    checkField("upper_arm.length", upperArmLength, Bound::positive("m"));
+    checkField("upper_arm.length", upperArmLength, kSegmentLength);
     checkField("upper_arm.mass_fraction", upperArmMassFraction, Bound::open(0, 1));
     checkField("upper_arm.com_fraction", upperArmComFraction, Bound::open(0, 1));
     checkField("upper_arm.gyration_fraction", upperArmGyrationFraction, Bound::positive());
 
-    checkField("forearm_hand.forearm_length", forearmLength, Bound::positive("m"));
-    checkField("forearm_hand.hand_length", handLength, Bound::positive("m"));
+    checkField("forearm_hand.forearm_length", forearmLength, kSegmentLength);
+    checkField("forearm_hand.hand_length", handLength, kSegmentLength);
     checkField("forearm_hand.mass_fraction", forearmHandMassFraction, Bound::open(0, 1));
     checkField("forearm_hand.com_fraction", forearmHandComFraction,
                Bound{0, reach, true, false, "forearm lengths, elbow to fingertip"});
@@ -31,13 +41,13 @@ void ArmParameters::validate() const {
 
     checkField("transducer.strap_distance", strapDistance,
                Bound{0, forearmLength + handLength, true, false, "m, on the forearm or hand"});
-    checkField("transducer.range", transducerRange, Bound::positive("N"));
+    checkField("transducer.range", transducerRange, Bound{0, 1e5, true, false, "N"});
 
     checkField("elbow.min_angle_deg", minElbowAngleDeg, Bound::open(0, 180, "deg"));
     checkField("elbow.max_angle_deg", maxElbowAngleDeg,
                Bound{minElbowAngleDeg, 180, true, false, "deg, above min_angle_deg"});
-    checkField("elbow.stop_stiffness", stopStiffness, Bound::positive("N m/rad"));
-    checkField("elbow.stop_dissipation", stopDissipation, Bound::nonNegative("s/rad"));
+    checkField("elbow.stop_stiffness", stopStiffness, Bound{0, 1e6, true, false, "N m/rad"});
+    checkField("elbow.stop_dissipation", stopDissipation, Bound::closed(0, 100, "s/rad"));
 
     if (forearmRotation.enabled) {
         const ForearmRotation& r = forearmRotation;
@@ -55,8 +65,8 @@ void ArmParameters::validate() const {
 }
 
 ArmParameters ArmParameters::scaled(double newBodyMass, double newBodyHeight) const {
-    checkField("body.mass", newBodyMass, Bound::positive("kg"));
-    checkField("body.height", newBodyHeight, Bound::positive("m"));
+    checkField("body.mass", newBodyMass, kBodyMass);
+    checkField("body.height", newBodyHeight, kBodyHeight);
     ArmParameters p = *this;
     const double s = newBodyHeight / bodyHeight;
     p.bodyMass = newBodyMass;

@@ -215,7 +215,8 @@ private:
             body.line = b->GetLineNum();
             if (body.name.empty()) fail(b, "a body without a name");
             body.mass = number(b, "mass");
-            if (!(body.mass >= 0)) fail(child(b, "mass"), "mass " + formatNumber(body.mass) + ": expected >= 0 kg");
+            if (!(body.mass >= 0 && body.mass <= 1000))   // a body segment or a device, not a typo's 1e9
+                fail(child(b, "mass"), "mass " + formatNumber(body.mass) + ": expected 0 to 1000 kg");
             body.massCenter = vec3(b, "mass_center");
             if (b->FirstChildElement("inertia")) {
                 const std::vector<double> I = numbers(b, "inertia", 6);

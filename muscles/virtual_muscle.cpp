@@ -25,6 +25,9 @@ constexpr double kSteadyLmin = 1e-3;
 /// Root-finder tolerance on L (/ L0) for the steady solve.
 constexpr double kSteadyTolL = 1e-13;
 
+/// Exponents of the force-length curve (VM 4.0: 1.55-2.3): past 100, pow() overflows to inf.
+constexpr Bound kShapeExponent{0, 100, true, false, ""};
+
 std::string fmt(double v) {
     char buf[32];
     const auto r = std::to_chars(buf, buf + sizeof buf, v);  // shortest round-trip form
@@ -42,9 +45,9 @@ double FibreType::calcNfZeroLength() const {
 
 void FibreType::validate(const std::string& p) const {
     const std::string q = p + ".";
-    checkField(q + "beta", beta, Bound::positive());
-    checkField(q + "omega", omega, Bound::positive());
-    checkField(q + "rho", rho, Bound::positive());
+    checkField(q + "beta", beta, kShapeExponent);
+    checkField(q + "omega", omega, Bound{0, 10, true, false, "width of the force-length curve, L0"});
+    checkField(q + "rho", rho, kShapeExponent);
     checkField(q + "Vmax", Vmax, {-1e300, 0, false, true, "L0/s"});
     checkField(q + "cV0", cV0, Bound::any());
     checkField(q + "cV1", cV1, Bound::any());
@@ -89,9 +92,9 @@ void MuscleCoefficients::validate(const std::string& p) const {
 
 void MuscleParameters::validate() const {
     checkField("mass", mass, bounds::kMuscleMass);
-    checkField("optimal_fascicle_length", optimalFascicleLength, Bound::positive("m"));
+    checkField("optimal_fascicle_length", optimalFascicleLength, Bound{1e-3, 1, false, false, "m, a muscle fascicle"});
     checkField("optimal_tendon_length", optimalTendonLength, bounds::kTendonLength);
-    checkField("max_path_length", maxPathLength, Bound::positive("m"));
+    checkField("max_path_length", maxPathLength, Bound{0, 3, true, false, "m, a musculotendon path"});
     checkField("fibre_fractions.slow", slowFraction, Bound::closed(0, 1));
     checkField("motor_units.slow", numSlowUnits, bounds::kMotorUnits);
     checkField("motor_units.fast", numFastUnits, bounds::kMotorUnits);

@@ -214,9 +214,24 @@ Study readStudy(const std::string& path) {
     }
     s.noiseLevels = n.has("noise_levels") ? n.getNumbers("noise_levels", Bound{0, 0.5, false, true, "relative sd"})
                                           : std::vector<double>{s.truths.front().population.transducerNoise};
+    for (std::size_t i = 0; i < s.noiseLevels.size(); ++i)   // a level twice would be computed and written twice
+        for (std::size_t j = 0; j < i; ++j)
+            if (s.noiseLevels[i] == s.noiseLevels[j])
+                throw InputError(n.where("noise_levels") + ": field 'noise_levels' lists " +
+                                 formatNumber(s.noiseLevels[i]) + " twice: expected each level once");
     for (const ParamNode& m : n.children("methods")) {
         ElbowMethod e;
         e.kind = m.getChoice("method", getElbowMethodKinds(), "");
+        // What a method kind does not use would be ignored: refused at its line.
+        const bool usesActivationSd = e.kind == "synergist-va" || e.kind == "channels";
+        for (const char* key : {"activation_sd", "free_slow_fraction", "include_synergists", "noise_level"}) {
+            const bool used = e.kind != "thesis" && (std::string(key) != "activation_sd" || usesActivationSd);
+            if (m.has(key) && !used)
+                throw InputError(m.where(key) + ": field '" + key + "' with method " + e.kind +
+                                 ": that method does not use it, so it would be ignored" +
+                                 (std::string(key) == "activation_sd" ? " (synergist-va and channels measure activation)"
+                                                                      : " (the synergist-aware methods take it)"));
+        }
         e.label = m.getString("label", e.kind);
         e.options.activationSd = m.getNumber("activation_sd", Bound{0, 0.5, false, false}, 0.02);
         e.options.freeSlowFraction = m.getBool("free_slow_fraction", false);

@@ -110,7 +110,7 @@ TEST(ArmParameters, ValidationNamesFieldValueAndBound) {
     ArmParameters p;
     p.bodyMass = -70;
     std::string msg = errorOf([&] { p.validate(); });
-    EXPECT_TRUE(contains(msg, "body.mass") && contains(msg, "-70") && contains(msg, "> 0")) << msg;
+    EXPECT_TRUE(contains(msg, "body.mass") && contains(msg, "-70") && contains(msg, "(0, 700] (kg, a person)")) << msg;
 
     p = ArmParameters();
     p.originDistance = 0.05;  // A < B
@@ -152,7 +152,7 @@ TEST(ArmParameters, FileErrorsNameFileLineAndField) {
          "colour:", {"unknown field", "elbow.colour"}},
         {"unknown_top.yaml", readText(kDefaultFile) + "gravty: 9.8\n", "gravty:", {"unknown field", "gravty"}},
         {"negative_mass.yaml", editedDefault("mass: 73.0", "mass: -73.0"), "mass: -73.0",
-         {"body.mass", "-73", "> 0"}},
+         {"body.mass", "-73", "(0, 700]"}},
         {"a_below_b.yaml", editedDefault("origin_distance: 0.37", "origin_distance: 0.04"),
          "origin_distance:", {"biceps.origin_distance", "0.04"}},
         {"range.yaml", editedDefault("max_angle_deg: 180", "max_angle_deg: 190"), "max_angle_deg:",

@@ -87,7 +87,7 @@ TEST(MuscleFile, NegativeMassNamesFileLineFieldAndBound) {
 
 TEST(MuscleFile, ZeroLengthsAreRejected) {
     expectMentions(loadError(writeVariant("optimal_fascicle_length: 0.16", "optimal_fascicle_length: 0")),
-                   {"optimal_fascicle_length", "= 0", "> 0"});
+                   {"optimal_fascicle_length", "= 0", "[0.001, 1] (m, a muscle fascicle)"});
     expectMentions(loadError(writeVariant("optimal_tendon_length: 0.245", "optimal_tendon_length: 0")),
                    {"optimal_tendon_length", "= 0"});
 }
