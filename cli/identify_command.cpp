@@ -346,9 +346,10 @@ void addElbowValidationPlots(const std::vector<ElbowValidationRow>& rows, Output
 }
 
 void runElbowValidate(const ValidateOptions& o) {
-    const Population family = o.population.empty() ? loadDefaultPopulation() : loadPopulation(o.population);
-    const Population population = o.truthPopulation.empty() ? family : loadPopulation(o.truthPopulation);
-    const Population prior = o.prior.empty() ? family : loadPopulation(o.prior);
+    // Files as everywhere else: a path, or a name under the assets folder.
+    const Population family = o.population.empty() ? loadDefaultPopulation() : loadPopulation(findAsset(o.population));
+    const Population population = o.truthPopulation.empty() ? family : loadPopulation(findAsset(o.truthPopulation));
+    const Population prior = o.prior.empty() ? family : loadPopulation(findAsset(o.prior));
     const bool inFamily = o.truthPopulation.empty() && o.prior.empty();
     ElbowValidationSettings s;
     s.subjects = capForQuickRun(o.subjects, kQuickSubjects, "validation subjects");
@@ -357,7 +358,7 @@ void runElbowValidate(const ValidateOptions& o) {
     s.activationSd = o.activationSd;
     s.freeSlowFraction = o.freeSlowFraction;
     if (!o.protocol.empty()) {
-        s.protocol = readTorqueProtocol(o.protocol);
+        s.protocol = readTorqueProtocol(findAsset(o.protocol));
     } else {
         std::vector<double> angles = getThesisMvcFlexionDeg();
         if (!o.angles.empty()) angles = o.angles;

@@ -35,7 +35,7 @@ void runIdentifyTorque(const IdentifyTorqueOptions& o) {
     checkOutputFolder("--out", o.out);
     const std::string file = findAsset(o.data);
     const std::vector<TorqueObservation> data = readTorqueData(file);
-    const Population prior = o.population.empty() ? loadDefaultPopulation() : loadPopulation(o.population);
+    const Population prior = o.population.empty() ? loadDefaultPopulation() : loadPopulation(findAsset(o.population));
     std::printf("torque data %s: %zu trials; prior population '%s' (model '%s')\n", file.c_str(), data.size(),
                 prior.name.c_str(), prior.base.name.c_str());
     TorqueIdentificationOptions to;

@@ -383,6 +383,7 @@ std::vector<BadInput> makeCatalogue() {
         {"StudyNoiseLevelTwice", {{"s.yaml", replaceAll(kStudyHead, "noise_levels: [0.02]", "noise_levels: [0.02, 0.02]") +
                                              "methods:\n  - {method: thesis}\n"}},
          "study IN/s.yaml --out OUT/s", {"s.yaml:", "lists 0.02 twice"}},
+        {"MuscleSteadyPathInfinite", {}, "muscle steady --path inf", {"--path = inf", "(0, 3]"}},
         {"PopulationSdNegative", {{"p.yaml", "name: p\nmodel: elbow\ntendon_length:\n  sd: -0.1\n"}},
          "validate --truth elbow --truth-population IN/p.yaml --subjects 2 --out OUT/v", {"p.yaml:3", "'tendon_length.sd' = -0.1"}},
         {"StudySubjectsZero", {{"s.yaml", replaceAll(kStudyHead, "subjects: 1", "subjects: 0") + "methods:\n  - {method: thesis}\n"}},

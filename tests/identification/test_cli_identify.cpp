@@ -163,6 +163,17 @@ TEST(CliValidate, TinyConfigurationPrintsItsTableAndWritesTheCsv) {
 
 // validate --truth elbow: both identifiers on drawn subjects, per-subject and summary CSV, plots; the
 // elbow-only options are refused without it.
+// Population and protocol files are found as every file option finds them: a path, or a name under the
+// assets folder (the shipped `subjects/...` and `protocols/...`).
+TEST(CliValidate, PopulationAndProtocolNamesUnderTheAssetsFolderAreFound) {
+    const fs::path d = freshDir("validate_by_name");
+    const CommandResult r = runArmsim("validate --truth elbow --subjects 1 --truth-population subjects/mismatch/stronger.yaml "
+                                      "--protocol protocols/designed_emg_torque.yaml --activation-sd 0 --out " + d.string());
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    EXPECT_NE(r.output.find("stronger"), std::string::npos) << r.output;
+    EXPECT_TRUE(fs::exists(d / "elbow_validation.csv"));
+}
+
 TEST(CliValidate, ElbowTruthWritesPerSubjectAndSummaryFilesAndPlots) {
     const fs::path d = freshDir("elbow_validate");
     const CommandResult r = runArmsim("validate --truth elbow --subjects 3 --jobs 2 --out " + d.string());
