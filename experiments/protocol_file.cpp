@@ -103,7 +103,12 @@ void readEmg(const ParamNode& n, Protocol& p) {
         if (err.getField() == "outputRate")
             throw InputError(n.where() + ": the EMG output rate is trial.sample_rate = " + fmt::format("{:g}", a.outputRate) +
                              " Hz: " + err.getDetail());
-        n.throwLocated(FieldError(n.path(acquisitionKey(err.getField())), err.getDetail()));
+        std::string detail = err.getDetail();
+        const std::string key = acquisitionKey(err.getField());
+        if (key == "band_high" || key == "band_low" || key == "anti_alias_cutoff" || key == "mains_frequency")
+            detail += fmt::format(" (frequencies stay below half of trial.sample_rate = {:g} Hz: the EMG is sampled "
+                                  "with the other channels; raise sample_rate or lower the frequency)", a.outputRate);
+        n.throwLocated(FieldError(n.path(key), detail));
     }
 }
 

@@ -16,6 +16,23 @@ namespace armsim {
 
 namespace {
 
+/// tinyxml2's error in words (its ErrorStr is "Error=XML_ERROR_... ErrorID=14 (0xe) Line number=4: ...").
+std::string describeXmlError(tinyxml2::XMLError e) {
+    switch (e) {
+    case tinyxml2::XML_ERROR_MISMATCHED_ELEMENT: return "an element closed by another element's end tag (or never closed)";
+    case tinyxml2::XML_ERROR_PARSING_ELEMENT: return "a malformed element (a tag that does not end, or a stray '<')";
+    case tinyxml2::XML_ERROR_PARSING_ATTRIBUTE: return "a malformed attribute (expected name=\"value\")";
+    case tinyxml2::XML_ERROR_PARSING_TEXT: return "malformed text between tags";
+    case tinyxml2::XML_ERROR_PARSING_CDATA: return "a malformed CDATA section";
+    case tinyxml2::XML_ERROR_PARSING_COMMENT: return "a comment that does not end ('-->')";
+    case tinyxml2::XML_ERROR_PARSING_DECLARATION: return "a malformed declaration ('<?xml ...?>')";
+    case tinyxml2::XML_ERROR_EMPTY_DOCUMENT: return "the file holds no element";
+    case tinyxml2::XML_ELEMENT_DEPTH_EXCEEDED: return "elements nested too deep";
+    default: return std::string("unreadable XML (") + tinyxml2::XMLDocument::ErrorIDToName(e) + ")";
+    }
+}
+
+
 using tinyxml2::XMLElement;
 
 // Muscle models the reader accepts, with the numeric properties each may carry (OpenSim's names).
@@ -171,9 +188,8 @@ public:
 
     OsimModel read(const std::string& xml) {
         tinyxml2::XMLDocument doc;
-        if (doc.Parse(xml.c_str(), xml.size()) != tinyxml2::XML_SUCCESS)
-            throw OsimError(source_ + ":" + std::to_string(doc.ErrorLineNum()) + ": not valid XML: " +
-                            std::string(doc.ErrorStr() ? doc.ErrorStr() : "?"));
+        if (const tinyxml2::XMLError e = doc.Parse(xml.c_str(), xml.size()); e != tinyxml2::XML_SUCCESS)
+            throw OsimError(source_ + ":" + std::to_string(doc.ErrorLineNum()) + ": not valid XML: " + describeXmlError(e));
         const XMLElement* root = doc.RootElement();
         if (!root || std::string(root->Name()) != "OpenSimDocument")
             throw OsimError(source_ + ": expected an <OpenSimDocument> (an OpenSim model file)");

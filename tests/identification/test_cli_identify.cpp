@@ -275,6 +275,17 @@ TEST(CliDesign, DesignedProtocolRunsAndItsDataAreIdentified) {
     r = runArmsim("identify-torque " + (d / "missing.csv").string());
     EXPECT_NE(r.exitCode, 0);
     EXPECT_NE(r.output.find("missing.csv"), std::string::npos) << r.output;
+
+    // Where the judging noise comes from is said as it is: with no repeated condition it is the prior
+    // population's, not "estimated from the repetitions".
+    {
+        std::ofstream single(d / "single.csv");
+        single << "flexion_deg,torque_Nm\n90,60\n45,50\n120,55\n30,40\n135,45\n";
+    }
+    r = runArmsim("identify-torque " + (d / "single.csv").string() + " --out " + (d / "single_fit").string());
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    EXPECT_NE(r.output.find("no condition is repeated to estimate it from"), std::string::npos) << r.output;
+    EXPECT_EQ(r.output.find("estimated from the repetitions"), std::string::npos) << r.output;
 }
 
 // The two-axis protocol (docs/channels.md): its run writes the forearm axis and the supination efforts,
