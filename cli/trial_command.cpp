@@ -288,6 +288,9 @@ void runTrialCommand(const TrialOptions& o) {
                     s.restForce);
         std::printf("  estimate, fixed ratio  %8.2f N (error %+.2f %%)\n", s.meanForceFixedRatio,
                     100 * (s.meanForceFixedRatio - s.meanForce) / s.meanForce);
+        if (setup.getNumMuscles() > 1)   // the thesis's estimates assume one muscle makes the whole torque
+            std::printf("  (the estimates are the thesis's one-muscle method: the tared torque of all %d muscles "
+                        "credited to %s)\n", setup.getNumMuscles(), setup.muscles[setup.primary].params.name.c_str());
         spec.title = "isometric trial at " + std::to_string(int(radToDeg(s.elbowAngle) + 0.5)) + " deg";
         spec.yLabel = "force (N)";
         spec.series.push_back({"true muscle force", r.series.getColumn("time_s"), r.series.getColumn("muscle_force_N")});

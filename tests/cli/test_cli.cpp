@@ -155,6 +155,12 @@ TEST(Cli, TrialWritesTheSeriesAndRejectsBadSettings) {
     EXPECT_EQ(t.getNumRows(), 141);  // 0.7 s at 200 Hz, both ends
     EXPECT_TRUE(t.hasColumn("strap_force_N"));
     EXPECT_TRUE(t.hasColumn("state_feff_6"));
+    // The thesis's one-muscle estimates: plain on the one-muscle arm, said for what they are on the twin.
+    EXPECT_EQ(r.output.find("one-muscle method"), std::string::npos) << r.output;
+    r = runArmsim("trial --model twin --angle 90 --hold 0.2 --rest 0.1 --rate 100 --out " + (d / "twin.csv").string());
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    EXPECT_NE(r.output.find("the thesis's one-muscle method: the tared torque of all 10 muscles credited to"),
+              std::string::npos) << r.output;
 
     r = runArmsim("trial --angle 30 --out " + (d / "bad.csv").string());
     EXPECT_EQ(r.exitCode, 2);
