@@ -90,18 +90,26 @@ private:
     }
 };
 
-/// Refuses a second document with content. yaml-cpp 0.7's LoadAll never ends on some malformed input (a
-/// token no node starts with is never consumed; jbeder/yaml-cpp#1319), so the parser is asked for two
-/// documents only, and a document that did not move past the first one's start is not a second one.
+/// Refuses a second document with content, after any number of empty ones. yaml-cpp 0.7's LoadAll never
+/// ends on some malformed input (a token no node starts with is never consumed; jbeder/yaml-cpp#1319), so
+/// the documents are walked here while each starts past the last: a parse that does not move is that
+/// stray token, refused at its line.
 void checkSingleDocument(const std::string& text, const std::string& sourceName) {
     std::istringstream in(text);
     YAML::Parser parser(in);
     ContentFinder first;
     if (!parser.HandleNextDocument(first)) return;
-    ContentFinder second;
-    if (!parser.HandleNextDocument(second) || !second.hasContent || second.start.pos <= first.start.pos) return;
-    throw InputError(sourceName + ":" + std::to_string(second.content.line + 1) +
-                     ": a second YAML document (after '---'): expected one document per file");
+    for (int lastStart = first.start.pos;;) {
+        ContentFinder next;
+        if (!parser.HandleNextDocument(next)) return;
+        if (next.start.pos <= lastStart)
+            throw InputError(sourceName + ":" + std::to_string(next.start.line + 1) +
+                             ": invalid YAML: text no value starts with (a stray ',', ']' or '}'?)");
+        if (next.hasContent)
+            throw InputError(sourceName + ":" + std::to_string(next.content.line + 1) +
+                             ": a second YAML document (after '---'): expected one document per file");
+        lastStart = next.start.pos;
+    }
 }
 
 }  // namespace

@@ -260,10 +260,10 @@ void addIdentifyCommand(CLI::App& app) {
         // One --bounds or --start per unknown: a second would silently win.
         for (const auto& [option, list] : {std::pair<const char*, const std::vector<std::string>*>{"--bounds", &o->bounds},
                                            {"--start", &o->starts}}) {
-            std::set<std::string> seen;
+            std::set<ParameterId> seen;   // by the unknown it names (tendon_length is optimal_tendon_length)
             for (const std::string& item : *list) {
-                const std::string name = item.substr(0, item.find('='));
-                if (!seen.insert(name).second)
+                const std::string name = splitAssignment(option, item).first;
+                if (!seen.insert(parseParameter(option, name)).second)
                     throw InputError(std::string(option) + " " + item + ": '" + name + "' is given twice: expected one " +
                                      option + " per unknown");
             }

@@ -136,7 +136,7 @@ void addMuscleCommands(CLI::App& app) {
         c->add_option("--activation", *U, "activation U in [0, 1]")->capture_default_str();
         c->callback([=] {
             checkActivation(*U);
-            checkField("--path", *path, Bound{0, 3, true, false, "m, up to the muscle's P_max"});
+            checkField("--path", *path, Bound{0, 3, true, false, "m"});
             const std::shared_ptr<const MuscleModel> built = opts->build();
             const MuscleModel& m = *built;
             const SteadyState s = m.calcSteadyState(*path, *U);
@@ -237,7 +237,7 @@ void addMuscleCommands(CLI::App& app) {
         c->add_option("--plot", *plot, "PNG plot of force and activation (optional)");
         c->callback([=] {
             checkActivation(*U);
-            checkField("--path", settings->pathLength, Bound{0, 3, true, false, "m, up to the muscle's P_max"});
+            checkField("--path", settings->pathLength, Bound{0, 3, true, false, "m"});
             checkField("--onset", *onset, Bound::nonNegative("s"));
             checkField("--rise", *rise, Bound::nonNegative("s"));
             if (trace->empty() && *U > 0 && !(*onset < settings->duration))

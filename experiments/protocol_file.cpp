@@ -1,4 +1,5 @@
 #include "basics/files.h"
+#include "basics/numbers.h"
 #include "basics/param_node.h"
 #include "experiments/protocol.h"
 #include "experiments/protocol_run.h"
@@ -105,7 +106,11 @@ void readEmg(const ParamNode& n, Protocol& p) {
                              " Hz: " + err.getDetail());
         std::string detail = err.getDetail();
         const std::string key = acquisitionKey(err.getField());
-        if (key == "band_high" || key == "band_low" || key == "anti_alias_cutoff" || key == "mains_frequency")
+        const double value = key == "band_high" ? a.bandHigh
+                             : key == "anti_alias_cutoff" ? a.antiAliasCutoff
+                             : key == "mains_frequency" ? a.mainsFrequency
+                                                        : kNaN;
+        if (value >= a.outputRate / 2)   // past Nyquist: the sample rate, not the frequency, may be what to change
             detail += fmt::format(" (frequencies stay below half of trial.sample_rate = {:g} Hz: the EMG is sampled "
                                   "with the other channels; raise sample_rate or lower the frequency)", a.outputRate);
         n.throwLocated(FieldError(n.path(key), detail));

@@ -95,11 +95,11 @@ ProtocolFileRun runArmProtocolFile(const std::string& path, const ProtocolFileOp
     ProtocolRunOptions options{run.outDir, o.jobs, o.progress, {}};
     if (o.beforeCommit)
         options.beforeCommit = [&](OutputFolder& dir, const ProtocolResult& r) { o.beforeCommit(dir, subject, r); };
-    const ProtocolResult r = runProtocol(protocol, subject, options);
+    ProtocolResult r = runProtocol(protocol, subject, options);
     run.text = formatProtocolResult(protocol, r, run.outDir);
     run.files = r.files;
     run.armProtocol = protocol;
-    run.armResult = r;
+    run.armResult = std::move(r);   // the trial table can be large: not copied
     return run;
 }
 

@@ -16,6 +16,14 @@ namespace armsim {
 
 namespace {
 
+/// " (element <NAME>)" when tinyxml2's error text names an element, else "".
+std::string findXmlErrorElement(const std::string& errorText) {
+    const std::size_t at = errorText.find("name=");
+    if (at == std::string::npos) return "";
+    const std::size_t end = errorText.find_first_of(" \t\n", at + 5);
+    return " (element <" + errorText.substr(at + 5, end == std::string::npos ? std::string::npos : end - at - 5) + ">)";
+}
+
 /// tinyxml2's error in words (its ErrorStr is "Error=XML_ERROR_... ErrorID=14 (0xe) Line number=4: ...").
 std::string describeXmlError(tinyxml2::XMLError e) {
     switch (e) {
@@ -189,7 +197,8 @@ public:
     OsimModel read(const std::string& xml) {
         tinyxml2::XMLDocument doc;
         if (const tinyxml2::XMLError e = doc.Parse(xml.c_str(), xml.size()); e != tinyxml2::XML_SUCCESS)
-            throw OsimError(source_ + ":" + std::to_string(doc.ErrorLineNum()) + ": not valid XML: " + describeXmlError(e));
+            throw OsimError(source_ + ":" + std::to_string(doc.ErrorLineNum()) + ": not valid XML: " + describeXmlError(e) +
+                            findXmlErrorElement(doc.ErrorStr() ? doc.ErrorStr() : ""));
         const XMLElement* root = doc.RootElement();
         if (!root || std::string(root->Name()) != "OpenSimDocument")
             throw OsimError(source_ + ": expected an <OpenSimDocument> (an OpenSim model file)");
@@ -231,8 +240,8 @@ private:
             body.line = b->GetLineNum();
             if (body.name.empty()) fail(b, "a body without a name");
             body.mass = number(b, "mass");
-            if (!(body.mass >= 0 && body.mass <= 1000))   // a body segment or a device, not a typo's 1e9
-                fail(child(b, "mass"), "mass " + formatNumber(body.mass) + ": expected 0 to 1000 kg");
+            if (!(body.mass >= 0 && body.mass <= 1e5))   // a segment of any animal modelled (100 t), not a typo's 1e9
+                fail(child(b, "mass"), "mass " + formatNumber(body.mass) + ": expected 0 to 1e5 kg");
             body.massCenter = vec3(b, "mass_center");
             if (b->FirstChildElement("inertia")) {
                 const std::vector<double> I = numbers(b, "inertia", 6);

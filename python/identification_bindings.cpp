@@ -597,8 +597,10 @@ synthetic data, are NaN: the reader ignores them): pass it to identify_torque. V
 level (relative force sd, a fraction: 0.02 = 2 %), identified by every method (default lm and the
 two-output learning family) with the `forward` model (corrected | faithful | steady).
 Returns the rows as columns: truth, noise, method, true_mass_kg, true_tendon_length_m, mass_kg,
-tendon_length_m, mass_error (relative), tendon_length_error_m, mass_covered, tendon_length_covered (1/0, -1
-without an interval), stop_reason, iterations, evaluations, wall_time_s.)");
+tendon_length_m, mass_error and tendon_length_error (relative; tendon_length_error was named
+tendon_length_error_m before 2026-11-27, a fraction all along), mass_covered, tendon_length_covered (1/0, -1
+without an interval), stop_reason, iterations, evaluations, wall_time_s: validation.csv's columns
+(studies/validation.h) in SI units.)");
 
     mod.def("validate_elbow", &validateElbowPy, "population"_a = py::none(), "subjects"_a = 200, "seed"_a = 1u,
             "noise"_a = py::none(), "activation_sd"_a = 0.02, "angles"_a = py::none(), "repetitions"_a = py::none(),

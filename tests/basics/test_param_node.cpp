@@ -91,6 +91,12 @@ TEST(ParamNode, OneDocumentPerFileAndNoHangOnATokenNoNodeStartsWith) {
     EXPECT_TRUE(has(two, "two.yaml:3: a second YAML document")) << two;
     EXPECT_NO_THROW(ParamNode::loadString("a: 1\n---\n", "trailing.yaml"));
     EXPECT_NO_THROW(ParamNode::loadString("---\na: 1\n", "leading.yaml"));
+    EXPECT_NO_THROW(ParamNode::loadString("a: 1\n---\n# nothing\n---\n", "empties.yaml"));
+    // Content after empty documents, and a stray token after the first document, are refused too.
+    const std::string third = messageOf([] { ParamNode::loadString("a: 1\n---\n---\nb: 2\n", "third.yaml"); });
+    EXPECT_TRUE(has(third, "third.yaml:4: a second YAML document")) << third;
+    const std::string stray = messageOf([] { ParamNode::loadString("{a: 1}\n, b: 2\n", "stray.yaml"); });
+    EXPECT_TRUE(has(stray, "stray.yaml:2: invalid YAML")) << stray;
     for (const char* text : {",", ",\n", "a: 1\n,\n", "- ,\n"}) {
         EXPECT_EXIT(
             {
