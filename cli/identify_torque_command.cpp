@@ -31,6 +31,14 @@ struct IdentifyTorqueOptions {
     std::string out = "out/identify_torque";
 };
 
+/// Where the judging noise level comes from, for a person.
+std::string describeNoiseSource(const IdentifyTorqueOptions& o, const std::vector<MuscleEstimate>& estimates) {
+    const int dof = estimates.empty() ? 0 : estimates.back().noiseDegreesOfFreedom;
+    if (std::isfinite(o.noiseLevel)) return "--noise-level";
+    if (dof > 0) return "estimated from the repetitions, " + std::to_string(dof) + " degrees of freedom";
+    return "the prior population's transducer noise: no condition is repeated to estimate it from";
+}
+
 void runIdentifyTorque(const IdentifyTorqueOptions& o) {
     checkOutputFolder("--out", o.out);
     const std::string file = findAsset(o.data);
@@ -53,14 +61,10 @@ void runIdentifyTorque(const IdentifyTorqueOptions& o) {
     if (!skipped.empty()) std::printf("%s\n", skipped.c_str());
     const double noise = findJudgingNoiseLevel(to, estimates);
     const MuscleParameters& b = prior.base.biceps();
-    const int noiseDof = estimates.empty() ? 0 : estimates.back().noiseDegreesOfFreedom;
-    const std::string noiseSource =
-        std::isfinite(o.noiseLevel) ? "--noise-level"
-        : noiseDof > 0 ? "estimated from the repetitions, " + std::to_string(noiseDof) + " degrees of freedom"
-                       : "the prior population's transducer noise: no condition is repeated to estimate it from";
     std::printf("prior (population base) %s: M %.1f g, L0T %.1f cm; residuals judged against a relative torque sd of "
                 "%.1f %% (%s)\n",
-                b.name.c_str(), 1000 * b.mass, 100 * b.optimalTendonLength, 100 * noise, noiseSource.c_str());
+                b.name.c_str(), 1000 * b.mass, 100 * b.optimalTendonLength, 100 * noise,
+                describeNoiseSource(o, estimates).c_str());
     std::printf("%-13s %9s %21s %9s %21s %10s %12s %6s %8s\n", "method", "M (g)", "95 % interval", "L0T (cm)",
                 "95 % interval", "rms (N m)", "chi2 / dof", "p", "verdict");
     for (const MuscleEstimate& e : estimates) {

@@ -215,6 +215,22 @@ void runOsimFreeTrialCommand(const TrialOptions& o, bool initialAngleGiven, bool
     if (!o.plot.empty()) std::printf("wrote %s\n", o.plot.c_str());
 }
 
+/// An isometric trial's summary: the true force beside the transducer and the thesis's two estimates.
+void printIsometricSummary(const ArmSetup& setup, const IsometricSummary& s, double averagingWindow) {
+    std::printf("isometric trial at %.1f deg: path %.2f cm, moment arm %.2f cm\n", radToDeg(s.elbowAngle),
+                100 * s.pathLength, 100 * s.momentArm);
+    std::printf("  true muscle force      %8.2f N (mean of the last %.2f s; final %.2f N)\n", s.meanForce,
+                averagingWindow, s.finalForce);
+    std::printf("  transducer (tared)     %8.2f N%s\n", s.meanStrapForce, s.saturated ? "  SATURATED" : "");
+    std::printf("  estimate, moment arm   %8.2f N (tare hides %.2f N of passive force)\n", s.meanForceMomentArm,
+                s.restForce);
+    std::printf("  estimate, fixed ratio  %8.2f N (error %+.2f %%)\n", s.meanForceFixedRatio,
+                100 * (s.meanForceFixedRatio - s.meanForce) / s.meanForce);
+    if (setup.getNumMuscles() > 1)   // the thesis's estimates assume one muscle makes the whole torque
+        std::printf("  (the estimates are the thesis's one-muscle method: the tared torque of all %d muscles "
+                    "credited to %s)\n", setup.getNumMuscles(), setup.muscles[setup.primary].params.name.c_str());
+}
+
 void runTrialCommand(const TrialOptions& o) {
     // Every output checked and staged before the trial; all appear together at the end, or none.
     OutputFiles files;
@@ -279,18 +295,7 @@ void runTrialCommand(const TrialOptions& o) {
         if (!o.video.empty())
             files.writeWith(videoPath, [&](const std::string& p) { frames = renderVideo(o, p, setup, r.series, 0); });
         const IsometricSummary& s = r.summary;
-        std::printf("isometric trial at %.1f deg: path %.2f cm, moment arm %.2f cm\n", radToDeg(s.elbowAngle),
-                    100 * s.pathLength, 100 * s.momentArm);
-        std::printf("  true muscle force      %8.2f N (mean of the last %.2f s; final %.2f N)\n", s.meanForce,
-                    iso.averagingWindow, s.finalForce);
-        std::printf("  transducer (tared)     %8.2f N%s\n", s.meanStrapForce, s.saturated ? "  SATURATED" : "");
-        std::printf("  estimate, moment arm   %8.2f N (tare hides %.2f N of passive force)\n", s.meanForceMomentArm,
-                    s.restForce);
-        std::printf("  estimate, fixed ratio  %8.2f N (error %+.2f %%)\n", s.meanForceFixedRatio,
-                    100 * (s.meanForceFixedRatio - s.meanForce) / s.meanForce);
-        if (setup.getNumMuscles() > 1)   // the thesis's estimates assume one muscle makes the whole torque
-            std::printf("  (the estimates are the thesis's one-muscle method: the tared torque of all %d muscles "
-                        "credited to %s)\n", setup.getNumMuscles(), setup.muscles[setup.primary].params.name.c_str());
+        printIsometricSummary(setup, s, iso.averagingWindow);
         spec.title = "isometric trial at " + std::to_string(int(radToDeg(s.elbowAngle) + 0.5)) + " deg";
         spec.yLabel = "force (N)";
         spec.series.push_back({"true muscle force", r.series.getColumn("time_s"), r.series.getColumn("muscle_force_N")});
