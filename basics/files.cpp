@@ -1,6 +1,7 @@
 #include "basics/files.h"
 
 #include "basics/errors.h"
+#include "basics/write_target.h"
 
 #include <algorithm>
 #include <cstdio>
@@ -39,6 +40,15 @@ bool haveSameBytes(const std::string& a, const std::string& b) {
                                 std::istreambuf_iterator<char>(y), std::istreambuf_iterator<char>());
 }
 }  // namespace
+
+WriteTarget findWriteTarget(const std::string& path) {
+    namespace fs = std::filesystem;
+    std::error_code ec;
+    if (!fs::is_symlink(path, ec)) return {path, true};
+    const std::string resolved = fs::weakly_canonical(path, ec).string();
+    if (ec) return {"", false};
+    return {resolved, !fs::exists(resolved, ec) || fs::is_regular_file(resolved, ec)};
+}
 
 void setInputProtection(bool on) {
     std::lock_guard<std::mutex> lock(inputMutex);
@@ -180,12 +190,11 @@ void writeFileAtomically(const std::string& path, const std::string& text) {
 AtomicFileWriter::AtomicFileWriter(const std::string& path) : path_(path), target_(path) {
     namespace fs = std::filesystem;
     std::error_code ec;
-    if (fs::is_symlink(path, ec)) {   // written through: the link stays, its target is replaced
-        target_ = fs::weakly_canonical(path, ec).string();
-        if (ec || (fs::exists(target_, ec) && !fs::is_regular_file(target_, ec)))
-            throw InputError(path + ": a link to " + (target_.empty() ? std::string("nothing that can be resolved") : target_) +
-                             ", which is not a regular file: expected a file to write");
-    }
+    const WriteTarget where = findWriteTarget(path);
+    target_ = where.path;
+    if (!where.isFile)
+        throw InputError(path + ": a link to " + (target_.empty() ? std::string("nothing that can be resolved") : target_) +
+                         ", which is not a regular file: expected a file to write");
     const fs::path target(target_);
     if (target.has_parent_path()) fs::create_directories(target.parent_path(), ec);
     tmp_ = target_ + ".tmp." + std::to_string(::getpid());

@@ -2,6 +2,7 @@
 
 #include "basics/errors.h"
 #include "basics/files.h"
+#include "basics/write_target.h"
 
 #include <signal.h>
 #include <unistd.h>
@@ -351,13 +352,11 @@ std::string OutputFiles::add(const std::string& option, const std::string& path,
     checkNotInput(option, path);
     fs::path target = fs::path(path).lexically_normal();
     std::error_code ec;
-    if (fs::is_symlink(target, ec)) {   // written through: the link stays, its target gets the file
-        const fs::path resolved = fs::weakly_canonical(target, ec);
-        if (ec || (fs::exists(resolved, ec) && !fs::is_regular_file(resolved, ec)))
-            throw InputError(option + " '" + path + "': a link to '" + resolved.string() +
-                             "', which is not a regular file: expected a file path");
-        target = resolved;
-    }
+    const WriteTarget where = findWriteTarget(target.string());   // a link is written through
+    if (!where.isFile)
+        throw InputError(option + " '" + path + "': a link to '" + where.path +
+                         "', which is not a regular file: expected a file path");
+    target = where.path;
     const fs::path absolute = fs::absolute(target, ec).lexically_normal();
     for (const Entry& e : entries_)
         if (fs::absolute(e.target, ec).lexically_normal() == absolute)

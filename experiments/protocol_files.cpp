@@ -7,27 +7,21 @@
 #include "basics/param_node.h"
 #include "experiments/protocol_run.h"
 
-#include <cstdarg>
-#include <cstdio>
+#include <fmt/printf.h>
 
 namespace armsim {
 
 namespace {
 
-/// printf-style formatting appended to text.
-void appendf(std::string& text, const char* format, ...) {
-    va_list args, copy;
-    va_start(args, format);
-    va_copy(copy, args);
-    const int n = std::vsnprintf(nullptr, 0, format, copy);
-    va_end(copy);
-    if (n > 0) {
-        std::string part(std::size_t(n) + 1, '\0');
-        std::vsnprintf(part.data(), part.size(), format, args);
-        part.resize(std::size_t(n));
-        text += part;
-    }
-    va_end(args);
+/// printf-style formatting (fmt's) appended to text.
+template <class... Args>
+void appendf(std::string& text, const char* format, const Args&... args) {
+    text += fmt::sprintf(format, args...);
+}
+
+/// The run folder: none when computing only, else the one asked for, else out/<protocol name>.
+std::string findRunFolder(const ProtocolFileOptions& o, const std::string& name) {
+    return !o.write ? std::string() : o.outDir.empty() ? "out/" + name : o.outDir;
 }
 
 void appendFit(std::string& text, const char* label, const QuadraticFit& q, const char* xUnit, double xScale,
@@ -90,7 +84,7 @@ ProtocolFileRun runArmProtocolFile(const std::string& path, const ProtocolFileOp
     const ArmSetup subject = loadProtocolSubject(protocol);
     run.kind = getProtocolKindName(protocol.kind);
     run.name = protocol.name;
-    run.outDir = !o.write ? std::string() : o.outDir.empty() ? "out/" + protocol.name : o.outDir;
+    run.outDir = findRunFolder(o, protocol.name);
     if (o.onStart) o.onStart(protocol.name, "protocol " + protocol.name + " (" + run.kind + "): " + protocol.description + "\n");
     ProtocolRunOptions options{run.outDir, o.jobs, o.progress, {}};
     if (o.beforeCommit)
@@ -128,7 +122,7 @@ ProtocolFileRun runTorqueProtocolFile(const std::string& path, const ProtocolFil
     const TorqueProtocol protocol = readTorqueProtocol(path);
     run.kind = "torque";
     run.name = protocol.name;
-    run.outDir = !o.write ? std::string() : o.outDir.empty() ? "out/" + protocol.name : o.outDir;
+    run.outDir = findRunFolder(o, protocol.name);
     if (o.onStart)
         o.onStart(protocol.name, "protocol " + protocol.name + " (torque): " + protocol.description + "\n  " +
                   std::to_string(protocol.getNumTrials()) + " trials: " + describeConditions(protocol) + "\n");

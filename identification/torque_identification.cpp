@@ -16,6 +16,13 @@ using ElbowIdentifier = MuscleEstimate (*)(const ElbowMethod& method, const Popu
                                            const std::vector<TorqueObservation>& data, unsigned seed, int subject,
                                            const std::vector<ChannelObservation>& channels);
 
+/// The subject's voluntary activation as twitch interpolation measures it (sd activationSd), drawn per
+/// subject from the seed.
+double measureSubjectActivation(const std::vector<TorqueObservation>& data, double activationSd, unsigned seed,
+                                int subject) {
+    return measureVoluntaryActivation(data, activationSd, seed + 7919u * unsigned(subject));
+}
+
 MuscleEstimate identifyWithThesisMethod(const ElbowMethod&, const Population& population,
                                         const std::vector<TorqueObservation>& data, unsigned, int,
                                         const std::vector<ChannelObservation>&) {
@@ -35,7 +42,7 @@ MuscleEstimate identifyWithMeasuredActivation(const ElbowMethod& method, const P
                                               const std::vector<ChannelObservation>&) {
     SynergistOptions o = method.options;
     checkField("activation_sd", o.activationSd, Bound{0, 0.5, true, false});
-    o.measuredActivation = measureVoluntaryActivation(data, o.activationSd, seed + 7919u * unsigned(subject));
+    o.measuredActivation = measureSubjectActivation(data, o.activationSd, seed, subject);
     return identifySynergistAware(population, data, o);
 }
 
@@ -47,9 +54,7 @@ MuscleEstimate identifyWithChannels(const ElbowMethod& method, const Population&
                          "none: add ultrasound or emg to its conditions, or measurements)");
     SynergistOptions o = method.options;
     checkField("activation_sd", o.activationSd, Bound{0, 0.5, false, false});
-    o.measuredActivation = o.activationSd > 0
-                               ? measureVoluntaryActivation(data, o.activationSd, seed + 7919u * unsigned(subject))
-                               : kNaN;
+    o.measuredActivation = o.activationSd > 0 ? measureSubjectActivation(data, o.activationSd, seed, subject) : kNaN;
     o.channels = channels;
     return identifySynergistAware(population, data, o);
 }

@@ -384,13 +384,11 @@ std::vector<StudyResult> runStudyGroup(const Study& study, long group, const std
     return out;
 }
 
-namespace {
-
 // results.csv's columns: the one description of a result that results.csv's header, its rows and the
 // journal's lines all follow.
 #define ARMSIM_AT(member) [](auto& r) -> auto& { return r.member; }
 
-const FieldTable<StudyResult>& getResultFields() {
+const FieldTable<StudyResult>& getStudyResultFields() {
     using R = StudyResult;
     static const FieldTable<R> fields({
         integerField<R>("task", "", ARMSIM_AT(task)),
@@ -438,13 +436,9 @@ const FieldTable<StudyResult>& getResultFields() {
 
 #undef ARMSIM_AT
 
-}  // namespace
+std::string getStudyResultsHeader() { return getStudyResultFields().getHeader(); }
 
-const FieldTable<StudyResult>& getStudyResultFields() { return getResultFields(); }
-
-std::string getStudyResultsHeader() { return getResultFields().getHeader(); }
-
-std::string formatStudyResult(const StudyResult& r) { return getResultFields().formatRow(r).getText(); }
+std::string formatStudyResult(const StudyResult& r) { return getStudyResultFields().formatRow(r).getText(); }
 
 std::string formatStudyJournalLine(const StudyResult& r) {
     const std::string body = formatStudyResult(r) + '\t' + formatNumber(r.synthesisTime) + ',' +
@@ -462,7 +456,7 @@ bool parseStudyJournalLine(const std::string& line, StudyResult& r) {
                                    timing = splitCsvRecord(body.substr(tab + 1));
     if (timing.size() != 3) return false;
     r = StudyResult();
-    if (!getResultFields().parseRow(c, r)) return false;
+    if (!getStudyResultFields().parseRow(c, r)) return false;
     long rank = 0;
     if (!parseCsvNumber(timing[0], r.synthesisTime) || !parseCsvNumber(timing[1], r.identificationTime) || !parseCsvInteger(timing[2], rank))
         return false;
