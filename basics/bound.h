@@ -31,10 +31,13 @@ namespace bounds {
 constexpr Bound kHandLoad{0, 50, false, false, "kg"};   ///< a load held in the hand
 constexpr Bound kMuscleMass{0, 10, true, false, "kg"};  ///< a muscle's mass (10 L; the largest muscles ~1 kg)
 constexpr Bound kTendonLength{0, 2, true, false, "m"};  ///< a muscle's optimal tendon length L0T
+constexpr Bound kPathLength{0, 3, true, false, "m"};    ///< a musculotendon path's length (a whole limb's ~1 m)
 constexpr Bound kMotorUnits{0, 1000, false, false, ""}; ///< motor units of one fibre type
 constexpr Bound kMaxIsometricForce{0, 1e5, true, false, "N"};  ///< a muscle's F0 (the strongest ~10 kN)
-/// An integrator's relative accuracy: CPodes refuses much below 1e-12 ("too much accuracy requested").
-constexpr Bound kAccuracy{1e-12, 0.1, false, false, ""};
+/// An integrator's relative accuracy: CPodes refuses much below 1e-12 ("too much accuracy requested"),
+/// and the muscles' stiff ODE fails its corrector below about 1e-10 (a thesis-arm trial at 1e-11 and
+/// 1e-12: CPodes flag -4, measured 2026-11-28).
+constexpr Bound kAccuracy{1e-10, 0.1, false, false, ""};
 }  // namespace bounds
 
 /// Throws FieldError naming field, value and bound unless value is finite and inside bound.

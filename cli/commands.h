@@ -79,6 +79,14 @@ CLI::Option* addNumberListOption(CLI::App& app, const std::string& name, std::ve
 CLI::Option* addNameListOption(CLI::App& app, const std::string& name, std::vector<std::string>& values,
                                const std::string& description);
 
+/// findAsset(name) for an option's value: a path, or a name under the assets folder; else InputError
+/// naming the option ("--population 'nope': no such file (looked here and in ...)").
+std::string findAssetFor(const std::string& option, const std::string& name);
+
+/// A plot's path as typed ends in .png (any case; empty: no plot): else InputError naming the option
+/// ("--plot 'p.svg': extension '.svg': expected .png (plots are PNG images)").
+const std::string& checkPngPath(const std::string& option, const std::string& path);
+
 /// Checks, before any work and without creating anything, that the output folder given to `option`
 /// can be created or written (it, or its nearest existing ancestor, is a writable folder): InputError
 /// naming the option, the path and the reason.

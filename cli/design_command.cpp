@@ -99,7 +99,7 @@ PlotSpec makeDesignPlot(const DesignResult& d, bool channels, int repetitions) {
 
 void runDesign(const DesignOptions& o) {
     checkOutputFolder("--out", o.out);
-    const Population population = o.population.empty() ? loadDefaultPopulation() : loadPopulation(findAsset(o.population));
+    const Population population = o.population.empty() ? loadDefaultPopulation() : loadPopulation(findAssetFor("--population", o.population));
     DesignSettings s;
     s.flexionDeg = o.angles;
     s.levels = o.levels;

@@ -1,5 +1,6 @@
 // armsim forward: OpenSim's Forward tool on an .osim model (model/osim_forward.h): excitations from a
 // controls file, states written as OpenSim writes them. Parses and calls; no science here.
+#include "basics/bound.h"
 #include "basics/errors.h"
 #include "basics/numbers.h"
 #include "basics/files.h"
@@ -10,6 +11,7 @@
 #include "model/osim_forward.h"
 
 #include <chrono>
+#include <map>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -85,7 +87,14 @@ void runForward(const ForwardOptions& given, CLI::Option* outOption) {
     s.integration.maxStepSize = o.maxStepSize;
     s.progress = [](double t, double duration) { printTimeProgress("forward", t, duration); };
     const auto start = std::chrono::steady_clock::now();
-    const OsimForwardResult r = runOsimForward(model, controls, o.initialStates.empty() ? nullptr : &initial, s);
+    std::map<std::string, std::string> typed;   // settings the command line gave, named as typed
+    if (std::isfinite(given.finalTime)) typed["final_time"] = "--final-time";
+    if (std::isfinite(given.initialTime)) typed["initial_time"] = "--initial-time";
+    if (std::isfinite(given.accuracy)) typed["accuracy"] = "--accuracy";
+    typed["sample_rate"] = "--rate";
+    if (typed.count("final_time")) typed["duration"] = "--final-time";
+    OsimForwardResult r;
+    runNamingOptions(typed, [&] { r = runOsimForward(model, controls, o.initialStates.empty() ? nullptr : &initial, s); });
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     for (const std::string& note : r.notes) std::printf("note: %s\n", note.c_str());
     const Table& t = r.states;
@@ -138,7 +147,7 @@ void addForwardCommand(CLI::App& app) {
     c->add_option("--rate", o->rate, "rows of states.sto per second [Hz]")->capture_default_str()->transform(inRange(1e-3, 1e6));
     c->add_option("--accuracy", o->accuracy,
                   "integrator relative accuracy (default: the setup's integrator_error_tolerance, else 1e-5)")
-        ->transform(inRange(1e-12, 1e-1));
+        ->transform(inRange(bounds::kAccuracy.lo, bounds::kAccuracy.hi));
     c->add_option("--muscle-model", o->muscleModel,
                   "every muscle under this model: thelen2003, thelen2003_opensim2 (OpenSim 2.x's equations) or "
                   "degroote2016 (default: each muscle's type in the file)");

@@ -347,9 +347,9 @@ void addElbowValidationPlots(const std::vector<ElbowValidationRow>& rows, Output
 
 void runElbowValidate(const ValidateOptions& o) {
     // Files as everywhere else: a path, or a name under the assets folder.
-    const Population family = o.population.empty() ? loadDefaultPopulation() : loadPopulation(findAsset(o.population));
-    const Population population = o.truthPopulation.empty() ? family : loadPopulation(findAsset(o.truthPopulation));
-    const Population prior = o.prior.empty() ? family : loadPopulation(findAsset(o.prior));
+    const Population family = o.population.empty() ? loadDefaultPopulation() : loadPopulation(findAssetFor("--population", o.population));
+    const Population population = o.truthPopulation.empty() ? family : loadPopulation(findAssetFor("--truth-population", o.truthPopulation));
+    const Population prior = o.prior.empty() ? family : loadPopulation(findAssetFor("--prior", o.prior));
     const bool inFamily = o.truthPopulation.empty() && o.prior.empty();
     ElbowValidationSettings s;
     s.subjects = capForQuickRun(o.subjects, kQuickSubjects, "validation subjects");
@@ -358,7 +358,7 @@ void runElbowValidate(const ValidateOptions& o) {
     s.activationSd = o.activationSd;
     s.freeSlowFraction = o.freeSlowFraction;
     if (!o.protocol.empty()) {
-        s.protocol = readTorqueProtocol(findAsset(o.protocol));
+        s.protocol = readTorqueProtocol(findAssetFor("--protocol", o.protocol));
     } else {
         std::vector<double> angles = getThesisMvcFlexionDeg();
         if (!o.angles.empty()) angles = o.angles;
@@ -366,15 +366,16 @@ void runElbowValidate(const ValidateOptions& o) {
     }
     if (o.noiseGiven)
         for (double pct : o.noise) s.noiseLevels.push_back(pct / 100.0);
+    const long fits = countElbowValidationFits(population, prior, s);   // checks the settings and the work's size
     if (!inFamily)
         std::printf("out of family: truth population '%s' (%s, model %s), identifiers' prior '%s' (%s, model %s)\n",
                     population.name.c_str(), population.file.c_str(), population.base.name.c_str(), prior.name.c_str(),
                     prior.file.c_str(), prior.base.name.c_str());
-    std::printf("validation on virtual subjects of the %s model as truth: population '%s' (%s), %d subjects, seed %u; "
+    std::printf("validation on virtual subjects of the %s model as truth: population '%s' (%s), %d subjects (%ld fits), seed %u; "
                 "protocol '%s' (%d trials: %s); identifiers: thesis (biceps only), synergist-aware (MAP) and, with "
                 "--activation-sd > 0, synergist-aware with voluntary activation measured by twitch interpolation "
                 "(synergist-va)%s\n",
-                population.base.name.c_str(), population.name.c_str(), population.file.c_str(), s.subjects, s.seed,
+                population.base.name.c_str(), population.name.c_str(), population.file.c_str(), s.subjects, fits, s.seed,
                 s.protocol.name.c_str(),
                 s.protocol.getNumTrials(), describeConditions(s.protocol).c_str(),
                 s.protocol.hasChannels() ? "; with the protocol's channels besides torque, the same MAP fitting every "

@@ -9,6 +9,8 @@
 #include "identification/torque_identification.h"
 #include "muscles/muscle_file.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -35,15 +37,18 @@ struct IdentifyTorqueOptions {
 std::string describeNoiseSource(const IdentifyTorqueOptions& o, const std::vector<MuscleEstimate>& estimates) {
     const int dof = estimates.empty() ? 0 : estimates.back().noiseDegreesOfFreedom;
     if (std::isfinite(o.noiseLevel)) return "--noise-level";
-    if (dof > 0) return "estimated from the repetitions, " + std::to_string(dof) + " degrees of freedom";
-    return "the prior population's transducer noise: no condition is repeated to estimate it from";
+    const bool floored = !estimates.empty() && estimates.back().noiseLevel == kMinTorqueNoiseLevel;
+    const std::string floor = floored ? fmt::format("; raised to the floor of {:g} %: the repetitions scatter less",
+                                                    100 * kMinTorqueNoiseLevel) : "";
+    if (dof > 0) return "estimated from the repetitions, " + std::to_string(dof) + " degrees of freedom" + floor;
+    return "the prior population's transducer noise: no condition is repeated to estimate it from" + floor;
 }
 
 void runIdentifyTorque(const IdentifyTorqueOptions& o) {
     checkOutputFolder("--out", o.out);
     const std::string file = findAsset(o.data);
     const std::vector<TorqueObservation> data = readTorqueData(file);
-    const Population prior = o.population.empty() ? loadDefaultPopulation() : loadPopulation(findAsset(o.population));
+    const Population prior = o.population.empty() ? loadDefaultPopulation() : loadPopulation(findAssetFor("--population", o.population));
     std::printf("torque data %s: %zu trials; prior population '%s' (model '%s')\n", file.c_str(), data.size(),
                 prior.name.c_str(), prior.base.name.c_str());
     TorqueIdentificationOptions to;
@@ -53,8 +58,8 @@ void runIdentifyTorque(const IdentifyTorqueOptions& o) {
     to.freeSlowFraction = o.freeSlowFraction;
     to.emgCrosstalk = o.emgCrosstalk;
     if (!o.channels.empty()) {
-        to.channels = readChannelData(findAsset(o.channels));
-        std::printf("channel data %s: %zu measurements\n", findAsset(o.channels).c_str(), to.channels.size());
+        to.channels = readChannelData(findAssetFor("--channels", o.channels));
+        std::printf("channel data %s: %zu measurements\n", findAssetFor("--channels", o.channels).c_str(), to.channels.size());
     }
     std::string skipped;
     const std::vector<MuscleEstimate> estimates = identifyTorqueData(prior, data, to, &skipped);
@@ -150,7 +155,7 @@ void addIdentifyTorqueCommand(CLI::App& app) {
     c->add_option("--population", o->population, "prior population (default assets/subjects/default_population.yaml)");
     c->add_option("--noise-level", o->noiseLevel,
                   "relative sd of one trial's torque (default: estimated from repeated trials)")
-        ->transform(inRange(1e-4, 0.5));
+        ->transform(inRange(kMinTorqueNoiseLevel, 0.5));
     c->add_option("--activation", o->activation, "measured voluntary activation (twitch interpolation): adds synergist-va")
         ->check(CLI::Validator(
             [](std::string& text) {

@@ -116,6 +116,16 @@ int finishStdout(int status) {
     return status == 0 ? 2 : status;
 }
 
+// The command typed, with its subcommand ("model show"), for messages; "COMMAND" before one is known.
+std::string getCommandPath(const CLI::App& app) {
+    std::string path;
+    for (const CLI::App* a = &app; !a->get_subcommands().empty();) {
+        a = a->get_subcommands().front();
+        path += (path.empty() ? "" : " ") + a->get_name();
+    }
+    return path.empty() ? "COMMAND" : path;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -149,14 +159,14 @@ int main(int argc, char** argv) {
     } catch (const CLI::CallForVersion& e) {
         return finishStdout(app.exit(e));
     } catch (const CLI::ConversionError& e) {
-        std::cerr << "armsim: error: " << explainConversion(app, e.what()) << " (armsim COMMAND --help lists its options)\n";
+        std::cerr << "armsim: error: " << explainConversion(app, e.what()) << " (armsim " << getCommandPath(app) << " --help lists its options)\n";
         return 2;
     } catch (const CLI::ValidationError& e) {
         // CLI11's "--rate: = 0: expected ..." (inRange's message after the option's name) as "--rate = 0: ...".
         std::string what = e.what();
         if (const std::size_t at = what.find(": = "); at != std::string::npos && what.rfind("--", 0) == 0)
             what.replace(at, 4, " = ");
-        std::cerr << "armsim: error: " << what << " (armsim COMMAND --help lists its options)\n";
+        std::cerr << "armsim: error: " << what << " (armsim " << getCommandPath(app) << " --help lists its options)\n";
         return 2;
     } catch (const CLI::ParseError& e) {
         const std::string unknown = findUnknownCommand(app, argc, argv);
@@ -170,7 +180,11 @@ int main(int argc, char** argv) {
         std::cerr << "armsim: error: cannot use '" << e.path1().string() << "': " << e.code().message() << "\n";
         return 2;
     } catch (const armsim::InterruptedError& e) {
-        std::cerr << "armsim: " << e.what() << ": stopped (unfinished output removed; a study resumes from its journal)\n";
+        // Only the study keeps work across a stop (its journal); every other command leaves nothing.
+        const bool study = getCommandPath(app) == "study";
+        std::cerr << "armsim: " << e.what() << ": stopped ("
+                  << (study ? "unfinished output removed; the study resumes from its journal when run again"
+                            : "unfinished output removed") << ")\n";
         return 128 + armsim::getInterruption();
     } catch (const armsim::SimulationError& e) {
         std::cerr << "armsim: simulation failed: " << e.what() << "\n";

@@ -87,7 +87,7 @@ ArmSetup MuscleOptions::loadSetup() const {
     if (mass) check("--mass", *mass, bounds::kMuscleMass), p.mass = *mass;
     if (tendonLength) check("--tendon-length", *tendonLength, bounds::kTendonLength), p.optimalTendonLength = *tendonLength;
     if (maxPathLength) {
-        check("--max-path", *maxPathLength, Bound{0, 3, true, false, "m"});
+        check("--max-path", *maxPathLength, bounds::kPathLength);
         p.maxPathLength = *maxPathLength;
         s.muscles[s.primary].maxPathFromRange = false;
     }
@@ -136,7 +136,7 @@ void addMuscleCommands(CLI::App& app) {
         c->add_option("--activation", *U, "activation U in [0, 1]")->capture_default_str();
         c->callback([=] {
             checkActivation(*U);
-            checkField("--path", *path, Bound{0, 3, true, false, "m"});
+            checkField("--path", *path, bounds::kPathLength);
             const std::shared_ptr<const MuscleModel> built = opts->build();
             const MuscleModel& m = *built;
             const SteadyState s = m.calcSteadyState(*path, *U);
@@ -169,18 +169,29 @@ void addMuscleCommands(CLI::App& app) {
         c->callback([=] {
             checkActivation(*U);
             checkField("--step", *step, Bound::positive("m"));
+            if (!(*to >= *from))
+                throw InputError("--to " + formatNumber(*to) + " m is below --from " + formatNumber(*from) +
+                                 " m: expected --to at least --from");
+            if (*to > *from && *step > *to - *from)
+                throw InputError("--step " + formatNumber(*step) + " m is longer than --from " + formatNumber(*from) +
+                                 " m to --to " + formatNumber(*to) + " m: expected a step that gives two path lengths "
+                                 "at least (or --to equal to --from for one)");
             if ((*to - *from) / *step > 1e6)
                 throw InputError("--step " + formatNumber(*step) + " m over " + formatNumber(*from) + ".." +
                                  formatNumber(*to) + " m gives " + formatNumber(std::floor((*to - *from) / *step) + 1) +
                                  " path lengths: expected at most 1000001");
-            if (!(*to >= *from)) throw InputError("--to must not be below --from");
             OutputFiles files;  // both appear at the end, or neither
             opts->declareInputs(files);
-            const std::string csvPath = files.add("--out", *out, true), plotPath = files.add("--plot", *plot);
+            const std::string csvPath = files.add("--out", *out, true), plotPath = files.add("--plot", checkPngPath("--plot", *plot));
             const std::shared_ptr<const MuscleModel> built = opts->build();
             const MuscleModel& m = *built;
-            m.checkPathLength(*from);
-            m.checkPathLength(*to);
+            for (const auto& [option, P] : {std::pair<const char*, double>{"--from", *from}, {"--to", *to}}) {
+                try {
+                    m.checkPathLength(P);
+                } catch (const InputError& e) {
+                    throw InputError(std::string(option) + ": " + e.what());
+                }
+            }
             Table t({"path_length_m", "activation", "force_N", "fascicle_length_m", "converged"});
             const int n = int(std::floor((*to - *from) / *step + 1e-9)) + 1;
             std::vector<double> x, y;
@@ -237,7 +248,7 @@ void addMuscleCommands(CLI::App& app) {
         c->add_option("--plot", *plot, "PNG plot of force and activation (optional)");
         c->callback([=] {
             checkActivation(*U);
-            checkField("--path", settings->pathLength, Bound{0, 3, true, false, "m"});
+            checkField("--path", settings->pathLength, bounds::kPathLength);
             checkField("--onset", *onset, Bound::nonNegative("s"));
             checkField("--rise", *rise, Bound::nonNegative("s"));
             if (trace->empty() && *U > 0 && !(*onset < settings->duration))
@@ -252,7 +263,7 @@ void addMuscleCommands(CLI::App& app) {
             OutputFiles files;  // both appear at the end, or neither
             opts->declareInputs(files);
             files.addInput("--activation-trace", *trace);
-            const std::string csvPath = files.add("--out", *out, true), plotPath = files.add("--plot", *plot);
+            const std::string csvPath = files.add("--out", *out, true), plotPath = files.add("--plot", checkPngPath("--plot", *plot));
             const std::shared_ptr<const MuscleModel> built = opts->build();
             const MuscleModel& m = *built;
             MuscleIsometricSettings s = *settings;

@@ -1,8 +1,10 @@
 #include "basics/errors.h"
 #include "basics/files.h"
 #include "basics/format.h"
+#include "basics/numbers.h"
 #include "basics/output_folder.h"
 #include "cli/commands.h"
+#include "muscles/muscle_file.h"
 #include "numerics/stiff_ode.h"
 
 #include <fmt/format.h>
@@ -10,6 +12,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -18,6 +21,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <set>
 #include <unistd.h>
 #include <vector>
 
@@ -209,6 +213,8 @@ namespace {
 struct LogProgress {
     std::mutex mutex;
     std::map<std::string, std::pair<std::chrono::steady_clock::time_point, std::chrono::steady_clock::time_point>> started;
+    std::map<std::string, double> startFraction;   // the share done at a label's first report
+    std::set<std::string> estimated;   // labels whose early estimate of the whole was printed
 };
 LogProgress& logProgress() {
     static LogProgress p;
@@ -230,6 +236,30 @@ double getLogProgressInterval() {
     return interval;
 }
 
+// Long work says early how long it will take: once, kEstimateAfter into it (or the log's interval, if
+// shorter), a line with the time left at the rate so far, when that is kLongWork or more (a terminal's bar
+// or a log's 10 s cadence alone would leave a user of a week-long run guessing). True if printed.
+// The time left [s] at the rate since a label's first report (done `from` then; the clock starts there).
+double calcTimeLeft(double fraction, double from, double elapsed) {
+    return fraction > from ? elapsed * (1 - fraction) / (fraction - from) : kNaN;
+}
+
+bool printEarlyEstimate(const std::string& label, double fraction, const std::string& amount, double elapsed,
+                        LogProgress& p) {
+    constexpr double kEstimateAfter = 2, kLongWork = 60;   // [s]
+    const double from = p.startFraction[label];
+    if (fraction <= from || elapsed < std::min(kEstimateAfter, getLogProgressInterval()) || p.estimated.count(label))
+        return false;
+    p.estimated.insert(label);
+    const double left = calcTimeLeft(fraction, from, elapsed);
+    if (!(left >= kLongWork)) return false;
+    std::fprintf(stderr, "%s%s: %s after %s: about %s left at this rate (stop with Ctrl-C)\n",
+                 isatty(fileno(stderr)) ? "\r\x1b[K" : "", label.c_str(), amount.c_str(), formatDuration(elapsed).c_str(),
+                 formatDuration(left).c_str());
+    std::fflush(stderr);
+    return true;
+}
+
 // quickEndSilent: on a log, no end line for work that ended before its first periodic line.
 void printProgressLine(const std::string& label, double fraction, const std::string& amount, bool finished,
                        bool quickEndSilent = false) {
@@ -246,18 +276,26 @@ void printProgressLine(const std::string& label, double fraction, const std::str
     const std::lock_guard<std::mutex> lock(p.mutex);
     const Clock::time_point now = Clock::now();
     auto [at, inserted] = p.started.try_emplace(label, now, now);
+    if (inserted) p.startFraction[label] = fraction;
     const double sinceLast = std::chrono::duration<double>(now - at->second.second).count();
     const double elapsed = std::chrono::duration<double>(now - at->second.first).count();
-    if (finished) p.started.erase(at);
+    const double left = calcTimeLeft(fraction, p.startFraction[label], elapsed);
+    if (finished) {
+        p.started.erase(at);
+        p.startFraction.erase(label);
+        p.estimated.erase(label);
+    } else if (printEarlyEstimate(label, fraction, amount, elapsed, p)) {
+        at->second.second = now;
+        return;
+    }
     if (!tty) {
         if (finished) {
             if (!quickEndSilent || elapsed >= kLogInterval) std::fprintf(stderr, "%s: %s done\n", label.c_str(), amount.c_str());
         } else if (!inserted && sinceLast >= kLogInterval) {
             at->second.second = now;
-            std::string left = "time left unknown";
-            if (fraction > 0) left = "about " + formatDuration(elapsed * (1 - fraction) / fraction) + " left";
+            const std::string leftText = std::isfinite(left) ? "about " + formatDuration(left) + " left" : "time left unknown";
             std::fprintf(stderr, "%s: %s (%.0f %%) after %s, %s\n", label.c_str(), amount.c_str(), 100 * fraction,
-                         formatDuration(elapsed).c_str(), left.c_str());
+                         formatDuration(elapsed).c_str(), leftText.c_str());
         }
         std::fflush(stderr);
         return;
@@ -266,12 +304,32 @@ void printProgressLine(const std::string& label, double fraction, const std::str
     if (!finished) at->second.second = now;
     constexpr int kWidth = 30;
     const int filled = int(std::clamp(fraction, 0.0, 1.0) * kWidth);
-    std::fprintf(stderr, "\r%-28s [%s%s] %s", label.c_str(), std::string(filled, '#').c_str(),
-                 std::string(kWidth - filled, ' ').c_str(), amount.c_str());
+    const std::string leftText = !finished && std::isfinite(left) && elapsed >= 1 ? ", ~" + formatDuration(left) + " left" : "";
+    std::fprintf(stderr, "\r%-28s [%s%s] %s%s\x1b[K", label.c_str(), std::string(filled, '#').c_str(),
+                 std::string(kWidth - filled, ' ').c_str(), amount.c_str(), leftText.c_str());
     if (finished) std::fprintf(stderr, "\n");
     std::fflush(stderr);
 }
 }  // namespace
+
+std::string findAssetFor(const std::string& option, const std::string& name) {
+    try {
+        return findAsset(name);
+    } catch (const InputError& e) {
+        std::string what = e.what();
+        if (what.rfind(name + ": ", 0) == 0) what.erase(0, name.size() + 2);   // the name is said once
+        throw InputError(option + " '" + name + "': " + what);
+    }
+}
+
+const std::string& checkPngPath(const std::string& option, const std::string& path) {
+    std::string ext = std::filesystem::path(path).extension().string();
+    for (char& ch : ext) ch = char(std::tolower(static_cast<unsigned char>(ch)));
+    if (!path.empty() && ext != ".png")
+        throw InputError(option + " '" + path + "': " + (ext.empty() ? "no extension" : "extension '" + ext + "'") +
+                         ": expected .png (plots are PNG images)");
+    return path;
+}
 
 void printProgress(const std::string& label, int done, int total) {
     printProgressLine(label, total > 0 ? double(done) / total : 1.0, std::to_string(done) + "/" + std::to_string(total),
@@ -291,6 +349,22 @@ void printTimeProgress(const std::string& label, double t, double duration) {
     printProgressLine(label, duration > 0 ? t / duration : 1.0, fmt::format("{:.1f}/{} s", t, formatNumber(duration)),
                       t >= duration * (1 - 1e-12), true);
 }
+
+namespace {
+// A numeric option given '' is refused by name (CLI11 reads it as 0: "--fps = 0" blamed a value never typed).
+void refuseEmptyNumbers(CLI::App& app) {
+    for (CLI::Option* option : app.get_options()) {
+        const std::string type = option->get_type_name();
+        if (option->get_items_expected_max() != 1) continue;   // lists say which item is empty
+        if (type.rfind("FLOAT", 0) == 0 || type.rfind("INT", 0) == 0 || type.rfind("UINT", 0) == 0 ||
+            type.rfind("NUMBER", 0) == 0)
+            option->check(CLI::Validator(
+                [](std::string& text) { return text.empty() ? std::string("is empty: expected a number") : std::string(); },
+                "", "non-empty number"));
+    }
+    for (CLI::App* sub : app.get_subcommands({})) refuseEmptyNumbers(*sub);
+}
+}  // namespace
 
 void addRegisteredCommands(CLI::App& app) {
     auto& c = commands();
@@ -339,6 +413,7 @@ void addRegisteredCommands(CLI::App& app) {
         folder.commit();
         std::printf("\nAll results are in %s/\n", ctx->outDir.c_str());
     });
+    refuseEmptyNumbers(app);
 }
 
 }  // namespace armsim::cli

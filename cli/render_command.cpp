@@ -1,6 +1,7 @@
 // armsim render: a video and/or PNG still of a recorded trial (replayed from its table); and the
 // main-job step that leaves an MVC video, a free-movement video and a still in the output directory.
 #include "basics/files.h"
+#include "basics/format.h"
 #include "basics/output_folder.h"
 #include "basics/param_node.h"
 #include "cli/commands.h"
@@ -70,7 +71,7 @@ void runOsimRenderCommand(const RenderOptions& o) {
     const Table table = Table::readCsv(o.table);
     OsimVideoResult r;
     files.writeWith(v.videoPath.empty() ? v.stillPath : v.videoPath, [&](const std::string&) {
-        runNamingOptions({{"still_at", "--still-at"}}, [&] {
+        runNamingOptions({{"still_at", "--still-at"}, {"playback_speed", "--speed"}, {"fps", "--fps"}}, [&] {
             r = getRenderPlugin("render").renderOsimTrialVideo(model, table, v,
                                                                [](int d, int n) { printProgress("rendering", d, n); });
         });
@@ -129,13 +130,34 @@ void runRenderCommand(const RenderOptions& o) {
     const Table table = Table::readCsv(o.table);
     TrialVideoResult r;
     files.writeWith(v.videoPath.empty() ? v.stillPath : v.videoPath, [&](const std::string&) {
-        r = getRenderPlugin("render").renderTrialVideo(setup, table, v, [](int d, int n) { printProgress("rendering", d, n); });
+        runNamingOptions(options, [&] {   // settings checked against the table (its duration, its times)
+            r = getRenderPlugin("render").renderTrialVideo(setup, table, v,
+                                                           [](int d, int n) { printProgress("rendering", d, n); });
+        });
     });
     files.commit();
     if (!r.stillPath.empty()) std::printf("wrote %s (still at t = %.3f s)\n", o.still.c_str(), *v.stillTime);
     if (!r.videoPath.empty())
         std::printf("wrote %s (%d frames, %dx%d, %g fps, %s)\n", o.out.c_str(), r.frames, v.render.width,
                     v.render.height, v.fps, v.codec.c_str());
+}
+
+// Options that would be ignored, or a still half given, are refused naming them (before "nothing to write").
+void refuseUnusedRenderOptions(const CLI::App& c, const RenderOptions& o) {
+    if (c.count("--out") > 0 && o.out.empty())
+        throw InputError("--out is empty: expected a video file (.mp4 or .avi), or no --out for a still alone");
+    if (c.count("--still") > 0 && o.still.empty()) throw InputError("--still is empty: expected a .png file");
+    if (c.count("--still") > 0 && c.count("--still-at") == 0)
+        throw InputError("--still '" + o.still + "' needs --still-at T: the trial time of the still [s]");
+    if (c.count("--still-at") > 0 && c.count("--still") == 0)
+        throw InputError("--still-at " + formatNumber(o.stillAt) + " needs --still FILE.png: the file of the still");
+    if (o.out.empty())
+        for (const char* name : {"--fps", "--codec", "--speed"})
+            if (c.count(name) > 0)
+                throw InputError(std::string(name) + " is a video's option: without --out VIDEO it would be ignored (a "
+                                 "still takes --still-at, --still, --width, --height, --supersample)");
+    if (c.count("--arrow-scale") > 0 && o.arrow == "none")
+        throw InputError("--arrow-scale with --arrow none: there is no arrow to scale");
 }
 
 void addRenderCommand(CLI::App& app) {
@@ -171,6 +193,7 @@ void addRenderCommand(CLI::App& app) {
     o->muscle.add(*c);
     o->muscle.addMuscleModel(*c);
     c->callback([o, c] {
+        refuseUnusedRenderOptions(*c, *o);
         if (isOsimModel(o->muscle.model)) {
             for (const char* name : {"--render-settings", "--color-by", "--fixed-thickness", "--arrow", "--arrow-scale", "--load",
                                      "--no-floor", "--muscle", "--arm", "--slow-units", "--fast-units", "--mass",

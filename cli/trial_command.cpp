@@ -30,6 +30,7 @@ struct TrialOptions {
     std::string type = "isometric";
     double angleDeg = 90, activation = 1.0, rest = 0.5, rise = 0.0, hold = 3.0;
     double initialAngleDeg = 150, initialVelocityDegps = 0, onset = 0.2, duration = 2.0, load = 0.0;
+    bool loadGiven = false;      // --load given; else the arm file's hand_load
     double rate = 1000, accuracy = 1e-4;
     std::string out = "out/trial.csv", plot, video;
 };
@@ -94,7 +95,7 @@ struct OsimTrialOutputs {
     explicit OsimTrialOutputs(const TrialOptions& o) : osim(findOsimModelFile(o.muscle.model)) {
         files.addInput("--model", osim);
         csvPath = files.add("--out", o.out, true);
-        plotPath = files.add("--plot", o.plot);
+        plotPath = files.add("--plot", checkPngPath("--plot", o.plot));
         videoPath = files.add("--video", o.video);
         checkOsimVideo(o, videoPath);
         model = readOsimFile(osim);
@@ -236,7 +237,7 @@ void runTrialCommand(const TrialOptions& o) {
     OutputFiles files;
     o.muscle.declareInputs(files);
     files.addInput("--settings", o.settingsFile);
-    const std::string csvPath = files.add("--out", o.out, true), plotPath = files.add("--plot", o.plot),
+    const std::string csvPath = files.add("--out", o.out, true), plotPath = files.add("--plot", checkPngPath("--plot", o.plot)),
                       videoPath = files.add("--video", o.video);
 #ifdef ARMSIM_WITH_RENDER
     if (!o.video.empty()) getRenderPlugin("--video").validate(makeVideoSettings(o, videoPath, o.load));
@@ -278,7 +279,7 @@ void runTrialCommand(const TrialOptions& o) {
         free.activation = o.rise > 0 ? ActivationProfile::ramp(o.onset, o.onset + o.rise, 0.0, o.activation)
                                      : ActivationProfile::step(o.onset, 0.0, o.activation);
         free.duration = o.duration;
-        free.handLoad = o.load;
+        free.handLoad = o.loadGiven ? o.load : setup.arm.handLoad;
         free.sampleRate = o.rate;
         free.integration.accuracy = o.accuracy;
         runNamingOptions({{"initial_angle_deg", "--initial-angle"}, {"initial_velocity_degps", "--initial-velocity"},
@@ -344,7 +345,7 @@ void addTrialCommand(CLI::App& app) {
     c->add_option("--initial-velocity", o->initialVelocityDegps, "free: elbow angular velocity at t = 0 [deg/s]");
     c->add_option("--onset", o->onset, "free: activation onset [s]")->capture_default_str();
     c->add_option("--duration", o->duration, "free: simulated time [s]")->capture_default_str();
-    c->add_option("--load", o->load, "free: mass held in the hand [kg]")->capture_default_str();
+    c->add_option("--load", o->load, "free: mass held in the hand [kg] (default: the arm file's hand_load, 0 in the shipped ones)");
     c->add_option("--rate", o->rate, "samples per second [Hz]")->capture_default_str();
     c->add_option("--accuracy", o->accuracy, "integrator relative accuracy")->capture_default_str();
     c->add_option("--out", o->out, "CSV output")->capture_default_str();
@@ -409,6 +410,7 @@ void addTrialCommand(CLI::App& app) {
             if (!free && c->count(name) > 0)
                 throw InputError(std::string(name) + " is a free movement's option: the isometric trial (the default "
                                  "--type) would ignore it; add --type free");
+        o->loadGiven = c->count("--load") > 0;
         runTrialCommand(*o);
     });
 }

@@ -309,7 +309,7 @@ void readSubmaximalConditions(const ParamNode& c, Protocol& p, const ArmParamete
 void readForceLengthConditions(const ParamNode& c, Protocol& p, const ArmParameters& arm, double pMax) {
     if (c.has("elbow_angle_range_deg"))
         p.elbowAngles = toRadians(readRange(c, "elbow_angle_range_deg", getTrialAngleBound(arm)));
-    p.maxPathLength = c.getNumber("max_path_length", Bound::positive("m"), 0.0);
+    p.maxPathLength = c.getNumber("max_path_length", bounds::kPathLength, 0.0);
     const double limit = p.maxPathLength > 0 ? p.maxPathLength : pMax;
     if (c.has("path_range"))
         p.pathLengths = readRange(c, "path_range", {0, limit, true, false,

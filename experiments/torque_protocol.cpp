@@ -545,7 +545,10 @@ std::vector<TorqueObservation> makeTorqueData(const Table& t, const std::string&
         if (!std::isfinite(o.flexionDeg) || o.flexionDeg < 0 || o.flexionDeg > 180)
             fail("flexion_deg", o.flexionDeg, "in [0, 180] (0 = extended)");
         o.torque = t.get(r, "torque_Nm");
-        if (!std::isfinite(o.torque)) fail("torque_Nm", o.torque, "a finite number");
+        // A person's elbow: the strongest flexion MVCs are about 150 N m; 1000 N m bounds any arm, and
+        // keeps a value in the wrong unit (N mm) from reaching the fit as an impossible force.
+        const Bound kElbowTorque{-1000, 1000, false, false, "N m"};
+        if (!kElbowTorque.contains(o.torque)) fail("torque_Nm", o.torque, kElbowTorque.describe());
         if (t.hasColumn("effort")) {
             const double e = t.get(r, "effort");
             const Effort* found = std::find_if(std::begin(kEfforts), std::end(kEfforts),

@@ -925,14 +925,14 @@ const SynergistOptions& SynergistFit::checkInputs() {
 void SynergistFit::setNoise(MuscleEstimate& est) {
     std::tie(est.noiseLevel, est.noiseDegreesOfFreedom) = estimateNoiseLevel(data_);
     if (std::isfinite(options_.noiseLevel)) {
-        checkField("noise level", options_.noiseLevel, Bound{0, 0.5, true, true, "relative sd"});
+        checkField("noise level", options_.noiseLevel, Bound::closed(kMinTorqueNoiseLevel, 0.5, "relative sd"));
         est.noiseLevel = options_.noiseLevel;
         est.noiseDegreesOfFreedom = 0;
     } else if (!std::isfinite(est.noiseLevel)) {
         est.noiseLevel = prior_.transducerNoise;
         est.noiseDegreesOfFreedom = 0;
     }
-    est.noiseLevel = std::max(est.noiseLevel, 0.002);  // floor: the scatter of few repetitions can be ~0
+    est.noiseLevel = std::max(est.noiseLevel, kMinTorqueNoiseLevel);
     for (const Row& row : rows_) {
         const TorqueObservation& o = data_[row.observation];
         torque_.push_back(row.forearm ? o.forearmTorque : o.torque);

@@ -30,6 +30,11 @@
 
 namespace armsim {
 
+/// The smallest relative torque sd a fit weights its data by [1]: a few repetitions can scatter by ~0,
+/// which would weight the data as exact (0.2 %: about 0.1 N m of an MVC). An estimated level is raised to
+/// it and says so; a given one below it is refused.
+constexpr double kMinTorqueNoiseLevel = 0.002;
+
 /// The synergist-aware identifier's model and extra measurements.
 struct SynergistOptions {
     /// Which muscles the model groups (names in the population's base model); empty: the model file's
@@ -47,8 +52,9 @@ struct SynergistOptions {
     /// Free the flexors' slow-fibre fractions (one shift for the biceps heads, one for the synergists;
     /// prior sd the population's): submaximal efforts depend on them.
     bool freeSlowFraction = false;
-    /// Relative sd of one trial's torque [1]; NaN: estimated from the repetitions (pooled over the
-    /// conditions), or the population's transducer noise when nothing is repeated.
+    /// Relative sd of one trial's torque [1], at least kMinTorqueNoiseLevel; NaN: estimated from the
+    /// repetitions (pooled over the conditions; raised to kMinTorqueNoiseLevel), or the population's
+    /// transducer noise when nothing is repeated.
     double noiseLevel = kNaN;
     /// Measurements besides torque (experiments/channels.h), each a residual (model - value) / sd.
     std::vector<ChannelObservation> channels;

@@ -22,16 +22,20 @@ void ArmParameters::validate() const {
     checkField("body.height", bodyHeight, kBodyHeight);
 
     checkField("upper_arm.length", upperArmLength, kSegmentLength);
-    checkField("upper_arm.mass_fraction", upperArmMassFraction, Bound::open(0, 1));
+    // A segment of one arm: Winter 2009 Table 4.1 gives 0.028 (upper arm) and 0.022 (forearm + hand) of
+    // the body's mass and radii of gyration of 0.32-0.47 segment lengths; the bounds leave room for any person.
+    const Bound kSegmentMassFraction{0, 0.1, true, false, "of body mass"};
+    const Bound kGyrationFraction{0, 1, true, false, "segment lengths"};
+    checkField("upper_arm.mass_fraction", upperArmMassFraction, kSegmentMassFraction);
     checkField("upper_arm.com_fraction", upperArmComFraction, Bound::open(0, 1));
-    checkField("upper_arm.gyration_fraction", upperArmGyrationFraction, Bound::positive());
+    checkField("upper_arm.gyration_fraction", upperArmGyrationFraction, kGyrationFraction);
 
     checkField("forearm_hand.forearm_length", forearmLength, kSegmentLength);
     checkField("forearm_hand.hand_length", handLength, kSegmentLength);
-    checkField("forearm_hand.mass_fraction", forearmHandMassFraction, Bound::open(0, 1));
+    checkField("forearm_hand.mass_fraction", forearmHandMassFraction, kSegmentMassFraction);
     checkField("forearm_hand.com_fraction", forearmHandComFraction,
                Bound{0, reach, true, false, "forearm lengths, elbow to fingertip"});
-    checkField("forearm_hand.gyration_fraction", forearmHandGyrationFraction, Bound::positive());
+    checkField("forearm_hand.gyration_fraction", forearmHandGyrationFraction, kGyrationFraction);
     checkField("forearm_hand.hand_com_fraction", handComFraction,
                Bound{1, reach, false, false, "forearm lengths, wrist to fingertip"});
 

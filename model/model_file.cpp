@@ -505,11 +505,19 @@ ArmSetup loadModelFile(const std::string& file) {
                 } catch (const InputError& e) {
                     throw InputError(roles.where(key) + ": field " + describeField(roles.path(key)) + ": " + e.what());
                 }
+                if (std::count(out.begin(), out.end(), out.back()) > 1)
+                    throw InputError(roles.where(key) + ": field " + describeField(roles.path(key)) + " lists '" + name +
+                                     "' twice: expected each muscle once");
             }
             return out;
         };
         if (roles.has("biceps")) s.bicepsHeads = read("biceps");
         if (roles.has("synergists")) s.synergists = read("synergists");
+        for (int m : s.synergists)   // a head fitted twice, as a head and as a synergist
+            if (std::find(s.bicepsHeads.begin(), s.bicepsHeads.end(), m) != s.bicepsHeads.end())
+                throw InputError(roles.where("synergists") + ": field 'roles.synergists' lists '" +
+                                 s.muscles[m].params.name + "', one of roles.biceps: expected the biceps heads' "
+                                 "synergists (the other flexors), each muscle in one role");
         if (roles.has("surface_emg")) s.surfaceEmg = read("surface_emg");
         roles.finish();
         if (!s.bicepsHeads.empty() && std::find(s.bicepsHeads.begin(), s.bicepsHeads.end(), s.primary) == s.bicepsHeads.end())

@@ -72,7 +72,7 @@ bool isOsimModel(const std::string& name) {
 
 void OsimForwardSettings::validate() const {
     if (std::isfinite(initialTime) && !(finalTime > initialTime))
-        throw FieldError("final_time", "final time " + formatNumber(finalTime) + " s: expected after the initial time " +
+        throw FieldError("final_time", "= " + formatNumber(finalTime) + " s: expected after the initial time " +
                                            formatNumber(initialTime) + " s");
     checkField("final_time", finalTime, Bound{-1e9, 1e9, true, true, "s"});
     checkField("sample_rate", sampleRate, Bound::positive("Hz"));

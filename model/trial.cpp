@@ -91,7 +91,14 @@ std::vector<ActivationProfile> readActivationProfiles(const ArmSetup& setup, con
         if (!table.hasColumn(column))
             throw InputError(tableName + " has no column '" + column + "' (model '" + setup.name +
                              "'): was it written for another model?");
-        profiles.emplace_back(time, table.getColumn(column), tableName + " " + column);
+        const std::vector<double> values = table.getColumn(column);
+        for (std::size_t i = 0; i < values.size(); ++i)   // named by the file's line, as typed
+            if (!(values[i] >= 0 && values[i] <= 1)) {
+                const int line = table.getSourceLine(int(i));
+                throw InputError(tableName + " " + (line > 0 ? "line " + std::to_string(line) : "row " + std::to_string(i + 1)) +
+                                 ": column '" + column + "' = " + formatNumber(values[i]) + ": expected in [0, 1]");
+            }
+        profiles.emplace_back(time, values, tableName + " " + column);
     }
     return profiles;
 }
@@ -671,7 +678,7 @@ FreeMovementSettings readFreeMovementSettings(const ParamNode& n, const ArmParam
     const double rise = n.getNumber("rise", Bound::nonNegative("s"), 0.0);
     s.activation = rise > 0 ? ActivationProfile::ramp(onset, onset + rise, 0.0, U) : ActivationProfile::step(onset, 0.0, U);
     s.duration = n.getNumber("duration", any, s.duration);
-    s.handLoad = n.getNumber("hand_load", any, s.handLoad);
+    s.handLoad = n.getNumber("hand_load", any, arm.handLoad);   // the arm file's load unless the trial gives one
     s.sampleRate = n.getNumber("sample_rate", any, s.sampleRate);
     s.integration.accuracy = n.getNumber("accuracy", any, s.integration.accuracy);
     n.finish();

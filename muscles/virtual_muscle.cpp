@@ -94,7 +94,7 @@ void MuscleParameters::validate() const {
     checkField("mass", mass, bounds::kMuscleMass);
     checkField("optimal_fascicle_length", optimalFascicleLength, Bound{1e-3, 1, false, false, "m, a muscle fascicle"});
     checkField("optimal_tendon_length", optimalTendonLength, bounds::kTendonLength);
-    checkField("max_path_length", maxPathLength, Bound{0, 3, true, false, "m, a musculotendon path"});
+    checkField("max_path_length", maxPathLength, bounds::kPathLength);
     checkField("fibre_fractions.slow", slowFraction, Bound::closed(0, 1));
     checkField("motor_units.slow", numSlowUnits, bounds::kMotorUnits);
     checkField("motor_units.fast", numFastUnits, bounds::kMotorUnits);

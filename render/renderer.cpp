@@ -1,6 +1,7 @@
 #include "render/renderer.h"
 
 #include "basics/angles.h"
+#include "basics/errors.h"
 #include "basics/param_node.h"
 #include "render/meshes.h"
 
@@ -637,6 +638,7 @@ struct OffscreenRenderer::Impl {
         cv::Mat& out = frame;
         for (int row = 0; row < tilesY; ++row) {
             for (int col = 0; col < tilesX; ++col) {
+                checkInterruption();   // a large frame takes seconds: a stop waits one tile at most
                 const int x = col * tileWidth, y = row * tileHeight;
                 if (x >= width || y >= height) continue;
                 // The tile and its margin in normalized device coordinates (y up), stretched onto [-1, 1].

@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <set>
 #include <cmath>
 #include <cstdio>
 
@@ -173,6 +174,11 @@ struct TrialRenderer::Impl {
         name = settings.tableName.empty() ? "trial table" : "trial table '" + settings.tableName + "'";
         checkTable();
         const double frames = (time.back() - time.front()) * settings.fps / settings.playbackSpeed;
+        if (!settings.videoPath.empty() && !(frames >= 1))
+            throw FieldError("playback_speed", "= " + fmt::format("{:g}", settings.playbackSpeed) + ": the " + name +
+                                                   " lasts " + fmt::format("{:g}", time.back() - time.front()) +
+                                                   " s, less than one frame at " + fmt::format("{:g}", settings.fps) +
+                                                   " fps: expected a table lasting at least one frame (a slower playback)");
         if (!settings.videoPath.empty() && !(frames <= 1e6))
             throw FieldError("playback_speed", "= " + fmt::format("{:g}", settings.playbackSpeed) + ": the " + name + " would give " +
                                                    fmt::format("{:g}", frames) + " frames at " + fmt::format("{:g}", settings.fps) +
@@ -245,6 +251,31 @@ struct TrialRenderer::Impl {
             if (i > 0 && !(time[i] > time[i - 1]))
                 throw InputError(name + " " + rowName(table, i) + ": time_s = " + fmt::format("{:.10g}", time[i]) +
                                  ": expected a time after the previous row's " + fmt::format("{:.10g}", time[i - 1]) + " s");
+        }
+        checkColumnValues();
+    }
+
+    // What a trial writes: every state and transducer cell finite, an elbow angle within a turn either
+    // way, a muscle force inside the F0 bound, a saturation flag 0 or 1.
+    void checkColumnValues() const {
+        const auto bad = [&](int i, const std::string& c, const std::string& expected) {
+            return InputError(name + " " + rowName(table, i) + ": column '" + c + "' = " +
+                              fmt::format("{:g}", table.get(i, c)) + ": expected " + expected);
+        };
+        const Bound kAngle{-360, 360, false, false, "deg"};
+        const Bound kForce{-bounds::kMaxIsometricForce.hi, bounds::kMaxIsometricForce.hi, false, false, "N"};
+        std::set<std::string> forces = {"muscle_force_N"};
+        for (const MuscleSpec& m : setup.muscles) forces.insert("force_" + m.params.name + "_N");
+        for (const std::string& c : table.getColumnNames()) {
+            const bool state = c.rfind("state_", 0) == 0, strapColumn = c == "strap_force_N";
+            const bool force = forces.count(c) > 0;
+            for (int i = 0; i < table.getNumRows(); ++i) {
+                const double x = table.get(i, c);
+                if ((state || strapColumn) && !std::isfinite(x)) throw bad(i, c, "a finite number");
+                if (c == "elbow_angle_deg" && !kAngle.contains(x)) throw bad(i, c, kAngle.describe());
+                if (force && std::isfinite(x) && !kForce.contains(x)) throw bad(i, c, kForce.describe());
+                if (c == "saturated" && x != 0 && x != 1) throw bad(i, c, "0 or 1");
+            }
         }
     }
 

@@ -91,7 +91,10 @@ void checkOutputPath(const std::string& what, const std::string& path, const std
 std::string makeTemporaryPath(const std::string& path) {
     static std::atomic<unsigned> counter{0};
     const fs::path p(path);
-    const std::string name = "." + p.stem().string() + ".tmp-" + std::to_string(::getpid()) + "-" +
+    // A staging file's name is hidden already (".armsim-partial-<pid>-..."): kept as its prefix, so a
+    // temporary left by a killed process is recognised and removed by the next run in the folder.
+    const std::string hide = p.stem().string().rfind('.', 0) == 0 ? "" : ".";
+    const std::string name = hide + p.stem().string() + ".tmp-" + std::to_string(::getpid()) + "-" +
                              std::to_string(counter++) + p.extension().string();
     return (p.has_parent_path() ? p.parent_path() / name : fs::path(name)).string();
 }

@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
 # Fuzzes every loader of armsim with libFuzzer (issue 15; docs/reliability.md).
 #   scripts/fuzz.sh [SECONDS_PER_LOADER] [RUNS_PER_LOADER] [PARALLEL]   (0 seconds: no time limit)
-# Builds build-fuzz/ with clang, AddressSanitizer and UndefinedBehaviorSanitizer (every library
-# instrumented), then runs each loader from its seed corpus (fuzz/corpus/<loader>/; new inputs go to
+#   ARMSIM_FUZZ_BUILD=build-sanitize scripts/fuzz.sh 30   (CI: the sanitizer stage's tree, built with the
+#                                                         same instrumentation, so nothing is compiled twice)
+# Builds build-fuzz/ (or $ARMSIM_FUZZ_BUILD) with clang, AddressSanitizer and UndefinedBehaviorSanitizer
+# (every library instrumented), then runs each loader from its seed corpus (fuzz/corpus/<loader>/; new inputs go to
 # build-fuzz/corpus/<loader>/) for the given time or number of runs (default 30 s), with seed 1,
 # PARALLEL loaders at a time (default: the number of cores). A crash, hang (> 10 s per input), leak or
 # sanitizer report fails the run (non-zero exit) with the input saved in build-fuzz/.
@@ -11,22 +13,28 @@ cd "$(dirname "$0")/.."
 seconds=${1:-30}
 runs=${2:--1}
 parallel=${3:-$(nproc)}
-cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_COMPILER=clang++ -DARMSIM_FUZZ=ON \
-  -DARMSIM_RENDER=OFF -DARMSIM_PYTHON=OFF -DARMSIM_TESTS=OFF -DARMSIM_BENCHMARKS=OFF \
-  -DCMAKE_CXX_FLAGS="-O1 -g -fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=undefined" \
-  -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=address,undefined" >/dev/null
-cmake --build build-fuzz -j2 --target fuzz_loaders
+build=${ARMSIM_FUZZ_BUILD:-build-fuzz}
+if [[ -z "${ARMSIM_FUZZ_BUILD:-}" ]]; then
+  cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_COMPILER=clang++ -DARMSIM_FUZZ=ON \
+    -DARMSIM_RENDER=OFF -DARMSIM_PYTHON=OFF -DARMSIM_TESTS=OFF -DARMSIM_BENCHMARKS=OFF \
+    -DCMAKE_CXX_FLAGS="-O1 -gline-tables-only -fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=undefined" \
+    -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=address,undefined" >/dev/null
+elif ! grep -q "^ARMSIM_FUZZ:BOOL=ON" "$build/CMakeCache.txt" 2>/dev/null; then
+  echo "fuzz: ARMSIM_FUZZ_BUILD=$build is not a tree configured with -DARMSIM_FUZZ=ON (scripts/sanitize.sh makes one)"
+  exit 2
+fi
+cmake --build "$build" -j2 --target fuzz_loaders
 
 fuzzLoader() {
   local loader=$1
-  mkdir -p build-fuzz/corpus/$loader
-  if (cd build-fuzz && ARMSIM_FUZZ_LOADER=$loader UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 \
+  mkdir -p "$build/corpus/$loader"
+  if (cd "$build" && ARMSIM_FUZZ_LOADER=$loader UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 \
       ./fuzz/fuzz_loaders corpus/$loader ../fuzz/corpus/$loader -max_total_time=$seconds -runs=$runs \
         -seed=1 -timeout=10 -rss_limit_mb=4096 -print_final_stats=1 > fuzz_$loader.log 2>&1); then
-    echo "== $loader: $(grep -E '^Done' build-fuzz/fuzz_$loader.log)"
+    echo "== $loader: $(grep -E '^Done' "$build/fuzz_$loader.log")"
   else
-    echo "== $loader: FAILED (build-fuzz/fuzz_$loader.log)"
-    grep -E "ERROR|SUMMARY|Test unit written" build-fuzz/fuzz_$loader.log || true
+    echo "== $loader: FAILED ($build/fuzz_$loader.log)"
+    grep -E "ERROR|SUMMARY|Test unit written" "$build/fuzz_$loader.log" || true
     return 1
   fi
 }

@@ -452,6 +452,11 @@ void DesignSettings::validate() const {
         checkField("trials", trials, Bound{double(repetitions), 10000, false, false, "at least one block of repetitions"});
     else
         checkField("trials", trials, Bound{double(repetitions), 100, false, false, "at least one block of repetitions, at most 100"});
+    if (budgetMinutes <= 0 && trials % repetitions != 0)   // the design picks whole blocks: the rest would be dropped
+        throw FieldError("trials", "= " + std::to_string(trials) + ": expected a multiple of the repetitions " +
+                                       std::to_string(repetitions) + " (the design picks blocks of them: " +
+                                       std::to_string(trials / repetitions * repetitions) + " or " +
+                                       std::to_string((trials / repetitions + 1) * repetitions) + ")");
     checkField("draws", draws, Bound::closed(1, 100000));
     checkField("activation_sd", activationSd, Bound::closed(0, 0.5));
     checkField("jobs", jobs, Bound::closed(1, 1024));

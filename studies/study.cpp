@@ -155,7 +155,7 @@ void Study::validate() const {
         checkField(f + ".activation_sd", methods[i].options.activationSd,
                    Bound{0, 0.5, methods[i].kind != "channels", false});
         if (std::isfinite(methods[i].options.noiseLevel))
-            checkField(f + ".noise_level", methods[i].options.noiseLevel, Bound{0, 0.5, true, false});
+            checkField(f + ".noise_level", methods[i].options.noiseLevel, Bound::closed(kMinTorqueNoiseLevel, 0.5, "relative sd"));
     }
     if (getNumTasks() > kMaxTasks)
         throw FieldError("subjects", "x truths x protocols x noise levels x methods = " + std::to_string(getNumTasks()) +

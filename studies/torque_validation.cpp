@@ -2,9 +2,12 @@
 #include "basics/numbers.h"
 
 #include "basics/bound.h"
+#include "basics/format.h"
 #include "basics/csv.h"
 #include "basics/parallel.h"
 #include "basics/quick_run.h"
+
+#include <fmt/format.h>
 
 #include <algorithm>
 #include <cmath>
@@ -87,6 +90,13 @@ ValidationPlan planElbowValidation(const Population& population, const Populatio
         m.options.emgCrosstalk = settings.protocol.channelNoise.emgCrosstalk;
         plan.methods.push_back(m);
     }
+    const double fits = double(settings.subjects) * double(plan.levels.size()) * double(plan.methods.size());
+    if (fits > kMaxElbowValidationFits)
+        throw InputError(fmt::format("{} subjects x {} noise levels x {} identifiers = {:.0f} fits, each a row kept in "
+                                     "memory (about {}): expected at most {:.0f} (fewer subjects or noise levels; "
+                                     "armsim study journals its rows)",
+                                     settings.subjects, plan.levels.size(), plan.methods.size(), fits,
+                                     formatBytes(2 * fits * sizeof(ElbowValidationRow)), kMaxElbowValidationFits));
     return plan;
 }
 
@@ -116,6 +126,11 @@ ElbowValidationSubject runPlannedSubject(const Population& population, const Pop
 }
 
 }  // namespace
+
+long countElbowValidationFits(const Population& truth, const Population& prior, const ElbowValidationSettings& settings) {
+    const ValidationPlan plan = planElbowValidation(truth, prior, settings);
+    return long(settings.subjects) * long(plan.levels.size()) * long(plan.methods.size());
+}
 
 ElbowValidationSubject runElbowValidationSubject(const Population& truth, const Population& prior,
                                                  const ElbowValidationSettings& settings, int index) {

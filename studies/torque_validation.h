@@ -84,6 +84,11 @@ struct ElbowValidationSettings {
 std::vector<ElbowValidationRow> runElbowValidation(const Population& truth, const Population& prior,
                                                    const ElbowValidationSettings& settings,
                                                    const std::function<void(int, int)>& progress = {});
+/// The most fits (rows) one runElbowValidation makes: every row is kept in memory (and copied once).
+constexpr double kMaxElbowValidationFits = 4e6;
+/// The fits runElbowValidation(truth, prior, settings) makes: subjects x noise levels x methods, after
+/// the same checks (InputError above kMaxElbowValidationFits, naming the three numbers).
+long countElbowValidationFits(const Population& truth, const Population& prior, const ElbowValidationSettings& settings);
 /// One subject of such a validation: the person, its clean (noise-free) torque data and channels as
 /// synthesized, and one row per noise level and method.
 struct ElbowValidationSubject {

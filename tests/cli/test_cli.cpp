@@ -772,6 +772,42 @@ TEST(Cli, ProgressReachesALogFileWhileTheWorkRuns) {
     EXPECT_EQ(quiet.output.find("forward: "), quiet.output.find("forward: arm26")) << quiet.output;
 }
 
+// A free trial holds the arm file's hand_load unless --load gives one (the file's value was replaced by
+// the option's default of 0): the file's 5 kg and --load 5 give the same table, and differ from none.
+TEST(Cli, AFreeTrialHoldsTheArmFilesHandLoad) {
+    const fs::path d = freshDir("arm_hand_load");
+    std::string arm = armsim::testing::readFileText(fs::path(ARMSIM_SOURCE_DIR) / "assets/arm/default_male.yaml");
+    const std::size_t at = arm.find("hand_load: 0");
+    ASSERT_NE(at, std::string::npos);
+    std::ofstream(d / "a.yaml") << arm.replace(at, 12, "hand_load: 5");
+    const std::string trial = "trial --type free --duration 0.3 --rate 100 --out ";
+    const CommandResult file = runArmsim(trial + (d / "file.csv").string() + " --arm " + (d / "a.yaml").string());
+    const CommandResult option = runArmsim(trial + (d / "option.csv").string() + " --load 5");
+    const CommandResult none = runArmsim(trial + (d / "none.csv").string());
+    ASSERT_EQ(file.exitCode, 0) << file.output;
+    ASSERT_EQ(option.exitCode, 0) << option.output;
+    ASSERT_EQ(none.exitCode, 0) << none.output;
+    using armsim::testing::readFileText;
+    EXPECT_EQ(readFileText(d / "file.csv"), readFileText(d / "option.csv"));
+    EXPECT_NE(readFileText(d / "file.csv"), readFileText(d / "none.csv"));
+}
+
+// Long work says early how long it takes: the validation's head line counts its fits, and once the
+// first subjects are done (here 0.3 s in: the estimate comes at min(2 s, the log's interval)) a line
+// gives the time left at that rate; a stop then leaves nothing.
+TEST(Cli, LongWorkIsCountedUpFrontAndEstimatedEarly) {
+    const fs::path d = freshDir("early_estimate");
+    const CommandResult r = armsim::testing::runCommand(
+        "ARMSIM_PROGRESS_SECONDS=0.3 timeout -s INT 8 " + std::string(ARMSIM_EXE) +
+        " validate --truth elbow --subjects 1000000 --out " + (d / "v").string());
+    EXPECT_NE(r.output.find("1000000 subjects (3000000 fits)"), std::string::npos) << r.output;
+    const std::regex estimate(R"(subjects: [0-9]+/1000000 after [0-9a-z]+: about [0-9a-z]+ left at this rate)");
+    EXPECT_TRUE(std::regex_search(r.output, estimate)) << r.output;
+    EXPECT_NE(r.output.find("stopped (unfinished output removed)"), std::string::npos) << r.output;
+    EXPECT_EQ(r.output.find("journal"), std::string::npos) << r.output;   // only a study resumes
+    EXPECT_FALSE(fs::exists(d / "v"));
+}
+
 // A folder whose overview cannot be written (an index.html that is not armsim's, here a folder): the
 // command's files are there and complete, and the exit status says the overview is missing (2, not 0).
 TEST(Cli, AnOverviewThatCannotBeWrittenIsAnError) {

@@ -286,6 +286,15 @@ TEST(CliDesign, DesignedProtocolRunsAndItsDataAreIdentified) {
     ASSERT_EQ(r.exitCode, 0) << r.output;
     EXPECT_NE(r.output.find("no condition is repeated to estimate it from"), std::string::npos) << r.output;
     EXPECT_EQ(r.output.find("estimated from the repetitions"), std::string::npos) << r.output;
+    // Repetitions that agree exactly: the level is raised to its floor, and the line says so.
+    {
+        std::ofstream twice(d / "twice.csv");
+        twice << "flexion_deg,torque_Nm\n90,60\n45,50\n120,55\n90,60\n45,50\n120,55\n";
+    }
+    r = runArmsim("identify-torque " + (d / "twice.csv").string() + " --out " + (d / "twice_fit").string());
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    EXPECT_NE(r.output.find("relative torque sd of 0.2 % (estimated from the repetitions, 3 degrees of freedom; raised to "
+                            "the floor of 0.2 %"), std::string::npos) << r.output;
 }
 
 // The two-axis protocol (docs/channels.md): its run writes the forearm axis and the supination efforts,

@@ -15,12 +15,17 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <sstream>
+#include <vector>
+
+#include <unistd.h>
 #include <memory>
 #include <string>
 
 namespace {
 
 using armsim::test::ScratchDir;
+namespace fs = std::filesystem;
 
 constexpr double kFpsTolerance = 1e-6;   // container frame rate vs requested (1/s)
 constexpr double kRest = 0.2, kHold = 0.3;  // recorded isometric trial (s)
@@ -109,8 +114,15 @@ TEST(RenderCli, BadOptionsAreNamedErrors) {
         {"--out " + dir.file("a.mp4") + " --width 0", "width"},
         {"--out " + dir.file("a.mp4") + " --width 321", "even"},
         {"--out " + dir.file("t.csv") + "/a.mp4", "is a file"},  // a missing folder is made; a file in the way is not
-        {"--still-at 9 --still " + dir.file("a.png"), "still_at"},
+        {"--still-at 9 --still " + dir.file("a.png"), "--still-at"},
         {"", "nothing to write"},
+        // Options that would be ignored, or half a still, named (issue 34).
+        {"--still " + dir.file("a.png"), "--still '" + dir.file("a.png") + "' needs --still-at"},
+        {"--still-at 0.1", "--still-at 0.1 needs --still FILE.png"},
+        {"--out '' --still-at 0.1 --still " + dir.file("a.png"), "--out is empty"},
+        {"--fps 60 --still-at 0.1 --still " + dir.file("a.png"), "--fps is a video's option: without --out VIDEO"},
+        {"--speed 2 --still-at 0.1 --still " + dir.file("a.png"), "--speed is a video's option"},
+        {"--out " + dir.file("a.mp4") + " --arrow none --arrow-scale 0.001", "--arrow-scale with --arrow none"},
     };
     for (const Case& c : cases) {
         const CommandResult r = runArmsim("render " + table + " " + c.args);
@@ -118,6 +130,88 @@ TEST(RenderCli, BadOptionsAreNamedErrors) {
         EXPECT_NE(r.output.find(c.expect), std::string::npos) << c.args << ": " << r.output;
     }
     EXPECT_EQ(dir.list().size(), 2u);   // t.csv and t.mp4 only
+}
+
+// A damaged trial table is refused naming its file's line, the column and the value (issue 34: NaN
+// states, an angle of 1e308 deg, an activation of 7, a flag of 7, a force of -1e6 N were rendered), and
+// a table shorter than one frame makes no one-frame video.
+TEST(RenderCli, DamagedTablesAreRefusedNamingLineAndColumn) {
+    ScratchDir dir;
+    ASSERT_EQ(recordTrial(dir).exitCode, 0);
+    std::vector<std::string> lines;
+    {
+        std::ifstream in(dir.file("t.csv"));
+        for (std::string line; std::getline(in, line);) lines.push_back(line);
+    }
+    std::vector<std::string> header;
+    {
+        std::stringstream h(lines[0]);
+        for (std::string cell; std::getline(h, cell, ',');) header.push_back(cell);
+    }
+    const auto withCell = [&](const std::string& column, const std::string& value) {   // line 5 of the file
+        const std::size_t at = std::find(header.begin(), header.end(), column) - header.begin();
+        EXPECT_LT(at, header.size()) << column;
+        std::stringstream row(lines[4]);
+        std::vector<std::string> cells;
+        for (std::string cell; std::getline(row, cell, ',');) cells.push_back(cell);
+        cells.at(at) = value;
+        std::string text;
+        for (std::size_t i = 0; i < lines.size(); ++i) {
+            std::string line = lines[i];
+            if (i == 4) {
+                line.clear();
+                for (std::size_t k = 0; k < cells.size(); ++k) line += (k ? "," : "") + cells[k];
+            }
+            text += line + "\n";
+        }
+        const std::string file = dir.file("bad_" + column + ".csv");
+        std::ofstream(file) << text;
+        return file;
+    };
+    std::string state;
+    for (const std::string& c : header)
+        if (c.rfind("state_", 0) == 0) state = c;
+    ASSERT_FALSE(state.empty());
+    const std::pair<std::string, std::string> cells[] = {
+        {state, "nan"}, {"elbow_angle_deg", "1e308"}, {"activation", "7"}, {"saturated", "7"},
+        {"muscle_force_N", "-1e6"}, {"strap_force_N", "nan"}};
+    for (const auto& [column, value] : cells) {
+        const CommandResult r = runArmsim("render " + withCell(column, value) + " --out " + dir.file("x.mp4"));
+        EXPECT_EQ(r.exitCode, 2) << column << ": " << r.output;
+        EXPECT_NE(r.output.find("line 5: column '" + column + "'"), std::string::npos) << column << ": " << r.output;
+    }
+    std::ofstream(dir.file("one_row.csv")) << lines[0] << "\n" << lines[1] << "\n";
+    const CommandResult oneRow = runArmsim("render " + dir.file("one_row.csv") + " --out " + dir.file("x.mp4"));
+    EXPECT_EQ(oneRow.exitCode, 2) << oneRow.output;
+    EXPECT_NE(oneRow.output.find("--speed = 1: the trial table"), std::string::npos) << oneRow.output;
+    EXPECT_NE(oneRow.output.find("less than one frame"), std::string::npos) << oneRow.output;
+    EXPECT_FALSE(fs::exists(dir.file("x.mp4")));
+    // One row still makes a still.
+    const CommandResult still = runArmsim("render " + dir.file("one_row.csv") + " --still-at 0 --still " + dir.file("s.png"));
+    EXPECT_EQ(still.exitCode, 0) << still.output;
+}
+
+// A render killed outright (SIGKILL: no handler runs) leaves only files the next run in the folder
+// recognises as a dead process's staging and removes.
+TEST(RenderCli, AKilledRenderLeavesNothingTheNextRunKeeps) {
+    ScratchDir dir;
+    ASSERT_EQ(recordTrial(dir).exitCode, 0);
+    fs::create_directories(dir.file("out"));
+    armsim::testing::runCommand("timeout -s KILL 1.5 " + std::string(ARMSIM_EXE) + " render " + dir.file("t.csv") +
+                                " --speed 0.1 --out " + dir.file("out/v.mp4"));
+    for (const fs::directory_entry& e : fs::directory_iterator(dir.file("out"))) {
+        const std::string name = e.path().filename().string();
+        ASSERT_EQ(name.rfind(".armsim-partial-", 0), 0u) << e.path();
+        // The killed process may stay a zombie for a moment (its parent, timeout, was killed too): until
+        // the system reaps it, it counts as running and its files are left alone.
+        const std::string pid = name.substr(16, name.find('-', 16) - 16);
+        for (int k = 0; k < 100 && fs::exists("/proc/" + pid); ++k) usleep(50000);
+    }
+    const CommandResult r = runArmsim("render " + dir.file("t.csv") + " --still-at 0.1 --still " + dir.file("out/s.png"));
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    std::vector<std::string> names;
+    for (const fs::directory_entry& e : fs::directory_iterator(dir.file("out"))) names.push_back(e.path().filename().string());
+    EXPECT_EQ(names, std::vector<std::string>{"s.png"});
 }
 
 TEST(RenderCli, ProtocolVideoRendersEveryTrial) {
