@@ -221,7 +221,8 @@ void addDesignCommand(CLI::App& app) {
         ->transform(inRange(1.0, 10000.0));
     c->add_flag("--free-slow-fraction", o->freeSlowFraction,
                 "the identifier frees the flexors' slow-fibre fractions (biceps heads, synergists)");
-    c->add_option("--trials", o->trials, "budget: total trials (at most 100)")->capture_default_str();
+    c->add_option("--trials", o->trials, "budget: total trials, a multiple of --repetitions (at most 100; default "
+                                         "the most whole blocks within 15)");
     c->add_option("--repetitions", o->repetitions, "trials per picked condition (>= 2 lets the identifier estimate its noise)")
         ->capture_default_str()
         ->transform(inRange(1, 100));
@@ -241,6 +242,7 @@ void addDesignCommand(CLI::App& app) {
         if (c->count("--budget") && c->count("--trials"))
             throw InputError("--trials with --budget: a lab-minute budget sets how many trials fit, so --trials would "
                              "be ignored; give one or the other");
+        if (!c->count("--trials")) o->trials = getDefaultDesignTrials(o->repetitions);   // whole blocks
         runDesign(*o);
     });
 }

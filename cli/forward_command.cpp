@@ -92,7 +92,6 @@ void runForward(const ForwardOptions& given, CLI::Option* outOption) {
     if (std::isfinite(given.initialTime)) typed["initial_time"] = "--initial-time";
     if (std::isfinite(given.accuracy)) typed["accuracy"] = "--accuracy";
     typed["sample_rate"] = "--rate";
-    if (typed.count("final_time")) typed["duration"] = "--final-time";
     OsimForwardResult r;
     runNamingOptions(typed, [&] { r = runOsimForward(model, controls, o.initialStates.empty() ? nullptr : &initial, s); });
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -38,8 +38,8 @@ std::string describeNoiseSource(const IdentifyTorqueOptions& o, const std::vecto
     const int dof = estimates.empty() ? 0 : estimates.back().noiseDegreesOfFreedom;
     if (std::isfinite(o.noiseLevel)) return "--noise-level";
     const bool floored = !estimates.empty() && estimates.back().noiseLevel == kMinTorqueNoiseLevel;
-    const std::string floor = floored ? fmt::format("; raised to the floor of {:g} %: the repetitions scatter less",
-                                                    100 * kMinTorqueNoiseLevel) : "";
+    const std::string floor = floored ? fmt::format("; raised to the floor of {:g} %{}", 100 * kMinTorqueNoiseLevel,
+                                                    dof > 0 ? ": the repetitions scatter less" : "") : "";
     if (dof > 0) return "estimated from the repetitions, " + std::to_string(dof) + " degrees of freedom" + floor;
     return "the prior population's transducer noise: no condition is repeated to estimate it from" + floor;
 }

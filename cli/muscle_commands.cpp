@@ -172,7 +172,7 @@ void addMuscleCommands(CLI::App& app) {
             if (!(*to >= *from))
                 throw InputError("--to " + formatNumber(*to) + " m is below --from " + formatNumber(*from) +
                                  " m: expected --to at least --from");
-            if (*to > *from && *step > *to - *from)
+            if (*to > *from && (*to - *from) / *step + 1e-9 < 1)   // as the sweep counts its lengths
                 throw InputError("--step " + formatNumber(*step) + " m is longer than --from " + formatNumber(*from) +
                                  " m to --to " + formatNumber(*to) + " m: expected a step that gives two path lengths "
                                  "at least (or --to equal to --from for one)");

@@ -38,6 +38,7 @@ struct RenderOptions {
     CLI::Option* stillAtOption = nullptr;
     CLI::Option* widthOption = nullptr;
     CLI::Option* heightOption = nullptr;
+    CLI::Option* loadOption = nullptr;
 };
 
 // armsim render of an OpenSim model's trial table (--model FILE.osim): render/osim_video.h. The arm
@@ -105,7 +106,8 @@ void runRenderCommand(const RenderOptions& o) {
                                                : ForceArrowKind::Auto;
     v.scene.arrowScale = o.arrowScale;
     v.scene.floor = !o.noFloor;
-    v.scene.handLoad = o.load;
+    const ArmSetup setup = o.muscle.loadSetup();
+    v.scene.handLoad = o.loadOption->count() ? o.load : setup.arm.handLoad;   // as the trial held it
     if (o.stillAtOption->count()) v.stillTime = o.stillAt;
     v.tableName = o.table;
     if (o.out.empty() && !v.stillTime)
@@ -126,7 +128,6 @@ void runRenderCommand(const RenderOptions& o) {
     v.videoPath = files.add("--out", o.out);
     v.stillPath = files.add("--still", o.still);
 
-    const ArmSetup setup = o.muscle.loadSetup();
     const Table table = Table::readCsv(o.table);
     TrialVideoResult r;
     files.writeWith(v.videoPath.empty() ? v.stillPath : v.videoPath, [&](const std::string&) {
@@ -187,7 +188,8 @@ void addRenderCommand(CLI::App& app) {
     c->add_option("--arrow-scale", o->arrowScale,
                   "arrow length per newton [m/N] (0: a round scale, the peak force within 15 cm)")
         ->capture_default_str();
-    c->add_option("--load", o->load, "mass held in the hand [kg], drawn as a ball (as given to armsim trial)");
+    o->loadOption = c->add_option("--load", o->load, "mass held in the hand [kg], drawn as a ball (as given to armsim "
+                                                     "trial; default: the arm file's hand_load)");
     c->add_flag("--no-floor", o->noFloor, "no floor (with 10 cm ticks)");
     c->add_flag("--no-overlay", o->noOverlay, "no text panel and plots");
     o->muscle.add(*c);
@@ -223,7 +225,8 @@ void runTrialVideos(const MainJobContext& ctx) {
     iso.elbowAngle = degToRad(90);
     iso.activation = subject.effort.voluntaryActivation;
     iso.antagonistActivation = subject.effort.coContraction;
-    const FreeMovementSettings free;
+    FreeMovementSettings free;
+    free.handLoad = setup.arm.handLoad;   // the arm file's load, as armsim trial holds it
     // Two Systems, two threads.
     auto freeTable = std::async(ctx.jobs > 1 ? std::launch::async : std::launch::deferred,
                                 [&] { return runFreeMovement(setup, free); });

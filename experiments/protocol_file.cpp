@@ -124,7 +124,7 @@ IsometricTrialSettings readTrialTemplate(const ParamNode& n, const ArmParameters
     s.holdDuration = n.getNumber("hold", Bound::positive("s"), s.holdDuration);
     s.sampleRate = n.getNumber("sample_rate", Bound::positive("Hz"), s.sampleRate);
     s.averagingWindow = n.getNumber("averaging_window", Bound::positive("s"), std::min(s.averagingWindow, s.holdDuration));
-    s.integration.accuracy = n.getNumber("accuracy", bounds::kAccuracy, s.integration.accuracy);
+    s.integration.accuracy = n.getNumber("accuracy", bounds::kTrialAccuracy, s.integration.accuracy);
     n.finish();
     s.elbowAngle = degToRad(0.5 * (arm.minElbowAngleDeg + arm.maxElbowAngleDeg));
     n.rethrowWithLocation([&] { s.validate(arm); });

@@ -568,7 +568,8 @@ std::vector<TorqueObservation> makeTorqueData(const Table& t, const std::string&
         }
         if (t.hasColumn("forearm_torque_Nm")) {
             o.forearmTorque = t.get(r, "forearm_torque_Nm");  // NaN: not read in this trial
-            if (std::isinf(o.forearmTorque)) fail("forearm_torque_Nm", o.forearmTorque, "a finite number or NaN (not read)");
+            if (std::isinf(o.forearmTorque) || std::abs(o.forearmTorque) > kElbowTorque.hi)
+                fail("forearm_torque_Nm", o.forearmTorque, "in [-1000, 1000] (N m) or NaN (not read)");
         }
         if (isForearmEffort(o.effort) && !std::isfinite(o.forearmTorque))
             throw InputError(at + ": a " + getEffortName(o.effort) + " effort without its forearm torque: expected a "

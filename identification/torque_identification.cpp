@@ -188,7 +188,7 @@ std::string formatTorquePredictionsCsv(const std::vector<TorqueObservation>& dat
 }
 
 void TorqueIdentificationOptions::validate() const {
-    if (!std::isnan(noiseLevel)) checkField("noise_level", noiseLevel, Bound::closed(1e-4, 0.5));
+    if (!std::isnan(noiseLevel)) checkField("noise_level", noiseLevel, Bound::closed(kMinTorqueNoiseLevel, 0.5, "relative sd"));
     if (!std::isnan(activation)) checkField("activation", activation, Bound{0, 1, true, false, "fraction of full drive"});
     checkField("activation_sd", activationSd, Bound::closed(1e-4, 0.5));
     checkField("emg_crosstalk", emgCrosstalk, Bound::closed(0, 0.5));

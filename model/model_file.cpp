@@ -513,10 +513,11 @@ ArmSetup loadModelFile(const std::string& file) {
         };
         if (roles.has("biceps")) s.bicepsHeads = read("biceps");
         if (roles.has("synergists")) s.synergists = read("synergists");
+        const std::vector<int> heads = s.getBicepsHeads();   // the primary alone when roles.biceps is absent
         for (int m : s.synergists)   // a head fitted twice, as a head and as a synergist
-            if (std::find(s.bicepsHeads.begin(), s.bicepsHeads.end(), m) != s.bicepsHeads.end())
+            if (std::find(heads.begin(), heads.end(), m) != heads.end())
                 throw InputError(roles.where("synergists") + ": field 'roles.synergists' lists '" +
-                                 s.muscles[m].params.name + "', one of roles.biceps: expected the biceps heads' "
+                                 s.muscles[m].params.name + "', a biceps head (roles.biceps, or the primary): expected the biceps heads' "
                                  "synergists (the other flexors), each muscle in one role");
         if (roles.has("surface_emg")) s.surfaceEmg = read("surface_emg");
         roles.finish();

@@ -124,6 +124,7 @@ void IsometricTrialSettings::validate(const ArmParameters& arm) const {
         throw FieldError("effort", std::string("= ") + getEffortName(effort) +
                                        ": the model's arm has no forearm rotation (expected flexion or extension)");
     checkIsometricEffort(activation, antagonistActivation, restDuration, riseTime, holdDuration, sampleRate, averagingWindow);
+    checkField("accuracy", integration.accuracy, bounds::kTrialAccuracy);
     integration.validate();
 }
 
@@ -395,6 +396,7 @@ void FreeMovementSettings::validate(const ArmParameters& arm) const {
     checkField("hand_load", handLoad, bounds::kHandLoad);
     checkField("sample_rate", sampleRate, Bound::positive("Hz"));
     calcNumSamples(duration, sampleRate);
+    checkField("accuracy", integration.accuracy, bounds::kTrialAccuracy);
     integration.validate();
     const std::vector<double>& t = activation.getBreakpoints();
     if (activation.getValue(0) == 0 && activation.getMaxValue() > 0 && !t.empty() && t.front() >= duration)

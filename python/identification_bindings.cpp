@@ -445,7 +445,7 @@ py::tuple validateElbowPy(const py::object& population, int subjects, unsigned s
 
 py::dict designPy(const py::object& population, const std::vector<double>& angles,
                   const std::optional<std::vector<double>>& levels,
-                  bool extension, int trials, int repetitions, int draws, unsigned seed, double activationSd,
+                  bool extension, std::optional<int> trials, int repetitions, int draws, unsigned seed, double activationSd,
                   bool freeSlowFraction, int jobs, const std::optional<std::vector<double>>& postures,
                   const std::string& criterion, double budgetMinutes) {
     const Population pop = toPopulation(population);
@@ -458,7 +458,7 @@ py::dict designPy(const py::object& population, const std::vector<double>& angle
     s.ownModelCriterion = criterion == "own";
     s.budgetMinutes = budgetMinutes;
     s.extension = extension;
-    s.trials = trials;
+    s.trials = trials ? *trials : getDefaultDesignTrials(repetitions);
     s.repetitions = repetitions;
     s.draws = draws;
     s.seed = seed;
@@ -622,13 +622,14 @@ coverages; mass_interval_width relative, tendon_interval_width_m). Releases the 
 
     mod.def("design_protocol", &designPy, "population"_a = py::none(),
             "angles"_a = std::vector<double>{15, 30, 45, 60, 75, 90, 105, 120, 135}, "levels"_a = py::none(),
-            "extension"_a = true, "trials"_a = 15, "repetitions"_a = 3, "draws"_a = 32, "seed"_a = 1u,
+            "extension"_a = true, "trials"_a = py::none(), "repetitions"_a = 3, "draws"_a = 32, "seed"_a = 1u,
             "activation_sd"_a = 0.02, "free_slow_fraction"_a = false, "jobs"_a = 2, "postures"_a = py::none(),
             "criterion"_a = "considered", "budget_minutes"_a = 0.0,
             R"(The torque protocol that minimises the synergist-aware identifier's expected uncertainty of
 the biceps mass and tendon length over the population (as `armsim design`): greedy picks of blocks
 of `repetitions` trials among flexion MVCs at `angles` [deg], extension MVCs (extension=True) and
-submaximal `levels` (fractions of MVC), within `trials`; with `postures` [deg, + = supination] also
+submaximal `levels` (fractions of MVC), within `trials` (a multiple of repetitions; None: the most whole
+blocks within 15); with `postures` [deg, + = supination] also
 flexion, extension, supination and pronation MVCs in those forearm postures (both transducer axes
 read). criterion: 'considered' (the widths the identifier's intervals report, with what its fit
 shares) or 'own' (the fit's own Laplace widths). budget_minutes > 0: design across channels within

@@ -203,7 +203,7 @@ void addSimulationBindings(py::module_& mod) {
         "lock's torque is recorded). Samples are taken every 1/rate s of simulated time from the start,\n"
         "however advance_to cuts the time.")
         .def(py::init([](const Model& m, bool locked, double angleDeg, double velocityDegps,
-                         std::optional<double> rotationDeg, double handLoadKg, const py::object& excitation,
+                         std::optional<double> rotationDeg, std::optional<double> handLoadKg, const py::object& excitation,
                          double rateHz, const std::string& start, std::optional<double> accuracy) {
                  auto ps = std::make_unique<PySimulation>();
                  ps->model = m;
@@ -212,7 +212,7 @@ void addSimulationBindings(py::module_& mod) {
                  s.elbowAngle = degToRad(angleDeg);
                  s.elbowVelocity = degToRad(velocityDegps);
                  if (rotationDeg) s.forearmRotationDeg = *rotationDeg;
-                 s.handLoad = handLoadKg;
+                 s.handLoad = handLoadKg ? *handLoadKg : m.setup.arm.handLoad;   // None: the model's arm file
                  s.sampleRate = rateHz;
                  if (start != "steady" && start != "initial")
                      throw InputError("start = '" + start + "': expected 'steady' or 'initial'");
@@ -232,11 +232,12 @@ void addSimulationBindings(py::module_& mod) {
                  return ps;
              }),
              py::arg("model"), py::arg("locked") = false, py::arg("angle_deg") = 90.0, py::arg("velocity_degps") = 0.0,
-             py::arg("rotation_deg") = py::none(), py::arg("hand_load") = 0.0, py::arg("excitation") = py::none(),
+             py::arg("rotation_deg") = py::none(), py::arg("hand_load") = py::none(), py::arg("excitation") = py::none(),
              py::arg("rate") = 1000.0, py::arg("start") = "steady", py::arg("accuracy") = py::none(),
              "model: an armsim.Model. locked: hold the elbow at angle_deg (included angle, deg; 180 = extended).\n"
              "velocity_degps: dtheta/dt at the start (+ = extending; free only). rotation_deg: forearm rotation the\n"
-             "radius is held at (+ = supination; None: the model's posture). hand_load: a mass in the hand [kg].\n"
+             "radius is held at (+ = supination; None: the model's posture). hand_load: a mass in the hand [kg]\n"
+             "(None: the arm file's hand_load, 0 in the shipped ones).\n"
              "rate: samples per second of simulated time [Hz].\n"
              "excitation U in [0, 1] per muscle: None (0), a number (every muscle), one number per muscle, a dict\n"
              "{muscle: number}, a dict of arrays {'time_s': t, muscle: u, ...} (linear between rows), a callable\n"

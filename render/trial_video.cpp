@@ -1,6 +1,7 @@
 #include "render/trial_video.h"
 
 #include "basics/bound.h"
+#include "basics/errors.h"
 #include "model/geometry.h"
 #include "model/trial.h"
 #include "render/video.h"
@@ -174,6 +175,9 @@ struct TrialRenderer::Impl {
         name = settings.tableName.empty() ? "trial table" : "trial table '" + settings.tableName + "'";
         checkTable();
         const double frames = (time.back() - time.front()) * settings.fps / settings.playbackSpeed;
+        if (!settings.videoPath.empty() && table.getNumRows() < 2)
+            throw InputError("the " + name + " has one row (t = " + fmt::format("{:g}", time[0]) + " s): a video needs "
+                             "two rows or more (one row makes a still: --still-at, --still)");
         if (!settings.videoPath.empty() && !(frames >= 1))
             throw FieldError("playback_speed", "= " + fmt::format("{:g}", settings.playbackSpeed) + ": the " + name +
                                                    " lasts " + fmt::format("{:g}", time.back() - time.front()) +
@@ -266,15 +270,26 @@ struct TrialRenderer::Impl {
         const Bound kForce{-bounds::kMaxIsometricForce.hi, bounds::kMaxIsometricForce.hi, false, false, "N"};
         std::set<std::string> forces = {"muscle_force_N"};
         for (const MuscleSpec& m : setup.muscles) forces.insert("force_" + m.params.name + "_N");
-        for (const std::string& c : table.getColumnNames()) {
-            const bool state = c.rfind("state_", 0) == 0, strapColumn = c == "strap_force_N";
-            const bool force = forces.count(c) > 0;
-            for (int i = 0; i < table.getNumRows(); ++i) {
-                const double x = table.get(i, c);
-                if ((state || strapColumn) && !std::isfinite(x)) throw bad(i, c, "a finite number");
-                if (c == "elbow_angle_deg" && !kAngle.contains(x)) throw bad(i, c, kAngle.describe());
-                if (force && std::isfinite(x) && !kForce.contains(x)) throw bad(i, c, kForce.describe());
-                if (c == "saturated" && x != 0 && x != 1) throw bad(i, c, "0 or 1");
+        enum class Rule { None, Finite, Angle, Force, Flag };
+        std::vector<Rule> rules;   // per column, found once (a 1e6-row table is checked in a second or so)
+        for (const std::string& c : table.getColumnNames())
+            rules.push_back(c.rfind("state_", 0) == 0 || c == "strap_force_N" ? Rule::Finite
+                            : c == "elbow_angle_deg"                          ? Rule::Angle
+                            : forces.count(c) > 0                             ? Rule::Force
+                            : c == "saturated"                                ? Rule::Flag
+                                                                              : Rule::None);
+        for (int i = 0; i < table.getNumRows(); ++i) {
+            if (i % 4096 == 0) checkInterruption();
+            for (int k = 0; k < table.getNumColumns(); ++k) {
+                const double x = table.get(i, k);
+                const std::string& c = table.getColumnNames()[k];
+                switch (rules[k]) {
+                    case Rule::Finite: if (!std::isfinite(x)) throw bad(i, c, "a finite number"); break;
+                    case Rule::Angle: if (!kAngle.contains(x)) throw bad(i, c, kAngle.describe()); break;
+                    case Rule::Force: if (std::isfinite(x) && !kForce.contains(x)) throw bad(i, c, kForce.describe()); break;
+                    case Rule::Flag: if (x != 0 && x != 1) throw bad(i, c, "0 or 1"); break;
+                    case Rule::None: break;
+                }
             }
         }
     }

@@ -455,8 +455,9 @@ void DesignSettings::validate() const {
     if (budgetMinutes <= 0 && trials % repetitions != 0)   // the design picks whole blocks: the rest would be dropped
         throw FieldError("trials", "= " + std::to_string(trials) + ": expected a multiple of the repetitions " +
                                        std::to_string(repetitions) + " (the design picks blocks of them: " +
-                                       std::to_string(trials / repetitions * repetitions) + " or " +
-                                       std::to_string((trials / repetitions + 1) * repetitions) + ")");
+                                       std::to_string(trials / repetitions * repetitions) +
+                                       ((trials / repetitions + 1) * repetitions <= 100
+                                            ? " or " + std::to_string((trials / repetitions + 1) * repetitions) : "") + ")");
     checkField("draws", draws, Bound::closed(1, 100000));
     checkField("activation_sd", activationSd, Bound::closed(0, 0.5));
     checkField("jobs", jobs, Bound::closed(1, 1024));

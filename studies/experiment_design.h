@@ -44,6 +44,12 @@ struct LabCosts {
     double calcMinutes(const TorqueProtocol& protocol) const;
 };
 
+/// The trials of a design not given any: the most whole blocks of `repetitions` within the thesis's 15
+/// (15 for 3 or 5, 14 for 2), one block when a block is larger.
+inline int getDefaultDesignTrials(int repetitions) {
+    return repetitions >= 1 && repetitions <= 15 ? 15 / repetitions * repetitions : repetitions;
+}
+
 /// What an experimenter may do.
 struct DesignSettings {
     std::vector<double> flexionDeg = {15, 30, 45, 60, 75, 90, 105, 120, 135};  ///< allowed angles [deg]
@@ -61,7 +67,7 @@ struct DesignSettings {
     /// 2026-11-26: it buys information that the population's per-muscle variation takes back, e.g.
     /// flexion MVCs in other forearm postures).
     bool ownModelCriterion = false;
-    int trials = 15;                     ///< budget: total trials (thesis: 5 angles x 3)
+    int trials = 15;                     ///< budget: total trials, whole blocks of repetitions (thesis: 5 angles x 3)
     int repetitions = 3;                 ///< trials per pick (>= 2: the identifier estimates its noise from repeats)
     int draws = 32;                      ///< prior draws the criterion averages over
     unsigned seed = 1;

@@ -236,7 +236,7 @@ Study readStudy(const std::string& path) {
         e.options.activationSd = m.getNumber("activation_sd", Bound{0, 0.5, false, false}, 0.02);
         e.options.freeSlowFraction = m.getBool("free_slow_fraction", false);
         e.options.includeSynergists = m.getBool("include_synergists", true);
-        if (m.has("noise_level")) e.options.noiseLevel = m.getNumber("noise_level", Bound{0, 0.5, true, false});
+        if (m.has("noise_level")) e.options.noiseLevel = m.getNumber("noise_level", Bound::closed(kMinTorqueNoiseLevel, 0.5, "relative sd"));
         m.finish();
         s.methods.push_back(e);
     }

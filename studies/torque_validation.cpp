@@ -10,6 +10,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <iterator>
 #include <cmath>
 
 namespace armsim {
@@ -148,7 +149,10 @@ std::vector<ElbowValidationRow> runElbowValidation(const Population& population,
         perSubject[s] = runPlannedSubject(population, prior, settings, plan, s).rows;
     }, progress);
     std::vector<ElbowValidationRow> rows;
-    for (auto& r : perSubject) rows.insert(rows.end(), r.begin(), r.end());
+    for (auto& r : perSubject) {
+        rows.insert(rows.end(), std::make_move_iterator(r.begin()), std::make_move_iterator(r.end()));
+        std::vector<ElbowValidationRow>().swap(r);   // each subject's rows freed as they are merged
+    }
     return rows;
 }
 

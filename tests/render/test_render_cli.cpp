@@ -18,7 +18,6 @@
 #include <sstream>
 #include <vector>
 
-#include <unistd.h>
 #include <memory>
 #include <string>
 
@@ -183,8 +182,13 @@ TEST(RenderCli, DamagedTablesAreRefusedNamingLineAndColumn) {
     std::ofstream(dir.file("one_row.csv")) << lines[0] << "\n" << lines[1] << "\n";
     const CommandResult oneRow = runArmsim("render " + dir.file("one_row.csv") + " --out " + dir.file("x.mp4"));
     EXPECT_EQ(oneRow.exitCode, 2) << oneRow.output;
-    EXPECT_NE(oneRow.output.find("--speed = 1: the trial table"), std::string::npos) << oneRow.output;
-    EXPECT_NE(oneRow.output.find("less than one frame"), std::string::npos) << oneRow.output;
+    EXPECT_NE(oneRow.output.find("has one row (t = 0 s): a video needs two rows or more"), std::string::npos) << oneRow.output;
+    // Two rows 10 ms apart at 30 fps: less than a frame; a slower playback would make one.
+    std::ofstream(dir.file("short.csv")) << lines[0] << "\n" << lines[1] << "\n" << lines[2] << "\n";
+    const CommandResult shortTable = runArmsim("render " + dir.file("short.csv") + " --out " + dir.file("x.mp4"));
+    EXPECT_EQ(shortTable.exitCode, 2) << shortTable.output;
+    EXPECT_NE(shortTable.output.find("--speed = 1: the trial table"), std::string::npos) << shortTable.output;
+    EXPECT_NE(shortTable.output.find("less than one frame"), std::string::npos) << shortTable.output;
     EXPECT_FALSE(fs::exists(dir.file("x.mp4")));
     // One row still makes a still.
     const CommandResult still = runArmsim("render " + dir.file("one_row.csv") + " --still-at 0 --still " + dir.file("s.png"));
@@ -197,16 +201,18 @@ TEST(RenderCli, AKilledRenderLeavesNothingTheNextRunKeeps) {
     ScratchDir dir;
     ASSERT_EQ(recordTrial(dir).exitCode, 0);
     fs::create_directories(dir.file("out"));
-    armsim::testing::runCommand("timeout -s KILL 1.5 " + std::string(ARMSIM_EXE) + " render " + dir.file("t.csv") +
-                                " --speed 0.1 --out " + dir.file("out/v.mp4"));
-    for (const fs::directory_entry& e : fs::directory_iterator(dir.file("out"))) {
-        const std::string name = e.path().filename().string();
-        ASSERT_EQ(name.rfind(".armsim-partial-", 0), 0u) << e.path();
-        // The killed process may stay a zombie for a moment (its parent, timeout, was killed too): until
-        // the system reaps it, it counts as running and its files are left alone.
-        const std::string pid = name.substr(16, name.find('-', 16) - 16);
-        for (int k = 0; k < 100 && fs::exists("/proc/" + pid); ++k) usleep(50000);
+    // Killed once its video's temporary exists (the shell reaps it: no zombie counts as running).
+    const std::string out = dir.file("out");
+    armsim::testing::runCommand(
+        "sh -c '" + std::string(ARMSIM_EXE) + " render " + dir.file("t.csv") + " --speed 0.1 --out " + out +
+        "/v.mp4 >/dev/null 2>&1 & pid=$!; for i in $(seq 200); do ls -a " + out + " | grep -q tmp && break; "
+        "sleep 0.05; done; kill -KILL $pid; wait $pid'");
+    int left = 0;
+    for (const fs::directory_entry& e : fs::directory_iterator(out)) {
+        EXPECT_EQ(e.path().filename().string().rfind(".armsim-partial-", 0), 0u) << e.path();
+        ++left;
     }
+    ASSERT_GT(left, 0) << "the render was not caught writing its video";
     const CommandResult r = runArmsim("render " + dir.file("t.csv") + " --still-at 0.1 --still " + dir.file("out/s.png"));
     ASSERT_EQ(r.exitCode, 0) << r.output;
     std::vector<std::string> names;
