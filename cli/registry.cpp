@@ -21,7 +21,6 @@
 #include <map>
 #include <memory>
 #include <mutex>
-#include <set>
 #include <unistd.h>
 #include <vector>
 
@@ -209,12 +208,15 @@ void setQuiet(bool quiet) { gQuiet = quiet; }
 bool isQuiet() { return gQuiet; }
 
 namespace {
-// A log file's progress: when each label started and last printed (a run prints a handful of labels).
+// One label's progress (a run prints a handful of labels).
+struct LabelProgress {
+    std::chrono::steady_clock::time_point start, lastPrinted;
+    double startFraction = 0;   // the share done at the label's first report
+    bool estimated = false;     // its early estimate of the whole is out
+};
 struct LogProgress {
     std::mutex mutex;
-    std::map<std::string, std::pair<std::chrono::steady_clock::time_point, std::chrono::steady_clock::time_point>> started;
-    std::map<std::string, double> startFraction;   // the share done at a label's first report
-    std::set<std::string> estimated;   // labels whose early estimate of the whole was printed
+    std::map<std::string, LabelProgress> labels;
 };
 LogProgress& logProgress() {
     static LogProgress p;
@@ -236,22 +238,21 @@ double getLogProgressInterval() {
     return interval;
 }
 
-// Long work says early how long it will take: once, kEstimateAfter into it (or the log's interval, if
-// shorter), a line with the time left at the rate so far, when that is kLongWork or more (a terminal's bar
-// or a log's 10 s cadence alone would leave a user of a week-long run guessing). True if printed.
 // The time left [s] at the rate since a label's first report (done `from` then; the clock starts there).
 double calcTimeLeft(double fraction, double from, double elapsed) {
     return fraction > from ? elapsed * (1 - fraction) / (fraction - from) : kNaN;
 }
 
+// Long work says early how long it will take: once, kEstimateAfter into it (or the log's interval, if
+// shorter), a line with the time left at the rate so far, when that is kLongWork or more (a terminal's bar
+// or a log's 10 s cadence alone would leave a user of a week-long run guessing). True if printed.
 bool printEarlyEstimate(const std::string& label, double fraction, const std::string& amount, double elapsed,
-                        LogProgress& p) {
+                        LabelProgress& l) {
     constexpr double kEstimateAfter = 2, kLongWork = 60;   // [s]
-    const double from = p.startFraction[label];
-    if (fraction <= from || elapsed < std::min(kEstimateAfter, getLogProgressInterval()) || p.estimated.count(label))
+    if (l.estimated || fraction <= l.startFraction || elapsed < std::min(kEstimateAfter, getLogProgressInterval()))
         return false;
-    p.estimated.insert(label);
-    const double left = calcTimeLeft(fraction, from, elapsed);
+    l.estimated = true;
+    const double left = calcTimeLeft(fraction, l.startFraction, elapsed);
     if (!(left >= kLongWork)) return false;
     std::fprintf(stderr, "%s%s: %s after %s: about %s left at this rate (stop with Ctrl-C)\n",
                  isatty(fileno(stderr)) ? "\r\x1b[K" : "", label.c_str(), amount.c_str(), formatDuration(elapsed).c_str(),
@@ -275,24 +276,22 @@ void printProgressLine(const std::string& label, double fraction, const std::str
     LogProgress& p = logProgress();
     const std::lock_guard<std::mutex> lock(p.mutex);
     const Clock::time_point now = Clock::now();
-    auto [at, inserted] = p.started.try_emplace(label, now, now);
-    if (inserted) p.startFraction[label] = fraction;
-    const double sinceLast = std::chrono::duration<double>(now - at->second.second).count();
-    const double elapsed = std::chrono::duration<double>(now - at->second.first).count();
-    const double left = calcTimeLeft(fraction, p.startFraction[label], elapsed);
+    auto [at, inserted] = p.labels.try_emplace(label, LabelProgress{now, now, fraction, false});
+    LabelProgress& l = at->second;
+    const double sinceLast = std::chrono::duration<double>(now - l.lastPrinted).count();
+    const double elapsed = std::chrono::duration<double>(now - l.start).count();
+    const double left = calcTimeLeft(fraction, l.startFraction, elapsed);
     if (finished) {
-        p.started.erase(at);
-        p.startFraction.erase(label);
-        p.estimated.erase(label);
-    } else if (printEarlyEstimate(label, fraction, amount, elapsed, p)) {
-        at->second.second = now;
+        p.labels.erase(at);
+    } else if (printEarlyEstimate(label, fraction, amount, elapsed, l)) {
+        l.lastPrinted = now;
         return;
     }
     if (!tty) {
         if (finished) {
             if (!quickEndSilent || elapsed >= kLogInterval) std::fprintf(stderr, "%s: %s done\n", label.c_str(), amount.c_str());
         } else if (!inserted && sinceLast >= kLogInterval) {
-            at->second.second = now;
+            l.lastPrinted = now;
             const std::string leftText = std::isfinite(left) ? "about " + formatDuration(left) + " left" : "time left unknown";
             std::fprintf(stderr, "%s: %s (%.0f %%) after %s, %s\n", label.c_str(), amount.c_str(), 100 * fraction,
                          formatDuration(elapsed).c_str(), leftText.c_str());
@@ -301,7 +300,7 @@ void printProgressLine(const std::string& label, double fraction, const std::str
         return;
     }
     if (!finished && !inserted && sinceLast < kTerminalInterval) return;
-    if (!finished) at->second.second = now;
+    if (!finished) l.lastPrinted = now;
     constexpr int kWidth = 30;
     const int filled = int(std::clamp(fraction, 0.0, 1.0) * kWidth);
     const std::string leftText = !finished && std::isfinite(left) && elapsed >= 1 ? ", ~" + formatDuration(left) + " left" : "";
