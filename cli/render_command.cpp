@@ -129,6 +129,10 @@ void runRenderCommand(const RenderOptions& o) {
     v.stillPath = files.add("--still", o.still);
 
     const Table table = Table::readCsv(o.table);
+    if (o.loadOption->count() && table.hasColumn("strap_force_N"))   // as armsim trial refuses it
+        throw InputError("--load = " + formatNumber(o.load) + " kg: " + o.table + " is an isometric trial (it has "
+                         "strap_force_N), which holds the arm file's hand_load (" + formatNumber(setup.arm.handLoad) +
+                         " kg); --load is a free trial's option");
     TrialVideoResult r;
     files.writeWith(v.videoPath.empty() ? v.stillPath : v.videoPath, [&](const std::string&) {
         runNamingOptions(options, [&] {   // settings checked against the table (its duration, its times)

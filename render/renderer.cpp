@@ -206,6 +206,13 @@ RenderSettings readRenderSettings(const ParamNode& node) {
         s.camera.orthoHeight = c.getNumber("ortho_height", Bound::positive("m"), s.camera.orthoHeight);
         s.camera.nearClip = c.getNumber("near_clip", Bound::positive("m"), s.camera.nearClip);
         s.camera.farClip = c.getNumber("far_clip", Bound::positive("m"), s.camera.farClip);
+        // A key the chosen projection would ignore is refused, as options that would be ignored are.
+        const char* unused = s.camera.orthographic ? "vertical_fov" : "ortho_height";
+        if (c.has(unused))
+            throw InputError(c.where(unused) + ": field " + describeField(c.path(unused)) + " is ignored by " +
+                             (s.camera.orthographic ? "an orthographic camera (orthographic: true sets the view by "
+                                                      "ortho_height)"
+                                                    : "a perspective camera (it applies with orthographic: true)"));
         c.finish();
     }
     node.finish();

@@ -122,6 +122,8 @@ TEST(RenderCli, BadOptionsAreNamedErrors) {
         {"--fps 60 --still-at 0.1 --still " + dir.file("a.png"), "--fps is a video's option: without --out VIDEO"},
         {"--speed 2 --still-at 0.1 --still " + dir.file("a.png"), "--speed is a video's option"},
         {"--out " + dir.file("a.mp4") + " --arrow none --arrow-scale 0.001", "--arrow-scale with --arrow none"},
+        // The table is an isometric trial, which armsim trial refuses a --load for.
+        {"--out " + dir.file("a.mp4") + " --load 2", "--load = 2 kg: " + table + " is an isometric trial"},
     };
     for (const Case& c : cases) {
         const CommandResult r = runArmsim("render " + table + " " + c.args);

@@ -114,6 +114,19 @@ TEST(RenderSettings, ReadsYamlStrictly) {
     } catch (const InputError& e) {
         EXPECT_NE(std::string(e.what()).find("widht"), std::string::npos) << e.what();
     }
+    // A camera key the projection ignores is refused with its line (issue 34), both ways.
+    for (const char* text : {"camera:\n  orthographic: true\n  vertical_fov: 0.5\n",
+                             "camera:\n  orthographic: false\n  ortho_height: 0.5\n"}) {
+        try {
+            readRenderSettings(ParamNode::loadString(text, "render.yaml"));
+            ADD_FAILURE() << "ignored camera key accepted: " << text;
+        } catch (const InputError& e) {
+            EXPECT_NE(std::string(e.what()).find("render.yaml:3"), std::string::npos) << e.what();
+            EXPECT_NE(std::string(e.what()).find("is ignored by"), std::string::npos) << e.what();
+        }
+    }
+    EXPECT_EQ(readRenderSettings(ParamNode::loadString("camera:\n  orthographic: true\n  ortho_height: 0.5\n",
+                                                       "render.yaml")).camera.orthoHeight, 0.5);
     try {
         readRenderSettings(ParamNode::loadString("width: 640\nheight: 361\n", "render.yaml"));
         ADD_FAILURE() << "odd height accepted";
