@@ -5,6 +5,7 @@
 #include "basics/format.h"
 
 #include <string>
+#include <vector>
 
 namespace armsim {
 
@@ -43,5 +44,10 @@ constexpr Bound kTrialAccuracy{1e-8, 0.1, false, false, ""};
 
 /// Throws FieldError naming field, value and bound unless value is finite and inside bound.
 void checkField(const std::string& field, double value, const Bound& bound);
+
+/// Throws FieldError naming `field` when angles meant in degrees look like radians: every one within
+/// [-pi, pi] and one of them not whole (0.52, 1.05, 1.57 are 30, 60 and 90 deg in radians). Whole
+/// degrees (0, 1, 2) and any set with an angle past pi pass.
+void checkDegreesNotRadians(const std::string& field, const std::vector<double>& degrees);
 
 }  // namespace armsim

@@ -22,6 +22,15 @@ void checkUniqueColumnNames(const std::vector<std::string>& names, const std::st
                                  std::to_string(j + 1) + " and " + std::to_string(i + 1) + "): expected each name once");
 }
 
+void checkCommaSeparatedHeader(const std::vector<std::string>& cells, const std::string& where) {
+    for (const std::string& c : cells)
+        for (const auto& [sep, name] : {std::pair<char, const char*>{'\t', "a tab"}, {';', "a semicolon"}})
+            if (c.find(sep) != std::string::npos)
+                throw InputError(where + ": the header's '" + c.substr(0, 60) + (c.size() > 60 ? "..." : "") +
+                                 "' holds " + name + ": expected comma-separated columns (save the file as CSV "
+                                 "with commas)");
+}
+
 int Table::findColumn(const std::string& name) const {
     for (int i = 0; i < getNumColumns(); ++i)
         if (names_[i] == name) return i;
@@ -132,6 +141,7 @@ Table Table::readCsv(const std::string& path) {
             continue;
         const std::vector<std::string> cells = split(line);
         if (header) {
+            checkCommaSeparatedHeader(cells, path + ":" + std::to_string(lineNo));
             checkUniqueColumnNames(cells, path + ":" + std::to_string(lineNo));
             t.names_ = cells;
             header = false;

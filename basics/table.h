@@ -9,6 +9,9 @@ namespace armsim {
 /// Throws InputError "<where>: column 'x' appears twice in the header (columns i and j)" when a name
 /// repeats (a reader would silently take one of them).
 void checkUniqueColumnNames(const std::vector<std::string>& names, const std::string& where);
+/// InputError (at `where`) when a CSV header's cells hold a tab or a semicolon: the file is tab- or
+/// semicolon-separated, which a comma split reads as one column.
+void checkCommaSeparatedHeader(const std::vector<std::string>& cells, const std::string& where);
 
 /// Named columns of doubles, one row per sample. Column names carry their unit as a suffix
 /// ("time_s", "force_N", "activation"), so a CSV header is self-describing.

@@ -118,9 +118,11 @@ void runDesign(const DesignOptions& o) {
                       {"repetitions", "--repetitions"}, {"trials", "--trials"}, {"draws", "--draws"},
                       {"activation_sd", "--activation-sd"}, {"jobs", "--jobs"}, {"budget", "--budget"}},
                      [&] { s.validate(); });
-    std::printf("experiment design for the synergist-aware identifier: population '%s', budget %d trials in blocks "
+    const std::string budget = s.budgetMinutes > 0 ? formatNumber(s.budgetMinutes, 6) + " lab minutes"
+                                                   : std::to_string(s.trials) + " trials";
+    std::printf("experiment design for the synergist-aware identifier: population '%s', budget %s in blocks "
                 "of %d, angles %s deg, extension MVCs %s, submaximal EMG-feedback levels %s, VA %s; %d prior draws\n",
-                population.name.c_str(), s.trials, s.repetitions, formatList(o.angles).c_str(), s.extension ? "allowed" : "not allowed",
+                population.name.c_str(), budget.c_str(), s.repetitions, formatList(o.angles).c_str(), s.extension ? "allowed" : "not allowed",
                 o.levels.empty() ? "none" : formatList(o.levels).c_str(),
                 s.activationSd > 0 ? ("measured (sd " + formatNumber(s.activationSd) + ")").c_str() : "not measured",
                 s.draws);
@@ -129,9 +131,9 @@ void runDesign(const DesignOptions& o) {
     thesis.name = "thesis";
     const bool channels = s.budgetMinutes > 0;
     if (channels)
-        std::printf("across channels: budget %s lab minutes, --trials ignored (MVC block %s, EMG set-up %s, ultrasound per condition %s, volume "
+        std::printf("across channels: budget %s lab minutes (MVC block %s, EMG set-up %s, ultrasound per condition %s, volume "
                     "scan %s, anthropometry %s min: docs/channels.md)\n",
-                    formatNumber(s.budgetMinutes).c_str(), formatNumber(s.costs.mvcBlock).c_str(),
+                    formatNumber(s.budgetMinutes, 6).c_str(), formatNumber(s.costs.mvcBlock).c_str(),
                     formatNumber(s.costs.emgSetup).c_str(), formatNumber(s.costs.ultrasoundAngle).c_str(),
                     formatNumber(s.costs.volumeScan).c_str(), formatNumber(s.costs.anthropometry).c_str());
     auto progress = [](int done, int n) { printProgress("design", done, n); };

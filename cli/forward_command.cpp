@@ -9,6 +9,7 @@
 #include "basics/plot.h"
 #include "cli/commands.h"
 #include "model/osim_forward.h"
+#include "numerics/stiff_ode.h"
 
 #include <chrono>
 #include <map>
@@ -93,7 +94,14 @@ void runForward(const ForwardOptions& given, CLI::Option* outOption) {
     if (std::isfinite(given.accuracy)) typed["accuracy"] = "--accuracy";
     typed["sample_rate"] = "--rate";
     OsimForwardResult r;
-    runNamingOptions(typed, [&] { r = runOsimForward(model, controls, o.initialStates.empty() ? nullptr : &initial, s); });
+    try {
+        runNamingOptions(typed, [&] { r = runOsimForward(model, controls, o.initialStates.empty() ? nullptr : &initial, s); });
+    } catch (const SampleCountError& e) {   // the run's length and the rate, as the options gave them
+        const std::string end = std::isfinite(given.finalTime) ? "--final-time" : "the controls' last time";
+        const std::string start = std::isfinite(given.initialTime) ? "--initial-time" : "the controls' first time";
+        throw InputError(end + " - " + start + " = " + formatNumber(e.getDuration()) + " s x --rate " +
+                         formatNumber(e.getSampleRate()) + " Hz " + e.getDetail());
+    }
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     for (const std::string& note : r.notes) std::printf("note: %s\n", note.c_str());
     const Table& t = r.states;

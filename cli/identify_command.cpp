@@ -248,7 +248,7 @@ void addIdentifyCommand(CLI::App& app) {
     c->add_option("--out", o->out, "output directory (report JSON, history CSV, convergence PNG)")->capture_default_str();
     c->callback([o, c] {
         // The faithful model's options would be ignored by the steady model.
-        for (const char* option : {"--estimate", "--hold", "--rate", "--no-warm-start"})
+        for (const char* option : {"--estimate", "--hold", "--rate", "--no-warm-start", "--jobs"})
             if (o->model.model == "steady" && c->count(option))
                 throw InputError(std::string(option) + " is an option of the faithful forward model: with --forward "
                                  "steady (the default) it would be ignored; add --forward faithful or corrected");
@@ -435,8 +435,8 @@ void runValidate(const ValidateOptions& o) {
     s.jobs = o.jobs;
     runNamingOptions({{"seeds", "--seeds"}, {"jobs", "--jobs"}}, [&] { s.validate(setup.arm); });
     std::printf("validation: data from the faithful model (thesis protocol, 1000 Hz, %s estimate) at %zu angles, "
-                "identified with the %s model, start 330 g / 22 cm\n",
-                o.estimate.c_str(), s.anglesDeg.size(), o.model.c_str());
+                "identified with the %s model, start 330 g / 22 cm; %.0f fits\n",
+                o.estimate.c_str(), s.anglesDeg.size(), o.model.c_str(), s.countFits());
     std::fflush(stdout);
     const std::vector<ValidationRow> rows = runValidation(setup.arm, setup.calcBicepsParameters(), s,
                                                           [](int d, int n) { printProgress("identifications", d, n); });
@@ -526,6 +526,7 @@ void addValidateCommand(CLI::App& app) {
                                      "thesis, synergist and synergist-va identifiers on --subjects drawn subjects)");
         runNamingOptions({{"angles", "--angles"}}, [&] {   // before any work, in the option's words
             for (double a : o->angles) checkField("angles", a, Bound::closed(0, 180, "deg, 0 = extended"));
+            checkDegreesNotRadians("angles", o->angles);
         });
         for (std::size_t i = 0; i < o->methods.size(); ++i)   // a method twice would run and be written twice
             for (std::size_t j = 0; j < i; ++j)

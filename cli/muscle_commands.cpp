@@ -26,7 +26,8 @@ void MuscleOptions::add(CLI::App& app) {
     app.add_option("--model", model, "model: a name under assets/models/ (thesis, elbow) or a model file")
         ->capture_default_str();
     app.add_option("--muscle", file, "muscle file replacing the primary muscle's parameters (path, or name under assets/)");
-    app.add_option("--arm", armFile, "arm file replacing the model's arm (path, or name under assets/)");
+    app.add_option("--arm", armFile, "arm file replacing the model's arm (path, or name under assets/); its biceps A and B are the thesis "
+                                       "method's straight-line geometry, the muscles keep the model's paths");
     app.add_option("--slow-units", slowUnits, "number of slow motor units (default: from the model)");
     app.add_option("--fast-units", fastUnits, "number of fast motor units (default: from the model)");
     app.add_option("--mass", mass, "muscle mass M [kg] (default: from the model)");

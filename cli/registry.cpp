@@ -13,10 +13,12 @@
 #include <algorithm>
 #include <atomic>
 #include <cctype>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <map>
 #include <memory>
@@ -198,6 +200,14 @@ void checkOutputFolder(const std::string& option, const std::string& dir) {
     if (::access(p.c_str(), W_OK | X_OK) != 0)
         throw InputError(option + " '" + dir + "': cannot write in " + p.string() + " (" + (p == given ? "the folder" : "its parent") +
                          " is not writable)");
+    // access() passes root on file systems that refuse new entries all the same (sysfs, procfs): make
+    // and remove a folder there, as the output's staging will, before any work.
+    std::string probe = (p / ".armsim-probe-XXXXXX").string();
+    if (::mkdtemp(probe.data()) == nullptr) {
+        const int err = errno;
+        throw InputError(option + " '" + dir + "': cannot make a folder in " + p.string() + " (" + std::strerror(err) + ")");
+    }
+    ::rmdir(probe.c_str());
 }
 
 namespace {

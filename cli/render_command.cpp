@@ -20,6 +20,7 @@
 #include <future>
 #include <map>
 #include <memory>
+#include <set>
 #endif
 
 namespace armsim::cli {
@@ -38,6 +39,7 @@ struct RenderOptions {
     CLI::Option* stillAtOption = nullptr;
     CLI::Option* widthOption = nullptr;
     CLI::Option* heightOption = nullptr;
+    CLI::Option* supersampleOption = nullptr;
     CLI::Option* loadOption = nullptr;
 };
 
@@ -86,14 +88,24 @@ void runOsimRenderCommand(const RenderOptions& o) {
 
 void runRenderCommand(const RenderOptions& o) {
     TrialVideoSettings v;
+    std::set<std::string> fromFile;   // width, height, supersample as the settings file gives them
     if (!o.renderSettingsFile.empty()) {
         const ParamNode node = ParamNode::loadFile(o.renderSettingsFile);
         v.autoCamera = !node.has("camera");
         v.render = getRenderPlugin("--render-settings").readRenderSettings(node);
+        const std::pair<const char*, const CLI::Option*> both[] = {
+            {"width", o.widthOption}, {"height", o.heightOption}, {"supersample", o.supersampleOption}};
+        for (const auto& [key, option] : both) {
+            if (!node.has(key)) continue;
+            if (option->count())
+                throw InputError(option->get_name() + " and " + node.where(key) + " (" + key + ": in --render-settings) "
+                                 "both set the frame's " + key + ": expected one of them");
+            fromFile.insert(key);
+        }
     }
-    if (o.renderSettingsFile.empty() || o.widthOption->count()) v.render.width = o.width;
-    if (o.renderSettingsFile.empty() || o.heightOption->count()) v.render.height = o.height;
-    if (o.renderSettingsFile.empty()) v.render.supersample = o.supersample;
+    if (!fromFile.count("width")) v.render.width = o.width;
+    if (!fromFile.count("height")) v.render.height = o.height;
+    if (!fromFile.count("supersample")) v.render.supersample = o.supersample;
     v.fps = o.fps;
     v.codec = o.codec;
     v.playbackSpeed = o.speed;
@@ -119,8 +131,8 @@ void runRenderCommand(const RenderOptions& o) {
     std::map<std::string, std::string> options = {
         {"hand_load", "--load"}, {"fps", "--fps"}, {"codec", "--codec"}, {"playback_speed", "--speed"},
         {"arrow_scale", "--arrow-scale"}, {"still_at", "--still-at"}, {"still", "--still"}};
-    if (o.renderSettingsFile.empty())
-        options.insert({{"width", "--width"}, {"height", "--height"}, {"supersample", "--supersample"}});
+    for (const char* key : {"width", "height", "supersample"})
+        if (!fromFile.count(key)) options.insert({key, std::string("--") + key});
     runNamingOptions(options, [&] { getRenderPlugin("render").validate(v); });  // before the table is read
     OutputFiles files;  // the video and the still appear together at the end, or neither
     o.muscle.declareInputs(files);
@@ -178,7 +190,7 @@ void addRenderCommand(CLI::App& app) {
     c->add_option("--codec", o->codec, "h264 | mjpg")->capture_default_str();
     c->add_option("--speed", o->speed, "trial seconds per video second (1 = the trial's time scale)")
         ->capture_default_str();
-    c->add_option("--supersample", o->supersample, "anti-aliasing factor 1-4 (1 = off)")->capture_default_str();
+    o->supersampleOption = c->add_option("--supersample", o->supersample, "anti-aliasing factor 1-4 (1 = off)")->capture_default_str();
     c->add_option("--render-settings", o->renderSettingsFile,
                   "YAML render settings (width, height, supersample, background, lighting, camera {...}); "
                   "without a camera key the sagittal camera is used");

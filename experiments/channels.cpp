@@ -8,11 +8,13 @@
 #include "basics/format.h"
 #include "basics/plot.h"
 #include "basics/portable_random.h"
+#include "basics/table.h"
 
 #include <algorithm>
 #include <cmath>
 #include <map>
 #include <sstream>
+#include <tuple>
 
 namespace armsim {
 
@@ -128,6 +130,56 @@ std::string formatChannelData(const std::vector<ChannelObservation>& data, bool 
            csv.getText();
 }
 
+namespace {
+
+constexpr double kMinSdRelative = kMinChannelSdRelative;
+constexpr double kMinSdEmg = kMinChannelSdEmg;
+
+// A measurement's identity in a file: channel, muscle, angle (-1: none), effort, level, repetition.
+using ChannelKey = std::tuple<std::string, std::string, double, int, double, int>;
+
+// Columns a channel does not read hold nothing, or what formatChannelData writes there (effort 1,
+// level 0): a value there is a row meant for another channel, or a slip.
+template <class Text, class Fail>
+void checkUnusedChannelColumns(const std::string& channel, const Text& text, const Fail& fail) {
+    const bool scan = channel == "volume" || channel == "upper_arm_length";
+    if (channel == "upper_arm_length" && !text("muscle").empty())
+        fail("muscle", "'" + text("muscle") + "'", "empty for upper_arm_length (the arm's, not a muscle's)");
+    if (!scan) return;
+    auto isNumber = [&](const char* c, double v) {
+        const std::string t = text(c);
+        try {
+            std::size_t used = 0;
+            return t.empty() || (std::stod(t, &used) == v && used == t.size());
+        } catch (const std::exception&) {
+            return false;
+        }
+    };
+    if (!text("flexion_deg").empty()) fail("flexion_deg", text("flexion_deg"), "empty for " + channel + " (not read at an angle)");
+    if (!isNumber("effort", 1)) fail("effort", text("effort"), "empty or 1 for " + channel + " (not read in an effort)");
+    if (!isNumber("level", 0)) fail("level", text("level"), "empty or 0 for " + channel + " (not read in an effort)");
+}
+
+// A channel file's header: each column's place; InputError at `at` for an unknown, repeated or missing one.
+std::map<std::string, int> readChannelHeader(const std::vector<std::string>& header, const std::string& at) {
+    static const std::vector<std::string> known = {"channel", "muscle", "flexion_deg", "effort", "level",
+                                                   "repetition", "value", "sd", "clean_value"};
+    checkCommaSeparatedHeader(header, at);
+    std::map<std::string, int> column;
+    for (std::size_t k = 0; k < header.size(); ++k) {
+        if (std::find(known.begin(), known.end(), header[k]) == known.end())
+            throw InputError(at + ": unknown column '" + header[k] +
+                             "': expected channel, muscle, flexion_deg, effort, level, repetition, value, sd "
+                             "(clean_value: truth of synthetic data, ignored)");
+        if (!column.emplace(header[k], int(k)).second) throw InputError(at + ": column '" + header[k] + "' appears twice");
+    }
+    for (const char* c : {"channel", "value", "sd"})
+        if (!column.count(c)) throw InputError(at + ": missing column '" + std::string(c) + "'");
+    return column;
+}
+
+}  // namespace
+
 std::vector<ChannelObservation> readChannelData(const std::string& path) {
     checkInputFile(path, 64u << 20);
     std::istringstream in(readFileText(path));
@@ -136,8 +188,7 @@ std::vector<ChannelObservation> readChannelData(const std::string& path) {
     std::vector<std::string> header;
     std::map<std::string, int> column;
     std::vector<ChannelObservation> data;
-    static const std::vector<std::string> known = {"channel", "muscle", "flexion_deg", "effort", "level",
-                                                   "repetition", "value", "sd", "clean_value"};
+    std::map<ChannelKey, int> lineOf;   // each measurement's first line
     while (std::getline(in, line)) {
         ++lineNo;
         if (lineNo == 1 && line.rfind("\xEF\xBB\xBF", 0) == 0) line.erase(0, 3);   // a UTF-8 byte-order mark
@@ -148,16 +199,7 @@ std::vector<ChannelObservation> readChannelData(const std::string& path) {
         const std::string at = path + ":" + std::to_string(lineNo);
         if (header.empty()) {
             header = cells;
-            for (std::size_t k = 0; k < header.size(); ++k) {
-                if (std::find(known.begin(), known.end(), header[k]) == known.end())
-                    throw InputError(at + ": unknown column '" + header[k] +
-                                     "': expected channel, muscle, flexion_deg, effort, level, repetition, value, sd "
-                                     "(clean_value: truth of synthetic data, ignored)");
-                if (!column.emplace(header[k], int(k)).second)
-                    throw InputError(at + ": column '" + header[k] + "' appears twice");
-            }
-            for (const char* c : {"channel", "value", "sd"})
-                if (!column.count(c)) throw InputError(at + ": missing column '" + std::string(c) + "'");
+            column = readChannelHeader(header, at);
             continue;
         }
         if (cells.size() != header.size())
@@ -212,8 +254,23 @@ std::vector<ChannelObservation> readChannelData(const std::string& path) {
                        : "in (0, " + formatNumber(limit) + "] " + (o.channel == "volume" ? "m^3" : "m") + " (SI units)");
         o.sd = number("sd", kNaN);
         if (!(o.sd > 0)) fail("sd", formatNumber(o.sd), "> 0 (the measurement's sd, units of value)");
+        // A floor no instrument reaches (docs/channels.md: ultrasound 5 %, a volume scan 10 %, a tape 1 %,
+        // EMG 15 %): an sd below it would pin the fit to one row and hide the rest.
+        const double floor = isEmg ? kMinSdEmg : kMinSdRelative * std::abs(o.value);
+        if (o.sd < floor)
+            fail("sd", formatNumber(o.sd), ">= " + formatNumber(floor, 3) + (isEmg ? " (of the MVC amplitude)" : " (0.1 % of the value)") +
+                                               ": no lab measures " + o.channel + " this finely");
+        checkUnusedChannelColumns(o.channel, text, fail);
         o.cleanValue = number("clean_value", kNaN);
         o.source = path;
+        const ChannelKey key{o.channel, o.muscle, std::isnan(o.flexionDeg) ? -1.0 : o.flexionDeg, int(o.effort), o.level, o.repetition};
+        const auto [earlier, fresh] = lineOf.emplace(key, lineNo);
+        if (!fresh)
+            throw InputError(at + ": the same measurement as line " + std::to_string(earlier->second) + " (" + o.channel +
+                             (o.muscle.empty() ? "" : " of " + o.muscle) +
+                             (std::isnan(o.flexionDeg) ? "" : " at " + formatNumber(o.flexionDeg) + " deg") + ", level " +
+                             formatNumber(o.level) + ", repetition " + std::to_string(o.repetition) +
+                             "): expected each once (a repeated measurement takes the next repetition number)");
         data.push_back(o);
     }
     if (header.empty()) throw InputError(path + ": no header line");

@@ -42,6 +42,11 @@ struct ChannelObservation {
 /// Floor of the level an EMG amplitude's relative error applies to: a relaxed muscle reads about 1-2 %
 /// of its MVC amplitude (an assumption, docs/channels.md), so the sd of small values does not vanish.
 inline constexpr double kEmgFloor = 0.02;
+/// The smallest sd a channel file may give: 0.1 % of the value (fascicle length, volume, upper-arm
+/// length), 1e-4 of the MVC amplitude (EMG). Finer than any instrument (docs/channels.md); the
+/// protocol's channel_noise has the matching lower bounds, so synthesized files read back.
+inline constexpr double kMinChannelSdRelative = 1e-3;
+inline constexpr double kMinChannelSdEmg = 1e-4;
 
 /// The names channels may have.
 const std::vector<std::string>& getChannelNames();

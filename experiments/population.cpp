@@ -70,7 +70,7 @@ void Population::validate() const {
     checkField("specific_tension.sd", specificTensionSd, Bound::closed(0, 1));
     checkField("geometry.mean_scale", geometryMeanScale, Bound::closed(0.5, 2));
     checkField("geometry.scale_sd", geometryScaleSd, Bound::closed(0, 0.2));
-    checkRange("voluntary_activation", voluntaryActivation, Bound{0, 1, true, false, "in (0, 1]"});
+    checkRange("voluntary_activation", voluntaryActivation, Bound{0, 1, true, false, "fraction of maximal drive"});
     checkRange("co_contraction", coContraction, Bound::closed(0, 1));
     checkField("trial_cv", trialCv, Bound::closed(0, 0.5));
     checkField("transducer_noise", transducerNoise, Bound::closed(0, 0.5));

@@ -98,6 +98,7 @@ void readEmg(const ParamNode& n, Protocol& p) {
     a.zeroPhase = n.getBool("zero_phase", a.zeroPhase);
     a.outputRate = p.trial.sampleRate;  // the EMG is sampled with the other channels
     n.finish();
+    if (!p.emgEnabled) return;   // no EMG is made: its filters need not suit the sample rate
     try {
         e.validate();
     } catch (const FieldError& err) {

@@ -106,7 +106,7 @@ void TorqueProtocol::validate() const {
     for (std::size_t k = 0; k < conditions.size(); ++k) {
         const TorqueCondition& c = conditions[k];
         if (!osim) checkField(conditionField(k, "flexion_deg"), c.flexionDeg, Bound::closed(0, 180, "deg, 0 = extended"));
-        checkField(conditionField(k, "level"), c.level, Bound{0, 1, true, false, "fraction of maximal, in (0, 1]"});
+        checkField(conditionField(k, "level"), c.level, Bound{0, 1, true, false, "fraction of maximal"});
         checkField(conditionField(k, "repetitions"), c.repetitions, Bound::closed(1, 100));
         if (isForearmEffort(c.effort) && (c.ultrasound || c.emg))
             throw FieldError(conditionField(k, "channels"),
@@ -125,6 +125,10 @@ void TorqueProtocol::validate() const {
                              "the same condition (angle, effort, level, posture) is listed twice: expected each "
                              "once (raise its repetitions instead)");
     }
+    std::vector<double> angles;
+    for (const TorqueCondition& c : conditions) angles.push_back(c.flexionDeg);
+    const auto fractional = std::find_if(angles.begin(), angles.end(), [](double a) { return a != std::round(a); });
+    if (fractional != angles.end()) checkDegreesNotRadians(conditionField(std::size_t(fractional - angles.begin()), "flexion_deg"), angles);
     checkField("trial.rest", restDuration, Bound::positive("s"));
     checkField("trial.hold", holdDuration, Bound::positive("s"));
     checkField("trial.averaging_window", averagingWindow, {0, holdDuration, true, false, "s, within the hold"});
@@ -136,11 +140,13 @@ void TorqueProtocol::validate() const {
             throw FieldError("measurements.volume_scan[" + std::to_string(k) + "]",
                              "'" + volumeScan[k] + "' is listed twice: expected each muscle once");
     const ChannelNoise& n = channelNoise;
-    checkField("channel_noise.fascicle_length", n.fascicleLength, Bound{0, 0.5, true, true, "relative sd"});
-    checkField("channel_noise.volume", n.volume, Bound{0, 0.5, true, true, "relative sd"});
-    checkField("channel_noise.emg", n.emg, Bound{0, 1, true, true, "relative sd"});
+    // Lower bounds: the finest sd a channel file may give (experiments/channels.h), so what a protocol
+    // writes reads back (an EMG sd is emg x max(|value|, kEmgFloor); an upper arm is under 1 m long).
+    checkField("channel_noise.fascicle_length", n.fascicleLength, Bound{kMinChannelSdRelative, 0.5, false, true, "relative sd"});
+    checkField("channel_noise.volume", n.volume, Bound{kMinChannelSdRelative, 0.5, false, true, "relative sd"});
+    checkField("channel_noise.emg", n.emg, Bound{kMinChannelSdEmg / kEmgFloor, 1, false, true, "relative sd"});
     checkField("channel_noise.emg_crosstalk", n.emgCrosstalk, Bound::closed(0, 0.5));
-    checkField("channel_noise.upper_arm_length", n.upperArmLength, Bound{0, 0.1, true, true, "m"});
+    checkField("channel_noise.upper_arm_length", n.upperArmLength, Bound{kMinChannelSdRelative, 0.1, false, true, "m"});
 }
 
 std::string describeConditions(const TorqueProtocol& protocol) {
@@ -229,7 +235,7 @@ TorqueProtocol readTorqueProtocol(const std::string& path) {
         TorqueCondition tc;
         tc.flexionDeg = c.getNumber("flexion_deg", Bound::any());   // validate(): the range the subject's model has
         tc.effort = parseEffortName(c.getChoice("effort", {"flexion", "extension", "supination", "pronation"}, "flexion"));
-        tc.level = c.getNumber("level", Bound{0, 1, true, false, "fraction of maximal, in (0, 1]"}, 1.0);
+        tc.level = c.getNumber("level", Bound{0, 1, true, false, "fraction of maximal"}, 1.0);
         tc.repetitions = c.getInt("repetitions", 1, 100, 1);
         if (c.has("rotation_deg")) tc.rotationDeg = c.getNumber("rotation_deg", Bound::closed(-180, 180, "deg, + = supination"));
         if (c.has("channels")) {
@@ -511,6 +517,31 @@ std::string formatTorqueData(const std::vector<TorqueObservation>& data, bool tr
     return out;
 }
 
+namespace {
+
+// Slips of unit a row-by-row bound cannot see, refused for the file as a whole: angles in radians, and
+// torques in kN m (every maximal effort under 0.5 N m; the weakest elbow MVCs measured are several N m).
+void checkTorqueDataUnits(const std::vector<TorqueObservation>& data, const std::string& path) {
+    std::vector<double> angles;
+    for (const TorqueObservation& o : data)
+        if (std::find(angles.begin(), angles.end(), o.flexionDeg) == angles.end()) angles.push_back(o.flexionDeg);
+    try {
+        checkDegreesNotRadians("flexion_deg", angles);
+    } catch (const FieldError& e) {
+        throw InputError(path + ": column 'flexion_deg' " + e.getDetail());
+    }
+    constexpr double kMinMaximalTorque = 0.5;   // N m
+    double largest = -1;
+    for (const TorqueObservation& o : data)
+        if (o.level == 1) largest = std::max(largest, isForearmEffort(o.effort) ? std::abs(o.forearmTorque) : std::abs(o.torque));
+    if (largest >= 0 && largest < kMinMaximalTorque)
+        throw InputError(path + ": every maximal effort's torque is under " + formatNumber(kMinMaximalTorque) +
+                         " N m (the largest is " + formatNumber(largest) + "): expected N m (a value in kN m is 1000 "
+                         "times too small; the weakest elbow MVCs are several N m)");
+}
+
+}  // namespace
+
 std::vector<TorqueObservation> readTorqueData(const std::string& path) {
     return makeTorqueData(Table::readCsv(path), path);
 }
@@ -603,6 +634,7 @@ std::vector<TorqueObservation> makeTorqueData(const Table& t, const std::string&
         }))
         throw InputError(path + ": column 'torque_Nm' (and forearm_torque_Nm) is 0 in every row: expected the tared "
                                 "torques measured (nothing to fit)");
+    checkTorqueDataUnits(data, path);
     return data;
 }
 

@@ -43,10 +43,12 @@ IdentificationReport identifyAndRecheck(const IdentificationProblem& pr, const I
     const FaithfulForceModel fast(arm, choice.makeIterationOptions()), reference(arm, choice.makeReferenceOptions());
     IdentificationReport r;
     if (iterationModel) iterationModel->clear();
+    // Every path inside the arm's range, before any work: the faithful model rechecks the fit below
+    // whichever model fits (an error here names the data's file and line).
+    fast.calcElbowAngles(pr.data);
     if (choice.model == "steady") {
         r = identify(pr, steady, o);
     } else {
-        fast.calcElbowAngles(pr.data);
         if (choice.model == "faithful")
             r = choice.warmStart ? identifyWarmStarted(pr, steady, fast, o) : identify(pr, fast, o);
         else

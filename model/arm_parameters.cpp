@@ -40,14 +40,17 @@ void ArmParameters::validate() const {
                Bound{1, reach, false, false, "forearm lengths, wrist to fingertip"});
 
     checkField("biceps.insertion_distance", insertionDistance, Bound{0, forearmLength, true, false, "m"});
+    // The origin lies on the upper arm or the shoulder girdle above it (the thesis's A = 0.37 m for a
+    // 0.32 m upper arm): twice the upper arm's length bounds it and keeps a value in mm out.
     checkField("biceps.origin_distance", originDistance,
-               Bound{insertionDistance, 1e300, true, false, "m, must exceed insertion_distance"});
+               Bound{insertionDistance, 2 * upperArmLength, true, false, "m, above insertion_distance and within twice upper_arm.length"});
 
     checkField("transducer.strap_distance", strapDistance,
                Bound{0, forearmLength + handLength, true, false, "m, on the forearm or hand"});
     checkField("transducer.range", transducerRange, Bound{0, 1e5, true, false, "N"});
 
     checkField("elbow.min_angle_deg", minElbowAngleDeg, Bound::open(0, 180, "deg"));
+    checkDegreesNotRadians("elbow.min_angle_deg", {minElbowAngleDeg, maxElbowAngleDeg});
     checkField("elbow.max_angle_deg", maxElbowAngleDeg,
                Bound{minElbowAngleDeg, 180, true, false, "deg, above min_angle_deg"});
     checkField("elbow.stop_stiffness", stopStiffness, Bound{0, 1e6, true, false, "N m/rad"});
@@ -58,6 +61,7 @@ void ArmParameters::validate() const {
         checkField("forearm_rotation.min_deg", r.minDeg, Bound::closed(-120, 0, "deg"));
         checkField("forearm_rotation.max_deg", r.maxDeg, Bound::closed(0, 120, "deg"));
         checkField("forearm_rotation.posture_deg", r.postureDeg, Bound::closed(r.minDeg, r.maxDeg, "deg"));
+        checkDegreesNotRadians("forearm_rotation.min_deg", {r.minDeg, r.maxDeg, r.postureDeg});
         checkField("forearm_rotation.mass_fraction", r.massFraction, Bound{0, 1, true, true, "of the forearm + hand mass"});
         const auto& d = r.axisDirection;
         checkField("forearm_rotation.axis_direction (length)", std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]),

@@ -156,6 +156,16 @@ double ArmGeometry::calcForearmMomentArm(const PathGeometry& g) const {
     return calcPathMomentArm(arm_.getMatter(), arm_.getRadius(), state_, g);
 }
 
+std::vector<double> findRestartTimes(const MuscleArm& model, bool stepsOnly) {
+    std::vector<double> times;
+    for (int i = 0; i < model.getNumMuscles(); ++i) {
+        const std::vector<double> t =
+            findRestartTimes(model.getMuscle(i), model.getMuscleForce(i).getActivationProfile(), stepsOnly);
+        times.insert(times.end(), t.begin(), t.end());
+    }
+    return times;
+}
+
 void resolveMaxPathLengths(ArmSetup& setup) {
     bool any = false;
     for (const MuscleSpec& m : setup.muscles) any = any || m.maxPathFromRange;

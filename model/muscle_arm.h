@@ -114,4 +114,8 @@ double calcPathMomentArm(const SimTK::SimbodyMatterSubsystem& matter, const SimT
 /// (sampled every degree, then refined to 1e-10 rad).
 void resolveMaxPathLengths(ArmSetup& setup);
 
+/// Where an integrator of the arm restarts: findRestartTimes (muscles/muscle_model.h) of every muscle
+/// and its own activation profile, together.
+std::vector<double> findRestartTimes(const MuscleArm& model, bool stepsOnly = false);
+
 }  // namespace armsim

@@ -284,8 +284,13 @@ OsimForwardResult runOsimForward(const OsimModel& model, const OsimStorage& cont
         if (settings.progress) settings.progress(x.getTime() - t0, settings.finalTime - t0);
     };
     // The excitations are continuous (linear between rows): the solver's error control takes their kinks
-    // without restarts.
-    const std::vector<double> breakpoints;
+    // without restarts, but not a jump of the muscle's own (a Virtual Muscle's recruitment threshold).
+    std::vector<double> breakpoints;
+    for (int i = 0; i < arm.getNumMuscles(); ++i) {
+        const MuscleForce& f = arm.getMuscleForce(i);
+        const std::vector<double> r = findRestartTimes(f.getMuscle(), f.getActivationProfile(), true);
+        breakpoints.insert(breakpoints.end(), r.begin(), r.end());
+    }
     auto check = [&](const SimTK::State& x) {
         for (int i = 0; i < arm.getNumMuscles(); ++i) {
             const MuscleForce& f = arm.getMuscleForce(i);

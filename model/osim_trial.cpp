@@ -139,7 +139,12 @@ OsimIsometricTrialResult runOsimIsometricTrial(const OsimModel& file, const Osim
         for (const std::vector<double>* v : {&F, &torque, &U, &a, &L}) row.insert(row.end(), v->begin(), v->end());
         result.series.appendRow(row);
     };
-    sum.stats = integrateSampled(f, 0.0, y, settings.getDuration(), settings.sampleRate, agonistProfile.getBreakpoints(),
+    std::vector<double> restarts;
+    for (int i = 0; i < n; ++i) {
+        const std::vector<double> r = findRestartTimes(*muscles[i], excitation[i]);
+        restarts.insert(restarts.end(), r.begin(), r.end());
+    }
+    sum.stats = integrateSampled(f, 0.0, y, settings.getDuration(), settings.sampleRate, restarts,
                                  settings.integration, sample, [&](double t, const double* yIn) {
                                      for (int i = 0; i < n; ++i) muscles[i]->checkStates(t, yIn + f.first[i]);
                                  });
@@ -238,8 +243,14 @@ Table runOsimFreeMovement(const OsimModel& file, const OsimFreeMovementSettings&
             f.getMuscle().checkStates(x.getTime(), y.data());
         }
     };
-    const IntegrationStats st = simulateSampled(arm.getSystem(), s, settings.duration, settings.sampleRate,
-                                                agonist.getBreakpoints(), settings.integration, sample, check);
+    std::vector<double> restarts;
+    for (int i = 0; i < n; ++i) {
+        const MuscleForce& f = arm.getMuscleForce(i);
+        const std::vector<double> r = findRestartTimes(f.getMuscle(), f.getActivationProfile());
+        restarts.insert(restarts.end(), r.begin(), r.end());
+    }
+    const IntegrationStats st = simulateSampled(arm.getSystem(), s, settings.duration, settings.sampleRate, restarts,
+                                                settings.integration, sample, check);
     // The sample grid may end short of the duration (duration x rate rounded): the run is done all the same.
     if (settings.progress && t.get(t.getNumRows() - 1, 0) < settings.duration) settings.progress(settings.duration);
     if (stats) *stats = st;

@@ -14,23 +14,6 @@ using namespace SimTK;
 
 namespace armsim {
 
-namespace {
-
-// Times where some excitation steps (two points at one time): the integrator restarts there. Kinks of a
-// piecewise-linear trace are left to the error control (a restart at every row of a dense trace costs
-// more than it gains).
-std::vector<double> findStepTimes(const MuscleArm& model) {
-    std::vector<double> steps;
-    for (int i = 0; i < model.getNumMuscles(); ++i) {
-        const std::vector<double>& t = model.getMuscleForce(i).getActivationProfile().getBreakpoints();
-        for (std::size_t k = 1; k < t.size(); ++k)
-            if (t[k] == t[k - 1]) steps.push_back(t[k]);
-    }
-    return steps;
-}
-
-}  // namespace
-
 void SimulationSettings::validate(const ArmParameters& arm) const {
     checkField("elbow_angle_deg", cleanDegrees(elbowAngle),
                Bound::closed(arm.minElbowAngleDeg, arm.maxElbowAngleDeg, "deg"));
@@ -196,7 +179,9 @@ void ArmSimulation::integrate(double duration, double sampleRate) {
         recordSample(s);
         lastSample_ = long(k);
     };
-    const std::vector<double> steps = findStepTimes(*model_);
+    // Steps and threshold passings; kinks of a piecewise-linear trace are left to the error control (a
+    // restart at every row of a dense trace costs more than it gains).
+    const std::vector<double> steps = findRestartTimes(*model_, true);
     IntegrationStats st;
     if (settings_.lockedElbow) {
         st = simulateSampled(model_->getSystem(), *state_, duration, sampleRate, steps, settings_.integration, sample,

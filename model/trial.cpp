@@ -363,11 +363,11 @@ IsometricTrialResult runIsometricTrial(const ArmSetup& setup, const IsometricTri
 
     if (settings.solver == TrialSolver::LockedOde) {
         sum.stats = integrateLockedArm(state, firstState, muscles, activations, sum.pathLengths, settings,
-                                       profile.getBreakpoints(), [&](double t, const double* y) { sample(t, y, nullptr); });
+                                       findRestartTimes(model), [&](double t, const double* y) { sample(t, y, nullptr); });
     } else {
         const bool perSample = settings.solver == TrialSolver::SimbodyPerSample;
         sum.stats = simulateSampled(
-            system, state, settings.getDuration(), settings.sampleRate, profile.getBreakpoints(),
+            system, state, settings.getDuration(), settings.sampleRate, findRestartTimes(model),
             settings.integration,
             [&](const State& s) { sample(s.getTime(), &s.getY()[0], perSample ? &s : nullptr); },
             [&](const State& s) { model.checkMuscleStates(s); });
@@ -624,11 +624,11 @@ Table runFreeMovement(const ArmSetup& setup, const FreeMovementSettings& setting
     };
     IntegrationStats st;
     if (settings.solver == FreeMovementSolver::SimbodySystem) {
-        st = simulateSampled(system, state, settings.duration, settings.sampleRate, settings.activation.getBreakpoints(),
+        st = simulateSampled(system, state, settings.duration, settings.sampleRate, findRestartTimes(model),
                              settings.integration, sample, [&](const State& s) { model.checkMuscleStates(s); });
     } else {
         st = integrateCoupledMuscles(model, state, settings.duration, settings.sampleRate,
-                                     settings.activation.getBreakpoints(), settings.integration,
+                                     findRestartTimes(model), settings.integration,
                                      settings.checkPartialEvaluations, sample);
     }
     if (stats) *stats = st;

@@ -47,6 +47,25 @@ ActivationProfile ActivationProfile::pulse(double tOn, double riseTime, double l
                              "activation pulse");
 }
 
+std::vector<double> ActivationProfile::findCrossings(const std::vector<double>& levels) const {
+    std::vector<double> crossings;
+    for (std::size_t k = 1; k < times_.size(); ++k) {
+        const double t0 = times_[k - 1], t1 = times_[k], U0 = values_[k - 1], U1 = values_[k];
+        if (!(t1 > t0) || U0 == U1) continue;
+        for (double level : levels) {
+            // Passed when U goes from one side of the level (U < level counts as below) to the other.
+            const bool rising = U1 > U0;
+            if (rising ? !(U0 < level && level <= U1) : !(U1 < level && level <= U0)) continue;
+            double t = t0 + (level - U0) / (U1 - U0) * (t1 - t0);
+            auto past = [&](double tt) { return rising ? getValue(tt) >= level : getValue(tt) < level; };
+            while (t < t1 && !past(t)) t = std::nextafter(t, t1);
+            crossings.push_back(t);
+        }
+    }
+    std::sort(crossings.begin(), crossings.end());
+    return crossings;
+}
+
 double ActivationProfile::getValue(double t) const {
     // First point with time > t; U is right-continuous at steps.
     const auto it = std::upper_bound(times_.begin(), times_.end(), t);

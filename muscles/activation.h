@@ -32,6 +32,9 @@ public:
     /// Times where U or its slope changes: an integrator should restart there.
     const std::vector<double>& getBreakpoints() const { return times_; }
     const std::vector<double>& getValues() const { return values_; }
+    /// Times where a sloped stretch of U(t) passes one of the levels, each the first double at which U
+    /// is on the far side of its level (so U(t) there is already past it). Sorted, one per passing.
+    std::vector<double> findCrossings(const std::vector<double>& levels) const;
     double getMaxValue() const;
 
 private:

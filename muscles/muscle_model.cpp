@@ -17,4 +17,14 @@ MuscleOutputs MuscleModel::calcOutputs(double pathLength, double U, const double
     return out;
 }
 
+std::vector<double> findRestartTimes(const MuscleModel& muscle, const ActivationProfile& profile, bool stepsOnly) {
+    const std::vector<double>& t = profile.getBreakpoints();
+    std::vector<double> times;
+    for (std::size_t k = 0; k < t.size(); ++k)
+        if (!stepsOnly || (k > 0 && t[k] == t[k - 1])) times.push_back(t[k]);
+    const std::vector<double> crossings = profile.findCrossings(muscle.getActivationThresholds());
+    times.insert(times.end(), crossings.begin(), crossings.end());
+    return times;
+}
+
 }  // namespace armsim

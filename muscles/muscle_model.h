@@ -8,6 +8,8 @@
 // excitation its activation dynamics follow); states are of order 1 (as CPodes needs).
 #pragma once
 
+#include "muscles/activation.h"
+
 #include <string>
 #include <vector>
 
@@ -117,6 +119,16 @@ public:
     /// true when the fascicle velocity is a state, so calcFascicleVelocity ignores P and U (callers that
     /// sample many states may then skip looking the input up).
     virtual bool hasFascicleVelocityState() const { return false; }
+    /// Activations U at which calcStateDerivative jumps (Virtual Muscle: the units' recruitment
+    /// thresholds; none for a model smooth in U). An integrator restarts where U(t) passes one, so no
+    /// step straddles a jump (findRestartTimes).
+    virtual std::vector<double> getActivationThresholds() const { return {}; }
 };
+
+/// Where an integrator of `muscle` driven by `profile` restarts: the profile's breakpoints (only its
+/// steps, two points at one time, when stepsOnly: a dense trace's every row would cost more than it
+/// gains) and the times it passes one of the muscle's activation thresholds. Unsorted, may repeat.
+std::vector<double> findRestartTimes(const MuscleModel& muscle, const ActivationProfile& profile,
+                                     bool stepsOnly = false);
 
 }  // namespace armsim

@@ -149,13 +149,14 @@ Table runMuscleIsometric(const MuscleModel& muscle, const MuscleIsometricSetting
     } else {
         z = muscle.calcInitialState(P);
     }
+    const std::vector<double> restarts = findRestartTimes(muscle, settings.activation);
     IntegrationStats st;
     if (!settings.integrateSimbodySystem) {
         st = integrateSampled(
             [&](double t, const double* y, double* ydot) {
                 muscle.calcStateDerivative(P, settings.activation.getValue(t), y, ydot);
             },
-            0.0, z, settings.duration, settings.sampleRate, settings.activation.getBreakpoints(),
+            0.0, z, settings.duration, settings.sampleRate, restarts,
             settings.integration, sample, [&](double t, const double* y) { muscle.checkStates(t, y); });
     } else {
         MultibodySystem system;
@@ -168,7 +169,7 @@ Table runMuscleIsometric(const MuscleModel& muscle, const MuscleIsometricSetting
         State state = system.getDefaultState();
         force.setMuscleStates(state, z);
         st = simulateSampled(
-            system, state, settings.duration, settings.sampleRate, settings.activation.getBreakpoints(),
+            system, state, settings.duration, settings.sampleRate, restarts,
             settings.integration, [&](const State& s) { sample(s.getTime(), &s.getZ()[0]); },
             [&](const State& s) { force.checkMuscleStates(s); });
     }

@@ -58,16 +58,19 @@ void FibreType::validate(const std::string& p) const {
     checkField(q + "af", af, Bound::positive("f0.5"));
     checkField(q + "nf0", nf0, Bound::positive());
     checkField(q + "nf1", nf1, Bound::any());
-    checkField(q + "Tf1", Tf1, Bound::positive("s"));
-    checkField(q + "Tf2", Tf2, Bound::nonNegative("s"));
-    checkField(q + "Tf3", Tf3, Bound::positive("s"));
-    checkField(q + "Tf4", Tf4, Bound::nonNegative("s"));
+    // Time constants: VM 4.0's are 14-47 ms (Tf), 43-350 ms (TS), 200 ms (TY); the upper bounds (30 to 50
+    // times those) keep a value in ms from passing as s.
+    const Bound kTf{0, 1, true, false, "s"}, kTfSlope{0, 1, false, false, "s"}, kSlow{0, 10, true, false, "s"};
+    checkField(q + "Tf1", Tf1, kTf);
+    checkField(q + "Tf2", Tf2, kTfSlope);
+    checkField(q + "Tf3", Tf3, kTf);
+    checkField(q + "Tf4", Tf4, kTfSlope);
     checkField(q + "aS1", aS1, Bound::positive());
     checkField(q + "aS2", aS2, Bound::positive());
-    checkField(q + "TS", TS, Bound::positive("s"));
+    checkField(q + "TS", TS, kSlow);
     checkField(q + "cY", cY, Bound::closed(0, 1));
     checkField(q + "VY", VY, Bound::positive("L0/s"));
-    checkField(q + "TY", TY, Bound::positive("s"));
+    checkField(q + "TY", TY, kSlow);
     if (f05 != 0.0) checkField(q + "f05", f05, Bound::positive("pps, or 0 = not given"));
 }
 
@@ -86,8 +89,10 @@ void MuscleCoefficients::validate(const std::string& p) const {
     checkField(q + "Ur", Ur, {0, 1, true, false, ""});
     checkField(q + "fmin", fmin, Bound::positive("f0.5"));
     checkField(q + "fmax", fmax, {fmin, 1e300, true, false, "f0.5, above fmin"});
-    checkField(q + "sigma", sigma, Bound::positive("N/m^2"));
-    checkField(q + "density", density, Bound::positive("kg/m^3"));
+    // Published specific tensions span 0.1-1 MPa, muscle density 1.04-1.11 g/cm^3: the bounds keep N/cm^2
+    // and g/cm^3 out.
+    checkField(q + "sigma", sigma, Bound{1e4, 3e6, false, false, "N/m^2"});
+    checkField(q + "density", density, Bound{500, 2000, false, false, "kg/m^3"});
 }
 
 void MuscleParameters::validate() const {
@@ -295,6 +300,12 @@ std::vector<double> VirtualMuscle::calcInitialState(double P) const {
 double VirtualMuscle::calcForce(double P, const double* y) const {
     const double LT = (P - params_.optimalFascicleLength * y[kL]) / params_.optimalTendonLength;
     return F0_ * calcSeriesElastic(params_.coefficients, LT);
+}
+
+std::vector<double> VirtualMuscle::getActivationThresholds() const {
+    std::vector<double> thresholds;
+    for (const MotorUnit& u : units_) thresholds.push_back(u.threshold);
+    return thresholds;
 }
 
 void VirtualMuscle::calcStateDerivative(double P, double U, const double* y, double* ydot,

@@ -189,6 +189,8 @@ public:
         return y[kV] * params_.optimalFascicleLength;
     }
     bool hasFascicleVelocityState() const override { return true; }
+    /// The units' recruitment thresholds thr_u: fenv jumps from 0 to fmin there.
+    std::vector<double> getActivationThresholds() const override;
 
     const MuscleParameters& getParameters() const { return params_; }
     const std::vector<MotorUnit>& getUnits() const { return units_; }

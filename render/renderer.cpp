@@ -176,6 +176,13 @@ void RenderSettings::validate() const {
         checkField("camera.vertical_fov", camera.verticalFov, Bound::open(0, kPi, "rad"));
     checkField("camera.near_clip", camera.nearClip, Bound::positive("m"));
     checkField("camera.far_clip", camera.farClip, {camera.nearClip, 1e300, true, false, "m (> near_clip)"});
+    // The point looked at lies inside the clip range, or the frame is empty (a position in mm, say).
+    const double distance = view.norm();
+    if (!(distance > camera.nearClip && distance < camera.farClip))
+        throw FieldError("camera.position", "= " + formatVec(camera.position) + ": " + formatNumber(distance, 4) +
+                                                " m from look_at, outside the clip range (" + formatNumber(camera.nearClip) +
+                                                ", " + formatNumber(camera.farClip) + ") m: expected the point looked at "
+                                                "between near_clip and far_clip (positions in m)");
 }
 
 RenderSettings readRenderSettings(const ParamNode& node) {

@@ -46,6 +46,12 @@ void ValidationSettings::validate(const ArmParameters& arm) const {
     for (double s : noiseLevels) checkField("noise", s, {0, 0.5, false, true, "relative force sd"});
     checkField("seeds", seeds, Bound::closed(0, 1e6));
     checkField("jobs", jobs, Bound::closed(1, 256));
+    const double fits = countFits();
+    if (fits > kMaxValidationFits)
+        throw FieldError("seeds", fmt::format("= {}: {} truths x {} noise levels x {} methods = {:.0f} fits, each a row "
+                                              "kept in memory (about {}): expected at most {:.0f} fits",
+                                              seeds, seeds + 1, noiseLevels.size(), methods.empty() ? getValidationMethods().size() : methods.size(),
+                                              fits, formatBytes(long(2 * fits * sizeof(ValidationRow))), kMaxValidationFits));
     if (anglesDeg.size() < 2) throw InputError("angles: expected at least two for two unknowns");
     for (double a : anglesDeg) checkField("angle", a, Bound::closed(arm.minElbowAngleDeg, arm.maxElbowAngleDeg, "deg"));
     for (Method m : methods)
@@ -53,6 +59,11 @@ void ValidationSettings::validate(const ArmParameters& arm) const {
             throw InputError("method '" + getMethodName(m) +
                              "': not for validation (it needs one unknown or one observation); expected one of lm, "
                              "ilc-constant, ilc-secant, ilc-bounded-secant, ilc-sign-search");
+}
+
+double ValidationSettings::countFits() const {
+    const std::size_t m = methods.empty() ? getValidationMethods().size() : methods.size();
+    return double(seeds + 1) * double(noiseLevels.size()) * double(m);
 }
 
 std::vector<Method> getValidationMethods() {

@@ -45,9 +45,16 @@ struct ValidationSettings {
     double startMass = kThesisStartMass;                 ///< [kg] every run's start (thesis Tables 7.2, 7.3)
     double startTendonLength = kThesisStartTendonLength;  ///< [m]
     int jobs = 2;                  ///< threads for the trials of one evaluation
-    /// InputError naming the field for bad values (noise in [0, 0.5), seeds >= 0, angles in the arm's range).
+    /// InputError naming the field for bad values (noise in [0, 0.5), seeds >= 0, angles in the arm's range,
+    /// at most kMaxValidationFits fits).
     void validate(const ArmParameters& arm) const;
+    /// (seeds + 1) x noise levels x methods: the identifications runValidation makes.
+    double countFits() const;
 };
+
+/// The most fits runValidation takes (its rows are kept in memory, about 1 GB at this count; a study
+/// journals its rows instead).
+constexpr double kMaxValidationFits = 4e6;
 
 /// One identification of one synthetic data set.
 struct ValidationRow {

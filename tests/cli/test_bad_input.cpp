@@ -21,6 +21,7 @@ namespace {
 namespace fs = std::filesystem;
 using armsim::testing::CommandResult;
 using armsim::testing::runArmsim;
+using armsim::readFileText;
 
 struct BadInput {
     std::string name;                           ///< test case name
@@ -587,6 +588,56 @@ std::vector<BadInput> makeCatalogue() {
          {"--model 'arm26'", "an OpenSim model", "`armsim trial`, `armsim model show`"}},
         {"CoordinateOnAnArmsimModel", {}, "trial --model thesis --coordinate r_elbow_flex --out OUT/t.csv",
          {"--coordinate", "only for OpenSim models"}},
+        // ---- the fifth sweep's classes (issue 34) ----------------------------------------------
+        // units a row-by-row bound cannot see: angles in radians, torques in kN m, a camera in mm
+        {"TorqueDataInRadians", {{"t.csv", "flexion_deg,effort,level,torque_Nm\n2.356,1,1,21.39\n2.094,1,1,29.12\n1.571,1,1,33.5\n"}},
+         "identify-torque IN/t.csv --out OUT/it", {"t.csv: column 'flexion_deg' = 2.356, 2.094, 1.571", "expected degrees", "135, 120, 90"}},
+        {"TorqueDataInKiloNewtonMetres", {{"t.csv", "flexion_deg,effort,level,torque_Nm\n135,1,1,0.02139\n120,1,1,0.02912\n"}},
+         "identify-torque IN/t.csv --out OUT/it", {"t.csv", "under 0.5 N m", "0.02912", "expected N m"}},
+        {"TorqueDataTabSeparated", {{"t.csv", "flexion_deg\teffort\tlevel\ttorque_Nm\n135\t1\t1\t21.39\n"}},
+         "identify-torque IN/t.csv --out OUT/it", {"t.csv:1", "holds a tab", "expected comma-separated columns"}},
+        {"TorqueProtocolAnglesInRadians", {{"p.yaml", kTorqueHead + "conditions:\n  - {flexion_deg: 1, effort: flexion, level: 1, repetitions: 3}\n"
+                                                                   "  - {flexion_deg: 1.57, effort: flexion, level: 1, repetitions: 3}\n"}},
+         "protocol IN/p.yaml --out OUT/run", {"p.yaml:5", "flexion_deg", "1, 1.57", "expected degrees"}},
+        {"DesignAnglesInRadians", {}, "design --angles 0.52,1.05,1.57 --out OUT/d", {"--angles = 0.52, 1.05, 1.57", "expected degrees", "29.8, 60.2, 90"}},
+        {"ValidateAnglesInRadians", {}, "validate --truth elbow --angles 0.52,1.05,1.57 --subjects 2 --out OUT/v",
+         {"--angles = 0.52, 1.05, 1.57", "expected degrees"}},
+        {"ArmFileElbowRangeInRadians", {{"a.yaml", replaceAll(replaceAll(arm, "min_angle_deg: 40 ", "min_angle_deg: 0.698"),
+                                                              "max_angle_deg: 180 ", "max_angle_deg: 3.1416")}},
+         "trial --arm IN/a.yaml --hold 0.2 --out OUT/t.csv", {"a.yaml", "elbow.min_angle_deg", "0.698, 3.1416", "expected degrees"}},
+        {"ArmFileOriginInMillimetres", {{"a.yaml", replaceAll(arm, "origin_distance: 0.37 ", "origin_distance: 370")}},
+         "trial --arm IN/a.yaml --hold 0.2 --out OUT/t.csv", {"a.yaml", "'biceps.origin_distance' = 370", "within twice upper_arm.length"}},
+        {"FibreTimeConstantInMilliseconds",
+         {{"m.yaml", readFileText(armsim::getAssetDirectory() + "/muscles/biceps_long_head.yaml")},
+          {"human_fibre_types.yaml", replaceAll(readFileText(armsim::getAssetDirectory() + "/muscles/human_fibre_types.yaml"),
+                                                "Tf1: 0.034283", "Tf1: 34.283")}},
+         "muscle steady --muscle IN/m.yaml", {"Tf1", "34.283", "(0, 1] (s)"}},
+        {"RenderCameraInMillimetres", {{"t.csv", "time_s\n0\n"}, {"rs.yaml", "camera:\n  position: [1500, 500, 2000]\n  look_at: [0, 0, 0]\n"}},
+         "render IN/t.csv --render-settings IN/rs.yaml --out OUT/v.mp4", {"rs.yaml", "camera.position", "outside the clip range", "(positions in m)"}},
+        // channel files: an sd no lab reaches, a row twice, a column the channel does not read
+        {"ChannelSdBelowAnyInstrument", {{"c.csv", channelHead + "volume,BIClong,,1,0,0,1e-4,5e-10\n"}},
+         "identify-torque measured/thesis_mvc_torque.csv --channels IN/c.csv --out OUT/it", {"c.csv:2", "column 'sd' = 5e-10", ">= 1e-07"}},
+        {"ChannelRowTwice", {{"c.csv", channelHead + "volume,BIClong,,1,0,0,1e-4,1e-5\nvolume,BIClong,,1,0,0,1.1e-4,1e-5\n"}},
+         "identify-torque measured/thesis_mvc_torque.csv --channels IN/c.csv --out OUT/it",
+         {"c.csv:3", "the same measurement as line 2", "repetition"}},
+        {"ChannelAngleForAVolume", {{"c.csv", channelHead + "volume,BIClong,90,1,0,0,1e-4,1e-5\n"}},
+         "identify-torque measured/thesis_mvc_torque.csv --channels IN/c.csv --out OUT/it",
+         {"c.csv:2", "column 'flexion_deg' = 90", "empty for volume"}},
+        {"ChannelMuscleForTheUpperArm", {{"c.csv", channelHead + "upper_arm_length,BIClong,,1,0,0,0.3,0.003\n"}},
+         "identify-torque measured/thesis_mvc_torque.csv --channels IN/c.csv --out OUT/it",
+         {"c.csv:2", "column 'muscle' = 'BIClong'", "empty for upper_arm_length"}},
+        // options that would be ignored, limits named by option, data out of range named by file and line
+        {"RenderWidthInBothPlaces", {{"t.csv", "time_s\n0\n"}, {"rs.yaml", "width: 800\n"}},
+         "render IN/t.csv --render-settings IN/rs.yaml --width 640 --out OUT/v.mp4", {"--width and", "rs.yaml:1", "both set the frame's width"}},
+        {"IdentifyJobsWithSteady", {}, "identify measured/thesis_measured.csv --jobs 2 --out OUT/id",
+         {"--jobs is an option of the faithful forward model"}},
+        {"ForceDataPathOutsideTheArm", {{"d.csv", "path_cm,force_N\n0.41,600\n0.375,458\n"}}, "identify IN/d.csv --out OUT/id",
+         {"d.csv:2", "path 0.0041 m", "outside the arm's elbow range"}},
+        {"ForwardSamplesNameTheOptions", {{"c.sto", sto + "time\tBIClong\n0\t0.1\n"}},
+         "forward --model arm26 --controls IN/c.sto --final-time 100000 --out OUT/f",
+         {"--final-time - the controls' first time = 1e+05 s x --rate 200 Hz", "expected at most 1e+07"}},
+        {"ValidateSeedsBeyondTheFits", {}, "validate --seeds 1000000 --out OUT/v", {"--seeds = 1000000", "fits", "expected at most 4000000 fits"}},
+        {"ValidateOutWhereNoFolderCanBeMade", {}, "validate --seeds 0 --noise 0 --out /proc/armsim_out", {"--out '/proc/armsim_out'", "/proc"}},
         {"MainJobBadModelWritesNothing", {{"m.yaml", "name: m\n"}}, "run --model IN/m.yaml --out OUT/r", {"m.yaml:1", "'arm'"}},
     };
 }

@@ -172,6 +172,19 @@ TEST(ProtocolFile, MalformedFilesNameFileLineAndKey) {
     fs::remove_all(d);
 }
 
+// A sample rate the EMG filters cannot take is refused while EMG is on, and accepted with enabled:
+// false (no EMG is made, so its band need not lie below Nyquist).
+TEST(ProtocolFile, DisabledEmgIsNotCheckedAgainstTheSampleRate) {
+    const fs::path d = freshDir("emg_disabled");
+    const std::string mvc = readText(kProtocols + "mvc_force_angle.yaml");
+    const std::string slow = replaced(mvc, "sample_rate: 1000 ", "sample_rate: 200 ");
+    EXPECT_NE(protocolError(d, slow).find("band_high"), std::string::npos);
+    const std::string off = replaced(slow, "enabled: true", "enabled: false");
+    EXPECT_EQ(protocolError(d, off), "");
+    EXPECT_FALSE(readProtocol(writeProtocol(d, "off.yaml", off).string()).emgEnabled);
+    fs::remove_all(d);
+}
+
 TEST(ProtocolRun, SameSeedGivesByteIdenticalFilesWhateverTheThreadCount) {
     const fs::path d = freshDir("determinism");
     const Protocol p = readProtocol(writeProtocol(d, "p.yaml", kSmallMvc).string());

@@ -3,6 +3,9 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <vector>
+
 using namespace armsim;
 
 TEST(ActivationProfile, PiecewiseLinearWithRightContinuousSteps) {
@@ -31,4 +34,25 @@ TEST(ActivationProfile, RejectsValuesOutsideZeroOneAndUnorderedTimes) {
     } catch (const InputError& e) {
         EXPECT_NE(std::string(e.what()).find("trace.csv point 1"), std::string::npos) << e.what();
     }
+}
+
+// A recruitment threshold passed on a sloped stretch: the crossing time is the first double at which U
+// is past the level (so a restart there sees the unit recruited), rising and falling alike.
+TEST(ActivationProfile, FindsWhereASlopedStretchPassesALevel) {
+    const ActivationProfile p({1.0, 11.0, 12.0, 12.0, 14.0}, {0.0, 1.0, 1.0, 0.3, 0.1});
+    const std::vector<double> levels{0.0, 0.064, 0.2, 0.5, 1.0};
+    const std::vector<double> t = p.findCrossings(levels);
+    // Rising 0 -> 1 over [1, 11]: 0.064, 0.2, 0.5 and 1 (at the end); 0 is where it starts, not passed.
+    // The step 1 -> 0.3 at 12 is a breakpoint, not a crossing. Falling 0.3 -> 0.1 over [12, 14]: 0.2.
+    const std::vector<double> expected{1.64, 3.0, 6.0, 11.0, 13.0};
+    ASSERT_EQ(t.size(), expected.size());
+    for (std::size_t k = 0; k < t.size(); ++k) {
+        EXPECT_NEAR(t[k], expected[k], 1e-12) << k;  // a few ulps from the exact time
+        const double U = p.getValue(t[k]), before = p.getValue(std::nextafter(t[k], 0.0));
+        const double level = k < 4 ? levels[k + 1] : 0.2;
+        if (k < 4) EXPECT_TRUE(U >= level && before < level) << k << ": U " << U << ", before " << before;
+        else EXPECT_TRUE(U < level && before >= level) << k << ": U " << U << ", before " << before;
+    }
+    EXPECT_TRUE(ActivationProfile::constant(0.5).findCrossings(levels).empty());
+    EXPECT_TRUE(ActivationProfile::step(1.0, 0.0, 1.0).findCrossings(levels).empty());
 }

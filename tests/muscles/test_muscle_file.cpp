@@ -105,7 +105,7 @@ TEST(MuscleFile, UnknownKeysAreErrorsWithTheirLine) {
 
 TEST(MuscleFile, FibreTypeValueOutOfBoundNamesItsFile) {
     expectMentions(loadError(writeVariant("", "", "  Tf3: 0.047033", "  Tf3: -1")),
-                   {"human_fibre_types.yaml:", "slow.Tf3", "-1", "> 0"});
+                   {"human_fibre_types.yaml:", "slow.Tf3", "-1", "(0, 1] (s)"});
 }
 
 TEST(MuscleFile, PmaxTooShortForTheTendon) {

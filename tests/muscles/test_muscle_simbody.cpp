@@ -202,6 +202,30 @@ TEST(MuscleIsometric, DirectOdeMatchesTheSimbodySystem) {
     }
 }
 
+// A slow ramp passes the units' recruitment thresholds inside what would be long steps (nothing moves
+// before the first one): each passing is a jump of fenv, so the integrator restarts there. Without the
+// restarts the default accuracy stepped over them and recorded passive force only (0.074 N at 3 s
+// instead of about 20 N), and 1e-6 failed at hmin. The force at 3 s agrees across accuracies 1e-4 and
+// 1e-7 and with the Simbody System.
+TEST(MuscleIsometric, ASlowRampRecruitsEveryUnitItPassesAtEveryAccuracy) {
+    constexpr double kRelTol = 2e-3;  // accuracy 1e-4 against 1e-7, relative to the final force
+    const VirtualMuscle m(bicepsLongHead());
+    MuscleIsometricSettings settings;
+    settings.pathLength = 0.375;
+    settings.activation = ActivationProfile::ramp(0.0, 10.0, 0.0, 1.0);  // U = 0.3 at 3 s: three units
+    settings.duration = 3.0;
+    settings.integration.accuracy = 1e-7;
+    const double reference = finalForce(runMuscleIsometric(m, settings));
+    EXPECT_GT(reference, 10.0);  // three recruited units, well above passive force
+    for (double accuracy : {1e-4, 1e-5, 1e-6}) {
+        settings.integration.accuracy = accuracy;
+        EXPECT_NEAR(finalForce(runMuscleIsometric(m, settings)), reference, kRelTol * reference) << accuracy;
+    }
+    settings.integration.accuracy = 1e-4;
+    settings.integrateSimbodySystem = true;
+    EXPECT_NEAR(finalForce(runMuscleIsometric(m, settings)), reference, kRelTol * reference) << "Simbody";
+}
+
 TEST(MuscleIsometric, BadSettingsAreRejected) {
     const VirtualMuscle m(bicepsLongHead());
     MuscleIsometricSettings settings;
