@@ -784,7 +784,7 @@ TEST(Cli, ProgressReachesALogFileWhileTheWorkRuns) {
 TEST(Cli, TrialsRunAtTheLowestAccuracyTheBoundAllows) {
     const fs::path d = freshDir("lowest_accuracy");
     const std::string lowest = armsim::formatNumber(armsim::bounds::kTrialAccuracy.lo);
-    for (const std::string& args : {"trial --rest 0.1 --hold 0.2", "trial --model elbow --rest 0.1 --hold 0.2",
+    for (const std::string args : {"trial --rest 0.1 --hold 0.2", "trial --model elbow --rest 0.1 --hold 0.2",
                                     "trial --type free --duration 0.5"}) {
         const CommandResult r = runArmsim(args + " --rate 100 --accuracy " + lowest + " --out " + (d / "t.csv").string());
         EXPECT_EQ(r.exitCode, 0) << args << "\n" << r.output;
