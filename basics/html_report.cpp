@@ -165,6 +165,8 @@ void writeFolderReport(const std::string& dir, const FolderReport& report) {
           << "<pre class=\"printed\">" << escape(report.printed) << "</pre>\n";
     for (auto& [folder, files] : byFolder) {
         std::sort(files.begin(), files.end());
+        const long notShown = std::max(0L, long(files.size()) - kMaxReportFilesPerFolder);
+        files.resize(files.size() - std::size_t(notShown));
         h << "<h2>" << (folder.empty() ? "Files" : escape(folder) + "/") << "</h2>\n";
         std::vector<std::string> others;
         for (const std::string& rel : files) {
@@ -200,6 +202,10 @@ void writeFolderReport(const std::string& dir, const FolderReport& report) {
             }
             h << "</ul>\n";
         }
+        if (notShown > 0)
+            h << "<p class=\"caption\">and " << notShown << " more files in <a href=\"" << toHref(folder.empty() ? "." : folder)
+              << "\">" << (folder.empty() ? "this folder" : escape(folder) + "/") << "</a>, not shown (the first "
+              << kMaxReportFilesPerFolder << " by name are above)</p>\n";
     }
     h << kCheck << "\n</body></html>\n";
     writeFileAtomically((root / "index.html").string(), h.str());

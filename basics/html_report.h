@@ -26,12 +26,14 @@ struct FolderReport {
 /// video loaded and records the result in its body's data-resources attribute ("ok" or the missing
 /// files: what the tests read in a real browser). An index.html that armsim did not write is left
 /// alone, and a folder of more than kMaxReportFiles files gets none: both throw std::runtime_error, as
-/// does a failed write.
+/// does a failed write. A folder of more than kMaxReportFilesPerFolder files shows its first ones by
+/// name and says how many more there are.
 void writeFolderReport(const std::string& dir, const FolderReport& report);
 /// Whether the file at path is a page writeFolderReport wrote.
 bool isFolderReport(const std::string& path);
 
 constexpr int kPreviewRows = 12;
-constexpr long kMaxReportFiles = 5000;
+constexpr long kMaxReportFiles = 200000;
+constexpr long kMaxReportFilesPerFolder = 200;
 
 }  // namespace armsim

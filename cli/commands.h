@@ -105,6 +105,10 @@ CLI::Validator inRange(double lo, double hi);
 /// stderr is not a terminal (a log): the end ("label: 10/10 done") and, for long work, a line every 10 s
 /// (ARMSIM_PROGRESS_SECONDS) with the share done and the time left at the rate so far.
 void printProgress(const std::string& label, int done, int total);
+/// A note on stderr when the activation reaches its largest value only after the trial's end (a ramp
+/// longer than the trial, a trace in ms): "note: the activation reaches its largest value, 1, at 100 s,
+/// after the trial ends at 0.5 s (U = 0.005 there)". Nothing otherwise.
+void noteUnreachedActivation(const ActivationProfile& activation, double duration);
 /// The same for a simulation at time t [s] of `duration` (a long forward or free run): "12.3/100 s"; on
 /// a log only for runs that last (a line every 10 s and the end).
 void printTimeProgress(const std::string& label, double t, double duration);

@@ -181,6 +181,12 @@ void runIdentify(const IdentifyOptions& o) {
     io.seed = o.seed;
     io.maxIterations = o.maxIterations;
     io.forceTolerance = o.tolerance;
+    // A tolerance every measured force already meets would end the fit at its start.
+    double largest = 0;
+    for (const Observation& x : pr.data.points) largest = std::max(largest, x.force);
+    if (o.tolerance >= largest)
+        throw InputError("--tolerance = " + formatNumber(o.tolerance) + " N: not below the largest measured force, " +
+                         formatNumber(largest) + " N (" + pr.data.source + "): expected a tolerance the fit must work to meet");
 
     IdentificationReport r;
     try {

@@ -159,14 +159,21 @@ void addModelCommands(CLI::App& app) {
         c->callback([=] {
             checkOutputFolder("--out", *out);
             const std::vector<AnatomyTarget> t = targets->empty() ? loadDefaultAnatomyTargets() : loadAnatomyTargets(*targets);
-            if (isOsimModel(*name)) {
-                const OsimModel m = readOsimFile(findOsimModelFile(*name));
-                printModelCheck(m.name + " (OpenSim)", writeOsimModelCheck(m, *coordinate, *muscleModel, t, *out), t,
-                                "no such muscle, a share family missing, no muscle masses for volumes, no armsim forearm");
-                return;
+            if (!isOsimModel(*name) && !coordinate->empty())
+                throw InputError("--coordinate '" + *coordinate + "': only for OpenSim models (.osim)");
+            try {
+                if (isOsimModel(*name)) {
+                    const OsimModel m = readOsimFile(findOsimModelFile(*name));
+                    printModelCheck(m.name + " (OpenSim)", writeOsimModelCheck(m, *coordinate, *muscleModel, t, *out), t,
+                                    "no such muscle, a share family missing, no muscle masses for volumes, no armsim forearm");
+                } else {
+                    checkModel(loadModelWithMuscles(*name, *muscleModel), t, *out);
+                }
+            } catch (const InputError& e) {   // an empty scorecard: name the file and the model
+                if (std::string(e.what()).rfind("none of the targets", 0) != 0) throw;
+                throw InputError("--targets " + (targets->empty() ? std::string("(the default)") : *targets) + " and --model " +
+                                 *name + ": " + e.what());
             }
-            if (!coordinate->empty()) throw InputError("--coordinate '" + *coordinate + "': only for OpenSim models (.osim)");
-            checkModel(loadModelWithMuscles(*name, *muscleModel), t, *out);
         });
     }
 

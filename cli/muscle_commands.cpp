@@ -22,6 +22,15 @@ void MuscleOptions::declareInputs(OutputFiles& files) const {
     if (isRegularFile(model)) files.addInput("--model", model);
 }
 
+namespace {
+// A steady solve that failed at a path the user typed: the path is the input's fault when no steady
+// state exists there (exit 2 naming the option), the solver's otherwise (exit 3).
+[[noreturn]] void throwSteadyFailure(const std::string& option, const std::string& message) {
+    if (message.rfind("no steady state at path", 0) == 0) throw InputError(option + ": " + message);
+    throw SimulationError(message);
+}
+}  // namespace
+
 void MuscleOptions::add(CLI::App& app) {
     app.add_option("--model", model, "model: a name under assets/models/ (thesis, elbow) or a model file")
         ->capture_default_str();
@@ -141,7 +150,7 @@ void addMuscleCommands(CLI::App& app) {
             const std::shared_ptr<const MuscleModel> built = opts->build();
             const MuscleModel& m = *built;
             const SteadyState s = m.calcSteadyState(*path, *U);
-            if (!s.converged) throw SimulationError(s.message);
+            if (!s.converged) throwSteadyFailure("--path", s.message);
             std::printf("muscle            %s\n", m.getName().c_str());
             std::printf("path length       %.6f m\nactivation        %.4f\n", *path, *U);
             std::printf("force Fse         %.4f N  (F0 = %.3f N)\n", s.force, m.getF0());
@@ -196,6 +205,8 @@ void addMuscleCommands(CLI::App& app) {
             Table t({"path_length_m", "activation", "force_N", "fascicle_length_m", "converged"});
             const int n = int(std::floor((*to - *from) / *step + 1e-9)) + 1;
             std::vector<double> x, y;
+            std::vector<double> failed;   // path lengths with no steady state
+            std::string why;
             for (int i = 0; i < n; ++i) {
                 const double P = std::min(*to, *from + i * *step);
                 const SteadyState s = m.calcSteadyState(P, *U);
@@ -204,8 +215,16 @@ void addMuscleCommands(CLI::App& app) {
                 if (s.converged) {
                     x.push_back(100 * P);
                     y.push_back(s.force);
+                } else {
+                    if (failed.empty()) why = s.message;
+                    failed.push_back(P);
                 }
             }
+            if (int(failed.size()) == n) throwSteadyFailure("--from " + formatNumber(*from) + " to --to " + formatNumber(*to), why);
+            if (!failed.empty())   // said, not left to a column of NaN
+                std::fprintf(stderr, "note: %zu of %d path lengths (%s to %s m) have no steady state; their rows hold NaN "
+                             "and converged 0 (the first: %s)\n", failed.size(), n, formatNumber(failed.front()).c_str(),
+                             formatNumber(failed.back()).c_str(), why.c_str());
             files.writeWith(csvPath, [&](const std::string& p) { t.writeCsv(p); });
             if (!plot->empty()) {
                 PlotSpec spec;
@@ -272,8 +291,10 @@ void addMuscleCommands(CLI::App& app) {
             else if (*rise > 0) s.activation = ActivationProfile::ramp(*onset, *onset + *rise, 0.0, *U);
             else if (*onset > 0) s.activation = ActivationProfile::step(*onset, 0.0, *U);
             else s.activation = ActivationProfile::constant(*U);
+            noteUnreachedActivation(s.activation, s.duration);
             IntegrationStats stats;
-            const Table t = runMuscleIsometric(m, s, &stats);
+            Table t;
+            runNamingOptions({{"path_length", "--path"}}, [&] { t = runMuscleIsometric(m, s, &stats); });
             files.writeWith(csvPath, [&](const std::string& p) { t.writeCsv(p); });
             const int last = t.getNumRows() - 1;
             if (!plot->empty()) {

@@ -340,6 +340,17 @@ const std::string& checkPngPath(const std::string& option, const std::string& pa
     return path;
 }
 
+void noteUnreachedActivation(const ActivationProfile& activation, double duration) {
+    const std::vector<double>& t = activation.getBreakpoints();
+    const std::vector<double>& U = activation.getValues();
+    const double peak = activation.getMaxValue();
+    const std::size_t k = std::size_t(std::find(U.begin(), U.end(), peak) - U.begin());
+    if (peak > 0 && k < t.size() && t[k] > duration)
+        std::fprintf(stderr, "note: the activation reaches its largest value, %s, at %s s, after the trial ends at %s s "
+                     "(U = %s there)\n", formatNumber(peak).c_str(), formatNumber(t[k]).c_str(), formatNumber(duration).c_str(),
+                     formatNumber(activation.getValue(duration), 4).c_str());
+}
+
 void printProgress(const std::string& label, int done, int total) {
     printProgressLine(label, total > 0 ? double(done) / total : 1.0, std::to_string(done) + "/" + std::to_string(total),
                       done >= total);

@@ -252,8 +252,12 @@ void runTrialCommand(const TrialOptions& o) {
     if (!o.settingsFile.empty()) {
         const ParamNode root = ParamNode::loadFile(o.settingsFile);
         type = root.getChoice("type", {"isometric", "free"}, "isometric");
-        if (type == "isometric") iso = readIsometricTrialSettings(root, setup.arm);
-        else free = readFreeMovementSettings(root, setup.arm);
+        if (type == "isometric") {
+            iso = readIsometricTrialSettings(root, setup.arm);
+            root.rethrowWithLocation([&] { iso.calcActivationProfiles(setup); });   // an effort the model's muscles make
+        } else {
+            free = readFreeMovementSettings(root, setup.arm);
+        }
     } else if (type == "isometric") {
         iso.elbowAngle = degToRad(o.angleDeg);
         iso.activation = o.activation;
@@ -265,7 +269,7 @@ void runTrialCommand(const TrialOptions& o) {
         iso.integration.accuracy = o.accuracy;
         runNamingOptions({{"elbow_angle_deg", "--angle"}, {"activation", "--activation"}, {"rest", "--rest"},
                           {"rise", "--rise"}, {"hold", "--hold"}, {"sample_rate", "--rate"}, {"accuracy", "--accuracy"}},
-                         [&] { iso.validate(setup.arm); });   // in the options' words, before any work
+                         [&] { iso.validate(setup.arm); iso.calcActivationProfiles(setup); });   // in the options' words, before any work
     } else {
         free.initialAngle = degToRad(o.initialAngleDeg);
         free.initialVelocity = degToRad(o.initialVelocityDegps);
@@ -291,7 +295,9 @@ void runTrialCommand(const TrialOptions& o) {
     PlotSpec spec;
     spec.xLabel = "time (s)";
     if (type == "isometric") {
-        const IsometricTrialResult r = runIsometricTrial(setup, iso);
+        IsometricTrialResult r;
+        runNamingOptions({{"elbow_angle_deg", o.settingsFile.empty() ? "--angle" : o.settingsFile + ": elbow_angle_deg"}},
+                         [&] { r = runIsometricTrial(setup, iso); });
         files.writeWith(csvPath, [&](const std::string& p) { r.series.writeCsv(p); });
         if (!o.video.empty())
             files.writeWith(videoPath, [&](const std::string& p) { frames = renderVideo(o, p, setup, r.series, 0); });
@@ -307,6 +313,7 @@ void runTrialCommand(const TrialOptions& o) {
     } else {
         IntegrationStats stats;
         free.progress = [d = free.duration](double t) { printTimeProgress("free movement", t, d); };
+        noteUnreachedActivation(free.activation, free.duration);
         const Table t = runFreeMovement(setup, free, &stats);
         files.writeWith(csvPath, [&](const std::string& p) { t.writeCsv(p); });
         if (!o.video.empty())

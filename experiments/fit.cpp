@@ -71,8 +71,16 @@ QuadraticFit fitQuadratic(const std::vector<double>& x, const std::vector<double
     q.fit = fitPolynomial(x, y, 2);
     const double c1 = q.fit.coefficients[1], c2 = q.fit.coefficients[2];
     q.hasMaximum = c2 < 0;
-    q.peakX = c2 != 0 ? -c1 / (2 * c2) : NAN;
-    q.peakY = c2 != 0 ? q.fit.evaluate(q.peakX) : NAN;
+    // A peak is a maximum inside the points' span, fitted at more abscissae than the three that fix any
+    // quadratic (through three, or their means, the fit says nothing of the curve's shape).
+    const auto [lo, hi] = std::minmax_element(x.begin(), x.end());
+    std::vector<double> distinct(x);
+    std::sort(distinct.begin(), distinct.end());
+    distinct.erase(std::unique(distinct.begin(), distinct.end()), distinct.end());
+    const double vertex = c2 != 0 ? -c1 / (2 * c2) : NAN;
+    const bool peak = q.hasMaximum && distinct.size() > 3 && vertex >= *lo && vertex <= *hi;
+    q.peakX = peak ? vertex : NAN;
+    q.peakY = peak ? q.fit.evaluate(vertex) : NAN;
     return q;
 }
 

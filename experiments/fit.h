@@ -27,8 +27,9 @@ PolynomialFit fitPolynomial(const std::vector<double>& x, const std::vector<doub
 struct QuadraticFit {
     PolynomialFit fit;     ///< degree-2 polynomial
     bool hasMaximum = false;  ///< c2 < 0: the vertex is a maximum
-    double peakX = 0;      ///< vertex -c1 / (2 c2) (NaN if c2 = 0)
-    double peakY = 0;      ///< value at the vertex
+    double peakX = 0;      ///< the vertex -c1 / (2 c2) when it is a maximum within the points' x span and
+                           ///< more than three distinct x were fitted; NaN otherwise (no peak)
+    double peakY = 0;      ///< value at the vertex (NaN: no peak)
 };
 
 /// fitPolynomial(x, y, 2) and its vertex (the thesis's "peak force 603.3 N at 101.2 deg").

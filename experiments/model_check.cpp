@@ -51,6 +51,10 @@ ModelCheckResult writeCheckFiles(std::vector<TargetScore> scores, const AnatomyC
                                  const std::string& outDir) {
     ModelCheckResult r;
     r.scores = std::move(scores);
+    // A target file none of whose targets the model has anything for would give an empty scorecard.
+    if (r.scores.empty())
+        throw InputError("none of the targets names something the model has (its muscles, share families, volumes "
+                         "or forearm): expected at least one target to score");
     r.summary = summarizeScores(r.scores);
     OutputFolder folder(outDir, OutputFolder::Mode::AddFiles);  // every file appears at the end, or none
     auto path = [&](const std::string& f) { return folder.getTargetPath(f); };

@@ -1,4 +1,5 @@
 #include "basics/files.h"
+#include "basics/format.h"
 #include "basics/numbers.h"
 #include "basics/param_node.h"
 #include "experiments/protocol.h"
@@ -28,7 +29,12 @@ std::vector<double> readRange(const ParamNode& parent, const std::string& key, c
     const double step = r.getNumber("step", Bound::positive(bound.unit));
     r.finish();
     if (to < from)
-        throw InputError(r.where("to") + ": field " + describeField(r.path("to")) + " is below 'from': expected from <= to");
+        throw InputError(r.where("to") + ": field " + describeField(r.path("to")) + " = " + formatNumber(to) + " is below 'from' = " +
+                         formatNumber(from) + ": expected from <= to");
+    if (to > from && step > to - from)   // one value: the sweep's other end would be dropped unseen
+        throw InputError(r.where("step") + ": field " + describeField(r.path("step")) + " = " + formatNumber(step) +
+                         " is longer than the range " + formatNumber(from) + " to " + formatNumber(to) +
+                         ": expected at most " + formatNumber(to - from) + " (from = to sweeps one value)");
     std::vector<double> v;
     for (int k = 0;; ++k) {
         const double x = from + k * step;

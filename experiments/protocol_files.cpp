@@ -9,6 +9,8 @@
 
 #include <fmt/printf.h>
 
+#include <cmath>
+
 namespace armsim {
 
 namespace {
@@ -26,8 +28,13 @@ std::string findRunFolder(const ProtocolFileOptions& o, const std::string& name)
 
 void appendFit(std::string& text, const char* label, const QuadraticFit& q, const char* xUnit, double xScale,
                const char* reference) {
-    appendf(text, "  %-34s peak %7.1f N at %6.1f %s (R^2 %.4f)%s\n", label, q.peakY, xScale * q.peakX, xUnit,
-            q.fit.rSquared, reference);
+    if (std::isnan(q.peakX))
+        appendf(text, "  %-34s no peak: %s (R^2 %.4f)%s\n", label,
+                !q.hasMaximum ? "the fit curves up" : "three angles or paths fix any quadratic, or the vertex lies outside them",
+                q.fit.rSquared, reference);
+    else
+        appendf(text, "  %-34s peak %7.1f N at %6.1f %s (R^2 %.4f)%s\n", label, q.peakY, xScale * q.peakX, xUnit,
+                q.fit.rSquared, reference);
 }
 
 void appendSummaryTable(std::string& text, const Protocol& p, const ProtocolResult& r) {

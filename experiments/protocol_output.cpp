@@ -59,9 +59,10 @@ void plotMvc(OutputFolder& dir, const Table& trials, const Table& summary, const
     const auto addFit = [&](const char* key, const char* label, int color) {
         const auto it = fits.find(key);
         if (it == fits.end()) return;
-        spec.series.push_back(curve(std::string(label) + fmt::format(" {:.1f} N", it->second.peakY) + " at " +
-                                        fmt::format("{:.1f} deg", it->second.peakX),
-                                    it->second.fit, a0, a1, color));
+        const QuadraticFit& q = it->second;
+        spec.series.push_back(curve(std::isnan(q.peakX) ? std::string("quadratic fit (no peak)")
+                                                        : std::string(label) + fmt::format(" {:.1f} N at {:.1f} deg", q.peakY, q.peakX),
+                                    q.fit, a0, a1, color));
     };
     addFit("muscle_force", "fit, peak", 0);
     addFit("force_fixed_ratio", "fit, peak", 1);

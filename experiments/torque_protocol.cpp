@@ -343,6 +343,16 @@ std::vector<TorqueObservation> synthesizeTorqueData(const VirtualSubject& subjec
     if (forearm && !subject.setup.arm.forearmRotation.enabled)
         throw InputError("protocol '" + protocol.name + "' reads the forearm axis (a rotation effort or measurements." +
                          "forearm_torque), but model '" + subject.setup.name + "' has no forearm rotation");
+    for (std::size_t k = 0; k < protocol.conditions.size(); ++k) {   // an effort no muscle of the model makes reads 0
+        const Effort effort = protocol.conditions[k].effort;
+        if (isForearmEffort(effort)) continue;   // its agonists depend on the pose (the trial checks them)
+        const bool made = std::any_of(subject.setup.muscles.begin(), subject.setup.muscles.end(),
+                                      [&](const MuscleSpec& m) { return isAgonistOf(effort, m.group, 0.0); });
+        if (!made)
+            throw FieldError(conditionField(k, "effort"), std::string("= ") + getEffortName(effort) + ": model '" +
+                                                              subject.setup.name + "' has no muscle that makes it (expected an "
+                                                              "effort of the model's muscles)");
+    }
     const SubjectEffort& e = subject.setup.effort;
     int maxRepetitions = 0;
     for (const TorqueCondition& c : protocol.conditions) maxRepetitions = std::max(maxRepetitions, c.repetitions);
@@ -519,6 +529,21 @@ std::string formatTorqueData(const std::vector<TorqueObservation>& data, bool tr
 
 namespace {
 
+// Each row's first line, by condition and torques (rows without repetition numbers).
+using RowLines = std::map<std::tuple<ConditionKey, double, double>, int>;
+
+// Without repetition numbers, a row equal to an earlier one is more likely pasted twice than a second
+// trial reading the same torque to the last digit (force data refuse it alike).
+void checkRowOnce(RowLines& firstLine, const ConditionKey& key, const TorqueObservation& o, const std::string& at) {
+    const double forearm = std::isnan(o.forearmTorque) ? -INFINITY : o.forearmTorque;   // NaN would not order
+    const auto [earlier, fresh] = firstLine.emplace(std::make_tuple(key, o.torque, forearm), o.line);
+    if (!fresh)
+        throw InputError(at + ": the same row as line " + std::to_string(earlier->second) + " (" + getEffortName(o.effort) +
+                         " at " + formatNumber(o.flexionDeg) + " deg, torque " + formatNumber(o.torque) +
+                         " N m): expected each trial once (repeated trials that read the same torque: give them a "
+                         "repetition column)");
+}
+
 // Slips of unit a row-by-row bound cannot see, refused for the file as a whole: angles in radians, and
 // torques in kN m (every maximal effort under 0.5 N m; the weakest elbow MVCs measured are several N m).
 void checkTorqueDataUnits(const std::vector<TorqueObservation>& data, const std::string& path) {
@@ -565,6 +590,7 @@ std::vector<TorqueObservation> makeTorqueData(const Table& t, const std::string&
     std::vector<TorqueObservation> data;
     std::map<ConditionKey, int> count;
     std::set<std::pair<ConditionKey, int>> seen;
+    RowLines firstLine;   // rows without repetition numbers
     for (int r = 0; r < t.getNumRows(); ++r) {
         const std::string at = t.describeRow(path, r);
         auto fail = [&](const std::string& column, double v, const std::string& expected) {
@@ -606,6 +632,7 @@ std::vector<TorqueObservation> makeTorqueData(const Table& t, const std::string&
             throw InputError(at + ": a " + getEffortName(o.effort) + " effort without its forearm torque: expected a "
                              "column forearm_torque_Nm with a finite value (+ = supination)");
         const ConditionKey key = getConditionKey(o);
+        if (!t.hasColumn("repetition")) checkRowOnce(firstLine, key, o, at);
         if (t.hasColumn("repetition")) {
             const double v = t.get(r, "repetition");
             if (!std::isfinite(v) || v != std::floor(v) || v < 0 || v > 1e6) fail("repetition", v, "an integer >= 0");

@@ -187,12 +187,23 @@ void SynergistModel::setGeometry(const std::vector<std::pair<double, double>>& p
 
 }
 
+void checkIdentifiablePrior(const Population& prior) {
+    const std::string where = "prior population '" + prior.name + "'" + (prior.file.empty() ? "" : " (" + prior.file + ")");
+    if (prior.strengthSubjectSd == 0 && prior.strengthMuscleSd == 0)
+        throw InputError(where + ": strength.subject_sd and strength.muscle_sd are both 0: the muscle masses would be known "
+                         "before any data: expected a spread > 0 to identify them");
+    if (prior.tendonLengthSd == 0)
+        throw InputError(where + ": tendon_length.sd = 0: the tendon lengths would be known before any data: expected a "
+                         "spread > 0 to identify them");
+}
+
 // The prior's mean and covariance of x and its bounds (SynergistModel's class comment).
 void SynergistModel::setPrior(const Population& prior, const SynergistOptions& options,
                               const std::vector<TorqueCondition>& conditions) {
     const int n = getNumParameters();
     const double s2 = prior.strengthSubjectSd * prior.strengthSubjectSd;
     const double m2 = prior.strengthMuscleSd * prior.strengthMuscleSd;
+    checkIdentifiablePrior(prior);
     auto uniformSd = [](const UniformRange& r) { return std::max((r.max - r.min) / std::sqrt(12.0), 1e-4); };
     priorCovariance_.assign(n, std::vector<double>(n, 0.0));
     auto& cov = priorCovariance_;

@@ -36,6 +36,11 @@ namespace armsim {
 constexpr double kMinTorqueNoiseLevel = 0.002;
 
 /// The synergist-aware identifier's model and extra measurements.
+/// InputError naming the population unless it can serve as the identifiers' prior: a spread > 0 of the
+/// muscle masses (strength.subject_sd or muscle_sd) and of the tendon lengths (tendon_length.sd), the
+/// quantities identified (with none the fit returns the prior's mean).
+void checkIdentifiablePrior(const Population& prior);
+
 struct SynergistOptions {
     /// Which muscles the model groups (names in the population's base model); empty: the model file's
     /// roles (ArmSetup::bicepsHeads, ArmSetup::synergists).

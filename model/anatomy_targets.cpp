@@ -1,5 +1,6 @@
 #include "model/anatomy_targets.h"
 
+#include "basics/bound.h"
 #include "basics/errors.h"
 #include "basics/format.h"
 #include "basics/param_node.h"
@@ -26,6 +27,28 @@ struct Unit {
 };
 const Unit kUnits[] = {{"mm", "m", 1e-3}, {"N m", "N m", 1}, {"cm^3", "m^3", 1e-6}, {"1", "1", 1},
                        {"deg", "deg", 1},  {"N m", "N m", 1}, {"1", "1", 1}};
+
+// Slips of unit the bands' bounds let through: a moment arm band in m (within 1 mm), a volume in m^3
+// (under 1 cm^3: no arm muscle is that small), an optimum angle in radians. (The bounds of an MVC, at
+// most 300 N m about the elbow and 100 N m about the forearm, twice the strongest measured, keep N cm
+// out.)
+void checkTargetUnits(const ParamNode& n, const AnatomyTarget& t, const Unit& u) {
+    const double lo = t.lower / u.toSi, hi = t.upper / u.toSi;
+    auto refuse = [&](const std::string& why) {
+        throw InputError(n.where("lower") + ": the band [" + formatNumber(lo) + ", " + formatNumber(hi) + "] " + u.file + ": " + why);
+    };
+    if (t.kind == TargetKind::MomentArm && std::abs(lo) < 1 && std::abs(hi) < 1)
+        refuse("within 1 mm: expected mm (a band in m, say 0.042 for 42 mm, would read as 0.042 mm)");
+    if (t.kind == TargetKind::Volume && hi < 1)
+        refuse("under 1 cm^3, smaller than any arm muscle: expected cm^3 (a volume in m^3 or L would read this small)");
+    if (t.kind == TargetKind::OptimumAngle) {
+        try {
+            checkDegreesNotRadians("lower", {lo, hi});
+        } catch (const FieldError& e) {
+            refuse(e.getDetail());
+        }
+    }
+}
 
 std::vector<int> findCovered(const std::vector<std::string>& muscles, const std::string& family) {
     std::vector<int> out;
@@ -131,16 +154,17 @@ std::vector<AnatomyTarget> loadAnatomyTargets(const std::string& path) {
             t.flexionDeg = n.getNumber("flexion_deg", Bound::closed(0, 180, "deg"));
         const Bound band = t.kind == TargetKind::Share ? Bound::closed(0, 1)
                            : t.kind == TargetKind::PostureRatio ? Bound::closed(0, 5)
-                           : t.kind == TargetKind::ForearmMvc ? Bound::closed(0, 1000, "N m")
+                           : t.kind == TargetKind::ForearmMvc ? Bound::closed(0, 100, "N m")
                            : t.kind == TargetKind::OptimumAngle ? Bound::closed(0, 180, "deg")
                            : t.kind == TargetKind::MomentArm ? Bound::closed(-200, 200, "mm")
-                           : t.kind == TargetKind::Mvc ? Bound::closed(0, 1000, "N m")
+                           : t.kind == TargetKind::Mvc ? Bound::closed(0, 300, "N m")
                                                        : Bound::closed(0, 1e5, "cm^3");
         t.lower = n.getNumber("lower", band) * u.toSi;
         t.upper = n.getNumber("upper", band) * u.toSi;
         if (t.lower > t.upper)
             throw InputError(n.where("upper") + ": field 'upper' = " + formatNumber(t.upper / u.toSi) + " " +
                              u.file + ": expected >= lower = " + formatNumber(t.lower / u.toSi) + " " + u.file);
+        checkTargetUnits(n, t, u);
         t.tolerance = n.getNumber("tolerance", Bound::closed(0, 1e5, u.file), 0.0) * u.toSi;
         if (t.lower == t.upper && t.tolerance == 0)
             throw InputError(n.where("upper") + ": a point value (lower = upper = " + formatNumber(t.upper / u.toSi) +

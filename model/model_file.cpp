@@ -233,7 +233,11 @@ PathElementSpec readViaElement(const ParamNode& n, int index) {
             throw InputError(s.where("axis") + ": field " + describeField(s.path("axis")) + " is the zero vector: expected a direction");
     }
     s.finish();
-    if (n.has("side")) e.side = readVec3(n, "side", Bound::closed(-1e3, 1e3));
+    if (n.has("side")) {
+        e.side = readVec3(n, "side", Bound::closed(-1e3, 1e3));
+        if (e.side[0] == 0 && e.side[1] == 0 && e.side[2] == 0)   // no side: it would be ignored
+            throw InputError(n.where("side") + ": field " + describeField(n.path("side")) + " is the zero vector: expected a direction");
+    }
     if (n.has("winds")) {
         e.winds = n.getBool("winds", false);
         if (e.winds && !n.has("side"))
@@ -315,6 +319,22 @@ MuscleSpec readMuscle(const ParamNode& n, const MuscleDefaults& defaults, const 
     n.finish();
     if (!m.maxPathFromRange) n.rethrowWithLocation([&] { m.params.validate(); });
     return m;
+}
+
+// roles.synergists: flexors (an extensor would be fitted to flexion torque), none of them a biceps head
+// (a head fitted twice).
+void checkSynergistRoles(const ArmSetup& s, const ParamNode& roles) {
+    const std::vector<int> heads = s.getBicepsHeads();   // the primary alone when roles.biceps is absent
+    for (int m : s.synergists) {
+        if (s.muscles[m].group != MuscleGroup::Flexor)
+            throw InputError(roles.where("synergists") + ": field 'roles.synergists' lists '" + s.muscles[m].params.name +
+                             "', of group " + getMuscleGroupName(s.muscles[m].group) +
+                             ": expected the biceps heads' synergists, flexors");
+        if (std::find(heads.begin(), heads.end(), m) != heads.end())
+            throw InputError(roles.where("synergists") + ": field 'roles.synergists' lists '" +
+                             s.muscles[m].params.name + "', a biceps head (roles.biceps, or the primary): expected the biceps heads' "
+                             "synergists (the other flexors), each muscle in one role");
+    }
 }
 
 // The thesis's A and B for a model without a `biceps` section: the primary muscle's origin and
@@ -513,12 +533,7 @@ ArmSetup loadModelFile(const std::string& file) {
         };
         if (roles.has("biceps")) s.bicepsHeads = read("biceps");
         if (roles.has("synergists")) s.synergists = read("synergists");
-        const std::vector<int> heads = s.getBicepsHeads();   // the primary alone when roles.biceps is absent
-        for (int m : s.synergists)   // a head fitted twice, as a head and as a synergist
-            if (std::find(heads.begin(), heads.end(), m) != heads.end())
-                throw InputError(roles.where("synergists") + ": field 'roles.synergists' lists '" +
-                                 s.muscles[m].params.name + "', a biceps head (roles.biceps, or the primary): expected the biceps heads' "
-                                 "synergists (the other flexors), each muscle in one role");
+        checkSynergistRoles(s, roles);
         if (roles.has("surface_emg")) s.surfaceEmg = read("surface_emg");
         roles.finish();
         if (!s.bicepsHeads.empty() && std::find(s.bicepsHeads.begin(), s.bicepsHeads.end(), s.primary) == s.bicepsHeads.end())
@@ -533,7 +548,8 @@ ArmSetup loadModelFile(const std::string& file) {
                     throw InputError(file + ": muscle '" + m.params.name + "' " + e.label +
                                      ": body 'radius' needs the arm's forearm_rotation section");
     if (!hasBiceps) deriveThesisGeometry(s);
-    root.rethrowWithLocation([&] { s.arm.validate(); });
+    // An inline arm's fields are named relative to its mapping ('forearm_rotation.posture_deg').
+    (root.isMapping("arm") ? root.child("arm") : root).rethrowWithLocation([&] { s.arm.validate(); });
     resolveMaxPathLengths(s);
     try {
         s.validate();

@@ -2,6 +2,7 @@
 
 #include "basics/bound.h"
 #include "basics/files.h"
+#include "basics/angles.h"
 #include "basics/format.h"
 
 #include <tinyxml2.h>
@@ -305,10 +306,19 @@ private:
             k.defaultValue = number(c, "default_value", false, 0);
             const std::vector<double> r = numbers(c, "range", 2, false, {-10, 10});
             k.range = {r[0], r[1]};
-            if (!(k.range[0] <= k.range[1])) fail(child(c, "range"), "range not increasing");
+            if (!(k.range[0] <= k.range[1]))
+                fail(child(c, "range"), "range [" + formatNumber(k.range[0]) + ", " + formatNumber(k.range[1]) +
+                                            "] not increasing: expected the lower end first");
             k.locked = flag(c, "locked", false);
             k.clamped = flag(c, "clamped", false);
             if (const std::string mt = text(c, "motion_type"); mt == "translational") k.rotational = false;
+            // A rotational range is in radians: an end past one turn (but not a huge "unbounded" sentinel)
+            // is a range in degrees, which would bound the coordinate nowhere.
+            for (double end : k.range)   // (without <range>, OpenSim's default -10 .. 10 holds)
+                if (k.rotational && c->FirstChildElement("range") && std::abs(end) > 2 * kPi + 0.01 && std::abs(end) < 1e3)
+                    fail(child(c, "range"), "range [" + formatNumber(k.range[0]) + ", " + formatNumber(k.range[1]) +
+                                                "] of a rotational coordinate: past one turn (2 pi): expected radians (" +
+                                                formatNumber(end) + " rad is " + formatNumber(std::round(radToDeg(end))) + " deg)");
             j.coordinates.push_back(k);
         }
     }

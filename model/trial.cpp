@@ -170,6 +170,16 @@ std::vector<bool> IsometricTrialSettings::findAgonists(const ArmSetup& setup) co
 
 std::vector<ActivationProfile> IsometricTrialSettings::calcActivationProfiles(const ArmSetup& setup) const {
     const std::vector<bool> agonist = findAgonists(setup);
+    // An effort no muscle makes (an extension on a biceps-only arm), or a co-contraction no muscle can
+    // give, would read zero or change nothing: refused, as a rotation effort without a forearm is.
+    const long agonists = std::count(agonist.begin(), agonist.end(), true);
+    if (agonists == 0 && activation > 0)
+        throw FieldError("effort", std::string("= ") + getEffortName(effort) + ": model '" + setup.name + "' has no muscle "
+                                       "that makes it (expected an effort of the model's muscles)");
+    if (agonists == long(agonist.size()) && antagonistActivation > 0)
+        throw FieldError("antagonist_activation", "= " + formatNumber(antagonistActivation) + ": model '" + setup.name +
+                                                      "' has no antagonist of a " + getEffortName(effort) +
+                                                      " effort (expected 0)");
     std::vector<ActivationProfile> profiles;
     for (std::size_t i = 0; i < setup.muscles.size(); ++i)
         profiles.push_back(riseTo(*this, agonist[i] ? activation : antagonistActivation));
@@ -280,6 +290,20 @@ void summarizeIsometricSeries(const MuscleArm& model, const IsometricTrialSettin
 
 }  // namespace
 
+namespace {
+
+// The estimate divides the torque by h: near full extension a vanishing h turns noise into force.
+void checkEstimateMomentArm(double h, double elbowAngle, const std::string& muscle) {
+    constexpr double kMinEstimateMomentArm = 1e-3;   // m
+    if (h < kMinEstimateMomentArm)
+        throw FieldError("elbow_angle_deg", "= " + formatNumber(cleanDegrees(elbowAngle)) + ": the " + muscle +
+                                                "'s moment arm there is " + formatNumber(1000 * h, 3) +
+                                                " mm, and the force estimate (torque / moment arm) needs at least 1 mm: "
+                                                "expected an angle further from full extension");
+}
+
+}  // namespace
+
 IsometricTrialResult runIsometricTrial(const ArmSetup& setup, const IsometricTrialSettings& settings) {
     settings.validate(setup.arm);
     const ActivationProfile profile = settings.calcActivationProfile();
@@ -327,6 +351,7 @@ IsometricTrialResult runIsometricTrial(const ArmSetup& setup, const IsometricTri
     std::vector<double> forces(n), row;
 
     const bool primaryVelocityIsState = muscles[primary]->hasFascicleVelocityState();
+    checkEstimateMomentArm(h, settings.elbowAngle, model.getMuscleName(primary));
     const TransducerAtAngle transducer(ap, settings.elbowAngle, h);
     // One sample from y = [q u z]; s is the realized-per-sample reference's State (else null).
     auto sample = [&](double t, const double* y, const State* s) {
@@ -675,7 +700,7 @@ FreeMovementSettings readFreeMovementSettings(const ParamNode& n, const ArmParam
     const Bound any = Bound::any();
     s.initialAngle = degToRad(n.getNumber("initial_angle_deg", any, radToDeg(s.initialAngle)));
     s.initialVelocity = degToRad(n.getNumber("initial_velocity_degps", any, 0.0));
-    const double U = n.getNumber("activation", Bound::closed(0, 1), 0.5);
+    const double U = n.getNumber("activation", Bound::closed(0, 1), 1.0);   // as `trial --activation`
     const double onset = n.getNumber("onset", Bound::nonNegative("s"), 0.2);
     const double rise = n.getNumber("rise", Bound::nonNegative("s"), 0.0);
     s.activation = rise > 0 ? ActivationProfile::ramp(onset, onset + rise, 0.0, U) : ActivationProfile::step(onset, 0.0, U);

@@ -1,6 +1,7 @@
 #include "muscles/activation.h"
 
 #include "basics/bound.h"
+#include "basics/format.h"
 #include "basics/table.h"
 
 #include <algorithm>
@@ -88,12 +89,17 @@ ActivationProfile loadActivationTrace(const std::string& csvPath) {
     const std::vector<double> time = t.getColumn("time_s"), U = t.getColumn("activation");
     for (int i = 0; i < t.getNumRows(); ++i) {
         const std::string at = csvPath + ":" + std::to_string(t.getSourceLine(i));
+        if (!std::isfinite(time[i])) throw InputError(at + ": column 'time_s' = " + formatNumber(time[i]) + ": expected a finite time");
         if (!(U[i] >= 0 && U[i] <= 1))
-            throw InputError(at + ": activation = " + std::to_string(U[i]) + ": expected in [0, 1]");
+            throw InputError(at + ": column 'activation' = " + formatNumber(U[i]) + ": expected in [0, 1]");
         if (i > 0 && !(time[i] >= time[i - 1]))
-            throw InputError(at + ": time_s = " + std::to_string(time[i]) + " is before the previous row's " +
-                             std::to_string(time[i - 1]) + ": expected nondecreasing times");
+            throw InputError(at + ": column 'time_s' = " + formatNumber(time[i]) + " is before the previous row's " +
+                             formatNumber(time[i - 1]) + ": expected nondecreasing times");
     }
+    // A trial starts at 0: a trace starting later would have its first value held back to 0 unseen.
+    if (time.front() > 0)
+        throw InputError(csvPath + ":" + std::to_string(t.getSourceLine(0)) + ": column 'time_s' = " + formatNumber(time.front()) +
+                         ": expected the trace to start at 0 s (or before), where the trial starts");
     return ActivationProfile(time, U, csvPath);
 }
 

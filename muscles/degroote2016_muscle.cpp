@@ -42,8 +42,9 @@ void DeGroote2016Parameters::validate() const {
     if (!(maxPathLength > 0))
         throw FieldError(q + "max_path_length", "max_path_length = " + formatNumber(maxPathLength) + ": expected > 0 (m)");
     checkField(q + "max_contraction_velocity", maxContractionVelocity, Bound::positive("optimal fibre lengths/s"));
-    checkField(q + "activation_time_constant", activationTimeConstant, Bound::positive("s"));
-    checkField(q + "deactivation_time_constant", deactivationTimeConstant, Bound::positive("s"));
+    // OpenSim's defaults are 10 and 40 ms; a bound of 1 s keeps a value in ms out.
+    checkField(q + "activation_time_constant", activationTimeConstant, Bound{0, 1, true, false, "s"});
+    checkField(q + "deactivation_time_constant", deactivationTimeConstant, Bound{0, 1, true, false, "s"});
     checkField(q + "activation_dynamics_smoothing", activationDynamicsSmoothing, Bound::positive());
     checkField(q + "active_force_width_scale", activeForceWidthScale, {1, 1e300, false, false, ""});
     checkField(q + "fiber_damping", fiberDamping, Bound::nonNegative());

@@ -144,6 +144,8 @@ Table runMuscleIsometric(const MuscleModel& muscle, const MuscleIsometricSetting
     std::vector<double> z;
     if (settings.startSteady) {
         const SteadyState ss = muscle.calcSteadyState(P, settings.activation.getValue(0));
+        if (!ss.converged && ss.message.rfind("no steady state at path", 0) == 0)   // the settings' path, not the solver
+            throw FieldError("path_length", "= " + formatNumber(P) + " m: " + ss.message);
         if (!ss.converged) throw SimulationError(ss.message);
         z = ss.states;
     } else {

@@ -51,8 +51,9 @@ void Thelen2003Parameters::validate() const {
         throw FieldError(q + "pennation_angle", "pennation_angle = " + formatNumber(pennationAngleAtOptimal) +
                                                     " rad: expected <= maximum_pennation_angle = " +
                                                     formatNumber(maximumPennationAngle) + " rad");
-    checkField(q + "activation_time_constant", activationTimeConstant, Bound::positive("s"));
-    checkField(q + "deactivation_time_constant", deactivationTimeConstant, Bound::positive("s"));
+    // OpenSim's defaults are 10 and 40 ms; a bound of 1 s keeps a value in ms out.
+    checkField(q + "activation_time_constant", activationTimeConstant, Bound{0, 1, true, false, "s"});
+    checkField(q + "deactivation_time_constant", deactivationTimeConstant, Bound{0, 1, true, false, "s"});
     // OpenSim refuses a_min < 0.01: below it the fibre velocity's singularity at a -> 0 is too near.
     checkField(q + "minimum_activation", minimumActivation, {0.01, 1, false, true, ""});
 }

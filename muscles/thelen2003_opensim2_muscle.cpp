@@ -42,8 +42,9 @@ void Thelen2003Opensim2Parameters::validate() const {
     checkField(q + "damping", damping, {0, 1e300, true, false, ""});
     checkField(q + "af", af, Bound::positive());
     checkField(q + "flen", flen, {1, 1e300, false, false, ""});
-    checkField(q + "activation_time_constant", activationTimeConstant, Bound::positive("s"));
-    checkField(q + "deactivation_time_constant", deactivationTimeConstant, Bound::positive("s"));
+    // OpenSim's defaults are 10 and 40 ms; a bound of 1 s keeps a value in ms out.
+    checkField(q + "activation_time_constant", activationTimeConstant, Bound{0, 1, true, false, "s"});
+    checkField(q + "deactivation_time_constant", deactivationTimeConstant, Bound{0, 1, true, false, "s"});
 }
 
 // ---- Curves ---------------------------------------------------------------------------------------

@@ -170,10 +170,11 @@ void RenderSettings::validate() const {
     if (!(upNorm > 1e-9) || SimTK::cross(view / view.norm(), camera.up / upNorm).norm() < 1e-6)
         throw FieldError("camera.up", "= " + formatVec(camera.up) +
                                           ": expected a nonzero direction not parallel to look_at - position");
+    // Lower bounds: a view of under 1 cm (or 0.01 rad) shows a speck of the arm, if any of it.
     if (camera.orthographic)
-        checkField("camera.ortho_height", camera.orthoHeight, Bound::positive("m"));
+        checkField("camera.ortho_height", camera.orthoHeight, Bound{0.01, 1e3, false, false, "m"});
     else
-        checkField("camera.vertical_fov", camera.verticalFov, Bound::open(0, kPi, "rad"));
+        checkField("camera.vertical_fov", camera.verticalFov, Bound{0.01, kPi, false, true, "rad"});
     checkField("camera.near_clip", camera.nearClip, Bound::positive("m"));
     checkField("camera.far_clip", camera.farClip, {camera.nearClip, 1e300, true, false, "m (> near_clip)"});
     // The point looked at lies inside the clip range, or the frame is empty (a position in mm, say).
@@ -209,8 +210,8 @@ RenderSettings readRenderSettings(const ParamNode& node) {
         s.camera.lookAt = readVec3(c, "look_at", s.camera.lookAt, Bound::any("m"));
         s.camera.up = readVec3(c, "up", s.camera.up, Bound::any());
         s.camera.orthographic = c.getBool("orthographic", s.camera.orthographic);
-        s.camera.verticalFov = c.getNumber("vertical_fov", Bound::open(0, kPi, "rad"), s.camera.verticalFov);
-        s.camera.orthoHeight = c.getNumber("ortho_height", Bound::positive("m"), s.camera.orthoHeight);
+        s.camera.verticalFov = c.getNumber("vertical_fov", Bound{0.01, kPi, false, true, "rad"}, s.camera.verticalFov);
+        s.camera.orthoHeight = c.getNumber("ortho_height", Bound{0.01, 1e3, false, false, "m"}, s.camera.orthoHeight);
         s.camera.nearClip = c.getNumber("near_clip", Bound::positive("m"), s.camera.nearClip);
         s.camera.farClip = c.getNumber("far_clip", Bound::positive("m"), s.camera.farClip);
         // A key the chosen projection would ignore is refused, as options that would be ignored are.

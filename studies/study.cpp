@@ -3,6 +3,7 @@
 #include "basics/numbers.h"
 
 #include "basics/format.h"
+#include "identification/synergist_identifier.h"
 #include "basics/csv.h"
 #include "basics/files.h"
 #include "basics/param_node.h"
@@ -87,6 +88,7 @@ void Study::validate() const {
     if (truths.size() > 1 && priorReference.empty())
         throw FieldError("prior", "is missing: several truths need the population the identifiers assume (`prior:`)");
     prior.validate();
+    checkIdentifiablePrior(prior);
     prior.base.requireVirtualMuscles("the identifiers (prior population '" + prior.name + "')");
     const std::string& priorPrimary = prior.base.muscles.at(prior.base.primary).params.name;
     for (std::size_t i = 0; i < truths.size(); ++i) {
@@ -157,6 +159,15 @@ void Study::validate() const {
         if (std::isfinite(methods[i].options.noiseLevel))
             checkField(f + ".noise_level", methods[i].options.noiseLevel, Bound::closed(kMinTorqueNoiseLevel, 0.5, "relative sd"));
     }
+    // A study in which every identifier skips every protocol (channels on torque-only protocols) would
+    // compute nothing.
+    const bool anyRuns = std::any_of(methods.begin(), methods.end(), [&](const ElbowMethod& m) {
+        return m.kind != "channels" || std::any_of(protocols.begin(), protocols.end(),
+                                                   [](const StudyProtocol& p) { return p.protocol.hasChannels(); });
+    });
+    if (!anyRuns)
+        throw FieldError("methods", "lists only 'channels', and no protocol records a channel besides torque: every task "
+                                    "would be skipped: expected a protocol with channels or another method");
     if (getNumTasks() > kMaxTasks)
         throw FieldError("subjects", "x truths x protocols x noise levels x methods = " + std::to_string(getNumTasks()) +
                                          " tasks: expected at most " + std::to_string(kMaxTasks));

@@ -6,6 +6,7 @@
 #include "basics/csv.h"
 #include "basics/parallel.h"
 #include "basics/quick_run.h"
+#include "identification/synergist_identifier.h"
 
 #include <fmt/format.h>
 
@@ -67,6 +68,7 @@ ValidationPlan planElbowValidation(const Population& population, const Populatio
                                    const ElbowValidationSettings& settings) {
     population.validate();
     prior.validate();
+    checkIdentifiablePrior(prior);
     prior.base.requireVirtualMuscles("the identifiers (prior population '" + prior.name + "')");
     const std::string& truthPrimary = population.base.muscles[population.base.primary].params.name;
     const std::string& priorPrimary = prior.base.muscles[prior.base.primary].params.name;

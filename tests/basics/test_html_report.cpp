@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 
@@ -54,5 +55,29 @@ TEST(HtmlReport, ShowsEveryFileOfTheFolderByItsRelativePath) {
     std::ofstream(d / "index.html") << "<html>mine</html>";
     EXPECT_THROW(writeFolderReport(d.string(), r), std::runtime_error);
     EXPECT_EQ(readFileText(d / "index.html"), "<html>mine</html>");
+    fs::remove_all(d);
+}
+
+// A folder of many files (a protocol of 5,000 trials writes 10,000): the page shows the first ones by
+// name, says how many more there are and links the folder; the run keeps its exit 0.
+TEST(HtmlReport, AFolderOfManyFilesShowsTheFirstAndCountsTheRest) {
+    const fs::path d = fs::path(::testing::TempDir()) / "armsim_html_many";
+    fs::remove_all(d);
+    fs::create_directories(d / "trials");
+    const long n = kMaxReportFilesPerFolder + 37;
+    for (long i = 0; i < n; ++i) {
+        char name[32];
+        std::snprintf(name, sizeof name, "t%05ld.sto", i);
+        std::ofstream(d / "trials" / name) << "x";
+    }
+    writeFolderReport(d.string(), FolderReport{});
+    const std::string html = readFileText(d / "index.html");
+    EXPECT_NE(html.find("href=\"trials/t00000.sto\""), std::string::npos);
+    char last[32], first[32];
+    std::snprintf(last, sizeof last, "t%05ld.sto", kMaxReportFilesPerFolder - 1);
+    std::snprintf(first, sizeof first, "t%05ld.sto", kMaxReportFilesPerFolder);
+    EXPECT_NE(html.find(last), std::string::npos);     // the last shown
+    EXPECT_EQ(html.find(first), std::string::npos);    // the first not shown
+    EXPECT_NE(html.find("and 37 more files in <a href=\"trials\">trials/</a>"), std::string::npos);
     fs::remove_all(d);
 }

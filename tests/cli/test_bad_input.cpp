@@ -638,6 +638,58 @@ std::vector<BadInput> makeCatalogue() {
          {"--final-time - the controls' first time = 1e+05 s x --rate 200 Hz", "expected at most 1e+07"}},
         {"ValidateSeedsBeyondTheFits", {}, "validate --seeds 1000000 --out OUT/v", {"--seeds = 1000000", "fits", "expected at most 4000000 fits"}},
         {"ValidateOutWhereNoFolderCanBeMade", {}, "validate --seeds 0 --noise 0 --out /proc/armsim_out", {"--out '/proc/armsim_out'", "/proc"}},
+        // ---- the sixth sweep's classes (issue 34) ----------------------------------------------
+        // efforts and co-contraction the model's muscles cannot make, estimates from a vanishing moment arm
+        {"TrialExtensionOnTheThesisArm", {{"s.yaml", "type: isometric\neffort: extension\nhold: 0.3\n"}},
+         "trial --settings IN/s.yaml --out OUT/t.csv", {"s.yaml:2", "'effort' = extension", "no muscle that makes it"}},
+        {"TrialAntagonistOnTheThesisArm", {{"s.yaml", "type: isometric\nantagonist_activation: 1\nhold: 0.3\n"}},
+         "trial --settings IN/s.yaml --out OUT/t.csv", {"s.yaml:2", "'antagonist_activation' = 1", "no antagonist"}},
+        {"TorqueProtocolExtensionOnTheThesisArm", {{"p.yaml", kTorqueHead + "subject: {model: thesis}\nconditions:\n"
+                                                             "  - {flexion_deg: 90, effort: extension, level: 1, repetitions: 1}\n"}},
+         "protocol IN/p.yaml --out OUT/run", {"'effort' (conditions, entry 1) = extension", "no muscle that makes it"}},
+        {"TrialAngleWithAVanishingMomentArm", {}, "trial --angle 179.9999 --out OUT/t.csv",
+         {"--angle = 179.9999", "moment arm there is", "at least 1 mm"}},
+        // steady states a typed path cannot have: bad input, not a solver failure
+        {"MuscleSteadyPathTooShort", {}, "muscle steady --path 1e-9", {"--path", "no steady state at path 1e-09 m"}},
+        {"MuscleTrialSteadyStartPathTooShort", {}, "muscle trial --model elbow --path 0.1 --steady-start --out OUT/t.csv",
+         {"--path = 0.1 m", "no steady state"}},
+        {"MuscleSweepWithNoSteadyStateAnywhere", {}, "muscle sweep --from 1e-6 --to 1e-3 --step 1e-4 --out OUT/s.csv",
+         {"--from 1e-06 to --to 0.001", "no steady state"}},
+        // inputs that ask nothing of the work
+        {"ActivationTraceStartingLate", {{"u.csv", "time_s,activation\n1,1\n2,1\n"}},
+         "muscle trial --activation-trace IN/u.csv --duration 0.5 --out OUT/t.csv", {"u.csv:2", "'time_s' = 1", "start at 0 s"}},
+        {"IdentifyToleranceAboveEveryForce", {}, "identify measured/thesis_measured.csv --method ilc-secant --tolerance 1e6 --out OUT/id",
+         {"--tolerance = 1e+06 N", "largest measured force, 600 N"}},
+        {"TorqueDataRowTwice", {{"t.csv", "flexion_deg,effort,level,torque_Nm\n135,1,1,21.39\n135,1,1,21.39\n90,1,1,35.37\n"}},
+         "identify-torque IN/t.csv --out OUT/it", {"t.csv:3", "the same row as line 2", "repetition column"}},
+        {"ValidatePriorWithoutSpread", {{"p.yaml", "name: zero\nmodel: twin\nstrength:\n  subject_sd: 0\n  muscle_sd: 0\n"}},
+         "validate --truth elbow --prior IN/p.yaml --subjects 2 --noise 0 --out OUT/v", {"prior population 'zero'", "both 0"}},
+        {"StudyWhoseEveryTaskIsSkipped", {{"s.yaml", kStudyHead + "methods:\n  - {method: channels}\n"}},
+         "study IN/s.yaml --out OUT/s", {"s.yaml:", "lists only 'channels'", "every task"}},
+        {"ForceLengthStepLongerThanTheRange", {{"p.yaml", "kind: force_length\nname: fl\nseed: 1\nrepetitions: 1\n"
+                                                          "trial: {rest: 0.2, hold: 0.3, averaging_window: 0.2}\n"
+                                                          "conditions:\n  elbow_angle_range_deg: {from: 40, to: 50, step: 500}\n"}},
+         "protocol IN/p.yaml --out OUT/run", {"p.yaml:7", "step' = 500 is longer than the range 40 to 50"}},
+        // model and target files: roles, wraps and units
+        {"ModelSynergistAnExtensor", {{"m.yaml", replaceAll(elbow, "synergists: [BRA, BRD]", "synergists: [BRA, TRIlong]")}},
+         "model show --model IN/m.yaml --out OUT/ms", {"m.yaml:68", "'TRIlong', of group extensor"}},
+        {"ModelWrapSideZero", {{"m.yaml", replaceAll(elbow, "side: [0.44621, 0.86849, 0.21591]", "side: [0, 0, 0]")}},
+         "model show --model IN/m.yaml --out OUT/ms", {"m.yaml:85", "side", "zero vector"}},
+        {"TargetsMomentArmInMetres", {{"t.yaml", "targets:\n  - {kind: moment_arm, muscle: BIC, flexion_deg: 90, lower: 0.0416, "
+                                                  "upper: 0.0493, tolerance: 3, source: x}\n"}},
+         "model check --model twin --targets IN/t.yaml --out OUT/mc", {"t.yaml:2", "within 1 mm", "expected mm"}},
+        {"TargetsMvcBeyondAnyElbow", {{"t.yaml", "targets:\n  - {kind: mvc, direction: flexion, flexion_deg: 90, lower: 500, "
+                                                  "upper: 600, tolerance: 5, source: x}\n"}},
+         "model check --model twin --targets IN/t.yaml --out OUT/mc", {"t.yaml:2", "500", "[0, 300] (N m)"}},
+        {"TargetsNoneScorable", {{"t.yaml", "targets:\n  - {kind: volume, muscle: DELT, lower: 100, upper: 200, source: x}\n"}},
+         "model check --model twin --targets IN/t.yaml --out OUT/mc", {"--targets", "none of the targets"}},
+        {"RenderFieldOfViewTiny", {{"t.csv", "time_s\n0\n"}, {"rs.yaml", "camera:\n  position: [0, 0, 2]\n  vertical_fov: 1e-9\n"}},
+         "render IN/t.csv --render-settings IN/rs.yaml --out OUT/v.mp4", {"rs.yaml:3", "vertical_fov", "1e-09", "[0.01"}},
+        {"OsimRangeInDegrees", {{"m.osim", replaceAll(arm26, "<range>0 2.2689280300000001</range>", "<range>0 130</range>")}},
+         "model show --model IN/m.osim --out OUT/ms", {"m.osim:", "past one turn", "expected radians", "7448 deg"}},
+        {"OsimActivationTimeInMilliseconds", {{"m.osim", replaceAll(arm26, "<activation_time_constant>0.01</activation_time_constant>",
+                                                                    "<activation_time_constant>10</activation_time_constant>")}},
+         "model show --model IN/m.osim --out OUT/ms", {"activation_time_constant", "10", "(0, 1] (s)"}},
         {"MainJobBadModelWritesNothing", {{"m.yaml", "name: m\n"}}, "run --model IN/m.yaml --out OUT/r", {"m.yaml:1", "'arm'"}},
     };
 }

@@ -286,10 +286,11 @@ TEST(CliDesign, DesignedProtocolRunsAndItsDataAreIdentified) {
     ASSERT_EQ(r.exitCode, 0) << r.output;
     EXPECT_NE(r.output.find("no condition is repeated to estimate it from"), std::string::npos) << r.output;
     EXPECT_EQ(r.output.find("estimated from the repetitions"), std::string::npos) << r.output;
-    // Repetitions that agree exactly: the level is raised to its floor, and the line says so.
+    // Repetitions that agree exactly (numbered: without numbers a row twice is refused as pasted twice):
+    // the level is raised to its floor, and the line says so.
     {
         std::ofstream twice(d / "twice.csv");
-        twice << "flexion_deg,torque_Nm\n90,60\n45,50\n120,55\n90,60\n45,50\n120,55\n";
+        twice << "flexion_deg,torque_Nm,repetition\n90,60,0\n45,50,0\n120,55,0\n90,60,1\n45,50,1\n120,55,1\n";
     }
     r = runArmsim("identify-torque " + (d / "twice.csv").string() + " --out " + (d / "twice_fit").string());
     ASSERT_EQ(r.exitCode, 0) << r.output;

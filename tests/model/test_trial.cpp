@@ -440,7 +440,7 @@ TEST(IsometricTrial, BandedNewtonAgreesWithTheSimbodySystem) {
             if (setup == &thesis && effort == Effort::Extension) continue;   // the biceps alone
             IsometricTrialSettings s = mvcAt(100);
             s.activation = 0.95;
-            s.antagonistActivation = 0.1;
+            s.antagonistActivation = setup == &thesis ? 0.0 : 0.1;   // the thesis arm has no antagonist
             s.effort = effort;
             s.holdDuration = 1.0;
             s.averagingWindow = 0.5;

@@ -75,7 +75,7 @@ TEST(RenderSettings, BadValuesNameFieldValueAndBound) {
         {"supersample", [](RenderSettings& s) { s.width = 4096; s.supersample = 3; }, "8192"},
         {"background", [](RenderSettings& s) { s.background = Vec3(1.5, 0, 0); }, "[0, 1]"},
         {"camera.vertical_fov", [](RenderSettings& s) { s.camera.verticalFov = 0; }, "(rad)"},
-        {"camera.ortho_height", [](RenderSettings& s) { s.camera.orthographic = true; s.camera.orthoHeight = -1; }, "> 0"},
+        {"camera.ortho_height", [](RenderSettings& s) { s.camera.orthographic = true; s.camera.orthoHeight = -1; }, "[0.01, 1000] (m)"},
         {"camera.look_at", [](RenderSettings& s) { s.camera.lookAt = s.camera.position; }, "different"},
         {"camera.up", [](RenderSettings& s) { s.camera.up = Vec3(0, 0, 1); }, "not parallel"},
         {"camera.far_clip", [](RenderSettings& s) { s.camera.farClip = 0.001; }, "near_clip"},
