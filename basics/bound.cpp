@@ -1,5 +1,7 @@
 #include "basics/bound.h"
 
+#include "basics/angles.h"
+
 #include <cmath>
 
 namespace armsim {
@@ -34,7 +36,7 @@ void checkField(const std::string& field, double value, const Bound& bound) {
 
 void checkDegreesNotRadians(const std::string& field, const std::vector<double>& degrees) {
     // pi as typed to three places (3.142) still counts as within pi.
-    constexpr double kPi = 3.14159265358979323846, kWhole = 1e-9, kTyped = 1e-3;
+    constexpr double kWhole = 1e-9, kTyped = 1e-3;
     bool fractional = false;
     for (double a : degrees) {
         if (!std::isfinite(a) || std::abs(a) > kPi + kTyped) return;
@@ -44,7 +46,7 @@ void checkDegreesNotRadians(const std::string& field, const std::vector<double>&
     std::string typed, asDegrees;
     for (std::size_t k = 0; k < degrees.size() && k < 5; ++k) {
         typed += (k ? ", " : "") + formatNumber(degrees[k]);
-        asDegrees += (k ? ", " : "") + formatNumber(std::round(degrees[k] * 180 / kPi * 10) / 10);
+        asDegrees += (k ? ", " : "") + formatNumber(std::round(radToDeg(degrees[k]) * 10) / 10);
     }
     if (degrees.size() > 5) typed += ", ...", asDegrees += ", ...";
     throw FieldError(field, "= " + typed + ": expected degrees; every angle is within pi and not all are whole, as "
