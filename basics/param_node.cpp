@@ -18,6 +18,7 @@ struct ParamNode::Impl {
     std::string prefix;   // dotted path of this mapping
     YAML::Node node;
     std::shared_ptr<std::set<std::string>> used = std::make_shared<std::set<std::string>>();
+    std::shared_ptr<std::set<std::string>> asked = std::make_shared<std::set<std::string>>();   // present or not
 };
 
 ParamNode::ParamNode(std::shared_ptr<Impl> impl) : impl_(std::move(impl)) {}
@@ -171,9 +172,13 @@ std::string ParamNode::where(const std::string& key) const {
     return impl_->source + ":" + std::to_string(line + 1);
 }
 
-bool ParamNode::has(const std::string& key) const { return bool(node()[key]); }
+bool ParamNode::has(const std::string& key) const {
+    impl_->asked->insert(key);
+    return bool(node()[key]);
+}
 
 YAML::Node ParamNode::requireKey(const std::string& key) const {
+    impl_->asked->insert(key);
     YAML::Node n = node()[key];
     if (!n) throw InputError(where() + ": missing required field " + describeField(path(key)));
     impl_->used->insert(key);
@@ -320,9 +325,13 @@ std::vector<std::string> ParamNode::getKeys() const {
 void ParamNode::finish() const {
     for (auto it = node().begin(); it != node().end(); ++it) {
         const std::string key = it->first.as<std::string>();
-        if (!impl_->used->count(key))
+        if (!impl_->used->count(key)) {
+            std::string fields;   // what the reader asked for here
+            for (const std::string& k : *impl_->asked) fields += (fields.empty() ? "" : ", ") + k;
             throw InputError(impl_->source + ":" + std::to_string(it->first.Mark().line + 1) +
-                             ": unknown field " + describeField(path(key)) + " (misspelt, or not a field here)");
+                             ": unknown field " + describeField(path(key)) + " (misspelt, or not a field here)" +
+                             (fields.empty() ? std::string() : ": expected one of " + fields));
+        }
     }
 }
 

@@ -3,6 +3,7 @@
 #include "basics/errors.h"
 #include "basics/files.h"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <cstdlib>
@@ -114,21 +115,73 @@ std::string Table::toCsv(int digits) const {
 
 void Table::writeCsv(const std::string& path, int digits) const { writeFileAtomically(path, toCsv(digits)); }
 
+void checkSampleTimes(const Table& t, const std::string& column, const std::string& source) {
+    const std::vector<double> time = t.getColumn(column);
+    const auto number = [](double x) {
+        std::ostringstream s;
+        s.precision(10);
+        s << x;
+        return s.str();
+    };
+    std::vector<double> steps;
+    for (std::size_t i = 1; i < time.size(); ++i) {
+        if (!(time[i] > time[i - 1]))
+            throw InputError(t.describeRow(source, int(i)) + ": " + column + " = " + number(time[i]) +
+                             ": expected a time after the previous row's " + number(time[i - 1]) + " s");
+        steps.push_back(time[i] - time[i - 1]);
+    }
+    if (steps.empty()) return;
+    std::vector<double> sorted = steps;
+    std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+    const double interval = sorted[sorted.size() / 2];
+    constexpr double kMaxGap = 2;   // intervals per row; a trial table's are equal, the last may be shorter
+    for (std::size_t i = 0; i < steps.size(); ++i)
+        if (steps[i] > kMaxGap * interval * (1 + 1e-9))
+            throw InputError(t.describeRow(source, int(i + 1)) + ": " + column + " jumps from " + number(time[i]) +
+                             " to " + number(time[i + 1]) + " s, " + number(steps[i] / interval) +
+                             " times the table's sample interval of " + number(interval) +
+                             " s: rows are missing; expected evenly spaced rows, as armsim trial writes them");
+}
+
+namespace {
+
+// The cells of one CSV line, trimmed of blanks; a cell in double quotes (RFC 4180: "" is a quote)
+// keeps its commas and loses its quotes.
+std::vector<std::string> splitCsvLine(const std::string& line, const std::string& at) {
+    std::vector<std::string> cells;
+    std::string cell;
+    bool quoted = false;
+    const auto push = [&] {
+        const auto b = cell.find_first_not_of(" \t\r"), e = cell.find_last_not_of(" \t\r");
+        cells.push_back(b == std::string::npos ? "" : cell.substr(b, e - b + 1));
+        cell.clear();
+    };
+    for (std::size_t i = 0; i < line.size(); ++i) {
+        const char c = line[i];
+        if (quoted) {
+            if (c != '"') cell += c;
+            else if (i + 1 < line.size() && line[i + 1] == '"') cell += '"', ++i;
+            else quoted = false;
+        } else if (c == '"' && cell.find_first_not_of(" \t") == std::string::npos) {
+            quoted = true;
+            cell.clear();
+        } else if (c == ',') {
+            push();
+        } else {
+            cell += c;
+        }
+    }
+    if (quoted) throw InputError(at + ": a double quote is opened and not closed: expected \"...\" around a cell");
+    push();
+    return cells;
+}
+
+}  // namespace
+
 Table Table::readCsv(const std::string& path) {
     checkInputFile(path, std::uintmax_t(4) << 30);
     std::ifstream in(path);
     if (!in) throw InputError(path + ": cannot open file (does it exist and is it readable?)");
-    auto split = [](const std::string& line) {
-        std::vector<std::string> cells;
-        std::stringstream s(line);
-        std::string cell;
-        while (std::getline(s, cell, ',')) {
-            const auto b = cell.find_first_not_of(" \t\r"), e = cell.find_last_not_of(" \t\r");
-            cells.push_back(b == std::string::npos ? "" : cell.substr(b, e - b + 1));
-        }
-        if (!line.empty() && line.back() == ',') cells.push_back("");
-        return cells;
-    };
     Table t;
     std::string line;
     int lineNo = 0;
@@ -139,7 +192,7 @@ Table Table::readCsv(const std::string& path) {
         if (!line.empty() && line.back() == '\r') line.pop_back();
         if (line.find_first_not_of(" \t") == std::string::npos || line[line.find_first_not_of(" \t")] == '#')
             continue;
-        const std::vector<std::string> cells = split(line);
+        const std::vector<std::string> cells = splitCsvLine(line, path + ":" + std::to_string(lineNo));
         if (header) {
             checkCommaSeparatedHeader(cells, path + ":" + std::to_string(lineNo));
             checkUniqueColumnNames(cells, path + ":" + std::to_string(lineNo));

@@ -140,7 +140,7 @@ void runIdentify(const IdentifyOptions& o) {
 
     IdentificationProblem pr;
     pr.base = base;
-    pr.data = readArmObservations(findAsset(o.data), setup.arm, o.subject);
+    runNamingOptions({{"subject", "--subject"}}, [&] { pr.data = readArmObservations(findAsset(o.data), setup.arm, o.subject); });
     pr.unknowns.clear();
     const std::string freeList = formatList(o.freeList);
     for (const std::string& name : o.freeList) pr.unknowns.push_back(makeUnknown(parseParameter("--free", name)));

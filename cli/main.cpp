@@ -89,14 +89,15 @@ std::string explainConversion(const CLI::App& app, const std::string& what) {
     for (const CLI::App* a : apps)
         for (const CLI::Option* o : a->get_options()) {
             if (o->get_name() != name && !o->check_name(name)) continue;
-            // "INT", or "INT:NUMBER in [1, 64]" with a range check (cli/commands.h: inRange).
+            // "INT", or "INT:NUMBER in [1, 64]" with a range check (cli/commands.h: inRange); "UINT"
+            // options are the seeds, 32-bit unsigned.
             const std::string type = o->get_type_name();
             const std::string base = type.substr(0, type.find(':'));
             const std::size_t in = type.find(" in [");
             const std::string range = in == std::string::npos ? "" : type.substr(in);
             const std::string expected = base == "FLOAT"  ? "a number"
                                          : base == "INT"  ? "an integer"
-                                         : base == "UINT" ? "a whole number >= 0"
+                                         : base == "UINT" ? "a whole number in [0, 4294967295]"
                                                           : base;
             return name + " = '" + value + "': expected " + expected + range;
         }

@@ -29,6 +29,17 @@ namespace {
     if (message.rfind("no steady state at path", 0) == 0) throw InputError(option + ": " + message);
     throw SimulationError(message);
 }
+
+// The muscle's own check of a path the user typed (and, for a trial, of its initial state there), named
+// as the option (InputError).
+void checkPathWithin(const MuscleModel& m, const std::string& option, double path, bool initialState = false) {
+    try {
+        m.checkPathLength(path);
+        if (initialState) m.calcInitialState(path);
+    } catch (const InputError& e) {
+        throw InputError(option + ": " + e.what());
+    }
+}
 }  // namespace
 
 void MuscleOptions::add(CLI::App& app) {
@@ -149,6 +160,7 @@ void addMuscleCommands(CLI::App& app) {
             checkField("--path", *path, bounds::kPathLength);
             const std::shared_ptr<const MuscleModel> built = opts->build();
             const MuscleModel& m = *built;
+            checkPathWithin(m, "--path", *path);
             const SteadyState s = m.calcSteadyState(*path, *U);
             if (!s.converged) throwSteadyFailure("--path", s.message);
             std::printf("muscle            %s\n", m.getName().c_str());
@@ -195,13 +207,8 @@ void addMuscleCommands(CLI::App& app) {
             const std::string csvPath = files.add("--out", *out, true), plotPath = files.add("--plot", checkPngPath("--plot", *plot));
             const std::shared_ptr<const MuscleModel> built = opts->build();
             const MuscleModel& m = *built;
-            for (const auto& [option, P] : {std::pair<const char*, double>{"--from", *from}, {"--to", *to}}) {
-                try {
-                    m.checkPathLength(P);
-                } catch (const InputError& e) {
-                    throw InputError(std::string(option) + ": " + e.what());
-                }
-            }
+            for (const auto& [option, P] : {std::pair<const char*, double>{"--from", *from}, {"--to", *to}})
+                checkPathWithin(m, option, P);
             Table t({"path_length_m", "activation", "force_N", "fascicle_length_m", "converged"});
             const int n = int(std::floor((*to - *from) / *step + 1e-9)) + 1;
             std::vector<double> x, y;
@@ -286,6 +293,7 @@ void addMuscleCommands(CLI::App& app) {
             const std::string csvPath = files.add("--out", *out, true), plotPath = files.add("--plot", checkPngPath("--plot", *plot));
             const std::shared_ptr<const MuscleModel> built = opts->build();
             const MuscleModel& m = *built;
+            checkPathWithin(m, "--path", settings->pathLength, !settings->startSteady);
             MuscleIsometricSettings s = *settings;
             if (!trace->empty()) s.activation = loadActivationTrace(*trace);
             else if (*rise > 0) s.activation = ActivationProfile::ramp(*onset, *onset + *rise, 0.0, *U);

@@ -73,7 +73,7 @@ std::vector<ChannelObservation> synthesizeChannelData(const VirtualSubject& subj
         }
         if (c->emg) {
             if (s.surfaceEmg.empty())
-                throw InputError("protocol '" + protocol.name + "' records emg at " + formatNumber(c->flexionDeg) +
+                throw InputError(protocol.describe() + " records emg at " + formatNumber(c->flexionDeg) +
                                  " deg, but model '" + s.name + "' names no muscles for it: expected a roles: "
                                  "surface_emg list in the model file");
             o.channel = "emg";
@@ -94,7 +94,8 @@ std::vector<ChannelObservation> synthesizeChannelData(const VirtualSubject& subj
         try {
             m = s.findMuscle(name);
         } catch (const InputError& x) {
-            throw InputError("protocol '" + protocol.name + "': measurements.volume_scan: " + x.what());
+            throw InputError((protocol.volumeScanWhere.empty() ? protocol.describe() : protocol.volumeScanWhere) +
+                             ": field 'measurements.volume_scan': " + x.what());
         }
         const MuscleParameters& p = s.muscles[m].params;
         ChannelObservation o;

@@ -307,9 +307,16 @@ void readSubmaximalConditions(const ParamNode& c, Protocol& p, const ArmParamete
         requireNonEmpty(c, "elbow_angles_deg", c.getNumbers("elbow_angles_deg", getTrialAngleBound(arm)), "angle"));
     std::vector<double> pct =
         requireNonEmpty(c, "levels_pct_mvc", c.getNumbers("levels_pct_mvc", {0, 100, true, false, "% MVC"}), "level");
-    if (std::find(pct.begin(), pct.end(), 100.0) == pct.end())
+    if (std::find(pct.begin(), pct.end(), 100.0) == pct.end()) {
+        const bool fractions = std::all_of(pct.begin(), pct.end(), [](double l) { return l <= 1; });
+        std::string percent;   // what fractions would have meant
+        for (double l : pct) percent += (percent.empty() ? "" : ", ") + formatNumber(100 * l, 6);
         throw InputError(c.where("levels_pct_mvc") + ": field 'conditions.levels_pct_mvc' lacks 100: the 100 % "
-                         "MVC trials are the reference of the other levels and of the EMG normalisation");
+                         "MVC trials are the reference of the other levels and of the EMG normalisation" +
+                         (fractions ? std::string("; every level is at most 1 % MVC: fractions? expected percent of MVC ([") +
+                                          percent + "])"
+                                    : std::string()));
+    }
     for (double l : pct) p.levels.push_back(l / 100.0);
 }
 

@@ -181,6 +181,7 @@ OsimModel loadOsimProtocolModel(const TorqueProtocol& protocol);
 TorqueProtocol readTorqueProtocol(const std::string& path) {
     const ParamNode root = ParamNode::loadFile(path);
     TorqueProtocol p;
+    p.source = path;
     p.name = root.getString("name");
     p.description = root.getString("description", "");
     root.getChoice("kind", {"torque"}, "torque");
@@ -215,7 +216,10 @@ TorqueProtocol readTorqueProtocol(const std::string& path) {
     }
     if (root.has("measurements")) {
         const ParamNode m = root.child("measurements");
-        if (m.has("volume_scan")) p.volumeScan = m.getStrings("volume_scan");
+        if (m.has("volume_scan")) {
+            p.volumeScan = m.getStrings("volume_scan");
+            p.volumeScanWhere = m.where("volume_scan");
+        }
         p.anthropometry = m.getBool("anthropometry", false);
         p.forearmTorque = m.getBool("forearm_torque", false);
         m.finish();
@@ -341,7 +345,7 @@ std::vector<TorqueObservation> synthesizeTorqueData(const VirtualSubject& subjec
     PortableRandom forearmRng{noiseSeed, subject.seed, unsigned(subject.index), 2u};
     const bool forearm = protocol.readsForearmTorque();
     if (forearm && !subject.setup.arm.forearmRotation.enabled)
-        throw InputError("protocol '" + protocol.name + "' reads the forearm axis (a rotation effort or measurements." +
+        throw InputError(protocol.describe() + " reads the forearm axis (a rotation effort or measurements." +
                          "forearm_torque), but model '" + subject.setup.name + "' has no forearm rotation");
     for (std::size_t k = 0; k < protocol.conditions.size(); ++k) {   // an effort no muscle of the model makes reads 0
         const Effort effort = protocol.conditions[k].effort;
@@ -442,7 +446,7 @@ OsimModel loadOsimProtocolModel(const TorqueProtocol& protocol) {
 std::vector<TorqueObservation> synthesizeOsimTorqueData(const TorqueProtocol& protocol, unsigned noiseSeed, int jobs) {
     protocol.validate();
     if (!protocol.usesOsimModel())
-        throw InputError("protocol '" + protocol.name + "': subject.model = '" + protocol.model + "' is not an OpenSim model");
+        throw InputError(protocol.describe() + ": subject.model = '" + protocol.model + "' is not an OpenSim model");
     const OsimModel model = loadOsimProtocolModel(protocol);
     PortableRandom rng{noiseSeed, 0u, 0u};
     int maxRepetitions = 0;

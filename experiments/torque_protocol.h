@@ -81,6 +81,10 @@ struct TorqueProtocol {
     unsigned seed = 1;               ///< population and noise seed
     /// Muscles whose volume a panoramic ultrasound scan measures (once each; names in the model).
     std::vector<std::string> volumeScan;
+    std::string volumeScanWhere;     ///< "file:line" of volume_scan when read from a file, for messages
+    std::string source;              ///< the file it was read from ("" when made in code), for messages
+    /// "<file>: protocol '<name>'" (or "protocol '<name>'"), how messages name it.
+    std::string describe() const { return (source.empty() ? "" : source + ": ") + "protocol '" + name + "'"; }
     bool anthropometry = false;      ///< the upper-arm length measured
     /// A two-axis transducer: every trial also reads the torque about the forearm axis (a model with a
     /// forearm rotation). Rotation efforts imply it (readsForearmTorque).

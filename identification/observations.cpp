@@ -89,6 +89,7 @@ ObservationSet makeObservations(const Table& t, const std::string& path, const O
 
     ObservationSet set;
     set.source = path;
+    std::set<int> subjects;   // every subject the file holds, for a --subject it lacks
     for (int r = 0; r < t.getNumRows(); ++r) {
         const std::string at = t.describeRow(path, r);
         auto fail = [&](const std::string& column, double v, const std::string& expected) {
@@ -105,6 +106,7 @@ ObservationSet makeObservations(const Table& t, const std::string& path, const O
         o.line = t.getSourceLine(r);
         o.trial = integer("trial");
         o.subject = integer("subject");
+        subjects.insert(o.subject);
         if (options.subject >= 0 && o.subject != options.subject) continue;
         o.force = t.get(r, "force_N");
         if (!std::isfinite(o.force) || o.force > 1e5)
@@ -136,8 +138,14 @@ ObservationSet makeObservations(const Table& t, const std::string& path, const O
                              ": expected at most " + std::to_string(kMaxForceRows) + " (one row per effort or per "
                              "averaged point; a force fit of a few unknowns needs tens)");
     }
-    if (set.points.empty())
-        throw InputError(path + ": no data rows for subject " + std::to_string(options.subject));
+    if (set.points.empty() && options.subject >= 0) {
+        std::string seen;
+        for (int k : subjects) seen += (seen.empty() ? "" : ", ") + std::to_string(k);
+        throw FieldError("subject", "= " + std::to_string(options.subject) + ": " + path + " has no rows of subject " +
+                                        std::to_string(options.subject) + " (" +
+                                        (t.hasColumn("subject") ? "its subjects: " + seen : "no 'subject' column: every row is subject 0") +
+                                        "): expected one of them");
+    }
     if (std::none_of(set.points.begin(), set.points.end(), [](const Observation& o) { return o.force > 0; }))
         throw InputError(path + ": column 'force_N' is 0 N in every row: expected a positive force in one row at "
                                 "least (nothing to fit: every mass and tendon length at their bounds would do)");

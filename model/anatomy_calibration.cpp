@@ -158,9 +158,19 @@ AnatomyCalibrationResult calibrateToAnatomy(const ArmSetup& setup, const std::ve
 
     AnatomyCalibrationResult result;
     result.before = scoreAnatomy(source, fitted, sweep);
-    if (result.before.empty())
-        throw InputError("anatomy calibration: no mvc, share, optimum_angle or volume target names a muscle of model '" +
-                         setup.name + "'");
+    if (result.before.empty()) {
+        std::string file = fitted.empty() ? std::string() : fitted.front().where;
+        if (const std::size_t colon = file.rfind(':'); colon != std::string::npos) file.erase(colon);
+        std::string named, muscles;
+        for (const AnatomyTarget& t : fitted)
+            if (!t.muscle.empty() && named.find("'" + t.muscle + "'") == std::string::npos)
+                named += (named.empty() ? "'" : ", '") + t.muscle + "'";
+        for (const MuscleSpec& m : setup.muscles) muscles += (muscles.empty() ? "" : ", ") + m.params.name;
+        throw InputError((file.empty() ? std::string("anatomy calibration") : file) +
+                         ": no mvc, share, optimum_angle or volume target names a muscle of model '" + setup.name + "'" +
+                         (named.empty() ? std::string() : " (the targets name " + named + ")") +
+                         ": expected targets of its muscles (" + muscles + ")");
+    }
     AnatomyProblem problem{&source, &fitted, &options, {}, &sweep, 0};
     for (const MuscleSpec& m : setup.muscles)
         if (std::find(problem.groups.begin(), problem.groups.end(), m.group) == problem.groups.end())

@@ -311,6 +311,10 @@ MuscleSpec readMuscle(const ParamNode& n, const MuscleDefaults& defaults, const 
     }
     m.path.push_back(readPoint(path.child("insertion"), "insertion"));
     path.finish();
+    if (std::all_of(m.path.begin(), m.path.end(), [&](const PathElementSpec& e) { return e.body == m.path[0].body; }))
+        throw InputError(path.where("insertion") + ": muscle '" + name + "': its origin, insertion and every via point are on the " +
+                         getArmBodyName(m.path[0].body) + ": expected a path that crosses a joint (one on a single body "
+                         "keeps its length, and has no moment arm, in every posture)");
     for (std::size_t k = 1; k + 1 < m.path.size(); ++k)
         if (m.path[k].kind != PathElementSpec::Kind::Point && m.path[k + 1].kind != PathElementSpec::Kind::Point)
             throw InputError(path.where("via") + ": muscle '" + name + "': wrapping surfaces '" + m.path[k].label +
@@ -334,6 +338,25 @@ void checkSynergistRoles(const ArmSetup& s, const ParamNode& roles) {
             throw InputError(roles.where("synergists") + ": field 'roles.synergists' lists '" +
                              s.muscles[m].params.name + "', a biceps head (roles.biceps, or the primary): expected the biceps heads' "
                              "synergists (the other flexors), each muscle in one role");
+    }
+}
+
+// Every muscle whose P_max is its longest path over the range has a steady state there, at rest and at
+// full drive (the longest fascicle any posture asks of it); a path lengthened by a misplaced point or a wrapping
+// surface's reversed side has none, and would fail the first trial that reaches that posture.
+void checkSteadyStatesAtLongestPaths(const ArmSetup& s, const std::string& file) {
+    for (int i = 0; i < s.getNumMuscles(); ++i) {
+        if (!s.muscles[i].maxPathFromRange) continue;
+        const double P = s.muscles[i].params.maxPathLength;
+        const std::shared_ptr<const MuscleModel> muscle = s.buildMuscleModel(i);
+        for (double U : {0.0, 1.0}) {
+            const SteadyState steady = muscle->calcSteadyState(P, U);
+            if (!steady.converged)
+                throw InputError(file + ": muscle '" + s.muscles[i].params.name + "': its path over the elbow's range reaches " +
+                                 formatNumber(P, 6) + " m, where it has no steady state at activation " +
+                                 formatNumber(U) + " (" + steady.message + "): expected a path the muscle can span (a "
+                                 "misplaced via point, or a wrapping surface's side reversed, lengthens it)");
+        }
     }
 }
 
@@ -558,6 +581,7 @@ ArmSetup loadModelFile(const std::string& file) {
     } catch (const InputError& e) {
         throw InputError(file + ": " + e.what());
     }
+    checkSteadyStatesAtLongestPaths(s, file);
     return s;
 }
 

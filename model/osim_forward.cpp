@@ -249,6 +249,14 @@ OsimForwardResult runOsimForward(const OsimModel& model, const OsimStorage& cont
                              formatNumber(settings.finalTime - t0) + " s: expected at most " + formatNumber(kMaxSamples) +
                              " steps (a larger step limit)");
 
+    {   // the rows fall every 1/rate from t0; said when the last is not the final time asked
+        const double lastRow = t0 + std::floor((settings.finalTime - t0) * settings.sampleRate + 1e-9) / settings.sampleRate;
+        if (lastRow < settings.finalTime - 1e-9 / settings.sampleRate)
+            result.notes.push_back("rows every " + formatNumber(1 / settings.sampleRate) + " s from " + formatNumber(t0) +
+                                   " s: the last at " + formatNumber(lastRow, 10) + " s, not at the final time " +
+                                   formatNumber(settings.finalTime) + " s (the interval from the start is not a whole "
+                                   "number of rows)");
+    }
     const std::map<std::string, ActivationProfile> excitations = makeExcitations(model, controls, t0, settings.finalTime, result.notes);
     const OsimArm arm(model, excitations, settings.muscleModel);
     SimTK::State s = arm.getDefaultState();

@@ -3,6 +3,7 @@
 #include "numerics/brent.h"
 
 #include "basics/bound.h"
+#include "basics/format.h"
 
 #include <algorithm>
 #include <charconv>
@@ -289,7 +290,8 @@ std::vector<double> VirtualMuscle::calcInitialState(double P) const {
     y[kL] = calcInitialFascicleLength(P);
     if (!(y[kL] > 0))
         throw InputError("path length = " + fmt(P) + " m is too short for muscle '" + params_.name +
-                         "': the initial fascicle length would be " + fmt(y[kL]) + " L0 (expected > 0)");
+                         "': its fascicle would start at " + formatNumber(y[kL], 6) + " L0: expected a path "
+                         "whose tendon, at its slack length, leaves a fascicle of positive length");
     if (yieldSlow_ >= 0) y[yieldSlow_] = 1.0;
     if (yieldFast_ >= 0) y[yieldFast_] = 1.0;
     for (int u = 0; u < getNumUnits(); ++u)

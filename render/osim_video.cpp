@@ -67,6 +67,7 @@ int findOsimTableCoordinate(const OsimArm& arm, const Table& table, const std::s
     const std::vector<std::string>& names = table.getColumnNames();
     if (names.empty() || names[0] != "time_s" || table.getNumRows() == 0)
         throw InputError(tableName + ": expected an OpenSim-model trial table (time_s first, rows)");
+    checkSampleTimes(table, "time_s", tableName);
     for (const std::string& n : names)
         if (n.size() > 4 && n.compare(n.size() - 4, 4, "_deg") == 0) {
             const int j = arm.findCoordinate(n.substr(0, n.size() - 4));

@@ -252,10 +252,8 @@ struct TrialRenderer::Impl {
                 if (!std::isfinite(table.get(i, c)))
                     throw InputError(name + " " + rowName(table, i) + ": column '" + c + "' = " +
                                      fmt::format("{:g}", table.get(i, c)) + ": expected a finite number");
-            if (i > 0 && !(time[i] > time[i - 1]))
-                throw InputError(name + " " + rowName(table, i) + ": time_s = " + fmt::format("{:.10g}", time[i]) +
-                                 ": expected a time after the previous row's " + fmt::format("{:.10g}", time[i - 1]) + " s");
         }
+        checkSampleTimes(table, "time_s", settings.tableName.empty() ? "trial table" : settings.tableName);
         checkColumnValues();
     }
 

@@ -475,12 +475,12 @@ ProtocolPrediction predictProtocol(const Population& prior, const TorqueProtocol
         try {
             prior.base.findMuscle(protocol.volumeScan[k]);
         } catch (const InputError& e) {
-            throw InputError("protocol '" + protocol.name + "': " + describeField("measurements.volume_scan[" + std::to_string(k) + "]") + ": " + e.what());
+            throw InputError((protocol.volumeScanWhere.empty() ? protocol.describe() : protocol.volumeScanWhere) + ": " + describeField("measurements.volume_scan[" + std::to_string(k) + "]") + ": " + e.what());
         }
     }
     for (const TorqueCondition& c : protocol.conditions)
         if (c.emg && prior.base.surfaceEmg.empty())
-            throw InputError("protocol '" + protocol.name + "' records emg, but model '" + prior.base.name +
+            throw InputError(protocol.describe() + " records emg, but model '" + prior.base.name +
                              "' names no muscles for it: expected a roles: surface_emg list in the model file");
     for (const TorqueCondition& c : protocol.conditions)
         for (const ChannelObservation& o : makeConditionRows(prior.base, c, c.ultrasound, c.emg)) {
@@ -497,7 +497,7 @@ ProtocolPrediction predictProtocol(const Population& prior, const TorqueProtocol
     }
     const bool forearm = protocol.readsForearmTorque();
     if (forearm && !prior.base.arm.forearmRotation.enabled)
-        throw InputError("protocol '" + protocol.name + "' reads the forearm axis, but the prior's model '" +
+        throw InputError(protocol.describe() + " reads the forearm axis, but the prior's model '" +
                          prior.base.name + "' has no forearm rotation");
     if (forearm)
         for (const TorqueCondition& c : protocol.conditions) counts.push_back(c.repetitions);
@@ -700,7 +700,7 @@ DesignResult designChannelProtocol(const Population& prior, const DesignSettings
     if (progress) progress(total, total);
     if (std::none_of(chosen.torque.begin(), chosen.torque.end(), [](int n) { return n > 0; }))
         throw InputError("design --budget " + formatNumber(settings.budgetMinutes) + " min: no MVC block (" +
-                         formatNumber(block) + " min) fits: expected a larger budget");
+                         formatNumber(block, 4) + " min) fits: expected a larger budget");
     result.protocol = makeDesignedProtocol(result.candidates, rows, chosen, forearm, noise);
     TorqueProtocol& p = result.protocol;
     result.predicted = evaluate(s, chosen.toCounts(rows, forearm), p.name, true);

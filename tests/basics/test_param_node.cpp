@@ -56,7 +56,7 @@ TEST(ParamNode, ReadsValuesAndRejectsUnreadKeysWithTheirLine) {
     EXPECT_EQ(sub.getInt("a", 0, 5), 2);
     sub.finish();
     EXPECT_EQ(n.getNumber("missing", Bound::any(), 7.0), 7.0);
-    EXPECT_EQ(messageOf([&] { n.finish(); }), "x.yaml:6: unknown field 'typo' (misspelt, or not a field here)");
+    EXPECT_EQ(messageOf([&] { n.finish(); }), "x.yaml:6: unknown field 'typo' (misspelt, or not a field here): expected one of list, mass, missing, name, sub");
 }
 
 TEST(ParamNode, OutOfBoundValueNamesFileLineFieldValueAndBound) {

@@ -66,3 +66,46 @@ TEST(Table, MalformedCellNamesFileLineAndColumn) {
     }
     fs::remove(p);
 }
+
+// A spreadsheet's CSV quotes cells (RFC 4180): the quotes go, a quoted comma stays inside its cell, ""
+// is a quote, and a quote left open is named with its line.
+TEST(Table, QuotedCellsReadAsTheirText) {
+    const fs::path p = fs::temp_directory_path() / ("armsim_quoted_" + std::to_string(::getpid()) + ".csv");
+    std::ofstream(p) << "\"time_s\", \"force_N\" ,c\n\"0\",\"1.5\",\"2\"\n";
+    const Table t = Table::readCsv(p.string());
+    EXPECT_EQ(t.getColumnNames(), (std::vector<std::string>{"time_s", "force_N", "c"}));
+    EXPECT_EQ(t.getRow(0), (std::vector<double>{0, 1.5, 2}));
+    std::ofstream(p) << "a,\"b,c\",\"d\"\"\"\n1,2,3\n";
+    EXPECT_EQ(Table::readCsv(p.string()).getColumnNames(), (std::vector<std::string>{"a", "b,c", "d\""}));
+    std::ofstream(p) << "a,b\n1,\"2\n";
+    try {
+        Table::readCsv(p.string());
+        ADD_FAILURE() << "an open quote accepted";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find(p.string() + ":2: a double quote is opened and not closed"), std::string::npos)
+            << e.what();
+    }
+    fs::remove(p);
+}
+
+// Trial tables are sampled evenly; a time that does not increase, or rows missing from the middle, is
+// named with its line and the interval (a last interval shorter than the rest is a trial's end).
+TEST(Table, SampleTimesMustIncreaseWithoutGaps) {
+    Table t({"time_s"});
+    for (double x : {0.0, 0.01, 0.02, 0.03, 0.035}) t.appendRow({x});
+    EXPECT_NO_THROW(checkSampleTimes(t, "time_s", "t.csv"));
+    t.appendRow({0.055});   // 2 intervals: the bound, inclusive
+    EXPECT_NO_THROW(checkSampleTimes(t, "time_s", "t.csv"));
+    t.appendRow({0.0851});   // 3.01 intervals
+    try {
+        checkSampleTimes(t, "time_s", "t.csv");
+        ADD_FAILURE() << "a gap accepted";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("t.csv row 7: time_s jumps from 0.055 to 0.0851 s, 3.01 times the table's "
+                                             "sample interval of 0.01 s: rows are missing"),
+                  std::string::npos) << e.what();
+    }
+    Table back({"time_s"});
+    for (double x : {0.0, 0.01, 0.01}) back.appendRow({x});
+    EXPECT_THROW(checkSampleTimes(back, "time_s", "t.csv"), InputError);
+}

@@ -651,6 +651,26 @@ std::vector<BadInput> makeCatalogue() {
          {"--angle = 179.9999", "moment arm there is", "at least 1 mm"}},
         // steady states a typed path cannot have: bad input, not a solver failure
         {"MuscleSteadyPathTooShort", {}, "muscle steady --path 1e-9", {"--path", "no steady state at path 1e-09 m"}},
+        {"MuscleSteadyPathPastPmax", {}, "muscle steady --path 3", {"--path: path length = 3 m exceeds max_path_length"}},
+        {"MuscleTrialPathPastPmax", {}, "muscle trial --path 3 --out OUT/t.csv", {"--path: path length = 3 m exceeds max_path_length"}},
+        {"IdentifySubjectAbsent", {{"f.csv", "path_cm,force_N,subject\n41,600,1\n37.5,458,1\n41,610,3\n"}},
+         "identify IN/f.csv --subject 5 --out OUT/id", {"--subject = 5: ", "has no rows of subject 5 (its subjects: 1, 3)"}},
+        {"SubmaximalLevelsAsFractions", {{"p.yaml", "name: bad\nkind: submaximal\nseed: 1\nsubject:\n  arm: arm/default_male.yaml\n"
+                                                    "  muscle: muscles/biceps_long_head.yaml\n" + kTrial +
+                                                    "conditions:\n  elbow_angles_deg: [90]\n  levels_pct_mvc: [0.25, 0.5, 1.0]\n"}},
+         "protocol IN/p.yaml --out OUT/run", {"p.yaml:", "lacks 100", "fractions? expected percent of MVC ([25, 50, 100])"}},
+        {"TorqueProtocolVolumeScanOfAnAbsentMuscle",
+         {{"p.yaml", kTorqueHead + "subject:\n  model: twin\nmeasurements:\n  volume_scan: [BIClong, DELT]\nconditions:\n"
+                                   "  - {flexion_deg: 90, effort: flexion, repetitions: 1}\n"}},
+         "protocol IN/p.yaml --out OUT/run", {"p.yaml:6: field 'measurements.volume_scan'", "has no muscle 'DELT'"}},
+        {"TorqueProtocolForearmAxisOnTheThesisArm",
+         {{"p.yaml", kTorqueHead + "subject:\n  model: thesis\nconditions:\n  - {flexion_deg: 90, effort: supination, repetitions: 1}\n"}},
+         "protocol IN/p.yaml --out OUT/run", {"p.yaml: protocol 'bad' reads the forearm axis", "no forearm rotation"}},
+        {"SeedPastUnsigned", {}, "design --seed 4294967296 --out OUT/d", {"--seed = '4294967296'", "[0, 4294967295]"}},
+        {"MuscleTrialPathShorterThanTheTendon", {}, "muscle trial --model elbow --path 0.1 --out OUT/t.csv",
+         {"--path: path length = 0.1 m is too short for muscle 'BIClong'", "start at -0.439"}},
+        {"IdentifySubjectWithoutAColumn", {}, "identify measured/thesis_measured.csv --subject 2 --out OUT/id",
+         {"--subject = 2: ", "no 'subject' column: every row is subject 0"}},
         {"MuscleTrialSteadyStartPathTooShort", {}, "muscle trial --model elbow --path 0.1 --steady-start --out OUT/t.csv",
          {"--path = 0.1 m", "no steady state"}},
         {"MuscleSweepWithNoSteadyStateAnywhere", {}, "muscle sweep --from 1e-6 --to 1e-3 --step 1e-4 --out OUT/s.csv",

@@ -351,12 +351,41 @@ TEST(ModelFile, BadFilesNameTheFileLineAndKey) {
                                   "      insertion: {body: forearm, location: [0, -0.05, 0]}\n"));
     EXPECT_NE(msg.find("follow each other"), std::string::npos) << msg;
 
+    // A path on one body (a flexor that does not cross the elbow) is named at its insertion's line.
+    msg = messageOf(writeTemp("bad6.yaml", head + muscle +
+                                               "    path:\n      origin: {body: upper_arm, location: [0, 0.3, 0]}\n"
+                                               "      insertion: {body: upper_arm, location: [0, -0.05, 0]}\n"));
+    EXPECT_NE(msg.find("bad6.yaml:8"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("muscle 'm': its origin, insertion and every via point are on the upper_arm"), std::string::npos) << msg;
+
     msg = messageOf(writeTemp("bad5.yaml", "name: bad\narm: arm/no_such_arm.yaml\nmuscles: []\n"));
     EXPECT_NE(msg.find("bad5.yaml:2"), std::string::npos) << msg;
 
     msg = messageOf("no_such_model");
     EXPECT_NE(msg.find("no such model"), std::string::npos) << msg;
     EXPECT_NE(msg.find("elbow"), std::string::npos) << msg;  // lists the shipped models
+}
+
+// A wrapping surface's side reversed sends the biceps long head round the far side of its sphere: at
+// full extension its path (0.4736 m against 0.4304 m) asks for a fascicle past nf's zero, where no
+// steady state exists. The load refuses it, naming the muscle and the length (it used to load, and
+// `model show` failed with exit 3 at 0 deg).
+TEST(ModelFile, APathTheMuscleCannotSpanIsRefusedAtLoad) {
+    std::ifstream in(std::string(ARMSIM_ASSET_DIR) + "/models/elbow.yaml");
+    std::stringstream buffer;
+    buffer << in.rdbuf();
+    std::string text = buffer.str();
+    for (std::size_t at = text.find("../"); at != std::string::npos; at = text.find("../", at))
+        text.replace(at, 3, std::string(ARMSIM_ASSET_DIR) + "/");
+    const std::string side = "side: [0.44621, 0.86849, 0.21591]";
+    const std::size_t at = text.find(side);
+    ASSERT_NE(at, std::string::npos);
+    EXPECT_EQ(messageOf(writeTemp("elbow_side.yaml", text)), "");   // the shipped model, moved: loads
+    text.replace(at, side.size(), "side: [-0.44621, -0.86849, -0.21591]");
+    const std::string msg = messageOf(writeTemp("elbow_side.yaml", text));
+    EXPECT_NE(msg.find("elbow_side.yaml: muscle 'BIClong': its path over the elbow's range reaches 0.473588 m, where it "
+                       "has no steady state at activation 0"),
+              std::string::npos) << msg;
 }
 
 // Drive apart from the fibre-type file (issue 28): max_firing_rate from the model file or the muscle

@@ -270,5 +270,14 @@ TEST(OsimForward, ControlsReplaceRepeatedTimesAndExtrapolateLinearly) {
     bool noted = false;
     for (const std::string& n : r.notes) noted = noted || n.find("extrapolated linearly") != std::string::npos;
     EXPECT_TRUE(noted);
+    // From 0.05 s to 0.3 s at 10 Hz the rows fall at 0.05, 0.15, 0.25 s: said, the last row named.
+    s.initialTime = 0.05;
+    s.finalTime = 0.3;
+    const OsimForwardResult offGrid = runOsimForward(model, controls, nullptr, s);
+    EXPECT_NEAR(offGrid.states.get(offGrid.states.getNumRows() - 1, 0), 0.25, 1e-12);
+    bool said = false;
+    for (const std::string& n : offGrid.notes) said = said || n.find("rows every 0.1 s from 0.05 s: the last at 0.25 s, not at the final time 0.3 s") != std::string::npos;
+    EXPECT_TRUE(said);
+    for (const std::string& n : r.notes) EXPECT_EQ(n.find("not at the final time"), std::string::npos) << n;
     fs::remove_all(dir);
 }

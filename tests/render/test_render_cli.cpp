@@ -192,6 +192,26 @@ TEST(RenderCli, DamagedTablesAreRefusedNamingLineAndColumn) {
     EXPECT_NE(shortTable.output.find("--speed = 1: the trial table"), std::string::npos) << shortTable.output;
     EXPECT_NE(shortTable.output.find("less than one frame"), std::string::npos) << shortTable.output;
     EXPECT_FALSE(fs::exists(dir.file("x.mp4")));
+    // Rows missing from the middle (lines 11-20 of the file: 0.09-0.18 s) are refused, not bridged by interpolation.
+    {
+        std::ofstream gap(dir.file("gap.csv"));
+        for (std::size_t i = 0; i < lines.size(); ++i)
+            if (i < 10 || i > 19) gap << lines[i] << "\n";
+    }
+    const CommandResult gap = runArmsim("render " + dir.file("gap.csv") + " --out " + dir.file("x.mp4"));
+    EXPECT_EQ(gap.exitCode, 2) << gap.output;
+    EXPECT_NE(gap.output.find("gap.csv:11: time_s jumps from 0.08 to 0.19 s, 11 times the table's sample interval of 0.01 s"),
+              std::string::npos) << gap.output;
+    // A spreadsheet's quoted header and cells read as the plain ones.
+    {
+        std::ofstream quoted(dir.file("quoted.csv"));
+        std::string header0;
+        for (std::size_t k = 0; k < header.size(); ++k) header0 += (k ? "," : "") + ("\"" + header[k] + "\"");
+        quoted << header0 << "\n";
+        for (std::size_t i = 1; i < lines.size(); ++i) quoted << (i == 1 ? "\"0\"" + lines[i].substr(1) : lines[i]) << "\n";
+    }
+    const CommandResult quotedStill = runArmsim("render " + dir.file("quoted.csv") + " --still-at 0.1 --still " + dir.file("q.png"));
+    EXPECT_EQ(quotedStill.exitCode, 0) << quotedStill.output;
     // One row still makes a still.
     const CommandResult still = runArmsim("render " + dir.file("one_row.csv") + " --still-at 0 --still " + dir.file("s.png"));
     EXPECT_EQ(still.exitCode, 0) << still.output;

@@ -89,9 +89,11 @@ first_run_gone() {
 has_ended() { case "$(job_state)" in COMPLETED | FAILED | CANCELLED | TIMEOUT | NODE_FAIL | OUT_OF_MEMORY) return 0 ;; esac; return 1; }
 
 if [ "$mode" = requeue ]; then
-    # Pause the job once a group is journaled (SIGSTOP to its ranks: the test does not race the
-    # study's end), then requeue it as a preemption would.
+    # Pause the job once a group is journaled, then requeue it as a preemption would. The ranks are
+    # stopped here first (SIGSTOP, at once): `scontrol suspend` goes through slurmctld, and on a loaded
+    # machine the study finished its last 14 tasks before that arrived. Slurm then suspends the job.
     wait_for 120 "a group in the job's journal" has_a_group
+    pkill -STOP -f -- "$armsim study $study --threads [0-9]+ --out $work/slurm" || true
     scontrol suspend "$job" || fail "job $job could not be paused (state $(job_state))"
     before=$(journal_results)
     [ "$before" -lt $tasks ] || fail "the job finished before it was paused ($before results)"
