@@ -33,7 +33,9 @@ constexpr Bound kHandLoad{0, 50, false, false, "kg"};   ///< a load held in the 
 constexpr Bound kMuscleMass{0, 10, true, false, "kg"};  ///< a muscle's mass (10 L; the largest muscles ~1 kg)
 constexpr Bound kTendonLength{0, 2, true, false, "m"};  ///< a muscle's optimal tendon length L0T
 constexpr Bound kPathLength{0, 3, true, false, "m"};    ///< a musculotendon path's length (a whole limb's ~1 m)
-constexpr Bound kMotorUnits{0, 1000, false, false, ""}; ///< motor units of one fibre type
+/// Motor units of one fibre type (Virtual Muscle lumps a muscle's units into a few; 100 + 100 make a 3 s
+/// trial of about 1.3 s, 1000 + 1000 one of minutes: docs/reliability.md).
+constexpr Bound kMotorUnits{0, 100, false, false, ""};
 constexpr Bound kMaxIsometricForce{0, 1e5, true, false, "N"};  ///< a muscle's F0 (the strongest ~10 kN)
 /// An integrator's relative accuracy: CPodes refuses much below 1e-12 ("too much accuracy requested").
 constexpr Bound kAccuracy{1e-12, 0.1, false, false, ""};

@@ -398,7 +398,10 @@ void OutputFiles::writeWith(const std::string& staging, const std::function<void
         writer(staging);
     } catch (const InputError& e) {  // any staging file named as the option and the file typed
         std::string message = e.what();
-        for (const Entry& x : entries_) message = replaceAll(std::move(message), x.staging, x.option + " '" + x.target + "'");
+        for (const Entry& x : entries_) {   // a quoted staging path loses its own quotes
+            message = replaceAll(std::move(message), "'" + x.staging + "'", x.option + " '" + x.target + "'");
+            message = replaceAll(std::move(message), x.staging, x.option + " '" + x.target + "'");
+        }
         throw InputError(message);
     }
 }

@@ -185,6 +185,7 @@ Table Table::readCsv(const std::string& path) {
     Table t;
     std::string line;
     int lineNo = 0;
+    int trailingEmpty = 0;   // empty names after the header's last column (trailing commas)
     bool header = true;
     while (std::getline(in, line)) {
         ++lineNo;
@@ -192,8 +193,14 @@ Table Table::readCsv(const std::string& path) {
         if (!line.empty() && line.back() == '\r') line.pop_back();
         if (line.find_first_not_of(" \t") == std::string::npos || line[line.find_first_not_of(" \t")] == '#')
             continue;
-        const std::vector<std::string> cells = splitCsvLine(line, path + ":" + std::to_string(lineNo));
+        std::vector<std::string> cells = splitCsvLine(line, path + ":" + std::to_string(lineNo));
         if (header) {
+            // Trailing commas (a spreadsheet's empty last columns) are no columns; an empty name inside is.
+            while (cells.size() > 1 && cells.back().empty()) cells.pop_back(), ++trailingEmpty;
+            for (std::size_t i = 0; i < cells.size(); ++i)
+                if (cells[i].empty())
+                    throw InputError(path + ":" + std::to_string(lineNo) + ": the header's column " + std::to_string(i + 1) +
+                                     " has no name: expected a name for every column");
             checkCommaSeparatedHeader(cells, path + ":" + std::to_string(lineNo));
             checkUniqueColumnNames(cells, path + ":" + std::to_string(lineNo));
             t.names_ = cells;
@@ -201,6 +208,7 @@ Table Table::readCsv(const std::string& path) {
             continue;
         }
         const std::string at = path + ":" + std::to_string(lineNo);
+        for (int k = 0; k < trailingEmpty && cells.size() > t.names_.size() && cells.back().empty(); ++k) cells.pop_back();
         if (cells.size() != t.names_.size())
             throw InputError(at + ": " + std::to_string(cells.size()) + " values, expected " +
                              std::to_string(t.names_.size()) + " (one per header column)");

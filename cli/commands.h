@@ -63,7 +63,7 @@ struct MainJobContext {
 /// work: what the step needs that could be missing (an InputError then stops the job before it starts).
 struct MainJobStepRegistrar {
     MainJobStepRegistrar(int order, std::string name, std::function<void(const MainJobContext&)> run,
-                         std::function<void()> check = {});
+                         std::function<void(const MainJobContext&)> check = {});
 };
 
 /// Adds every registered command to app (called by main).

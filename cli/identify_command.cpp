@@ -435,7 +435,23 @@ void runValidate(const ValidateOptions& o) {
         checkField("--noise", pct, {0, 50, false, true, "%, relative force sd"});
         s.noiseLevels.push_back(pct / 100.0);
     }
-    for (const std::string& m : o.methods) s.methods.push_back(parseMethodName(m));
+    // Levels of 0.05 % or less (no transducer is that quiet) are fractions typed for percent.
+    constexpr double kQuietestTransducerPct = 0.05;
+    if (std::any_of(o.noise.begin(), o.noise.end(), [](double p) { return p > 0; }) &&
+        std::all_of(o.noise.begin(), o.noise.end(), [](double p) { return p <= kQuietestTransducerPct; })) {
+        std::string percent;
+        for (double p : o.noise) percent += (percent.empty() ? "" : ",") + formatNumber(100 * p, 6);
+        throw InputError("--noise " + formatList(o.noise) + ": every level is at most " + formatNumber(kQuietestTransducerPct) +
+                         " %, quieter than any force transducer: fractions? expected percent of the force (--noise " +
+                         percent + ")");
+    }
+    for (const std::string& m : o.methods) {
+        try {
+            s.methods.push_back(parseMethodName(m));
+        } catch (const InputError& e) {
+            throw InputError(std::string("--methods: ") + e.what());
+        }
+    }
     s.model = parseValidationModelName(o.model);
     s.estimate = parseForceEstimateName(o.estimate);
     s.jobs = o.jobs;
@@ -685,8 +701,22 @@ void runOutOfFamilyPersonStep(const MainJobContext& ctx) {
 
 const CommandRegistrar registerIdentify(40, addIdentifyCommand);
 const CommandRegistrar registerValidate(41, addValidateCommand);
+// Before any step: the thesis's measured forces are paths the subject's arm must reach.
+void checkIdentificationStep(const MainJobContext& ctx) {
+    const std::string data = findAsset("measured/thesis_measured.csv");
+    try {
+        const ArmParameters arm = ctx.muscle.loadSetup().arm;
+        FaithfulForceModel(arm).calcElbowAngles(readArmObservations(data, arm));
+    } catch (const InputError& e) {
+        throw InputError("--model " + ctx.muscle.model + (ctx.muscle.armFile.empty() ? "" : " with --arm " + ctx.muscle.armFile) +
+                         ": the main job identifies the biceps from the thesis's measured forces (" + data +
+                         "), which this arm cannot take: " + e.what() +
+                         "; the main job needs an arm with the thesis's biceps geometry (--model thesis, the default)");
+    }
+}
+
 const MainJobStepRegistrar registerIdentificationStep(50, "Identification: mass and tendon length (thesis data, own MVC data)",
-                                                      runIdentificationStep);
+                                                      runIdentificationStep, checkIdentificationStep);
 const MainJobStepRegistrar registerOutOfFamilyPersonStep(
     52, "Identification out of family: one person of a stronger population, every channel of the recommended protocol",
     runOutOfFamilyPersonStep);

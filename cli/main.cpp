@@ -127,6 +127,19 @@ std::string getCommandPath(const CLI::App& app) {
     return path.empty() ? "COMMAND" : path;
 }
 
+// "armsim muscle needs a command: expected one of steady, sweep, trial" for CLI11's "A subcommand is
+// required" (which names neither the command nor its choices).
+std::string explainMissingSubcommand(const CLI::App& app, const std::string& what) {
+    if (what.find("subcommand is required") == std::string::npos) return what;
+    const CLI::App* innermost = &app;
+    while (!innermost->get_subcommands().empty()) innermost = innermost->get_subcommands().front();
+    std::string names;
+    for (const CLI::App* s : innermost->get_subcommands({})) names += (names.empty() ? "" : ", ") + s->get_name();
+    if (names.empty()) return what;
+    const std::string path = getCommandPath(app);
+    return (path == "COMMAND" ? std::string("armsim") : "armsim " + path) + " needs a command: expected one of " + names;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -171,7 +184,19 @@ int main(int argc, char** argv) {
         return 2;
     } catch (const CLI::ParseError& e) {
         const std::string unknown = findUnknownCommand(app, argc, argv);
-        std::cerr << "armsim: error: " << (unknown.empty() ? std::string(e.what()) : unknown)
+        std::string what = unknown.empty() ? explainMissingSubcommand(app, e.what()) : unknown;
+        if (const std::size_t at = what.find(": At Most 1 required but received "); at != std::string::npos) {
+            const std::string option = what.substr(0, at);
+            std::string values;   // as typed, in order
+            for (int i = 1; i < argc; ++i) {
+                const std::string a = argv[i];
+                if (a == option && i + 1 < argc) values += (values.empty() ? "" : ", ") + std::string(argv[i + 1]);
+                else if (a.rfind(option + "=", 0) == 0) values += (values.empty() ? "" : ", ") + a.substr(option.size() + 1);
+            }
+            what = option + " is given " + what.substr(at + 34) + " times" + (values.empty() ? "" : " (" + values + ")") +
+                   ": expected it once";
+        }
+        std::cerr << "armsim: error: " << what
                   << " (armsim --help lists the commands and options)\n";
         return 2;
     } catch (const armsim::InputError& e) {

@@ -6,15 +6,21 @@
 #include "muscles/muscle_file.h"
 
 #include <cstdio>
+#include <vector>
 
 namespace armsim::cli {
 
 namespace {
 
+// The thesis's sweep from 27 cm to P_max, checked by integration at its paths up to 43 cm that the muscle
+// reaches (the elbow's biceps long head ends at 42.6 cm).
 void runForceLength(const VirtualMuscle& m, const std::string& outDir) {
-    const ForceLengthSweep sweep =
-        calcForceLengthSweep(m, 0.27, 0.0025, {0.33, 0.36, 0.375, 0.40, 0.41, 0.43},
-                             [](int d, int n) { printProgress("force-length: integrations", d, n); });
+    std::vector<double> checks;
+    for (double P : {0.33, 0.36, 0.375, 0.40, 0.41, 0.43})
+        if (P <= m.getMaxPathLength()) checks.push_back(P);
+    const ForceLengthSweep sweep = calcForceLengthSweep(m, 0.27, 0.0025, checks, [](int d, int n) {
+        printProgress("force-length: integrations", d, n);
+    });
     sweep.table.writeCsv(outDir + "/force_length.csv");
     writePlotPng(outDir + "/force_length.png", sweep.plot);
     const auto& p = m.getParameters();

@@ -38,7 +38,7 @@ struct Step {
     int order;
     std::string name;
     std::function<void(const MainJobContext&)> run;
-    std::function<void()> check;
+    std::function<void(const MainJobContext&)> check;
 };
 
 std::vector<Command>& commands() {
@@ -57,7 +57,8 @@ CommandRegistrar::CommandRegistrar(int order, std::function<void(CLI::App&)> add
 }
 
 MainJobStepRegistrar::MainJobStepRegistrar(int order, std::string name,
-                                           std::function<void(const MainJobContext&)> run, std::function<void()> check) {
+                                           std::function<void(const MainJobContext&)> run,
+                                           std::function<void(const MainJobContext&)> check) {
     steps().push_back({order, std::move(name), std::move(run), std::move(check)});
 }
 
@@ -371,8 +372,9 @@ void printTimeProgress(const std::string& label, double t, double duration) {
 }
 
 namespace {
-// A numeric option given '' is refused by name (CLI11 reads it as 0: "--fps = 0" blamed a value never typed).
-void refuseEmptyNumbers(CLI::App& app) {
+// An option given '' is refused by name: CLI11 reads a number's '' as 0 ("--fps = 0" blamed a value
+// never typed), and a text option's '' read as not given (`--plot ''` made no plot, silently).
+void refuseEmptyValues(CLI::App& app) {
     for (CLI::Option* option : app.get_options()) {
         const std::string type = option->get_type_name();
         if (option->get_items_expected_max() != 1) continue;   // lists say which item is empty
@@ -381,8 +383,15 @@ void refuseEmptyNumbers(CLI::App& app) {
             option->check(CLI::Validator(
                 [](std::string& text) { return text.empty() ? std::string("is empty: expected a number") : std::string(); },
                 "", "non-empty number"));
+        else if (type.rfind("TEXT", 0) == 0 && option->get_expected_min() > 0) {   // '' would read as "not given"
+            const std::string expected = option->nonpositional() ? "a value (leave the option out for its default)"
+                                                                 : "a file name";
+            option->check(CLI::Validator(
+                [expected](std::string& text) { return text.empty() ? "is empty: expected " + expected : std::string(); },
+                "", "non-empty text"));
+        }
     }
-    for (CLI::App* sub : app.get_subcommands({})) refuseEmptyNumbers(*sub);
+    for (CLI::App* sub : app.get_subcommands({})) refuseEmptyValues(*sub);
 }
 }  // namespace
 
@@ -411,7 +420,7 @@ void addRegisteredCommands(CLI::App& app) {
         checkOutputFolder("--out", ctx->outDir);
         ctx->muscle.loadSetup();   // the model and its options checked before any step prints or writes
         for (const auto& step : s)
-            if (step.check) step.check();   // what a step needs (the renderer's plugin), before any work
+            if (step.check) step.check(*ctx);   // what a step needs (the renderer's plugin), before any work
         OutputFolder folder(ctx->outDir, OutputFolder::Mode::AddFiles, "manifest.json");  // protocol runs whole
         MainJobContext staged = *ctx;
         staged.outDir = folder.getStagingPath();
@@ -433,7 +442,7 @@ void addRegisteredCommands(CLI::App& app) {
         folder.commit();
         std::printf("\nAll results are in %s/\n", ctx->outDir.c_str());
     });
-    refuseEmptyNumbers(app);
+    refuseEmptyValues(app);
 }
 
 }  // namespace armsim::cli

@@ -270,7 +270,7 @@ void runTrialVideos(const MainJobContext& ctx) {
 
 const CommandRegistrar registerRender(60, addRenderCommand);
 const MainJobStepRegistrar registerVideos(60, "Videos: anatomical-twin MVC at 90 deg, thesis-arm free movement", runTrialVideos,
-                                          [] { checkRenderPluginFile("videos"); });
+                                          [](const MainJobContext&) { checkRenderPluginFile("videos"); });
 
 #else
 

@@ -41,7 +41,9 @@ std::vector<double> readRange(const ParamNode& parent, const std::string& key, c
         if (x > to + 1e-9 * std::max(1.0, std::abs(to))) break;
         v.push_back(std::min(x, to));
         if (v.size() > 10000)
-            throw InputError(r.where("step") + ": field " + describeField(r.path("step")) + " gives more than 10000 values");
+            throw InputError(r.where("step") + ": field " + describeField(r.path("step")) + " = " + formatNumber(step) +
+                             " over " + formatNumber(from) + " to " + formatNumber(to) + " gives " +
+                             formatNumber(std::floor((to - from) / step) + 1) + " values: expected at most 10000 (a longer step)");
     }
     return v;
 }
@@ -343,6 +345,9 @@ void readCompositionConditions(const ParamNode& c, Protocol& p, const ArmParamet
     p.fastUnitsTo = fu.getInt("to", p.fastUnitsFrom, 100);
     su.finish();
     fu.finish();
+    if (p.slowUnitsTo == 0 && p.fastUnitsTo == 0)   // a grid's 0 + 0 corner is its passive reference, not a grid
+        throw InputError(c.where("fast_units") + ": fields 'conditions.slow_units' and 'conditions.fast_units' both end at 0: "
+                         "the grid's one cell has no motor unit (passive force only): expected units in some cell");
     p.compositionActivation = c.getNumber("activation", Bound::closed(0, 1), p.compositionActivation);
     p.compositionPath = c.getNumber("path_length", {0, pMax, true, false, "m, up to the muscle's P_max"},
                                     p.compositionPath);

@@ -129,6 +129,14 @@ void TorqueProtocol::validate() const {
     for (const TorqueCondition& c : conditions) angles.push_back(c.flexionDeg);
     const auto fractional = std::find_if(angles.begin(), angles.end(), [](double a) { return a != std::round(a); });
     if (fractional != angles.end()) checkDegreesNotRadians(conditionField(std::size_t(fractional - angles.begin()), "flexion_deg"), angles);
+    std::vector<double> rotations;   // the postures given (NaN: the model's own)
+    std::size_t fractionalRotation = conditions.size();
+    for (std::size_t k = 0; k < conditions.size(); ++k)
+        if (std::isfinite(conditions[k].rotationDeg)) {
+            rotations.push_back(conditions[k].rotationDeg);
+            if (fractionalRotation == conditions.size() && rotations.back() != std::round(rotations.back())) fractionalRotation = k;
+        }
+    if (fractionalRotation < conditions.size()) checkDegreesNotRadians(conditionField(fractionalRotation, "rotation_deg"), rotations);
     checkField("trial.rest", restDuration, Bound::positive("s"));
     checkField("trial.hold", holdDuration, Bound::positive("s"));
     checkField("trial.averaging_window", averagingWindow, {0, holdDuration, true, false, "s, within the hold"});
@@ -244,7 +252,11 @@ TorqueProtocol readTorqueProtocol(const std::string& path) {
         if (c.has("rotation_deg")) tc.rotationDeg = c.getNumber("rotation_deg", Bound::closed(-180, 180, "deg, + = supination"));
         if (c.has("channels")) {
             const std::vector<std::string> channels = c.getStrings("channels");
-            for (const std::string& name : channels) {
+            for (std::size_t i = 0; i < channels.size(); ++i) {
+                const std::string& name = channels[i];
+                if (std::find(channels.begin(), channels.begin() + long(i), name) != channels.begin() + long(i))
+                    throw InputError(c.where("channels") + ": field " + describeField(c.path("channels")) + " lists '" + name +
+                                     "' twice: expected each channel once");
                 if (name == "ultrasound") tc.ultrasound = true;
                 else if (name == "emg") tc.emg = true;
                 else if (name != "torque")

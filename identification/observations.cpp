@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <set>
 #include <sstream>
 #include <tuple>
@@ -43,7 +44,7 @@ ObservationSet makeAnglePoints(const std::vector<double>& anglesDeg, const PathF
 }
 
 void validateObservations(const ObservationSet& set) {
-    std::set<std::tuple<int, int, double, double>> seen;
+    std::map<std::tuple<int, int, double, double>, int> seen;   // point -> its first row
     for (int i = 0; i < int(set.points.size()); ++i) {
         const Observation& o = set.points[i];
         const std::string at = set.where(i);
@@ -57,12 +58,12 @@ void validateObservations(const ObservationSet& set) {
             fail("path length [m]", o.pathLength, "a finite value > 0");
         if (!std::isfinite(o.activation) || o.activation < 0 || o.activation > 1)
             fail("activation", o.activation, "in [0, 1]");
-        if (!seen.insert({o.subject, o.trial, o.pathLength, o.activation}).second)
-            throw InputError(at + ": duplicate point: path " + formatNumber(o.pathLength) + " m, activation " +
-                             formatNumber(o.activation) + ", trial " + std::to_string(o.trial) + ", subject " +
-                             std::to_string(o.subject) +
-                             " appear earlier: expected each point once (give repeated trials a "
-                             "`trial` column, or average them)");
+        const auto [first, added] = seen.insert({{o.subject, o.trial, o.pathLength, o.activation}, i});
+        if (!added)
+            throw InputError(at + ": the same point as " + set.where(first->second) + " (path " +
+                             formatNumber(o.pathLength, 10) + " m, activation " + formatNumber(o.activation) + ", trial " +
+                             std::to_string(o.trial) + ", subject " + std::to_string(o.subject) +
+                             "): expected each point once (give repeated trials a `trial` column, or average them)");
     }
 }
 
@@ -146,6 +147,15 @@ ObservationSet makeObservations(const Table& t, const std::string& path, const O
                                         (t.hasColumn("subject") ? "its subjects: " + seen : "no 'subject' column: every row is subject 0") +
                                         "): expected one of them");
     }
+    // A muscle's maximal force is tens to hundreds of newtons; a file whose every force is under 1 N is
+    // in kN (the fit ran to its mass bound and said "not converged").
+    constexpr double kLeastMaximalForce = 1;   // N
+    const double largest = std::max_element(set.points.begin(), set.points.end(), [](const Observation& a, const Observation& b) {
+        return a.force < b.force;
+    })->force;
+    if (largest > 0 && largest < kLeastMaximalForce)
+        throw InputError(path + ": column 'force_N' is at most " + formatNumber(largest) + " N in every row: kN? expected "
+                         "newtons (a muscle's maximal force is tens to hundreds of N)");
     if (std::none_of(set.points.begin(), set.points.end(), [](const Observation& o) { return o.force > 0; }))
         throw InputError(path + ": column 'force_N' is 0 N in every row: expected a positive force in one row at "
                                 "least (nothing to fit: every mass and tendon length at their bounds would do)");

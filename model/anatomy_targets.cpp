@@ -133,6 +133,27 @@ bool doesFamilyCoverMuscle(const std::string& family, const std::string& muscle)
     return muscle.compare(0, family.size(), family) == 0;
 }
 
+namespace {
+// The file's angles of one field, in degrees unless all look like radians (basics/bound.h), named at
+// the first target whose angle is not whole.
+void checkTargetAnglesInDegrees(const std::vector<AnatomyTarget>& targets, double AnatomyTarget::*field, const char* name) {
+    std::vector<double> angles;
+    const AnatomyTarget* fractional = nullptr;
+    for (const AnatomyTarget& t : targets)
+        if (std::isfinite(t.*field) && (name != std::string("rotation_deg") || t.kind == TargetKind::ForearmMvc ||
+                                        t.kind == TargetKind::PostureRatio)) {
+            angles.push_back(t.*field);
+            if (!fractional && t.*field != std::round(t.*field)) fractional = &t;
+        }
+    if (!fractional) return;
+    try {
+        checkDegreesNotRadians(name, angles);
+    } catch (const InputError& e) {
+        throw InputError(fractional->where + ": " + e.what());
+    }
+}
+}  // namespace
+
 std::vector<AnatomyTarget> loadAnatomyTargets(const std::string& path) {
     const ParamNode root = ParamNode::loadFile(path);
     std::vector<AnatomyTarget> out;
@@ -176,6 +197,8 @@ std::vector<AnatomyTarget> loadAnatomyTargets(const std::string& path) {
     }
     root.finish();
     if (out.empty()) throw InputError(root.where("targets") + ": field 'targets' is empty: expected at least one target");
+    checkTargetAnglesInDegrees(out, &AnatomyTarget::flexionDeg, "flexion_deg");
+    checkTargetAnglesInDegrees(out, &AnatomyTarget::rotationDeg, "rotation_deg");
     return out;
 }
 

@@ -360,6 +360,19 @@ void checkSteadyStatesAtLongestPaths(const ArmSetup& s, const std::string& file)
     }
 }
 
+// The primary and roles.biceps: the thesis's biceps, a flexor (an extensor head would be an antagonist
+// in every flexion effort).
+void checkBicepsHeadsAreFlexors(const ArmSetup& s, const std::vector<ParamNode>& muscleNodes) {
+    for (int m : s.getBicepsHeads())
+        if (s.muscles[m].group != MuscleGroup::Flexor) {
+            const ParamNode& n = muscleNodes[std::size_t(m)];
+            throw InputError((n.has("group") ? n.where("group") : n.where()) + ": muscle '" + s.muscles[m].params.name +
+                             "' is the " + (m == s.primary ? "primary muscle" : "biceps head") + " but of group " +
+                             getMuscleGroupName(s.muscles[m].group) +
+                             ": expected a flexor (the biceps the identifiers and the thesis's estimate stand for)");
+        }
+}
+
 // The thesis's A and B for a model without a `biceps` section: the primary muscle's origin and
 // insertion distances from the elbow centre.
 void deriveThesisGeometry(ArmSetup& s) {
@@ -527,7 +540,8 @@ ArmSetup loadModelFile(const std::string& file) {
         for (const auto& [k, v] : model.coefficients) c[k] = v;
         model.coefficients = c;
     }
-    for (const ParamNode& m : root.children("muscles"))
+    const std::vector<ParamNode> muscleNodes = root.children("muscles");
+    for (const ParamNode& m : muscleNodes)
         s.muscles.push_back(readMuscle(m, MuscleDefaults{s.specificTension, s.maxFiringRate}, model));
     if (s.muscles.empty()) throw InputError(root.where("muscles") + ": field 'muscles' is empty: expected at least one muscle");
     if (root.has("primary")) {
@@ -564,6 +578,7 @@ ArmSetup loadModelFile(const std::string& file) {
                              s.muscles[s.primary].params.name + "': expected it among the biceps heads");
     }
     root.finish();
+    checkBicepsHeadsAreFlexors(s, muscleNodes);
     if (!s.arm.forearmRotation.enabled)
         for (const MuscleSpec& m : s.muscles)
             for (const PathElementSpec& e : m.path)

@@ -1,5 +1,6 @@
 #include "muscles/muscle_file.h"
 
+#include "basics/bound.h"
 #include "basics/files.h"
 #include "basics/param_node.h"
 
@@ -114,8 +115,14 @@ Bound getMaxFiringRateBound() { return Bound{0.5, 8, true, false, "f0.5, above f
 
 void readMuscleFields(const ParamNode& root, MuscleParameters& p, bool required, const MuscleDefaults& defaults) {
     const Bound any = Bound::any();
+    // Each quantity in its own bound where it is typed (the derived mass and L0T are checked again).
     auto number = [&](const std::string& key, double& field) {
-        if (required || root.has(key)) field = root.getNumber(key, any);
+        const Bound bound = key == "mass"                      ? bounds::kMuscleMass
+                            : key == "optimal_fascicle_length" ? getOptimalFascicleLengthBound()
+                            : key == "optimal_tendon_length"   ? bounds::kTendonLength
+                            : key == "max_path_length"         ? bounds::kPathLength
+                                                               : any;
+        if (required || root.has(key)) field = root.getNumber(key, bound);
     };
     // A field or the OpenSim quantity it is converted from (below), not both.
     auto numberOrConverted = [&](const std::string& key, const std::string& converted, double& field) {
@@ -147,8 +154,8 @@ void readMuscleFields(const ParamNode& root, MuscleParameters& p, bool required,
     }
     if (required || root.has("motor_units")) {
         const ParamNode mu = root.child("motor_units");
-        p.numSlowUnits = mu.getInt("slow", 0, 1000);
-        p.numFastUnits = mu.getInt("fast", 0, 1000);
+        p.numSlowUnits = mu.getInt("slow", 0, int(bounds::kMotorUnits.hi));
+        p.numFastUnits = mu.getInt("fast", 0, int(bounds::kMotorUnits.hi));
         if (p.numSlowUnits + p.numFastUnits == 0)  // (a composition grid's 0 + 0 cell is made in code, not read)
             throw InputError(mu.where("fast") + ": motor_units slow + fast = 0: expected at least one motor unit "
                                                 "(without units a muscle makes no active force)");
@@ -177,7 +184,7 @@ void readMuscleFields(const ParamNode& root, MuscleParameters& p, bool required,
         p.mass = F0 * p.optimalFascicleLength * p.coefficients.density / p.coefficients.sigma;
     }
     if (root.has("tendon_slack_length")) {
-        const double slack = root.getNumber("tendon_slack_length", Bound::positive("m"));
+        const double slack = root.getNumber("tendon_slack_length", bounds::kTendonLength);
         p.optimalTendonLength = slack / p.coefficients.LrT;
     }
 }

@@ -96,9 +96,11 @@ void MuscleCoefficients::validate(const std::string& p) const {
     checkField(q + "density", density, Bound{500, 2000, false, false, "kg/m^3"});
 }
 
+Bound getOptimalFascicleLengthBound() { return Bound{1e-3, 1, false, false, "m, a muscle fascicle"}; }
+
 void MuscleParameters::validate() const {
     checkField("mass", mass, bounds::kMuscleMass);
-    checkField("optimal_fascicle_length", optimalFascicleLength, Bound{1e-3, 1, false, false, "m, a muscle fascicle"});
+    checkField("optimal_fascicle_length", optimalFascicleLength, getOptimalFascicleLengthBound());
     checkField("optimal_tendon_length", optimalTendonLength, bounds::kTendonLength);
     checkField("max_path_length", maxPathLength, bounds::kPathLength);
     checkField("fibre_fractions.slow", slowFraction, Bound::closed(0, 1));

@@ -33,6 +33,7 @@
 // | Fse     | Outputs::Fse            | series-elastic force = the muscle's output force     | N        |
 #pragma once
 
+#include "basics/bound.h"
 #include "muscles/muscle_model.h"
 
 #include <string>
@@ -111,6 +112,9 @@ enum class Apportioning {
     Thesis,  ///< p_i = F_type (N + i) / sum_{n=1..N} (N + n) (thesis eq. 4.11/4.12)
     Equal    ///< p_i = F_type / N
 };
+
+/// L0's bound, [1 mm, 1 m] (a muscle fascicle), where it is typed and in validate().
+Bound getOptimalFascicleLengthBound();
 
 /// Everything that defines one muscle (model: immutable once built).
 struct MuscleParameters {

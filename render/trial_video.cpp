@@ -257,14 +257,19 @@ struct TrialRenderer::Impl {
         checkColumnValues();
     }
 
-    // What a trial writes: every state and transducer cell finite, an elbow angle within a turn either
-    // way, a muscle force inside the F0 bound, a saturation flag 0 or 1.
+    // What a trial writes: every state and transducer cell finite, an elbow angle within the arm's
+    // range, a muscle force inside the F0 bound, a saturation flag 0 or 1.
     void checkColumnValues() const {
         const auto bad = [&](int i, const std::string& c, const std::string& expected) {
             return InputError(name + " " + rowName(table, i) + ": column '" + c + "' = " +
                               fmt::format("{:g}", table.get(i, c)) + ": expected " + expected);
         };
-        const Bound kAngle{-360, 360, false, false, "deg"};
+        // The arm's elbow range, with room for a free trial pressing into its stop.
+        constexpr double kStopSlackDeg = 10;
+        const Bound kAngle{setup.arm.minElbowAngleDeg - kStopSlackDeg, setup.arm.maxElbowAngleDeg + kStopSlackDeg, false, false, "deg"};
+        const std::string angleExpected = kAngle.describe() + ": the arm's elbow range, " + formatNumber(setup.arm.minElbowAngleDeg) +
+                                          ".." + formatNumber(setup.arm.maxElbowAngleDeg) + " deg (included angle), within " +
+                                          formatNumber(kStopSlackDeg) + " deg";
         const Bound kForce{-bounds::kMaxIsometricForce.hi, bounds::kMaxIsometricForce.hi, false, false, "N"};
         std::set<std::string> forces = {"muscle_force_N"};
         for (const MuscleSpec& m : setup.muscles) forces.insert("force_" + m.params.name + "_N");
@@ -283,7 +288,7 @@ struct TrialRenderer::Impl {
                 const std::string& c = table.getColumnNames()[k];
                 switch (rules[k]) {
                     case Rule::Finite: if (!std::isfinite(x)) throw bad(i, c, "a finite number"); break;
-                    case Rule::Angle: if (!kAngle.contains(x)) throw bad(i, c, kAngle.describe()); break;
+                    case Rule::Angle: if (!kAngle.contains(x)) throw bad(i, c, angleExpected); break;
                     case Rule::Force: if (std::isfinite(x) && !kForce.contains(x)) throw bad(i, c, kForce.describe()); break;
                     case Rule::Flag: if (x != 0 && x != 1) throw bad(i, c, "0 or 1"); break;
                     case Rule::None: break;

@@ -24,6 +24,7 @@ constexpr double kMassGoal = 0.10;     // the design goal: mass RMSE <= 10 %
 constexpr double kTendonGoal = 0.010;  // the design goal: tendon-length RMSE <= 1 cm [m]
 constexpr double kMargin = 2e-4;       // prior draws stay this far inside the bounds (ln scales and activations)
 constexpr unsigned kMaxRedraws = 100;  // prior draws tried again for one without a steady state
+constexpr int kMaxDesignRepetitions = 100;   // of one condition: a torque protocol's bound on repetitions
 
 Eigen::MatrixXd toMatrix(const std::vector<std::vector<double>>& rows) {
     Eigen::MatrixXd m(int(rows.size()), rows.empty() ? 0 : int(rows.front().size()));
@@ -437,6 +438,7 @@ void DesignSettings::validate() const {
     checkDegreesNotRadians("angles", flexionDeg);
     for (double l : levels) checkField("levels", l, Bound::open(0, 1, "fraction of maximal, in (0, 1)"));
     for (double r : postures) checkField("postures", r, Bound::closed(-90, 90, "deg, + = supination"));
+    if (!postures.empty()) checkDegreesNotRadians("postures", postures);
     // A candidate given twice would be one condition listed twice in the designed protocol.
     auto once = [](const std::vector<double>& v, const char* field) {
         for (std::size_t i = 0; i < v.size(); ++i)
@@ -463,6 +465,11 @@ void DesignSettings::validate() const {
     checkField("activation_sd", activationSd, Bound::closed(0, 0.5));
     checkField("jobs", jobs, Bound::closed(1, 1024));
     checkField("budget", budgetMinutes, Bound::closed(0, 10000, "min"));
+    const double block = costs.mvcBlock * double(repetitions) / 3;   // designChannelProtocol's smallest torque pick
+    if (budgetMinutes > 0 && budgetMinutes < block)
+        throw FieldError("budget", "= " + formatNumber(budgetMinutes) + " min: no MVC block (" + formatNumber(block, 4) +
+                                       " min for " + std::to_string(repetitions) + " repetitions) fits: expected at least " +
+                                       formatNumber(block, 4) + " min");
 }
 
 ProtocolPrediction predictProtocol(const Population& prior, const TorqueProtocol& protocol,
@@ -658,7 +665,7 @@ DesignResult designChannelProtocol(const Population& prior, const DesignSettings
         for (int c = 0; c < nc; ++c) {
             Choice ch = chosen;
             ch.torque[c] += reps;
-            consider(ch, block, "torque", result.candidates[c]);
+            if (ch.torque[c] <= kMaxDesignRepetitions) consider(ch, block, "torque", result.candidates[c]);
             if (chosen.torque[c] > 0 && !chosen.ultrasound[c] && takesChannels(result.candidates[c])) {
                 ch = chosen;
                 ch.ultrasound[c] = true;

@@ -709,7 +709,7 @@ void checkStudyFitsOnDisk(const Study& study, long tasksToCompute, const std::st
     std::error_code ec;
     while (!fs::exists(at, ec) && at.has_parent_path() && at != at.parent_path()) at = at.parent_path();
     const fs::space_info space = fs::space(at, ec);
-    if (ec) return;   // a file system that does not say: nothing to check against
+    if (ec || space.capacity == 0) return;   // a file system that does not say (sysfs: 0 of 0): nothing to check against
     const double need = double(tasksToCompute) * kStudyBytesPerTask;
     if (need > double(space.available))
         throw InputError("study '" + study.name + "': " + study.describeSize() + ", " + std::to_string(tasksToCompute) +

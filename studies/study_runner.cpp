@@ -768,6 +768,12 @@ StudyOutcome runStudy(const Study& study, const StudyRunOptions& options, StudyC
     // A new folder is checked before it is made (nothing left behind); an existing one for what it lacks, below.
     const bool existed = std::filesystem::exists(outcome.output);
     checkStudyRunOptions(options, outcome.output, existed, link != nullptr);
+    if (sharded && options.shard >= study.getNumGroups())   // g % N == I holds for no group g
+        throw InputError("study: shard " + std::to_string(options.shard) + "/" + std::to_string(options.shards) +
+                         ": the study has " + std::to_string(study.getNumGroups()) +
+                         (study.getNumGroups() == 1 ? " group" : " groups") +
+                         " (truths x subjects x protocols), so this shard has none to compute: expected N at "
+                         "most the number of groups (--shard I/N)");
     if (!options.merge && !existed) checkStudyFitsOnDisk(study, study.getNumTasks() / std::max(1, options.shards), outcome.output);
     StudyFolder folder(outcome.output, fingerprint, study, options.restart, options.shard, options.shards);
     outcome.journalDrops = folder.getDropped();

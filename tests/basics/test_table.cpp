@@ -77,6 +77,19 @@ TEST(Table, QuotedCellsReadAsTheirText) {
     EXPECT_EQ(t.getRow(0), (std::vector<double>{0, 1.5, 2}));
     std::ofstream(p) << "a,\"b,c\",\"d\"\"\"\n1,2,3\n";
     EXPECT_EQ(Table::readCsv(p.string()).getColumnNames(), (std::vector<std::string>{"a", "b,c", "d\""}));
+    // Trailing commas (a spreadsheet's empty last columns) read as no columns; an unnamed column inside
+    // the header is refused with its place.
+    std::ofstream(p) << "a,b,,\n1,2,,\n3,4\n";
+    const Table trailing = Table::readCsv(p.string());
+    EXPECT_EQ(trailing.getColumnNames(), (std::vector<std::string>{"a", "b"}));
+    EXPECT_EQ(trailing.getRow(1), (std::vector<double>{3, 4}));
+    std::ofstream(p) << "a,,b\n1,2,3\n";
+    try {
+        Table::readCsv(p.string());
+        ADD_FAILURE() << "an unnamed column accepted";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find(":1: the header's column 2 has no name"), std::string::npos) << e.what();
+    }
     std::ofstream(p) << "a,b\n1,\"2\n";
     try {
         Table::readCsv(p.string());

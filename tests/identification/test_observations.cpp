@@ -84,7 +84,7 @@ TEST(ReadObservations, BadValuesNameFileLineAndValue) {
         {"nan.csv", "path_cm,force_N\n40,596\n37.5,nan\n", {"nan.csv:3", "force_N", "nan"}},
         {"neg.csv", "path_cm,force_N\n40,-5\n", {"neg.csv:2", "force_N", "-5"}},
         {"act.csv", "path_cm,force_N,activation\n40,596,1.2\n", {"act.csv:2", "activation", "1.2", "[0, 1]"}},
-        {"dup.csv", "path_cm,force_N\n40,596\n37.5,448\n40,590\n", {"dup.csv:4", "duplicate", "0.4"}},
+        {"dup.csv", "path_cm,force_N\n40,596\n37.5,448\n40,590\n", {"dup.csv:4", "the same point as", "dup.csv:2 (path 0.4 m"}},
         {"ang.csv", "angle_deg,force_N\n200,500\n", {"ang.csv:2", "angle_deg", "200"}},
         {"col.csv", "path_cm,force_N,weight\n40,596,1\n", {"col.csv", "unknown column 'weight'"}},
         {"two.csv", "path_cm,angle_deg,force_N\n40,90,596\n", {"two.csv", "exactly one of"}},

@@ -338,7 +338,7 @@ def test_the_bounds_table_holds_in_python_as_on_the_command_line(thesis):
     """basics/bound.h's table, through the module: the same bounds and words as the command line and the files
     (tests/cli/test_bad_input.cpp, BoundsTable)."""
     for kw, bound in ((dict(mass=11.0), "(0, 10] (kg)"), (dict(optimal_tendon_length=3.0), "(0, 2] (m)"),
-                      (dict(slow_units=1001), "[0, 1000]")):
+                      (dict(slow_units=101), "[0, 100]")):
         with pytest.raises(ValueError, match=re.escape(bound)):
             thesis.with_muscle(**kw)
     with pytest.raises(ValueError, match=re.escape("[0, 50] (kg)")):

@@ -118,7 +118,7 @@ TEST(RenderCli, BadOptionsAreNamedErrors) {
         // Options that would be ignored, or half a still, named (issue 34).
         {"--still " + dir.file("a.png"), "--still '" + dir.file("a.png") + "' needs --still-at"},
         {"--still-at 0.1", "--still-at 0.1 needs --still FILE.png"},
-        {"--out '' --still-at 0.1 --still " + dir.file("a.png"), "--out is empty"},
+        {"--out '' --still-at 0.1 --still " + dir.file("a.png"), "--out: is empty"},
         {"--fps 60 --still-at 0.1 --still " + dir.file("a.png"), "--fps is a video's option: without --out VIDEO"},
         {"--speed 2 --still-at 0.1 --still " + dir.file("a.png"), "--speed is a video's option"},
         {"--out " + dir.file("a.mp4") + " --arrow none --arrow-scale 0.001", "--arrow-scale with --arrow none"},
@@ -175,7 +175,7 @@ TEST(RenderCli, DamagedTablesAreRefusedNamingLineAndColumn) {
     ASSERT_FALSE(state.empty());
     const std::pair<std::string, std::string> cells[] = {
         {state, "nan"}, {"elbow_angle_deg", "1e308"}, {"activation", "7"}, {"saturated", "7"},
-        {"muscle_force_N", "-1e6"}, {"strap_force_N", "nan"}};
+        {"muscle_force_N", "-1e6"}, {"strap_force_N", "nan"}, {"elbow_angle_deg", "1.5708"}};
     for (const auto& [column, value] : cells) {
         const CommandResult r = runArmsim("render " + withCell(column, value) + " --out " + dir.file("x.mp4"));
         EXPECT_EQ(r.exitCode, 2) << column << ": " << r.output;

@@ -304,6 +304,12 @@ TEST(ExperimentDesign, ChannelDesignStaysWithinItsBudgetAndItsProtocolPredictsAl
     EXPECT_EQ(back.anthropometry, d.protocol.anthropometry);
     settings.budgetMinutes = 5;
     EXPECT_THROW(designChannelProtocol(prior, settings, thesis), InputError);
+    // A budget for thousands of trials: no condition gets more repetitions than a protocol may hold
+    // (100; the design used to pick 1,827 of one and fail after its work), and the protocol validates.
+    settings.budgetMinutes = 10000;
+    const DesignResult large = designChannelProtocol(prior, settings, thesis);
+    for (const TorqueCondition& c : large.protocol.conditions) EXPECT_LE(c.repetitions, 100);
+    EXPECT_NO_THROW(large.protocol.validate());
 }
 
 // The two-axis protocol (issue 31): the recommended protocol's rows plus the forearm axis and supination
