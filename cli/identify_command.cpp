@@ -392,11 +392,18 @@ void runElbowValidate(const ValidateOptions& o) {
     const std::vector<ElbowValidationSummary> summary = summarizeElbowValidation(rows);
     std::printf("%-13s %6s %9s %17s %17s %13s %20s %20s %13s\n", "method", "noise", "converged", "mass bias",
                 "mass RMSE", "coverage", "L0T bias", "L0T RMSE", "coverage");
+    std::set<double> mvcAngles;   // the thesis method's: flexion MVCs in the model's posture
+    for (const TorqueCondition& c : s.protocol.conditions)
+        if (c.effort == Effort::Flexion && c.level == 1 && std::isnan(c.rotationDeg)) mvcAngles.insert(c.flexionDeg);
     for (const ElbowValidationSummary& x : summary)
-        if (x.converged == 0)
+        if (x.converged == 0) {
+            std::string why;
+            if (x.method == "synergist-va") why = " (its twitch interpolation needs maximal efforts: has the protocol an MVC?)";
+            if (x.method == "thesis" && mvcAngles.size() < 2)
+                why = " (the thesis method fits flexion MVCs at >= 2 angles; the protocol has " + std::to_string(mvcAngles.size()) + ")";
             std::printf("%-13s %5.1f%% %5d/%-3d no fit converged: nothing to summarise%s\n", x.method.c_str(), 100 * x.noise,
-                        x.converged, x.subjects,
-                        x.method == "synergist-va" ? " (its twitch interpolation needs maximal efforts: has the protocol an MVC?)" : "");
+                        x.converged, x.subjects, why.c_str());
+        }
         else
         std::printf("%-13s %5.1f%% %5d/%-3d %+8.1f +/- %3.1f%% %8.1f +/- %3.1f%% %5.2f +/- %4.2f %+8.1f +/- %3.1f mm "
                     "%8.1f +/- %3.1f mm %5.2f +/- %4.2f\n",

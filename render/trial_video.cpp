@@ -111,8 +111,9 @@ OverlayStyle scaleOverlayStyle(OverlayStyle s, int height) {
 
 void TrialSceneSettings::validate() const {
     checkField("muscle_thickness", muscleThickness, {0, 64, true, false, "px"});
-    checkField("force_scale", forceScale, Bound::nonNegative("N (0 = the table's peak force)"));
-    checkField("arrow_scale", arrowScale, Bound::nonNegative("m/N (0 = automatic)"));
+    checkField("force_scale", forceScale, Bound::closed(0, bounds::kMaxIsometricForce.hi, "N, 0 = the table's peak force"));
+    // 10 cm per newton draws a 50 N strap force 5 m long, far outside any frame.
+    checkField("arrow_scale", arrowScale, Bound::closed(0, 0.1, "m/N, 0 = automatic"));
     checkField("hand_load", handLoad, bounds::kHandLoad);
 }
 

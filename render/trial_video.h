@@ -44,9 +44,9 @@ struct TrialSceneSettings {
     MuscleColoring muscleColoring = MuscleColoring::Activation;
     bool thicknessFollows = true;    ///< true: line thickness 3 + 5 x (coloured quantity) px
     double muscleThickness = 4;      ///< line thickness when thicknessFollows is false (px), in (0, 64]
-    double forceScale = 0;           ///< force at full red in Force colouring (N), >= 0; 0 = table peak
+    double forceScale = 0;           ///< force at full red in Force colouring (N), in [0, 1e5]; 0 = table peak
     ForceArrowKind forceArrow = ForceArrowKind::Auto;
-    double arrowScale = 0;           ///< arrow length per newton (m/N), >= 0; 0 = automatic: a
+    double arrowScale = 0;           ///< arrow length per newton (m/N), in [0, 0.1]; 0 = automatic: a
                                      ///< round 1, 2 or 5 x 10^k N per cm that keeps the table's peak
                                      ///< of the force shown within 15 cm
     bool floor = true;               ///< a floor with 10 cm ticks below the hand's lowest reach

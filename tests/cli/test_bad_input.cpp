@@ -429,6 +429,8 @@ std::vector<BadInput> makeCatalogue() {
         {"ValidateMethodsUnknown", {}, "validate --methods LM --out OUT/v", {"--methods: method 'LM': expected one of"}},
         {"MuscleWithoutItsCommand", {}, "muscle", {"armsim muscle needs a command: expected one of steady, sweep, trial"}},
         {"TrialRateTwice", {}, "trial --rate 100 --rate=200 --out OUT/t.csv", {"--rate is given 2 times (100, 200): expected it once"}},
+        {"RenderArrowScaleHuge", {{"t.csv", "time_s\n0\n"}}, "render IN/t.csv --out OUT/v.mp4 --arrow-scale 1e308",
+         {"--arrow-scale", "1e+308", "[0, 0.1] (m/N, 0 = automatic)"}},
         {"StudyShardPastTheGroups", {{"s.yaml", kStudyHead + "methods:\n  - {method: thesis}\n"}}, "study IN/s.yaml --shard 5/6 --out OUT/s",
          {"shard 5/6: the study has 1 group (truths x subjects x protocols)", "expected N at most the number of groups"}},
         {"StudyThesisMethodActivationSd", {{"s.yaml", kStudyHead + "methods:\n  - {method: thesis, activation_sd: 0.05}\n"}},
