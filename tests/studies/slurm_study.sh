@@ -93,7 +93,7 @@ if [ "$mode" = requeue ]; then
     # stopped here first (SIGSTOP, at once): `scontrol suspend` goes through slurmctld, and on a loaded
     # machine the study finished its last 14 tasks before that arrived. Slurm then suspends the job.
     wait_for 120 "a group in the job's journal" has_a_group
-    pkill -STOP -f -- "$armsim study $study --threads [0-9]+ --out $work/slurm" || true
+    pkill -STOP -f -- "^$armsim study $study --threads [0-9]+ --out $work/slurm" || true   # the ranks, not srun
     scontrol suspend "$job" || fail "job $job could not be paused (state $(job_state))"
     before=$(journal_results)
     [ "$before" -lt $tasks ] || fail "the job finished before it was paused ($before results)"
