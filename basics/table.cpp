@@ -4,6 +4,7 @@
 #include "basics/files.h"
 
 #include <algorithm>
+#include <cerrno>
 #include <charconv>
 #include <cmath>
 #include <cstdlib>
@@ -216,9 +217,13 @@ Table Table::readCsv(const std::string& path) {
         row.reserve(cells.size());
         for (std::size_t i = 0; i < cells.size(); ++i) {
             char* end = nullptr;
+            errno = 0;
             const double v = std::strtod(cells[i].c_str(), &end);
             if (cells[i].empty() || end != cells[i].c_str() + cells[i].size())
                 throw InputError(at + ": column '" + t.names_[i] + "' = '" + cells[i] + "': expected a number");
+            if (errno == ERANGE && std::abs(v) > 1)   // read as inf otherwise, and reported as "inf"
+                throw InputError(at + ": column '" + t.names_[i] + "' = '" + cells[i] +
+                                 "': beyond the largest number (1.8e+308): expected a finite number");
             row.push_back(v);
         }
         t.appendRow(row);

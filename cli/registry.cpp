@@ -381,7 +381,15 @@ void refuseEmptyValues(CLI::App& app) {
         if (type.rfind("FLOAT", 0) == 0 || type.rfind("INT", 0) == 0 || type.rfind("UINT", 0) == 0 ||
             type.rfind("NUMBER", 0) == 0)
             option->check(CLI::Validator(
-                [](std::string& text) { return text.empty() ? std::string("is empty: expected a number") : std::string(); },
+                [](std::string& text) {
+                    if (text.empty()) return std::string("is empty: expected a number");
+                    errno = 0;
+                    char* end = nullptr;
+                    const double x = std::strtod(text.c_str(), &end);
+                    if (end != text.c_str() && errno == ERANGE && std::abs(x) > 1)   // 1e309: read as inf otherwise
+                        return "'" + text + "' is beyond the largest number (1.8e+308): expected a finite number";
+                    return std::string();
+                },
                 "", "non-empty number"));
         else if (type.rfind("TEXT", 0) == 0 && option->get_expected_min() > 0) {   // '' would read as "not given"
             const std::string expected = option->nonpositional() ? "a value (leave the option out for its default)"
