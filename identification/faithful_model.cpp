@@ -46,7 +46,7 @@ void FaithfulProtocol::validate() const {
     checkField("protocol.accuracy", accuracy, Bound::open(0, 1));
     // The window must hold samples: at least two, or its mean is one sample's luck.
     checkField("protocol.averaging_window", averagingWindow * sampleRate,
-               Bound::closed(2, 1e300, "samples in the window (window x sample rate)"));
+               Bound::closed(2, 1e300, "samples in the window: window x sample rate"));
     calcNumSamples(restDuration + holdDuration, sampleRate);
 }
 

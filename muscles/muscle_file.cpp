@@ -109,7 +109,7 @@ void loadFibreTypes(const std::string& path, FibreType& slow, FibreType& fast, M
     root.finish();
 }
 
-Bound getSpecificTensionBound() { return Bound::closed(1e4, 2e6, "N/m^2 (1-200 N/cm^2)"); }
+Bound getSpecificTensionBound() { return Bound::closed(1e4, 2e6, "N/m^2, 1-200 N/cm^2"); }
 
 Bound getMaxFiringRateBound() { return Bound{0.5, 8, true, false, "f0.5, above fmin 0.5"}; }
 

@@ -176,7 +176,7 @@ void RenderSettings::validate() const {
     else
         checkField("camera.vertical_fov", camera.verticalFov, Bound{0.01, kPi, false, true, "rad"});
     checkField("camera.near_clip", camera.nearClip, Bound::positive("m"));
-    checkField("camera.far_clip", camera.farClip, {camera.nearClip, 1e300, true, false, "m (> near_clip)"});
+    checkField("camera.far_clip", camera.farClip, {camera.nearClip, 1e300, true, false, "m, beyond near_clip"});
     // The point looked at lies inside the clip range, or the frame is empty (a position in mm, say).
     const double distance = view.norm();
     if (!(distance > camera.nearClip && distance < camera.farClip))

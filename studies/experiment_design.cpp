@@ -436,7 +436,7 @@ void DesignSettings::validate() const {
     if (flexionDeg.empty()) throw FieldError("angles", "no angles: expected at least one");
     for (double q : flexionDeg) checkField("angles", q, Bound::closed(0, 180, "deg, 0 = extended"));
     checkDegreesNotRadians("angles", flexionDeg);
-    for (double l : levels) checkField("levels", l, Bound::open(0, 1, "fraction of maximal, in (0, 1)"));
+    for (double l : levels) checkField("levels", l, Bound::open(0, 1, "fraction of maximal"));
     for (double r : postures) checkField("postures", r, Bound::closed(-90, 90, "deg, + = supination"));
     if (!postures.empty()) checkDegreesNotRadians("postures", postures);
     // A candidate given twice would be one condition listed twice in the designed protocol.

@@ -73,8 +73,9 @@ ValidationPlan planElbowValidation(const Population& population, const Populatio
     const std::string& truthPrimary = population.base.muscles[population.base.primary].params.name;
     const std::string& priorPrimary = prior.base.muscles[prior.base.primary].params.name;
     if (truthPrimary != priorPrimary)
-        throw InputError("the prior's model '" + prior.base.name + "' identifies muscle '" + priorPrimary +
-                         "', the truth's model '" + population.base.name + "' has '" + truthPrimary +
+        throw InputError("the prior's model '" + prior.base.name + "'" + (prior.file.empty() ? "" : " (" + prior.file + ")") +
+                         " identifies muscle '" + priorPrimary + "', the truth's model '" + population.base.name + "'" +
+                         (population.file.empty() ? "" : " (" + population.file + ")") + " has '" + truthPrimary +
                          "' as its primary muscle: expected the same muscle");
     settings.protocol.validate();
     checkField("subjects", settings.subjects, Bound::closed(1, 1e6));
