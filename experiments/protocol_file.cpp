@@ -191,7 +191,13 @@ void readProtocolSensors(const ParamNode& root, Protocol& p, bool armTrials) {
             t.finish();
         }
         p.emg.acquisition.outputRate = p.trial.sampleRate;
-        if (s.has("emg")) readEmg(s.child("emg"), p);
+        if (s.has("emg")) {
+            const ParamNode emg = s.child("emg");
+            readEmg(emg, p);
+            if (!p.emgEnabled && p.kind == ProtocolKind::Submaximal)   // its levels are EMG feedback: no EMG, no level
+                throw InputError(emg.where("enabled") + ": field 'sensors.emg.enabled' = false: a submaximal protocol holds "
+                                 "each level by EMG feedback: expected EMG enabled (or kind: mvc)");
+        }
         s.finish();
     }
     p.emg.acquisition.outputRate = p.trial.sampleRate;

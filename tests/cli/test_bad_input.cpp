@@ -699,6 +699,11 @@ std::vector<BadInput> makeCatalogue() {
                                                     "  muscle: muscles/biceps_long_head.yaml\n" + kTrial +
                                                     "conditions:\n  elbow_angles_deg: [90]\n  levels_pct_mvc: [0.25, 0.5, 1.0]\n"}},
          "protocol IN/p.yaml --out OUT/run", {"p.yaml:", "lacks 100", "fractions? expected percent of MVC ([25, 50, 100])"}},
+        {"SubmaximalWithoutEmg", {{"p.yaml", "name: bad\nkind: submaximal\nseed: 1\nsubject:\n  arm: arm/default_male.yaml\n"
+                                              "  muscle: muscles/biceps_long_head.yaml\n" + kTrial +
+                                              "conditions:\n  elbow_angles_deg: [90]\n  levels_pct_mvc: [50, 100]\n"
+                                              "sensors:\n  emg:\n    enabled: false\n"}},
+         "protocol IN/p.yaml --out OUT/run", {"p.yaml:16: field 'sensors.emg.enabled' = false", "expected EMG enabled"}},
         {"TorqueProtocolVolumeScanOfAnAbsentMuscle",
          {{"p.yaml", kTorqueHead + "subject:\n  model: twin\nmeasurements:\n  volume_scan: [BIClong, DELT]\nconditions:\n"
                                    "  - {flexion_deg: 90, effort: flexion, repetitions: 1}\n"}},
