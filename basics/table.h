@@ -13,12 +13,6 @@ void checkUniqueColumnNames(const std::vector<std::string>& names, const std::st
 /// semicolon-separated, which a comma split reads as one column.
 void checkCommaSeparatedHeader(const std::vector<std::string>& cells, const std::string& where);
 
-/// InputError naming `source` and the line unless column `column` of t (a trial table's time_s)
-/// increases from row to row with no interval over twice the median one: rows missing from the middle
-/// of a table would otherwise be bridged by interpolation.
-class Table;
-void checkSampleTimes(const Table& t, const std::string& column, const std::string& source);
-
 /// Named columns of doubles, one row per sample. Column names carry their unit as a suffix
 /// ("time_s", "force_N", "activation"), so a CSV header is self-describing.
 class Table {
@@ -75,5 +69,10 @@ private:
     int numRows_ = 0;
     std::vector<int> lines_;
 };
+
+/// InputError naming `source` and the line unless column `column` of t (a trial table's time_s)
+/// increases from row to row with no interval over twice the median one: rows missing from the middle
+/// of a table would otherwise be bridged by interpolation.
+void checkSampleTimes(const Table& t, const std::string& column, const std::string& source);
 
 }  // namespace armsim
