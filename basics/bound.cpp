@@ -53,4 +53,10 @@ void checkDegreesNotRadians(const std::string& field, const std::vector<double>&
                             "radians would be (in degrees: " + asDegrees + ")");
 }
 
+std::size_t findFirstFractional(const std::vector<double>& values) {
+    for (std::size_t k = 0; k < values.size(); ++k)
+        if (values[k] != std::round(values[k])) return k;
+    return values.size();
+}
+
 }  // namespace armsim

@@ -51,5 +51,8 @@ void checkField(const std::string& field, double value, const Bound& bound);
 /// [-pi, pi] and one of them not whole (0.52, 1.05, 1.57 are 30, 60 and 90 deg in radians). Whole
 /// degrees (0, 1, 2) and any set with an angle past pi pass.
 void checkDegreesNotRadians(const std::string& field, const std::vector<double>& degrees);
+/// Index of the first value that is not whole (values.size(): none), for naming the entry or line that
+/// checkDegreesNotRadians' refusal points at.
+std::size_t findFirstFractional(const std::vector<double>& values);
 
 }  // namespace armsim

@@ -226,6 +226,13 @@ void addRenderCommand(CLI::App& app) {
         if (c->count("--muscle-model") > 0)
             throw InputError("--muscle-model: only for OpenSim models here (an armsim model's trial table records its "
                              "own muscles' states)");
+        // The drawing is the model's geometry (--model, --arm) in the table's recorded states and forces:
+        // a muscle's parameters would change nothing in the video.
+        for (const char* name : {"--muscle", "--slow-units", "--fast-units", "--mass", "--tendon-length", "--max-path"})
+            if (c->count(name) > 0)
+                throw InputError(std::string(name) + ": the trial table '" + o->table + "' records the muscle's states and "
+                                 "forces, so its parameters do not change the video (they are armsim trial's options; "
+                                 "render takes the geometry: --model, --arm)");
         runRenderCommand(*o);
     });
 }

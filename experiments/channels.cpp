@@ -181,6 +181,36 @@ std::map<std::string, int> readChannelHeader(const std::vector<std::string>& hea
 
 }  // namespace
 
+namespace {
+
+// The file's angles are degrees, not radians (as the torque data's), named at the first not whole.
+void checkChannelAnglesInDegrees(const std::string& path, const std::vector<ChannelObservation>& data) {
+    std::vector<double> angles;
+    std::vector<int> lines;
+    for (const ChannelObservation& o : data)
+        if (!std::isnan(o.flexionDeg)) angles.push_back(o.flexionDeg), lines.push_back(o.line);
+    try {
+        checkDegreesNotRadians("flexion_deg", angles);
+    } catch (const FieldError& e) {
+        throw InputError(path + ":" + std::to_string(lines[findFirstFractional(angles)]) + ": column 'flexion_deg' " +
+                         e.getDetail());
+    }
+}
+
+// A measurement (channel, muscle, angle, effort, level, repetition) given once; lineOf: each one's first line.
+void checkMeasuredOnce(const ChannelObservation& o, const std::string& at, std::map<ChannelKey, int>& lineOf) {
+    const ChannelKey key{o.channel, o.muscle, std::isnan(o.flexionDeg) ? -1.0 : o.flexionDeg, int(o.effort), o.level, o.repetition};
+    const auto [earlier, fresh] = lineOf.emplace(key, o.line);
+    if (!fresh)
+        throw InputError(at + ": the same measurement as line " + std::to_string(earlier->second) + " (" + o.channel +
+                         (o.muscle.empty() ? "" : " of " + o.muscle) +
+                         (std::isnan(o.flexionDeg) ? "" : " at " + formatNumber(o.flexionDeg) + " deg") + ", level " +
+                         formatNumber(o.level) + ", repetition " + std::to_string(o.repetition) +
+                         "): expected each once (a repeated measurement takes the next repetition number)");
+}
+
+}  // namespace
+
 std::vector<ChannelObservation> readChannelData(const std::string& path) {
     checkInputFile(path, 64u << 20);
     std::istringstream in(readFileText(path));
@@ -261,21 +291,23 @@ std::vector<ChannelObservation> readChannelData(const std::string& path) {
         if (o.sd < floor)
             fail("sd", formatNumber(o.sd), ">= " + formatNumber(floor, 3) + (isEmg ? " (of the MVC amplitude)" : " (0.1 % of the value)") +
                                                ": no lab measures " + o.channel + " this finely");
+        // A ceiling as far: an sd above the value itself (or above the MVC amplitude for EMG) says nothing
+        // of the muscle, and is a unit slip more often than a measurement (sd in mm beside a value in m).
+        if (const double ceiling = isEmg ? 1 : std::abs(o.value); o.sd > ceiling)
+            fail("sd", formatNumber(o.sd), "<= " + formatNumber(ceiling, 4) + (isEmg ? " (the MVC amplitude)" : " (the value itself)") +
+                                               ": is it in other units than value?");
         checkUnusedChannelColumns(o.channel, text, fail);
         o.cleanValue = number("clean_value", kNaN);
         o.source = path;
-        const ChannelKey key{o.channel, o.muscle, std::isnan(o.flexionDeg) ? -1.0 : o.flexionDeg, int(o.effort), o.level, o.repetition};
-        const auto [earlier, fresh] = lineOf.emplace(key, lineNo);
-        if (!fresh)
-            throw InputError(at + ": the same measurement as line " + std::to_string(earlier->second) + " (" + o.channel +
-                             (o.muscle.empty() ? "" : " of " + o.muscle) +
-                             (std::isnan(o.flexionDeg) ? "" : " at " + formatNumber(o.flexionDeg) + " deg") + ", level " +
-                             formatNumber(o.level) + ", repetition " + std::to_string(o.repetition) +
-                             "): expected each once (a repeated measurement takes the next repetition number)");
+        checkMeasuredOnce(o, at, lineOf);
+        if (data.size() == kMaxChannelRows)
+            throw InputError(at + ": more than " + std::to_string(kMaxChannelRows) + " measurements: expected at most " +
+                             std::to_string(kMaxChannelRows) + " (each is fitted; a lab's session records some hundreds)");
         data.push_back(o);
     }
     if (header.empty()) throw InputError(path + ": no header line");
     if (data.empty()) throw InputError(path + ": no data rows");
+    checkChannelAnglesInDegrees(path, data);
     return data;
 }
 

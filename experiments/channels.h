@@ -48,6 +48,10 @@ inline constexpr double kEmgFloor = 0.02;
 inline constexpr double kMinChannelSdRelative = 1e-3;
 inline constexpr double kMinChannelSdEmg = 1e-4;
 
+/// The most measurements a channel file may hold (each is a residual of every fit; 400,000 rows ran
+/// for minutes): the torque data's cap.
+inline constexpr std::size_t kMaxChannelRows = 10000;
+
 /// The names channels may have.
 const std::vector<std::string>& getChannelNames();
 

@@ -248,8 +248,10 @@ void EmgAcquisitionSettings::validate() const {
     checkField("notchQuality", notchQuality, Bound::positive());
     checkField("antiAliasCutoff", antiAliasCutoff, Bound::open(0, nyquist, "Hz"));
     checkField("antiAliasOrder", antiAliasOrder, Bound::closed(1, 20));
-    checkField("mainsAmplitude", mainsAmplitude, Bound::nonNegative("V"));
-    checkField("electrodeNoiseRms", electrodeNoiseRms, Bound::nonNegative("V"));
+    // At the electrodes a surface EMG is some 0.1-5 mV and their noise some uV: 10 mV of noise, or 1 V of
+    // mains, is a value in other units (mV typed as V).
+    checkField("mainsAmplitude", mainsAmplitude, Bound::closed(0, 1, "V"));
+    checkField("electrodeNoiseRms", electrodeNoiseRms, Bound::closed(0, 0.01, "V"));
 }
 
 namespace {

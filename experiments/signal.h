@@ -115,7 +115,7 @@ struct EmgAcquisitionSettings {
 
     /// Throws armsim::FieldError naming the field, value and bound: gain > 0;
     /// 0 < bandLow < bandHigh < outputRate/2; 0 < mainsFrequency < outputRate/2; notchQuality > 0;
-    /// 0 < antiAliasCutoff < outputRate/2; orders in range; amplitudes and noise >= 0.
+    /// 0 < antiAliasCutoff < outputRate/2; orders in range; mains in [0, 1] V, electrode noise in [0, 0.01] V.
     void validate() const;
 };
 

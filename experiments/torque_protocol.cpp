@@ -127,16 +127,14 @@ void TorqueProtocol::validate() const {
     }
     std::vector<double> angles;
     for (const TorqueCondition& c : conditions) angles.push_back(c.flexionDeg);
-    const auto fractional = std::find_if(angles.begin(), angles.end(), [](double a) { return a != std::round(a); });
-    if (fractional != angles.end()) checkDegreesNotRadians(conditionField(std::size_t(fractional - angles.begin()), "flexion_deg"), angles);
-    std::vector<double> rotations;   // the postures given (NaN: the model's own)
-    std::size_t fractionalRotation = conditions.size();
+    if (const std::size_t k = findFirstFractional(angles); k < angles.size())
+        checkDegreesNotRadians(conditionField(k, "flexion_deg"), angles);
+    std::vector<double> rotations;    // the postures given (NaN: the model's own)
+    std::vector<std::size_t> givenAt; // their conditions
     for (std::size_t k = 0; k < conditions.size(); ++k)
-        if (std::isfinite(conditions[k].rotationDeg)) {
-            rotations.push_back(conditions[k].rotationDeg);
-            if (fractionalRotation == conditions.size() && rotations.back() != std::round(rotations.back())) fractionalRotation = k;
-        }
-    if (fractionalRotation < conditions.size()) checkDegreesNotRadians(conditionField(fractionalRotation, "rotation_deg"), rotations);
+        if (std::isfinite(conditions[k].rotationDeg)) rotations.push_back(conditions[k].rotationDeg), givenAt.push_back(k);
+    if (const std::size_t k = findFirstFractional(rotations); k < rotations.size())
+        checkDegreesNotRadians(conditionField(givenAt[k], "rotation_deg"), rotations);
     checkField("trial.rest", restDuration, Bound::positive("s"));
     checkField("trial.hold", holdDuration, Bound::positive("s"));
     checkField("trial.averaging_window", averagingWindow, {0, holdDuration, true, false, "s, within the hold"});

@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <set>
 #include <array>
 #include <limits>
 #include <tuple>
@@ -87,6 +88,38 @@ std::pair<double, int> estimateNoiseLevel(const std::vector<TorqueObservation>& 
     return {dof > 0 ? std::sqrt(ss / dof) : NAN, dof};
 }
 
+// A muscle's surface EMG is a channel only where the model says electrodes reach it (roles.surface_emg):
+// a deep muscle's "EMG" is its neighbours' crosstalk, which the EMG model does not describe.
+void checkSurfaceEmgMuscle(const ArmSetup& base, int m, const std::string& at) {
+    if (std::find(base.surfaceEmg.begin(), base.surfaceEmg.end(), m) != base.surfaceEmg.end()) return;
+    std::string reached;
+    for (int k : base.surfaceEmg) reached += (reached.empty() ? "" : ", ") + base.muscles[k].params.name;
+    throw InputError(at + "emg of muscle '" + base.muscles[m].params.name + "': model '" + base.name + "' " +
+                     (reached.empty() ? "names no muscle surface electrodes reach (roles.surface_emg)"
+                                      : "has surface EMG of " + reached + " only (roles.surface_emg)") +
+                     ": expected EMG of one of those");
+}
+
+// An effort's EMG or fascicle length is recorded during a torque trial: a row at an angle, effort and
+// level no trial of the torque data has is another session's (or a unit slip) and would be fitted to an
+// activation the torque never constrains.
+void checkRecordedInATrial(const ChannelObservation& o, const std::vector<TorqueCondition>& conditions,
+                           const std::string& at) {
+    std::set<double> angles;   // the torque data's angles at this effort and level
+    for (const TorqueCondition& c : conditions)
+        if (c.effort == o.effort && c.level == o.level) {
+            if (std::abs(c.flexionDeg - o.flexionDeg) <= 1e-9) return;
+            angles.insert(c.flexionDeg);
+        }
+    std::string list;
+    for (double a : angles) list += (list.empty() ? "" : ", ") + formatNumber(a);
+    throw InputError(at + o.channel + " at " + formatNumber(o.flexionDeg) + " deg, " + getEffortName(o.effort) +
+                     " effort, level " + formatNumber(o.level) + ": the torque data has no such trial (" +
+                     (list.empty() ? "no " + std::string(getEffortName(o.effort)) + " trial at level " + formatNumber(o.level)
+                                   : "its trials of that effort and level are at " + list + " deg") +
+                     "): expected each channel row of an effort to come from a torque trial");
+}
+
 }  // namespace
 
 std::vector<double> calcTaredSteadyTorque(const ArmSetup& setup, const SubjectEffort& effort,
@@ -151,6 +184,8 @@ SynergistModel::SynergistModel(const Population& prior, const SynergistOptions& 
         }
         if (o.channel == "emg" && base.muscles[m].group != MuscleGroup::Flexor && base.muscles[m].group != MuscleGroup::Extensor)
             throw InputError(at + "emg of muscle '" + o.muscle + "': expected a flexor or an extensor (its MVC normalises it)");
+        if (o.channel == "emg") checkSurfaceEmgMuscle(base, m, at);
+        if ((o.channel == "emg" || o.channel == "fascicle_length") && o.level > 0) checkRecordedInATrial(o, conditions, at);
         channelMuscle_.push_back(m);
         channelAngle_.push_back(angle);
         channelKind_.push_back(kind);

@@ -197,6 +197,8 @@ void TorqueIdentificationOptions::validate() const {
 std::vector<MuscleEstimate> identifyTorqueData(const Population& prior, const std::vector<TorqueObservation>& data,
                                                const TorqueIdentificationOptions& o, std::string* skipped) {
     o.validate();
+    prior.base.requireVirtualMuscles("the identifiers (prior population '" + prior.name + "'" +
+                                     (prior.file.empty() ? "" : ", " + prior.file) + ")");
     std::vector<MuscleEstimate> estimates;
     std::set<double> mvcAngles;
     for (const TorqueObservation& d : data)

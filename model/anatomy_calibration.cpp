@@ -149,6 +149,7 @@ struct AnatomyProblem {
 AnatomyCalibrationResult calibrateToAnatomy(const ArmSetup& setup, const std::vector<AnatomyTarget>& targets,
                                             const AnatomyCalibrationOptions& options) {
     options.validate();
+    checkMomentArmSigns(setup, targets);   // scored, not fitted: refused before a fit of minutes
     std::vector<AnatomyTarget> fitted;
     for (const AnatomyTarget& t : targets)
         if (isFitted(t.kind)) fitted.push_back(t);

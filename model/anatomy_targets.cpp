@@ -223,7 +223,28 @@ AnatomyCurves calcAnatomyCurves(const ArmSetup& setup, const std::vector<double>
     return makeAnatomyCurves(setup, calcMvcGeometry(setup, flexionDeg));
 }
 
+// A moment-arm band on the other side of zero from the muscles it names (flexion positive): a flexor's
+// band below zero, an extensor's above it, is a sign slip the scorecard would report as a model's miss.
+void checkMomentArmSigns(const ArmSetup& setup, const std::vector<AnatomyTarget>& targets) {
+    std::vector<std::string> names;
+    for (const MuscleSpec& m : setup.muscles) names.push_back(m.params.name);
+    for (const AnatomyTarget& t : targets) {
+        if (t.kind != TargetKind::MomentArm) continue;
+        for (int m : findCovered(names, t.muscle)) {
+            const MuscleGroup g = setup.muscles[std::size_t(m)].group;
+            const bool wrong = (g == MuscleGroup::Flexor && t.upper < 0) || (g == MuscleGroup::Extensor && t.lower > 0);
+            if (!wrong) continue;
+            throw InputError(t.where + ": moment_arm of " + t.muscle + " at " + formatNumber(t.flexionDeg) + " deg: [" +
+                             formatNumber(1000 * t.lower, 6) + ", " + formatNumber(1000 * t.upper, 6) + "] mm, but " + names[std::size_t(m)] +
+                             " of model '" + setup.name + "' is " + (g == MuscleGroup::Flexor ? "a flexor" : "an extensor") +
+                             ": expected " + (g == MuscleGroup::Flexor ? "> 0" : "< 0") +
+                             " (elbow moment arms are positive in flexion)");
+        }
+    }
+}
+
 AnatomySweep calcAnatomySweep(const ArmSetup& setup, const std::vector<AnatomyTarget>& targets) {
+    checkMomentArmSigns(setup, targets);
     AnatomySweep sweep;
     sweep.flexionDeg = findAnatomyAngles(targets, setup.arm.getMinFlexionDeg(), setup.arm.getMaxFlexionDeg());
     sweep.geometry = calcMvcGeometry(setup, sweep.flexionDeg);

@@ -97,6 +97,10 @@ std::vector<TargetScore> scoreAnatomyCurves(const AnatomyCurves& curves, const s
 /// elbow's range). Targets naming no model muscle are skipped.
 std::vector<TargetScore> scoreAnatomy(const ArmSetup& setup, const std::vector<AnatomyTarget>& targets);
 
+/// Throws InputError at a moment_arm target's line when its band lies on the other side of zero from a
+/// muscle it names (flexors > 0, extensors < 0: elbow moment arms are positive in flexion).
+void checkMomentArmSigns(const ArmSetup& setup, const std::vector<AnatomyTarget>& targets);
+
 /// The angles scoreAnatomy evaluates a model at (each target's angle, and every 1 deg of the elbow's range
 /// when an optimum_angle target needs the fibre-length crossing) and the geometry there, per forearm
 /// posture for the forearm targets. Scales of a calibration change no geometry, so a fit computes it once.

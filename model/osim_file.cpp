@@ -17,6 +17,13 @@ namespace armsim {
 
 namespace {
 
+// Lengths past which a model is in other units (its lengths in mm read as hundreds of metres): a path
+// point or wrap centre within 1 m of its body's origin, a joint's frame within 2 m (a whole body's
+// bones are under 0.5 m long), a wrap surface's radius at most 0.5 m (the arm's are about 0.02 m).
+constexpr double kMaxPointDistance = 1.0;
+constexpr double kMaxOffsetDistance = 2.0;
+constexpr double kMaxWrapRadius = 0.5;
+
 /// " (element <NAME>)" when tinyxml2's error text names an element, else "".
 std::string findXmlErrorElement(const std::string& errorText) {
     const std::size_t at = errorText.find("name=");
@@ -125,6 +132,27 @@ public:
     Vec3d vec3(const XMLElement* e, const char* tag, bool required = true) const {
         const std::vector<double> v = numbers(e, tag, 3, required, {0, 0, 0});
         return {v[0], v[1], v[2]};
+    }
+
+    // A point or offset of a body's frame [m]: farther than `within` from its origin is a model in other
+    // units (a path point in mm reads as hundreds of metres and gave a 896,380 N m peak).
+    Vec3d position(const XMLElement* e, const char* tag, double within, bool required = true) const {
+        const Vec3d v = vec3(e, tag, required);
+        const double d = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+        if (d > within)
+            fail(child(e, tag), "(" + formatNumber(v[0]) + ", " + formatNumber(v[1]) + ", " + formatNumber(v[2]) + ") is " +
+                                    formatNumber(d, 4) + " m from the body's origin: expected within " + formatNumber(within) +
+                                    " m (OpenSim lengths are in metres: is it in mm?)");
+        return v;
+    }
+
+    // A wrap object's radius or semi-axis [m].
+    double radius(const XMLElement* e, const char* tag, double value) const {
+        if (!(value > 0)) fail(child(e, tag), std::string(tag) + " " + formatNumber(value) + ": expected > 0 m");
+        if (value > kMaxWrapRadius)
+            fail(child(e, tag), std::string(tag) + " " + formatNumber(value) + ": expected at most " + formatNumber(kMaxWrapRadius) +
+                                    " m (OpenSim lengths are in metres: is it in mm?)");
+        return value;
     }
 
     bool flag(const XMLElement* e, const char* tag, bool fallback) const {
@@ -273,7 +301,7 @@ private:
             o.body = body;
             o.line = w->GetLineNum();
             o.active = flag(w, "active", true);
-            o.translation = vec3(w, "translation", false);
+            o.translation = position(w, "translation", kMaxPointDistance, false);
             o.xyzBodyRotation = vec3(w, "xyz_body_rotation", false);
             o.quadrant = text(w, "quadrant", "all");
             static const std::set<std::string> quadrants = {"all", "x", "-x", "+x", "y", "-y", "+y", "z", "-z", "+z"};
@@ -288,11 +316,11 @@ private:
             } else if (kind == "WrapEllipsoid") {
                 o.kind = OsimWrapObject::Kind::Ellipsoid;
                 o.dimensions = vec3(w, "dimensions");
+                for (double a : o.dimensions) radius(w, "dimensions", a);
             } else {
                 fail(w, "wrap object type " + kind + " is not supported: expected WrapCylinder, WrapSphere or WrapEllipsoid");
             }
-            if ((o.kind == OsimWrapObject::Kind::Cylinder || o.kind == OsimWrapObject::Kind::Sphere) && !(o.radius > 0))
-                fail(child(w, "radius"), "radius " + formatNumber(o.radius) + ": expected > 0 m");
+            if (o.kind == OsimWrapObject::Kind::Cylinder || o.kind == OsimWrapObject::Kind::Sphere) radius(w, "radius", o.radius);
             m.wrapObjects.push_back(o);
         }
     }
@@ -375,7 +403,7 @@ private:
                     OsimFrame fr;
                     fr.name = f->Attribute("name") ? f->Attribute("name") : "";
                     fr.body = bodyOf(text(f, "socket_parent"));
-                    fr.translation = vec3(f, "translation", false);
+                    fr.translation = position(f, "translation", kMaxOffsetDistance, false);
                     fr.orientation = vec3(f, "orientation", false);
                     frames[fr.name] = fr;
                 }
@@ -408,10 +436,10 @@ private:
         j.line = e->GetLineNum();
         j.parent.body = text(e, "parent_body");
         if (j.parent.body.empty()) fail(e, "missing <parent_body>");
-        j.parent.translation = vec3(e, "location_in_parent", false);
+        j.parent.translation = position(e, "location_in_parent", kMaxOffsetDistance, false);
         j.parent.orientation = vec3(e, "orientation_in_parent", false);
         j.child.body = childBody;
-        j.child.translation = vec3(e, "location", false);
+        j.child.translation = position(e, "location", kMaxOffsetDistance, false);
         j.child.orientation = vec3(e, "orientation", false);
         if (const XMLElement* cs = e->FirstChildElement("CoordinateSet")) readCoordinates(cs->FirstChildElement("objects"), j);
         if (j.kind == OsimJoint::Kind::Custom) readSpatialTransform(e, j);
@@ -430,10 +458,10 @@ private:
             pt.body = bodyOf(text(p, "socket_parent_frame", text(p, "body")));
             if (pt.body.empty()) fail(p, "missing <socket_parent_frame> (4.x) or <body> (3.3)");
             if (kind == "PathPoint") {
-                pt.location = vec3(p, "location");
+                pt.location = position(p, "location", kMaxPointDistance);
             } else if (kind == "ConditionalPathPoint") {
                 pt.kind = OsimPathPoint::Kind::Conditional;
-                pt.location = vec3(p, "location");
+                pt.location = position(p, "location", kMaxPointDistance);
                 pt.coordinate = text(p, "socket_coordinate", text(p, "coordinate"));
                 if (pt.coordinate.rfind("/jointset/", 0) == 0) pt.coordinate = pt.coordinate.substr(pt.coordinate.rfind('/') + 1);
                 if (pt.coordinate.empty()) fail(p, "missing <socket_coordinate> (4.x) or <coordinate> (3.3)");
@@ -504,6 +532,9 @@ private:
                 if (!b.contains(v)) fail(child(f, tag), std::string(tag) + " " + formatNumber(v) + ": expected " + b.describe());
             };
             within("max_isometric_force", mu.maxIsometricForce, bounds::kMaxIsometricForce);
+            if (mu.maxIsometricForce < 1)   // the weakest muscles of an arm model are some 10 N
+                fail(child(f, "max_isometric_force"), "max_isometric_force " + formatNumber(mu.maxIsometricForce) +
+                                                          ": expected at least 1 N (OpenSim forces are in newtons: is it in kN?)");
             within("optimal_fiber_length", mu.optimalFiberLength, bounds::kTendonLength);
             within("tendon_slack_length", mu.tendonSlackLength, bounds::kTendonLength);
             for (const std::string& p : props->second)

@@ -149,6 +149,31 @@ std::map<std::string, ActivationProfile> makeExcitations(const OsimModel& model,
     return excitations;
 }
 
+constexpr double kMaxFibreStretch = 3;   // a fibre's longest length over its optimal one
+
+// A states file marked inDegrees=yes whose every rotational coordinate value, in every row, lies within
+// pi and is not whole holds radians (the elbow would start at 1.3 deg instead of 75).
+void checkStatesInDegrees(const OsimArm& arm, const OsimStorage& initial, const std::map<std::string, std::string>& jointOf) {
+    const Table& st = initial.table;
+    std::vector<double> angles;
+    for (int i = 0; i < arm.getNumCoordinates(); ++i) {
+        if (!arm.getCoordinate(i).rotational) continue;
+        const std::string& n = arm.getCoordinate(i).name;
+        const auto it = jointOf.find(n);
+        for (int k = 1; k < st.getNumColumns(); ++k) {
+            const std::string& c = st.getColumnNames()[k];
+            if (c != n && (it == jointOf.end() || c != "/jointset/" + it->second + "/" + n + "/value")) continue;
+            for (int r = 0; r < st.getNumRows(); ++r) angles.push_back(st.get(r, k));
+        }
+    }
+    try {
+        checkDegreesNotRadians("coordinates", angles);
+    } catch (const FieldError& e) {
+        throw InputError(initial.file + ": header 'inDegrees=yes', but its coordinate values " + e.getDetail() +
+                         ": expected inDegrees=no for radians, or the values in degrees");
+    }
+}
+
 // The initial state from the initial-states row `given` (coordinates in the file's unit, muscle states
 // in OpenSim's), each value checked; muscles without every state start at equilibrium. Notes the
 // columns nothing reads (a misspelt column would otherwise leave its state at the default).
@@ -161,6 +186,7 @@ void setInitialStates(const OsimModel& model, const OsimArm& arm, const OsimStor
     for (const OsimJoint& j : model.joints)
         for (const OsimCoordinate& k : j.coordinates) jointOf[k.name] = j.name;
     const double degree = initial && initial->header.inDegrees ? kPi / 180 : 1.0;
+    if (initial && initial->header.inDegrees) checkStatesInDegrees(arm, *initial, jointOf);
     // Every value of the row used is finite, and the columns nothing reads are named in a note (a
     // misspelt column would otherwise leave its state at the default).
     std::set<std::string> used;
@@ -193,10 +219,17 @@ void setInitialStates(const OsimModel& model, const OsimArm& arm, const OsimStor
         for (std::size_t k = 0; k < names.size(); ++k) {
             double v;
             if (take({muscle + "." + names[k], "/forceset/" + muscle + "/" + names[k]}, v)) {
-                if ((names[k] == "activation" && !(v >= 0 && v <= 1)) || (names[k] == "fiber_length" && !(v > 0)))
+                // A fibre past kMaxFibreStretch optimal lengths is beyond every force-length curve (a length
+                // in mm ended in the integrator's raw failure).
+                const double longest = kMaxFibreStretch * stateScales[i][k];
+                if ((names[k] == "activation" && !(v >= 0 && v <= 1)) ||
+                    (names[k] == "fiber_length" && !(v > 0 && v <= longest)))
                     throw InputError(initial->file + ": column '" + muscle + "." + names[k] + "' at t = " + formatNumber(t0) +
                                      " s: " + formatNumber(v) + ": expected " +
-                                     (names[k] == "activation" ? "an activation in [0, 1]" : "a fibre length > 0 m"));
+                                     (names[k] == "activation" ? "an activation in [0, 1]"
+                                                               : "a fibre length in (0, " + formatNumber(longest, 4) + "] m (" +
+                                                                     formatNumber(kMaxFibreStretch) + " times its optimal_fiber_length " +
+                                                                     formatNumber(stateScales[i][k], 4) + " m; OpenSim lengths are in metres)"));
                 y[k] = v / stateScales[i][k];
             } else {
                 all = false;

@@ -621,6 +621,8 @@ DesignResult designChannelProtocol(const Population& prior, const DesignSettings
     reference.validate();
     settings.validate();
     prior.validate();
+    prior.base.requireVirtualMuscles("the design's identifiers (prior population '" + prior.name + "'" +
+                                     (prior.file.empty() ? "" : ", " + prior.file) + ")");
     if (!(settings.budgetMinutes > 0)) throw FieldError("budget", "expected > 0 minutes for a design across channels");
     const ArmSetup& base = prior.base;
     const LabCosts& cost = settings.costs;
@@ -720,6 +722,8 @@ DesignResult designProtocol(const Population& prior, const DesignSettings& setti
     reference.validate();
     settings.validate();
     prior.validate();
+    prior.base.requireVirtualMuscles("the design's identifiers (prior population '" + prior.name + "'" +
+                                     (prior.file.empty() ? "" : ", " + prior.file) + ")");
     DesignResult result;
     result.candidates = makeCandidates(settings);
     const int picks = settings.trials / settings.repetitions;

@@ -193,12 +193,21 @@ Study readStudy(const std::string& path) {
     if (n.has("truths")) {
         if (!n.has("prior"))
             throw InputError(n.where("truths") + ": field 'truths' needs 'prior' (the population the identifiers assume)");
+        std::map<std::string, std::string> listed;   // each truth's population (its file), where it is first
         for (const ParamNode& t : n.children("truths")) {
             StudyTruth truth;
             truth.reference = t.getString("population");
             truth.population = loadStudyPopulation(t, "population", truth.reference);
             truth.label = t.getString("label", truth.population.name);
             t.finish();
+            // The same people twice under two labels would run every task twice and read as two results.
+            std::error_code ec;
+            const std::string same = truth.population.file.empty()
+                                         ? truth.reference
+                                         : std::filesystem::weakly_canonical(truth.population.file, ec).string();
+            if (const auto [first, fresh] = listed.emplace(same, t.where("population")); !fresh)
+                throw InputError(t.where("population") + ": truth population '" + truth.reference + "' is also the truth at " +
+                                 first->second + ": expected each population once (a second label runs the same people again)");
             s.truths.push_back(std::move(truth));
         }
         if (s.truths.empty()) throw InputError(n.where("truths") + ": field 'truths' is an empty list: expected at least one");

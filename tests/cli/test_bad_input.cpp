@@ -724,6 +724,64 @@ std::vector<BadInput> makeCatalogue() {
          {"--path = 0.1 m", "no steady state"}},
         {"MuscleSweepWithNoSteadyStateAnywhere", {}, "muscle sweep --from 1e-6 --to 1e-3 --step 1e-4 --out OUT/s.csv",
          {"--from 1e-06 to --to 0.001", "no steady state"}},
+        // ---- the eighth sweep's remainder (issue 34, 2026-11-28) -------------------------------------
+        {"OsimPathPointInMillimetres",
+         {{"m.osim", replaceAll(arm26, "<location>-0.027140000000000001 -0.11441 -0.0066400000000000001</location>",
+                                "<location>-27.14 -114.41 -6.64</location>")}},
+         "model show --model IN/m.osim --out OUT/ms", {"m.osim:", "117.8 m from the body's origin", "is it in mm?"}},
+        {"OsimWrapRadiusInMillimetres", {{"m.osim", replaceAll(arm26, "<radius>0.016</radius>", "<radius>16</radius>")}},
+         "model show --model IN/m.osim --out OUT/ms", {"m.osim:", "radius 16: expected at most 0.5 m"}},
+        {"OsimForceInKiloNewtons",
+         {{"m.osim", replaceAll(arm26, "<max_isometric_force>798.51999999999998</max_isometric_force>",
+                                "<max_isometric_force>0.79852</max_isometric_force>")}},
+         "model show --model IN/m.osim --out OUT/ms", {"m.osim:", "max_isometric_force 0.79852", "is it in kN?"}},
+        {"ChannelAnglesInRadians", {{"c.csv", "channel,muscle,flexion_deg,level,value,sd\nemg,BIClong,1.5708,1,0.9,0.1\n"
+                                              "emg,BIClong,2.0944,1,0.8,0.1\n"}},
+         "identify-torque measured/thesis_mvc_torque.csv --channels IN/c.csv --out OUT/it",
+         {"c.csv:2: column 'flexion_deg' = 1.5708, 2.0944: expected degrees", "(in degrees: 90, 120)"}},
+        {"ChannelSdAboveItsValue", {{"c.csv", "channel,muscle,flexion_deg,level,value,sd\nfascicle_length,BIClong,90,0,0.1,5\n"}},
+         "identify-torque measured/thesis_mvc_torque.csv --channels IN/c.csv --out OUT/it",
+         {"c.csv:2: column 'sd' = 5: expected <= 0.1 (the value itself)", "other units"}},
+        {"ChannelEmgOfADeepMuscle", {{"c.csv", "channel,muscle,flexion_deg,level,value,sd\nemg,BRA,90,1,0.9,0.1\n"}},
+         "identify-torque measured/thesis_mvc_torque.csv --channels IN/c.csv --out OUT/it",
+         {"c.csv:2: emg of muscle 'BRA'", "has surface EMG of BIClong, BICshort, BRD, TRIlong, TRIlat only"}},
+        {"ChannelRowWithoutATorqueTrial", {{"c.csv", "channel,muscle,flexion_deg,level,value,sd\nemg,BIClong,75,1,0.9,0.1\n"}},
+         "identify-torque measured/thesis_mvc_torque.csv --channels IN/c.csv --out OUT/it",
+         {"c.csv:2: emg at 75 deg, flexion effort, level 1: the torque data has no such trial", "are at 30, "}},
+        {"ChannelRowsPastTheCap", {{"c.csv", [] {
+              std::string t = "channel,muscle,flexion_deg,level,value,sd\n";
+              for (int k = 0; k <= 10000; ++k) t += "emg,BIClong,90,1,0.9,0.1," + std::to_string(k) + "\n";
+              return replaceAll(t, "sd\n", "sd,repetition\n");
+          }()}},
+         "identify-torque measured/thesis_mvc_torque.csv --channels IN/c.csv --out OUT/it",
+         {"c.csv:10002: more than 10000 measurements"}},
+        {"IdentifyTorqueHillTypePrior", {}, "identify-torque measured/thesis_mvc_torque.csv --population subjects/mismatch/hill_muscles.yaml --out OUT/it",
+         {"hill_muscles", "muscle_model thelen2003", "expected virtual_muscle"}},
+        {"EmgElectrodeNoiseInVolts", {{"p.yaml", "name: bad\nkind: mvc\nseed: 1\nsubject:\n  arm: arm/default_male.yaml\n"
+                                                  "  muscle: muscles/biceps_long_head.yaml\n" + kTrial + kAngles +
+                                                  "sensors:\n  emg:\n    electrode_noise_rms: 5\n"}},
+         "protocol IN/p.yaml --out OUT/run", {"p.yaml:", "electrode_noise_rms", "[0, 0.01] (V)"}},
+        {"ForwardStatesInDegreesHoldRadians", {{"c.sto", sto + "time\tBIClong\n0\t0.1\n"},
+                                              {"s.sto", replaceAll(sto, "inDegrees=no", "inDegrees=yes") + "time\tr_elbow_flex\n0\t1.309\n"}},
+         "forward --model arm26 --controls IN/c.sto --initial-states IN/s.sto --final-time 0.1 --out OUT/f",
+         {"s.sto: header 'inDegrees=yes', but its coordinate values = 1.309", "expected inDegrees=no for radians"}},
+        {"ForwardStatesFibreLengthInMillimetres", {{"c.sto", sto + "time\tBIClong\n0\t0.1\n"},
+                                                  {"s.sto", replaceAll(sto, "nColumns=2", "nColumns=3") +
+                                                                "time\tBIClong.activation\tBIClong.fiber_length\n0\t0.1\t115.7\n"}},
+         "forward --model arm26 --controls IN/c.sto --initial-states IN/s.sto --final-time 0.1 --out OUT/f",
+         {"s.sto: column 'BIClong.fiber_length' at t = 0 s: 115.7: expected a fibre length in (0, ", "OpenSim lengths are in metres"}},
+        {"CalibrateMomentArmOfTheWrongSign", {{"t.yaml", "targets:\n  - {kind: mvc, direction: flexion, flexion_deg: 90, lower: 50, "
+                                                          "upper: 70, tolerance: 5, source: x}\n"
+                                                          "  - {kind: moment_arm, muscle: BIC, flexion_deg: 90, lower: -49.3, "
+                                                          "upper: -41.6, tolerance: 3, source: x}\n"}},
+         "model calibrate --model twin --targets IN/t.yaml", {"t.yaml:3: moment_arm of BIC at 90 deg: [-49.3, -41.6] mm",
+                                                              "BIClong of model 'twin' is a flexor: expected > 0"}},
+        {"StudySameTruthTwice", {{"s.yaml", "kind: study\nname: bad\nsubjects: 1\nprior: default\ntruths:\n"
+                                            "  - {population: default, label: a}\n  - {population: default, label: b}\n"
+                                            "protocols: [thesis]\nnoise_levels: [0.02]\nmethods:\n  - {method: thesis}\n"}},
+         "study IN/s.yaml --out OUT/s", {"s.yaml:7: truth population 'default' is also the truth at", "s.yaml:6"}},
+        {"RenderMuscleParameterOnATable", {{"t.csv", "time_s\n0\n"}}, "render IN/t.csv --still-at 0.4 --still OUT/s.png --mass 0.5",
+         {"--mass: the trial table", "do not change the video"}},
         // inputs that ask nothing of the work
         {"ActivationTraceStartingLate", {{"u.csv", "time_s,activation\n1,1\n2,1\n"}},
          "muscle trial --activation-trace IN/u.csv --duration 0.5 --out OUT/t.csv", {"u.csv:2", "'time_s' = 1", "start at 0 s"}},

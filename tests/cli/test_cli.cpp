@@ -836,6 +836,32 @@ TEST(Cli, LongWorkIsCountedUpFrontAndEstimatedEarly) {
     fs::remove_all(d);
 }
 
+// Issue 34: a stop that comes once the command has returned (here raised at that point through
+// ARMSIM_TEST_STOP_AFTER_COMMAND; a SIGTERM while a study draws its last plot lands there) finds the
+// files committed. Before, the message said "unfinished output removed" over a study's complete
+// results.csv, summary.csv and plots, and index.html was missing. Now the overview joins them and the
+// message says the output is complete (exit 128 + the signal: the run was asked to stop).
+TEST(Cli, AStopAfterTheCommandFinishedSaysItsOutputIsComplete) {
+    const fs::path d = freshDir("stop_after_command");
+    std::ofstream(d / "s.yaml") << "kind: study\nname: after\nsubjects: 1\nprotocols: [thesis]\nnoise_levels: [0.02]\n"
+                                   "methods:\n  - {method: thesis}\n";
+    const struct {
+        std::string args, file;
+    } runs[] = {{"study " + (d / "s.yaml").string() + " --threads 1 --out " + (d / "s").string(), "s/results.csv"},
+                {"model show --model thesis --out " + (d / "m").string(), "m/mvc_flexion.csv"}};
+    for (const auto& run : runs) {
+        const CommandResult r = armsim::testing::runCommand("ARMSIM_TEST_STOP_AFTER_COMMAND=15 " + std::string(ARMSIM_EXE) +
+                                                            " " + run.args);
+        EXPECT_EQ(r.exitCode, 143) << r.output;
+        EXPECT_NE(r.output.find("interrupted by signal 15 after the command had finished: its output is complete"),
+                  std::string::npos) << r.output;
+        EXPECT_EQ(r.output.find("removed"), std::string::npos) << r.output;
+        EXPECT_TRUE(fs::exists(d / run.file)) << run.file;
+        EXPECT_TRUE(fs::exists(d / fs::path(run.file).parent_path() / "index.html")) << run.file;
+    }
+    fs::remove_all(d);
+}
+
 // A folder whose overview cannot be written (an index.html that is not armsim's, here a folder): the
 // command's files are there and complete, and the exit status says the overview is missing (2, not 0).
 TEST(Cli, AnOverviewThatCannotBeWrittenIsAnError) {

@@ -166,6 +166,33 @@ TEST(OsimFile, Version30000LayoutReadsToTheSameData) {
     EXPECT_EQ(readOsimText(noRange, "v3.osim").joints[0].coordinates[0].range, (std::array<double, 2>{-10, 10}));
 }
 
+// Issue 34: a model in other units reads as metres and newtons: a path point in mm gave a 896,380 N m
+// peak, a wrap radius of 16 (mm) and F0 0.8 (kN) were accepted. Each is refused at its line.
+TEST(OsimFile, LengthsAndForcesInOtherUnitsAreRefusedAtTheirLine) {
+    const std::string& t = arm26Text();
+    struct Case {
+        std::string from, to, expected;
+    } cases[] = {
+        {"<location>-0.027140000000000001 -0.11441 -0.0066400000000000001</location>", "<location>-27.14 -114.41 -6.64</location>",
+         "(-27.14, -114.41, -6.64) is 117.8 m from the body's origin: expected within 1 m (OpenSim lengths are in metres: is it in mm?)"},
+        {"<radius>0.016</radius>", "<radius>16</radius>", "radius 16: expected at most 0.5 m (OpenSim lengths are in metres: is it in mm?)"},
+        {"<dimensions>0.035000000000000003 0.02 0.02</dimensions>", "<dimensions>35 20 20</dimensions>", "dimensions 35: expected at most 0.5 m"},
+        {"<translation>0.0028 -0.29189999999999999 -0.0068999999999999999</translation>", "<translation>2.8 -291.9 -6.9</translation>",
+         "is 292 m from the body's origin: expected within 1 m"},
+        {"<translation>0 0.80000000000000004 0</translation>", "<translation>0 800 0</translation>", "is 800 m from the body's origin: expected within 2 m"},
+        {"<max_isometric_force>798.51999999999998</max_isometric_force>", "<max_isometric_force>0.79852</max_isometric_force>",
+         "max_isometric_force 0.79852: expected at least 1 N (OpenSim forces are in newtons: is it in kN?)"},
+    };
+    for (const Case& c : cases) {
+        const std::string bad = replaced(t, c.from, c.to);
+        const std::string e = errorOf(bad);
+        EXPECT_NE(e.find("bad.osim:" + std::to_string(lineOf(bad, c.to)) + ":"), std::string::npos) << c.to << "\n" << e;
+        EXPECT_NE(e.find(c.expected), std::string::npos) << c.to << "\n" << e;
+    }
+    // The shipped arm's own values pass (every case above is one value changed).
+    EXPECT_NO_THROW(readOsimText(t, "arm26.osim"));
+}
+
 TEST(OsimFile, ProblemsAreNamedWithFileLineAndElement) {
     const std::string& t = arm26Text();
     // Not XML.

@@ -343,9 +343,14 @@ TEST(Study, ReadsAStudyFileAndNamesTheFileLineAndFieldOfEveryError) {
         // Several truths (issue 31): a prior, unique labels, known keys, one way of naming the truth.
         {"kind: study\nsubjects: 2\ntruths:\n  - {population: default}\nprotocols: [thesis]\nmethods:\n  - {method: thesis}\n",
          "needs 'prior'"},
-        {"kind: study\nsubjects: 2\nprior: default\ntruths:\n  - {population: default}\n  - {population: default}\n"
+        {"kind: study\nsubjects: 2\nprior: default\ntruths:\n  - {population: default, label: x}\n"
+         "  - {population: " + std::string(ARMSIM_ASSET_DIR) + "/subjects/mismatch/hill_muscles.yaml, label: x}\n"
          "protocols: [thesis]\nmethods:\n  - {method: thesis}\n",
-         "'label' (truths, entry 2) = 'default': also the label of entry 1"},
+         "'label' (truths, entry 2) = 'x': also the label of entry 1"},
+        // The same people under two labels would run every task twice (issue 34).
+        {"kind: study\nsubjects: 2\nprior: default\ntruths:\n  - {population: default, label: a}\n"
+         "  - {population: default, label: b}\nprotocols: [thesis]\nmethods:\n  - {method: thesis}\n",
+         ".yaml:6: truth population 'default' is also the truth at "},
         {"kind: study\nsubjects: 2\nprior: default\ntruths:\n  - {population: default, lable: x}\n"
          "protocols: [thesis]\nmethods:\n  - {method: thesis}\n",
          "lable"},
