@@ -126,10 +126,21 @@ void runDesign(const DesignOptions& o) {
                 o.levels.empty() ? "none" : formatList(o.levels).c_str(),
                 s.activationSd > 0 ? ("measured (sd " + formatNumber(s.activationSd) + ")").c_str() : "not measured",
                 s.draws);
-    std::fflush(stdout);
     TorqueProtocol thesis;
     thesis.name = "thesis";
     const bool channels = s.budgetMinutes > 0;
+    if (o.validateSubjects > 0) {   // counted (and bounded) before the design's work
+        ElbowValidationSettings v;
+        v.subjects = capForQuickRun(o.validateSubjects, kQuickSubjects, "validation subjects");
+        v.activationSd = s.activationSd;
+        v.protocol = thesis;
+        long perProtocol = 0;
+        runNamingOptions({{"subjects", "--validate-subjects"}},
+                         [&] { perProtocol = countElbowValidationFits(population, population, v); });
+        std::printf("then validation of both protocols on %d subject%s: about %ld fits\n", v.subjects, v.subjects == 1 ? "" : "s",
+                    2 * perProtocol + (channels ? long(v.subjects) : 0L));
+    }
+    std::fflush(stdout);
     if (channels)
         std::printf("across channels: budget %s lab minutes (MVC block %s, EMG set-up %s, ultrasound per condition %s, volume "
                     "scan %s, anthropometry %s min: docs/channels.md)\n",

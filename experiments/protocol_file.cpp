@@ -187,7 +187,9 @@ void readProtocolSensors(const ParamNode& root, Protocol& p, bool armTrials) {
         const ParamNode s = root.child("sensors");
         if (s.has("transducer")) {
             const ParamNode t = s.child("transducer");
-            p.transducerNoiseRms = t.getNumber("noise_rms", Bound::closed(0, 1e4, "N"), 0.0);
+            // A strap transducer reads to about 1 N (the thesis's: 50 kgf full scale, 5.3.2); 50 N of noise,
+            // a tenth of that scale, is a value in other units (mN, or kgf read as N).
+            p.transducerNoiseRms = t.getNumber("noise_rms", Bound::closed(0, 50, "N"), 0.0);
             t.finish();
         }
         p.emg.acquisition.outputRate = p.trial.sampleRate;

@@ -186,7 +186,9 @@ std::vector<AnatomyTarget> loadAnatomyTargets(const std::string& path) {
             throw InputError(n.where("upper") + ": field 'upper' = " + formatNumber(t.upper / u.toSi) + " " +
                              u.file + ": expected >= lower = " + formatNumber(t.lower / u.toSi) + " " + u.file);
         checkTargetUnits(n, t, u);
-        t.tolerance = n.getNumber("tolerance", Bound::closed(0, 1e5, u.file), 0.0) * u.toSi;
+        // A tolerance over a quarter of the quantity's whole range would pass any model (1000 mm on a
+        // moment arm): a unit slip, not a band.
+        t.tolerance = n.getNumber("tolerance", Bound::closed(0, (band.hi - band.lo) / 4, band.unit), 0.0) * u.toSi;
         if (t.lower == t.upper && t.tolerance == 0)
             throw InputError(n.where("upper") + ": a point value (lower = upper = " + formatNumber(t.upper / u.toSi) +
                              " " + u.file + ") needs a tolerance > 0: expected a band or a tolerance");

@@ -782,6 +782,13 @@ std::vector<BadInput> makeCatalogue() {
          "study IN/s.yaml --out OUT/s", {"s.yaml:7: truth population 'default' is also the truth at", "s.yaml:6"}},
         {"RenderMuscleParameterOnATable", {{"t.csv", "time_s\n0\n"}}, "render IN/t.csv --still-at 0.4 --still OUT/s.png --mass 0.5",
          {"--mass: the trial table", "do not change the video"}},
+        {"TransducerNoiseInMilliNewtons", {{"p.yaml", "name: bad\nkind: mvc\nseed: 1\nsubject:\n  arm: arm/default_male.yaml\n"
+                                                       "  muscle: muscles/biceps_long_head.yaml\n" + kTrial + kAngles +
+                                                       "sensors:\n  transducer:\n    noise_rms: 1000\n"}},
+         "protocol IN/p.yaml --out OUT/run", {"p.yaml:", "noise_rms", "1000", "[0, 50] (N)"}},
+        {"TargetsToleranceThatPassesAnyModel", {{"t.yaml", "targets:\n  - {kind: moment_arm, muscle: BIC, flexion_deg: 90, lower: 41.6, "
+                                                            "upper: 49.3, tolerance: 1000, source: x}\n"}},
+         "model check --model twin --targets IN/t.yaml --out OUT/mc", {"t.yaml:2", "tolerance", "1000", "[0, 100] (mm)"}},
         // inputs that ask nothing of the work
         {"ActivationTraceStartingLate", {{"u.csv", "time_s,activation\n1,1\n2,1\n"}},
          "muscle trial --activation-trace IN/u.csv --duration 0.5 --out OUT/t.csv", {"u.csv:2", "'time_s' = 1", "start at 0 s"}},

@@ -235,6 +235,9 @@ TEST(CliDesign, DesignedProtocolRunsAndItsDataAreIdentified) {
     const fs::path protocol = d / "design" / "designed_protocol.yaml";
     ASSERT_TRUE(fs::exists(protocol)) << r.output;
     EXPECT_NE(r.output.find("designed protocol:"), std::string::npos) << r.output;
+    // Counted before the design's work: 2 protocols x (thesis, synergist, synergist-va) for one subject.
+    EXPECT_NE(r.output.find("then validation of both protocols on 1 subject: about 6 fits"), std::string::npos) << r.output;
+    EXPECT_LT(r.output.find("about 6 fits"), r.output.find("greedy picks")) << r.output;
     for (const char* f : {"design_predictions.csv", "design_steps.csv", "design_criterion.png"})
         EXPECT_TRUE(fs::exists(d / "design" / f)) << f;
     {  // --validate-subjects: both protocols, both synergist methods
