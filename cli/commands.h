@@ -101,6 +101,9 @@ void runNamingOptions(const std::map<std::string, std::string>& optionOfField, c
 /// an integral value is passed on in integer form, so an integer option takes 1e3 and 2.0 too.
 CLI::Validator inRange(double lo, double hi);
 
+/// Checks the environment variables armsim reads (ARMSIM_PROGRESS_SECONDS, ARMSIM_QUICK): InputError
+/// naming the variable and its value unless valid. Called once, before the command.
+void checkEnvironment();
 /// Prints a one-line progress bar to stderr ("label [#####     ] 5/10"); nothing with --quiet. When
 /// stderr is not a terminal (a log): the end ("label: 10/10 done") and, for long work, a line every 10 s
 /// (ARMSIM_PROGRESS_SECONDS) with the share done and the time left at the rate so far.

@@ -97,6 +97,21 @@ PlotSpec makeDesignPlot(const DesignResult& d, bool channels, int repetitions) {
     return plot;
 }
 
+// --validate-subjects' work, counted (and bounded) before the design's: the reference protocol's fits
+// twice, and the channels fit of a design across channels.
+void announceValidation(const Population& population, const DesignSettings& s, const TorqueProtocol& reference,
+                        int subjects, bool channels) {
+    ElbowValidationSettings v;
+    v.subjects = capForQuickRun(subjects, kQuickSubjects, "validation subjects");
+    v.activationSd = s.activationSd;
+    v.protocol = reference;
+    long perProtocol = 0;
+    runNamingOptions({{"subjects", "--validate-subjects"}},
+                     [&] { perProtocol = countElbowValidationFits(population, population, v); });
+    std::printf("then validation of both protocols on %d subject%s: about %ld fits\n", v.subjects, v.subjects == 1 ? "" : "s",
+                2 * perProtocol + (channels ? long(v.subjects) : 0L));
+}
+
 void runDesign(const DesignOptions& o) {
     checkOutputFolder("--out", o.out);
     const Population population = o.population.empty() ? loadDefaultPopulation() : loadPopulation(findAssetFor("--population", o.population));
@@ -126,27 +141,16 @@ void runDesign(const DesignOptions& o) {
                 o.levels.empty() ? "none" : formatList(o.levels).c_str(),
                 s.activationSd > 0 ? ("measured (sd " + formatNumber(s.activationSd) + ")").c_str() : "not measured",
                 s.draws);
-    TorqueProtocol thesis;
-    thesis.name = "thesis";
+    const TorqueProtocol thesis = [] { TorqueProtocol t; t.name = "thesis"; return t; }();
     const bool channels = s.budgetMinutes > 0;
-    if (o.validateSubjects > 0) {   // counted (and bounded) before the design's work
-        ElbowValidationSettings v;
-        v.subjects = capForQuickRun(o.validateSubjects, kQuickSubjects, "validation subjects");
-        v.activationSd = s.activationSd;
-        v.protocol = thesis;
-        long perProtocol = 0;
-        runNamingOptions({{"subjects", "--validate-subjects"}},
-                         [&] { perProtocol = countElbowValidationFits(population, population, v); });
-        std::printf("then validation of both protocols on %d subject%s: about %ld fits\n", v.subjects, v.subjects == 1 ? "" : "s",
-                    2 * perProtocol + (channels ? long(v.subjects) : 0L));
-    }
-    std::fflush(stdout);
+    if (o.validateSubjects > 0) announceValidation(population, s, thesis, o.validateSubjects, channels);
     if (channels)
         std::printf("across channels: budget %s lab minutes (MVC block %s, EMG set-up %s, ultrasound per condition %s, volume "
                     "scan %s, anthropometry %s min: docs/channels.md)\n",
                     formatNumber(s.budgetMinutes, 6).c_str(), formatNumber(s.costs.mvcBlock).c_str(),
                     formatNumber(s.costs.emgSetup).c_str(), formatNumber(s.costs.ultrasoundAngle).c_str(),
                     formatNumber(s.costs.volumeScan).c_str(), formatNumber(s.costs.anthropometry).c_str());
+    std::fflush(stdout);
     auto progress = [](int done, int n) { printProgress("design", done, n); };
     DesignResult d;
     runNamingOptions({{"postures", "--postures"}}, [&] {

@@ -140,11 +140,18 @@ std::string explainMissingSubcommand(const CLI::App& app, const std::string& wha
     return (path == "COMMAND" ? std::string("armsim") : "armsim " + path) + " needs a command: expected one of " + names;
 }
 
+// What stopped the run, for its last message.
+std::string describeStop(int sig) {
+    if (sig == SIGPIPE) return "standard output was closed (the reader of its pipe ended)";
+    return "interrupted by signal " + std::to_string(sig);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
     armsim::cli::startStdoutCapture();   // the report shows what the command printed
     armsim::setInputProtection(true);     // no output replaces or deletes a file the command read
+    std::signal(SIGPIPE, SIG_IGN);        // a closed pipe is an EPIPE on write: the run stops (cli/report.cpp)
     startSignalThread();
     armsim::quietCeresLogging();  // once, before any thread: armsim reports what Ceres would log
     CLI::App app{"armsim: a Simbody elbow with a Virtual Muscle biceps (simulate, identify, render)"};
@@ -156,6 +163,7 @@ int main(int argc, char** argv) {
     app.fallthrough();  // a command's unknown option may be one of these (armsim study s.yaml --quiet)
     armsim::cli::addRegisteredCommands(app);
     try {
+        armsim::cli::checkEnvironment();
         app.parse(argc, argv);
         // A stop that arrives once the command has returned finds its output committed, whole: the
         // overview page (a bounded, quick write) still joins it, and the message says the files are there.
@@ -171,8 +179,7 @@ int main(int argc, char** argv) {
             return stoppedAfter ? 128 + stoppedAfter : 2;
         }
         if (stoppedAfter) {
-            std::cerr << "armsim: interrupted by signal " << stoppedAfter
-                      << " after the command had finished: its output is complete\n";
+            std::cerr << "armsim: " << describeStop(stoppedAfter) << " after the command had finished: its output is complete\n";
             finishStdout(0);
             return 128 + stoppedAfter;
         }
@@ -218,7 +225,7 @@ int main(int argc, char** argv) {
     } catch (const armsim::InterruptedError& e) {
         // Only the study keeps work across a stop (its journal); every other command leaves nothing.
         const bool study = getCommandPath(app) == "study";
-        std::cerr << "armsim: " << e.what() << ": stopped ("
+        std::cerr << "armsim: " << describeStop(armsim::getInterruption()) << ": stopped ("
                   << (study ? "unfinished output removed; the study resumes from its journal when run again"
                             : "unfinished output removed") << ")\n";
         return 128 + armsim::getInterruption();

@@ -6,6 +6,7 @@
 #include "basics/parallel.h"
 #include "basics/table.h"
 #include "cli/commands.h"
+#include "cli/report.h"
 #include "cli/plugins.h"
 #include "experiments/protocol.h"
 #include "experiments/protocol_files.h"
@@ -103,6 +104,7 @@ void runProtocolCommand(const ProtocolOptions& o) {
             renderProtocolVideos(o, subject, r, dir);
         };
     const ProtocolFileRun r = runProtocolFile(findAsset(o.file), run);
+    if (!r.outDir.empty()) setReportFolder(r.outDir);   // --out, or out/NAME
     std::printf("%s", r.text.c_str());
 }
 

@@ -3,6 +3,7 @@
 #include "basics/format.h"
 #include "basics/numbers.h"
 #include "basics/output_folder.h"
+#include "basics/quick_run.h"
 #include "cli/commands.h"
 #include "muscles/muscle_file.h"
 #include "numerics/stiff_ode.h"
@@ -23,6 +24,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <regex>
 #include <unistd.h>
 #include <vector>
 
@@ -249,6 +251,7 @@ double getLogProgressInterval() {
     return interval;
 }
 
+
 // The time left [s] at the rate since a label's first report (done `from` then; the clock starts there).
 double calcTimeLeft(double fraction, double from, double elapsed) {
     return fraction > from ? elapsed * (1 - fraction) / (fraction - from) : kNaN;
@@ -352,6 +355,17 @@ void noteUnreachedActivation(const ActivationProfile& activation, double duratio
                      formatNumber(activation.getValue(duration), 4).c_str());
 }
 
+void checkEnvironment() {
+    if (const char* v = std::getenv("ARMSIM_PROGRESS_SECONDS")) {
+        char* end = nullptr;
+        const double x = std::strtod(v, &end);
+        if (end == v || *end != '\0' || !(x >= 1e-3 && x <= 86400))
+            throw InputError(std::string("environment variable ARMSIM_PROGRESS_SECONDS=") + v +
+                             ": expected seconds between progress lines on a log, in [0.001, 86400] (unset: 10)");
+    }
+    isQuickRun();   // ARMSIM_QUICK: 1 or 0
+}
+
 void printProgress(const std::string& label, int done, int total) {
     printProgressLine(label, total > 0 ? double(done) / total : 1.0, std::to_string(done) + "/" + std::to_string(total),
                       done >= total);
@@ -377,9 +391,23 @@ namespace {
 void refuseEmptyValues(CLI::App& app) {
     for (CLI::Option* option : app.get_options()) {
         const std::string type = option->get_type_name();
+        const bool integer = type.rfind("INT", 0) == 0 || type.rfind("UINT", 0) == 0;
+        const bool number = integer || type.rfind("FLOAT", 0) == 0 || type.rfind("NUMBER", 0) == 0;
+        // CLI11 reads 0x5A as 90 and an integer's 010 as octal 8, while every file reader refuses them:
+        // a number is decimal wherever it is typed.
+        if (number)
+            option->check(CLI::Validator(
+                [integer](std::string& text) {
+                    static const std::regex prefixed(R"(\s*[+-]?0[xXoObB].*)"), octal(R"(\s*[+-]?0[0-9]+\s*)");
+                    if (std::regex_match(text, prefixed))
+                        return "= '" + text + "': expected a decimal number (hexadecimal, octal and binary literals are not read)";
+                    if (integer && std::regex_match(text, octal))
+                        return "= '" + text + "': expected a decimal integer without leading zeros (it would read as octal)";
+                    return std::string();
+                },
+                "", "decimal number"));
         if (option->get_items_expected_max() != 1) continue;   // lists say which item is empty
-        if (type.rfind("FLOAT", 0) == 0 || type.rfind("INT", 0) == 0 || type.rfind("UINT", 0) == 0 ||
-            type.rfind("NUMBER", 0) == 0)
+        if (number)
             option->check(CLI::Validator(
                 [](std::string& text) {
                     if (text.empty()) return std::string("is empty: expected a number");

@@ -1,8 +1,10 @@
 #include "cli/report.h"
 
+#include "basics/errors.h"
 #include "basics/html_report.h"
 
 #include <cerrno>
+#include <csignal>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -113,6 +115,9 @@ ssize_t writeTee(void*, const char* data, std::size_t size) noexcept {
         if (n < 0) {
             if (errno == EINTR) continue;
             const int error = errno;
+            // The reader of a pipe has ended (`armsim run | head`): SIGPIPE is ignored (main), so the run
+            // stops as after SIGTERM, its unfinished output removed, instead of dying with a staging folder.
+            if (error == EPIPE && !getInterruption()) requestInterruption(SIGPIPE);
             try {
                 Captured& c = getCaptured();
                 std::lock_guard<std::mutex> lock(c.mutex);
@@ -174,10 +179,16 @@ std::string describeOutputFile(const std::string& relativePath) {
     return "";
 }
 
+namespace {
+std::string& reportFolder() {
+    static std::string folder;
+    return folder;
+}
+}  // namespace
+
+void setReportFolder(const std::string& dir) { reportFolder() = dir; }
+
 void writeCommandReport(const CLI::App& app, int argc, char** argv) {
-    // Under mpirun only rank 0 writes it (every rank runs this).
-    for (const char* rank : {"OMPI_COMM_WORLD_RANK", "PMI_RANK", "SLURM_PROCID"})
-        if (const char* v = std::getenv(rank); v && std::string(v) != "0") return;
     const CLI::App* ran = &app;
     for (;;) {
         const std::vector<const CLI::App*> subs = ran->get_subcommands([](const CLI::App* s) { return s->parsed(); });
@@ -185,9 +196,14 @@ void writeCommandReport(const CLI::App& app, int argc, char** argv) {
         ran = subs.front();
     }
     if (ran == &app) return;
+    // A study's ranks share one folder, which rank 0 writes; every other command writes its own output
+    // in each process that runs it, so its page too (a rank variable alone is no MPI run).
+    if (ran->get_name() == "study")
+        for (const char* rank : {"OMPI_COMM_WORLD_RANK", "PMI_RANK", "SLURM_PROCID"})
+            if (const char* v = std::getenv(rank); v && std::string(v) != "0") return;
     const CLI::Option* out = ran->get_option_no_throw("--out");
-    if (!out) return;
-    const std::string dir = out->as<std::string>();
+    if (!out && reportFolder().empty()) return;
+    const std::string dir = !reportFolder().empty() ? reportFolder() : out->as<std::string>();
     std::error_code ec;
     if (dir.empty() || !std::filesystem::is_directory(dir, ec)) return;
 

@@ -11,6 +11,9 @@ namespace armsim::cli {
 /// of the folder). Only rank 0 under mpirun or srun. Throws std::runtime_error when it cannot write
 /// (the caller warns: the command's own files stand).
 void writeCommandReport(const CLI::App& app, int argc, char** argv);
+/// The folder a command wrote when it is not its --out as typed (a study's `output:` from its file, a
+/// protocol's default out/NAME): writeCommandReport writes the page there.
+void setReportFolder(const std::string& dir);
 
 /// From now on, what the program writes through C's stdout also goes into a buffer (at most
 /// kMaxCapturedStdout bytes; the rest is noted as cut), which writeCommandReport shows. Standard output

@@ -1,6 +1,7 @@
 // armsim study STUDY.yaml: a population study on threads, or over MPI ranks under mpirun.
 #include "basics/errors.h"
 #include "cli/commands.h"
+#include "cli/report.h"
 #include "basics/format.h"
 #include "cli/plugins.h"
 #include "studies/study.h"
@@ -104,6 +105,7 @@ void runStudyCommand(const StudyOptions& o) {
     if (r.failed + r.notConverged > 0)
         std::printf("  %ld failed, %ld not converged: their reasons are in results.csv (status, reason)%s\n", r.failed,
                     r.notConverged, r.shards > 0 ? " once the shards are merged" : "");
+    setReportFolder(r.output);   // --out, or the study file's `output:`
     std::printf("wrote to %s:", r.output.c_str());
     for (const std::string& f : r.files) std::printf(" %s", f.c_str());
     std::printf("\n");

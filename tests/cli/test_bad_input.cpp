@@ -789,6 +789,11 @@ std::vector<BadInput> makeCatalogue() {
         {"TargetsToleranceThatPassesAnyModel", {{"t.yaml", "targets:\n  - {kind: moment_arm, muscle: BIC, flexion_deg: 90, lower: 41.6, "
                                                             "upper: 49.3, tolerance: 1000, source: x}\n"}},
          "model check --model twin --targets IN/t.yaml --out OUT/mc", {"t.yaml:2", "tolerance", "1000", "[0, 100] (mm)"}},
+        // CLI11 read 0x5A as 90 and an integer's 010 as octal 8; every file reader refuses both.
+        {"TrialAngleInHexadecimal", {}, "trial --angle 0x5A --hold 0.2 --out OUT/t.csv",
+         {"--angle = '0x5A': expected a decimal number"}},
+        {"TrialUnitsWithALeadingZero", {}, "trial --slow-units 010 --hold 0.2 --out OUT/t.csv",
+         {"--slow-units = '010': expected a decimal integer without leading zeros"}},
         // inputs that ask nothing of the work
         {"ActivationTraceStartingLate", {{"u.csv", "time_s,activation\n1,1\n2,1\n"}},
          "muscle trial --activation-trace IN/u.csv --duration 0.5 --out OUT/t.csv", {"u.csv:2", "'time_s' = 1", "start at 0 s"}},

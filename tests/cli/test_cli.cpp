@@ -862,6 +862,49 @@ TEST(Cli, AStopAfterTheCommandFinishedSaysItsOutputIsComplete) {
     fs::remove_all(d);
 }
 
+// Issue 34 (ninth sweep): every folder a command writes gets its overview page: a study's folder named
+// by its file's `output:`, a protocol's default out/NAME, and a command run with a rank variable but
+// no MPI (only a study shares its folder between ranks). Before, none of the three had index.html.
+TEST(Cli, EveryFolderACommandWritesGetsItsOverview) {
+    const fs::path d = freshDir("overview_everywhere");
+    std::ofstream(d / "s.yaml") << "kind: study\nname: here\nsubjects: 1\nprotocols: [thesis]\nnoise_levels: [0.02]\n"
+                                   "methods:\n  - {method: thesis}\noutput: from_file\n";
+    const std::string in = "cd " + d.string() + " && ";
+    const std::string exe = std::string(ARMSIM_EXE);
+    for (const std::string& run : {in + exe + " study s.yaml --threads 1",
+                                   in + exe + " protocol " + std::string(ARMSIM_ASSET_DIR) + "/protocols/arm26_torque.yaml",
+                                   in + "SLURM_PROCID=1 " + exe + " model show --model thesis --out shown"}) {
+        const CommandResult r = armsim::testing::runCommand(run);
+        EXPECT_EQ(r.exitCode, 0) << run << "\n" << r.output;
+    }
+    for (const char* folder : {"from_file", "out/arm26_torque", "shown"})
+        EXPECT_TRUE(fs::exists(d / folder / "index.html")) << folder;
+    fs::remove_all(d);
+}
+
+// Issue 34 (ninth sweep): `armsim run | head -c 1` used to die of SIGPIPE at its next line and leave
+// its staging folder. A closed pipe now stops the run as SIGTERM does: nothing left, a message that
+// says why, exit 128 + SIGPIPE. A bad environment variable is refused before any work.
+TEST(Cli, AClosedPipeStopsTheRunAndABadEnvironmentIsRefused) {
+    const fs::path d = freshDir("closed_pipe");
+    const CommandResult r = armsim::testing::runCommand("bash -c '" + std::string(ARMSIM_EXE) + " run --jobs 1 --out " +
+                                                        (d / "o").string() + " | head -c 1 >/dev/null; echo rc=${PIPESTATUS[0]}'");
+    EXPECT_NE(r.output.find("rc=141"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("standard output was closed (the reader of its pipe ended): stopped (unfinished output removed)"),
+              std::string::npos) << r.output;
+    EXPECT_TRUE(fs::is_empty(d)) << r.output;   // no folder, no staging folder
+    for (const char* value : {"abc", "0", "-5"}) {
+        const CommandResult e = armsim::testing::runCommand("ARMSIM_PROGRESS_SECONDS=" + std::string(value) + " " +
+                                                            std::string(ARMSIM_EXE) + " model show --model thesis --out " +
+                                                            (d / "m").string());
+        EXPECT_EQ(e.exitCode, 2) << e.output;
+        EXPECT_NE(e.output.find(std::string("environment variable ARMSIM_PROGRESS_SECONDS=") + value +
+                                ": expected seconds between progress lines"), std::string::npos) << e.output;
+        EXPECT_FALSE(fs::exists(d / "m"));
+    }
+    fs::remove_all(d);
+}
+
 // A folder whose overview cannot be written (an index.html that is not armsim's, here a folder): the
 // command's files are there and complete, and the exit status says the overview is missing (2, not 0).
 TEST(Cli, AnOverviewThatCannotBeWrittenIsAnError) {
