@@ -1,5 +1,6 @@
 #include "basics/storage_file.h"
 
+#include "basics/numbers.h"
 #include "basics/errors.h"
 #include "basics/files.h"
 
@@ -91,7 +92,7 @@ Table readStorage(const std::string& path, StorageHeader* header) {
         for (std::size_t c = 0; c < names.size(); ++c) {
             char* end = nullptr;
             const double v = std::strtod(p, &end);
-            if (end == p || (*end && *end != '\t'))
+            if (end == p || (*end && *end != '\t') || isHexadecimalText(p))
                 throw InputError(at() + ": column '" + names[c] + "': expected a number");
             row.push_back(v);
             p = *end ? end + 1 : end;

@@ -1,5 +1,6 @@
 #include "basics/table.h"
 
+#include "basics/numbers.h"
 #include "basics/errors.h"
 #include "basics/files.h"
 
@@ -219,7 +220,7 @@ Table Table::readCsv(const std::string& path) {
             char* end = nullptr;
             errno = 0;
             const double v = std::strtod(cells[i].c_str(), &end);
-            if (cells[i].empty() || end != cells[i].c_str() + cells[i].size())
+            if (cells[i].empty() || end != cells[i].c_str() + cells[i].size() || isHexadecimalText(cells[i].c_str()))
                 throw InputError(at + ": column '" + t.names_[i] + "' = '" + cells[i] + "': expected a number");
             if (errno == ERANGE && std::abs(v) > 1)   // read as inf otherwise, and reported as "inf"
                 throw InputError(at + ": column '" + t.names_[i] + "' = '" + cells[i] +

@@ -247,7 +247,7 @@ std::vector<ChannelObservation> readChannelData(const std::string& path) {
             } catch (const std::exception&) {
                 used = 0;
             }
-            if (used != v.size() || !std::isfinite(x))
+            if (used != v.size() || !std::isfinite(x) || isHexadecimalText(v.c_str()))
                 throw InputError(at + ": column '" + std::string(c) + "' = '" + v + "': expected a finite number");
             return x;
         };
@@ -272,7 +272,7 @@ std::vector<ChannelObservation> readChannelData(const std::string& path) {
         if (!(o.level >= 0 && o.level <= 1)) fail("level", formatNumber(o.level), "in [0, 1] (0: relaxed)");
         if (o.channel == "emg" && o.level == 0) fail("level", "0", "> 0 for emg (an effort's EMG)");
         const double rep = number("repetition", 0);
-        if (rep != std::floor(rep) || rep < 0 || rep > 1e6) fail("repetition", formatNumber(rep), "an integer >= 0");
+        if (rep != std::floor(rep) || rep < 0 || rep > 1e6) fail("repetition", formatNumber(rep), "an integer in [0, 1000000]");
         o.repetition = int(rep);
         o.value = number("value", kNaN);
         // Upper limits a typo (cm for m, mm^3 for m^3) or a unit slip passes: a fascicle or an upper arm

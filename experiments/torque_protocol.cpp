@@ -649,7 +649,7 @@ std::vector<TorqueObservation> makeTorqueData(const Table& t, const std::string&
         if (!t.hasColumn("repetition")) checkRowOnce(firstLine, key, o, at);
         if (t.hasColumn("repetition")) {
             const double v = t.get(r, "repetition");
-            if (!std::isfinite(v) || v != std::floor(v) || v < 0 || v > 1e6) fail("repetition", v, "an integer >= 0");
+            if (!std::isfinite(v) || v != std::floor(v) || v < 0 || v > 1e6) fail("repetition", v, "an integer in [0, 1000000]");
             o.repetition = int(v);
         } else {
             o.repetition = count[key];

@@ -1,5 +1,6 @@
 #include "model/osim_file.h"
 
+#include "basics/numbers.h"
 #include "basics/bound.h"
 #include "basics/files.h"
 #include "basics/angles.h"
@@ -166,7 +167,7 @@ public:
         try {
             std::size_t used = 0;
             x = std::stod(s, &used);
-            return used == s.size() && std::isfinite(x);
+            return used == s.size() && std::isfinite(x) && !isHexadecimalText(s.c_str());
         } catch (...) {
             return false;
         }

@@ -383,11 +383,11 @@ PYBIND11_MODULE(_armsim, mod) {
             return toDict(std::move(t));
         },
         py::arg("model"), py::arg("coordinate") = "", py::arg("initial_angle_deg") = py::none(),
-        py::arg("initial_velocity_degps") = 0.0, py::arg("effort") = "positive", py::arg("activation") = 0.5,
+        py::arg("initial_velocity_degps") = 0.0, py::arg("effort") = "positive", py::arg("activation") = 1.0,
         py::arg("onset") = 0.2, py::arg("rise") = 0.0, py::arg("duration") = 2.0, py::arg("rate") = 200.0,
         py::arg("muscle_model") = "", py::arg("accuracy") = 1e-5,
         "A free movement of an OpenSim model (what `armsim trial --model FILE.osim --type free` runs, with\n"
-        "these defaults: activation 0.5, 200 Hz): `coordinate`\n"
+        "these defaults: activation 1, 200 Hz): `coordinate`\n"
         "free from initial_angle_deg (None: its default), the other coordinates held at their defaults; the\n"
         "muscles that pull it the `effort` way at the start ('positive' or 'negative') excited to\n"
         "`activation` from `onset` [s] (a ramp over `rise` [s]; 0: a step), from every muscle in equilibrium.\n"

@@ -794,6 +794,10 @@ std::vector<BadInput> makeCatalogue() {
          {"--angle = '0x5A': expected a decimal number"}},
         {"TrialUnitsWithALeadingZero", {}, "trial --slow-units 010 --hold 0.2 --out OUT/t.csv",
          {"--slow-units = '010': expected a decimal integer without leading zeros"}},
+        {"IdentifyForceInHexadecimal", {{"f.csv", "path_cm,force_N\n41,0x258\n37.5,458\n38,470\n"}}, "identify IN/f.csv --out OUT/id",
+         {"f.csv:2: column 'force_N' = '0x258': expected a number"}},
+        {"TorqueDataRepetitionPastItsBound", {{"t.csv", "flexion_deg,effort,level,torque_Nm,repetition\n90,1,1,35,2147483647\n"}},
+         "identify-torque IN/t.csv --out OUT/it", {"t.csv:2", "column 'repetition' = 2147483647", "an integer in [0, 1000000]"}},
         // inputs that ask nothing of the work
         {"ActivationTraceStartingLate", {{"u.csv", "time_s,activation\n1,1\n2,1\n"}},
          "muscle trial --activation-trace IN/u.csv --duration 0.5 --out OUT/t.csv", {"u.csv:2", "'time_s' = 1", "start at 0 s"}},

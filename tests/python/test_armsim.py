@@ -268,6 +268,9 @@ def test_free_movement_of_an_osim_model():
     assert back["r_elbow_flex_deg"][-1] < 85
     with pytest.raises(ValueError, match="'initial_angle_deg' = 200"):
         armsim.free_movement("arm26", coordinate="r_elbow_flex", initial_angle_deg=200)
+    # The command line's default excitation, 1 (`armsim trial --type free --activation`), not 0.5 as before.
+    default = armsim.free_movement("arm26", coordinate="r_elbow_flex", duration=0.3, rate=100)
+    assert default["excitation"].max() == 1.0
 
 
 # The key-naming rule (README, Python): a returned key or column holding a quantity with a unit ends in
