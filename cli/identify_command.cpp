@@ -263,6 +263,10 @@ void addIdentifyCommand(CLI::App& app) {
             if (o->method != "lm" && c->count(option))
                 throw InputError(std::string(option) + " is an option of --method lm: --method " + o->method +
                                  " would ignore it");
+        if (c->count("--seed") && o->multistart <= 1)   // the seed draws the starts after the first
+            throw InputError("--seed " + std::to_string(o->seed) + " with --multistart " + std::to_string(o->multistart) +
+                             ": the seed draws the multi-start points after the first, so it would be ignored; add "
+                             "--multistart N (N > 1)");
         // One --bounds or --start per unknown: a second would silently win.
         for (const auto& [option, list] : {std::pair<const char*, const std::vector<std::string>*>{"--bounds", &o->bounds},
                                            {"--start", &o->starts}}) {

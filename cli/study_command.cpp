@@ -128,7 +128,12 @@ void addStudyCommand(CLI::App& app) {
                                        "merges the shards' journals and writes the files");
     c->add_flag("--merge", o->merge, "only assemble the journals (the shards') into the files; an error when "
                                      "cells are missing");
-    c->callback([o] { runStudyCommand(*o); });
+    c->callback([o, c] {
+        if (o->merge && c->count("--threads"))   // --merge computes nothing
+            throw InputError("--threads " + std::to_string(o->threads) + " with --merge: --merge only assembles the "
+                             "journals into the files (an error when cells are missing), so the threads would be ignored");
+        runStudyCommand(*o);
+    });
 }
 
 const CommandRegistrar registerStudy(58, addStudyCommand);

@@ -798,6 +798,10 @@ std::vector<BadInput> makeCatalogue() {
          {"f.csv:2: column 'force_N' = '0x258': expected a number"}},
         {"TorqueDataRepetitionPastItsBound", {{"t.csv", "flexion_deg,effort,level,torque_Nm,repetition\n90,1,1,35,2147483647\n"}},
          "identify-torque IN/t.csv --out OUT/it", {"t.csv:2", "column 'repetition' = 2147483647", "an integer in [0, 1000000]"}},
+        {"IdentifySeedWithOneStart", {}, "identify measured/thesis_measured.csv --seed 7 --out OUT/id",
+         {"--seed 7 with --multistart 1", "it would be ignored", "--multistart N"}},
+        {"StudyMergeWithThreads", {{"s.yaml", kStudyHead + "methods:\n  - {method: thesis}\n"}}, "study IN/s.yaml --merge --threads 2 --out OUT/s",
+         {"--threads 2 with --merge", "the threads would be ignored"}},
         // inputs that ask nothing of the work
         {"ActivationTraceStartingLate", {{"u.csv", "time_s,activation\n1,1\n2,1\n"}},
          "muscle trial --activation-trace IN/u.csv --duration 0.5 --out OUT/t.csv", {"u.csv:2", "'time_s' = 1", "start at 0 s"}},
