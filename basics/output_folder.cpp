@@ -55,6 +55,14 @@ void placeAllOrNone(const std::vector<Placement>& placements) {
         throw InputError(message);
     };
     for (const Placement& p : placements) {
+        if (p.from.empty()) {   // a file of an earlier result the new one does not hold: moved aside only
+            if (!fs::exists(p.to, ec)) continue;
+            if (p.aside.has_parent_path()) fs::create_directories(p.aside.parent_path(), ec);
+            fs::rename(p.to, p.aside, ec);
+            if (ec) fail(p.name + ": cannot remove the earlier result's file: " + ec.message());
+            aside.push_back({p.to, p.aside});
+            continue;
+        }
         if (p.to.has_parent_path()) fs::create_directories(p.to.parent_path(), ec);
         if (fs::exists(p.to, ec)) {
             if (p.aside.has_parent_path()) fs::create_directories(p.aside.parent_path(), ec);
@@ -98,6 +106,8 @@ OutputFolder::OutputFolder(const std::string& outDir, Mode mode, std::string mar
     if (outDir.empty()) return;
     target_ = fs::path(outDir).lexically_normal();
     if (target_.filename().empty()) target_ = target_.parent_path();
+    if (std::error_code e; fs::is_symlink(target_, e) && fs::is_directory(target_, e))
+        target_ = fs::canonical(target_, e);   // a link to a folder is written through, not replaced
     checkReplaceable();
     std::error_code ec;
     // AddFiles into an existing folder stages inside it (same file system, no write access to its parent
@@ -242,6 +252,11 @@ void OutputFolder::commitInto() {
     std::vector<Placement> placements;
     for (const std::string& f : files)
         placements.push_back({temp_ / f, target_ / f, old_ / f, (target_ / f).string()});
+    for (const std::string& f : resultFileNames_)
+        if (std::find(files.begin(), files.end(), f) == files.end() && fs::is_regular_file(target_ / f, ec)) {
+            checkNotReplacingInput((target_ / f).string(), "", target_.string());
+            placements.push_back({fs::path(), target_ / f, old_ / f, (target_ / f).string()});
+        }
     placeAllOrNone(placements);
     committed_ = true;
     fs::remove_all(temp_, ec);

@@ -63,6 +63,10 @@ public:
     std::string showPaths(std::string message) const;
     /// Adds every regular file found under the staging folder (written there without addFile).
     void addStagedFiles();
+    /// AddFiles: the names of every file this kind of result may hold. commit() removes those of them the
+    /// new result does not hold, with the rest (all or none), so no earlier result's file stays beside
+    /// it (an earlier design's design_validation.csv beside a design without validation).
+    void setResultFileNames(std::vector<std::string> names) { resultFileNames_ = std::move(names); }
     /// Moves the files into place, all or none: InputError naming the path when a rename fails, after
     /// restoring what was there (the earlier run, or the files the new ones were replacing).
     void commit();
@@ -75,6 +79,7 @@ private:
 
     Mode mode_;
     std::string marker_;
+    std::vector<std::string> resultFileNames_;
     std::filesystem::path target_, temp_, old_;
     bool committed_ = false;
     mutable std::mutex mutex_;

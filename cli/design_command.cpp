@@ -97,6 +97,10 @@ PlotSpec makeDesignPlot(const DesignResult& d, bool channels, int repetitions) {
     return plot;
 }
 
+// Every file a design writes: an earlier design's that this one does not write is removed at the commit.
+const std::vector<std::string> kDesignFiles = {"designed_protocol.yaml", "design_predictions.csv", "design_steps.csv",
+                                               "design_criterion.png", "design_validation.csv"};
+
 // --validate-subjects' work, counted (and bounded) before the design's: the reference protocol's fits
 // twice, and the channels fit of a design across channels.
 void announceValidation(const Population& population, const DesignSettings& s, const TorqueProtocol& reference,
@@ -174,11 +178,11 @@ void runDesign(const DesignOptions& o) {
     }
 
     OutputFolder out(o.out, OutputFolder::Mode::AddFiles);
+    out.setResultFileNames(kDesignFiles);
     const std::string protocolPath = out.getTargetPath("designed_protocol.yaml");
-    out.write("designed_protocol.yaml",
-                        "# Written by `armsim design` (studies/experiment_design.h). Run it with\n"
-                        "#   armsim protocol " + protocolPath + "\n#   armsim validate --truth elbow --protocol " +
-                            protocolPath + "\n" + formatTorqueProtocol(d.protocol));
+    out.write("designed_protocol.yaml", "# Written by `armsim design` (studies/experiment_design.h). Run it with\n"
+                                        "#   armsim protocol " + protocolPath + "\n#   armsim validate --truth elbow --protocol " +
+                                        protocolPath + "\n" + formatTorqueProtocol(d.protocol));
     out.write("design_predictions.csv", formatPredictionsCsv({reference, d.predicted}));
     out.write("design_steps.csv", formatDesignStepsCsv(d));
     const PlotSpec plot = makeDesignPlot(d, channels, s.repetitions);

@@ -8,6 +8,7 @@
 #include "experiments/protocol_run.h"
 
 #include <fmt/printf.h>
+#include <nlohmann/json.hpp>
 
 #include <cmath>
 
@@ -130,13 +131,27 @@ ProtocolFileRun runTorqueProtocolFile(const std::string& path, const ProtocolFil
     run.kind = "torque";
     run.name = protocol.name;
     run.outDir = findRunFolder(o, protocol.name);
+    // The run folder as an arm protocol's: checked before the work, replaced whole (an earlier run's
+    // channel_data.csv no longer stays beside a run that has none), its files all there or none.
+    OutputFolder dir(run.outDir, OutputFolder::Mode::ReplaceRun, "manifest.json");
     if (o.onStart)
         o.onStart(protocol.name, "protocol " + protocol.name + " (torque): " + protocol.description + "\n  " +
                   std::to_string(protocol.getNumTrials()) + " trials: " + describeConditions(protocol) + "\n");
     const TorqueProtocolRun r = runTorqueProtocol(protocol, o.jobs);
     run.text = formatTorqueTable(protocol, r);
-    if (!run.outDir.empty()) {
-        run.files = writeTorqueProtocolRun(run.outDir, protocol, r.data, r.channels);
+    if (dir.isEnabled()) {
+        const std::string staging = dir.getStagingPath();
+        for (const std::string& staged : writeTorqueProtocolRun(staging, protocol, r.data, r.channels))
+            run.files.push_back(dir.getTargetPath(staged.substr(staging.size() + 1)));
+        nlohmann::ordered_json manifest;
+        manifest["armsim_version"] = ARMSIM_VERSION;
+        manifest["protocol"] = protocol.name;
+        manifest["kind"] = "torque";
+        manifest["trials"] = r.data.size();
+        manifest["channel_measurements"] = r.channels.size();
+        writeFileAtomically(staging + "/manifest.json", manifest.dump(2) + "\n");
+        dir.addStagedFiles();
+        dir.commit();
         run.text += "wrote";
         for (const std::string& f : run.files) run.text += " " + f;
         run.text += "\n(identify with `armsim identify-torque " + run.outDir + "/torque_data.csv" +

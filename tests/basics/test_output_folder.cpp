@@ -338,3 +338,59 @@ TEST_F(OutputFolderTest, AnInputInsideTheTargetIsNeitherDeletedNorReplaced) {
     EXPECT_EQ(readAll(results / "data.csv"), "1\n");
     EXPECT_EQ(countEntries(root), 2);   // run/ and results/: nothing staged or moved aside left
 }
+
+// Issue 34 (ninth sweep): a second result of the same kind in a folder leaves none of the first's files
+// beside it (a design without validation used to keep the earlier design_validation.csv, linked from
+// the page); a user's own files stay; an earlier result's file that this command read is not deleted.
+TEST_F(OutputFolderTest, AnEarlierResultsFilesTheNewOneDoesNotHoldAreRemovedWithTheCommit) {
+    const fs::path target = root / "design";
+    fs::create_directories(target);
+    std::ofstream(target / "notes.txt") << "keep";
+    std::ofstream(target / "validation.csv") << "earlier";
+    std::ofstream(target / "design.csv") << "earlier";
+    {
+        OutputFolder out(target.string(), OutputFolder::Mode::AddFiles);
+        out.setResultFileNames({"design.csv", "validation.csv"});
+        out.write("design.csv", "new");
+        EXPECT_TRUE(fs::exists(target / "validation.csv"));   // nothing moves before the commit
+        out.commit();
+    }
+    EXPECT_EQ(readFileText((target / "design.csv").string()), "new");
+    EXPECT_FALSE(fs::exists(target / "validation.csv"));
+    EXPECT_EQ(readFileText((target / "notes.txt").string()), "keep");
+    EXPECT_EQ(countEntries(target), 2);   // no staging or moved-aside folder left inside
+    std::ofstream(target / "validation.csv") << "read";
+    setInputProtection(true);
+    noteInputFile((target / "validation.csv").string());
+    {
+        OutputFolder out(target.string(), OutputFolder::Mode::AddFiles);
+        out.setResultFileNames({"design.csv", "validation.csv"});
+        out.write("design.csv", "newer");
+        EXPECT_THROW(out.commit(), InputError);
+    }
+    setInputProtection(false);
+    EXPECT_EQ(readFileText((target / "validation.csv").string()), "read");
+    EXPECT_EQ(readFileText((target / "design.csv").string()), "new");
+}
+
+// A link to a run folder is written through: the run replaces the folder it points to, and the link
+// stays a link (before, the link became a folder and the earlier run stayed where it pointed).
+TEST_F(OutputFolderTest, ALinkToARunFolderIsWrittenThrough) {
+    const fs::path real = root / "real", link = root / "link";
+    {
+        OutputFolder out(real.string(), OutputFolder::Mode::ReplaceRun, "manifest.json");
+        out.write("old_only.csv", "x");
+        out.write("manifest.json", kManifest);
+        out.commit();
+    }
+    fs::create_directory_symlink(real, link);
+    {
+        OutputFolder out(link.string(), OutputFolder::Mode::ReplaceRun, "manifest.json");
+        out.write("new.csv", "y");
+        out.write("manifest.json", kManifest);
+        out.commit();
+    }
+    EXPECT_TRUE(fs::is_symlink(link));
+    EXPECT_FALSE(fs::exists(real / "old_only.csv"));
+    EXPECT_EQ(readFileText((link / "new.csv").string()), "y");
+}

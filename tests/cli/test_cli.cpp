@@ -905,6 +905,30 @@ TEST(Cli, AClosedPipeStopsTheRunAndABadEnvironmentIsRefused) {
     fs::remove_all(d);
 }
 
+// Issue 34 (ninth sweep): a torque protocol's run folder is a run as an arm protocol's: replaced whole
+// (the earlier run's channel_data.csv and its plots used to stay beside a run without channels, and the
+// data no longer matched), a user's folder refused before the work, written through a link.
+TEST(Cli, ATorqueProtocolReplacesItsEarlierRunWhole) {
+    const fs::path d = freshDir("torque_run_whole");
+    const std::string exe = std::string(ARMSIM_EXE), protocols = std::string(ARMSIM_ASSET_DIR) + "/protocols/";
+    fs::create_directories(d / "real");
+    fs::create_directory_symlink(d / "real", d / "link");
+    ASSERT_EQ(runArmsim("protocol " + protocols + "recommended.yaml --out " + (d / "real").string()).exitCode, 0);
+    ASSERT_TRUE(fs::exists(d / "real" / "channel_data.csv"));
+    const CommandResult r = runArmsim("protocol " + protocols + "designed_emg_torque.yaml --out " + (d / "link").string());
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    EXPECT_TRUE(fs::is_symlink(d / "link"));
+    for (const char* gone : {"channel_data.csv", "emg.png", "fascicle_length.png"}) EXPECT_FALSE(fs::exists(d / "real" / gone)) << gone;
+    for (const char* kept : {"torque_data.csv", "manifest.json", "index.html"}) EXPECT_TRUE(fs::exists(d / "real" / kept)) << kept;
+    fs::create_directories(d / "mine");
+    std::ofstream(d / "mine" / "notes.txt") << "a user's file\n";
+    const CommandResult refused = runArmsim("protocol " + protocols + "designed_emg_torque.yaml --out " + (d / "mine").string());
+    EXPECT_EQ(refused.exitCode, 2) << refused.output;
+    EXPECT_NE(refused.output.find("is not an armsim run"), std::string::npos) << refused.output;
+    EXPECT_EQ(refused.output.find("15 trials: flexion"), std::string::npos) << refused.output;   // refused before the work
+    fs::remove_all(d);
+}
+
 // A folder whose overview cannot be written (an index.html that is not armsim's, here a folder): the
 // command's files are there and complete, and the exit status says the overview is missing (2, not 0).
 TEST(Cli, AnOverviewThatCannotBeWrittenIsAnError) {
