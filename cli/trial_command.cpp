@@ -296,6 +296,7 @@ void runTrialCommand(const TrialOptions& o) {
     spec.xLabel = "time (s)";
     if (type == "isometric") {
         IsometricTrialResult r;
+        iso.progress = [d = iso.getDuration()](double t) { printTimeProgress("isometric trial", t, d); };   // a long hold's
         runNamingOptions({{"elbow_angle_deg", o.settingsFile.empty() ? "--angle" : o.settingsFile + ": elbow_angle_deg"}},
                          [&] { r = runIsometricTrial(setup, iso); });
         files.writeWith(csvPath, [&](const std::string& p) { r.series.writeCsv(p); });

@@ -137,7 +137,7 @@ ProtocolFileRun runTorqueProtocolFile(const std::string& path, const ProtocolFil
     if (o.onStart)
         o.onStart(protocol.name, "protocol " + protocol.name + " (torque): " + protocol.description + "\n  " +
                   std::to_string(protocol.getNumTrials()) + " trials: " + describeConditions(protocol) + "\n");
-    const TorqueProtocolRun r = runTorqueProtocol(protocol, o.jobs);
+    const TorqueProtocolRun r = runTorqueProtocol(protocol, o.jobs, o.progress);
     run.text = formatTorqueTable(protocol, r);
     if (dir.isEnabled()) {
         const std::string staging = dir.getStagingPath();

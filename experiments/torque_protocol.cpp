@@ -346,7 +346,7 @@ bool hasPostures(const std::vector<TorqueObservation>& data) {
 }
 
 std::vector<TorqueObservation> synthesizeTorqueData(const VirtualSubject& subject, const TorqueProtocol& protocol,
-                                                    unsigned noiseSeed, int jobs) {
+                                                    unsigned noiseSeed, int jobs, const std::function<void(int, int)>& progress) {
     protocol.validate();
     for (std::size_t k = 0; k < protocol.conditions.size(); ++k)   // an OpenSim protocol's angles are its coordinate's
         checkField(conditionField(k, "flexion_deg"), protocol.conditions[k].flexionDeg, Bound::closed(0, 180, "deg, 0 = extended"));
@@ -398,7 +398,7 @@ std::vector<TorqueObservation> synthesizeTorqueData(const VirtualSubject& subjec
             if (forearm) o.forearmNoiseDraw = forearmRng.drawNormal();
             data.push_back(o);
         }
-    const std::vector<IsometricTrialResult> results = runIsometricTrials(subject.setup, trials, jobs);
+    const std::vector<IsometricTrialResult> results = runIsometricTrials(subject.setup, trials, jobs, progress);
     for (std::size_t k = 0; k < data.size(); ++k) {
         data[k].cleanTorque = results[k].summary.meanMuscleTorque;
         if (forearm) data[k].cleanForearmTorque = results[k].summary.meanForearmTorque;
@@ -484,7 +484,7 @@ std::vector<TorqueObservation> synthesizeOsimTorqueData(const TorqueProtocol& pr
     return setTransducerNoise(std::move(data), protocol.transducerNoise);
 }
 
-TorqueProtocolRun runTorqueProtocol(const TorqueProtocol& protocol, int jobs) {
+TorqueProtocolRun runTorqueProtocol(const TorqueProtocol& protocol, int jobs, const std::function<void(int, int)>& progress) {
     TorqueProtocolRun run;
     if (protocol.usesOsimModel()) {
         run.subject = "OpenSim model " + protocol.model +
@@ -495,7 +495,7 @@ TorqueProtocolRun runTorqueProtocol(const TorqueProtocol& protocol, int jobs) {
     run.subject = protocol.population.empty() ? "model " + protocol.model
                                               : protocol.population + " person " + std::to_string(protocol.subjectIndex);
     const VirtualSubject subject = loadTorqueProtocolSubject(protocol);
-    run.data = synthesizeTorqueData(subject, protocol, protocol.seed, jobs);
+    run.data = synthesizeTorqueData(subject, protocol, protocol.seed, jobs, progress);
     if (protocol.hasChannels()) run.channels = synthesizeChannelData(subject, protocol, run.data, protocol.seed);
     return run;
 }

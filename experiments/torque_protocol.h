@@ -21,6 +21,7 @@
 #include "model/geometry.h"
 
 #include <cmath>
+#include <functional>
 #include <string>
 #include <tuple>
 #include <vector>
@@ -161,8 +162,10 @@ struct TorqueProtocolRun {
 
 /// Runs the protocol on its subject (`armsim protocol`, Python's run_protocol): synthesizeTorqueData
 /// and synthesizeChannelData on a population person or an armsim model, synthesizeOsimTorqueData on an
-/// OpenSim model. Seeded with the protocol's seed; trials on `jobs` threads.
-TorqueProtocolRun runTorqueProtocol(const TorqueProtocol& protocol, int jobs = 1);
+/// OpenSim model. Seeded with the protocol's seed; trials on `jobs` threads; progress(done, total) per
+/// trial of an armsim model, from the caller's thread.
+TorqueProtocolRun runTorqueProtocol(const TorqueProtocol& protocol, int jobs = 1,
+                                    const std::function<void(int, int)>& progress = {});
 
 /// The protocol's trials on its OpenSim model (usesOsimModel): each an isometric trial
 /// (model/osim_trial.h) of the coordinate locked at flexion_deg, the muscles that pull it the effort's
@@ -187,7 +190,8 @@ std::string formatPosture(double rotationDeg);
 /// Reproducible from (subject, noiseSeed); trials run on `jobs` threads. Trial order: repetition-major
 /// (every condition's first trial, then every second one, ...).
 std::vector<TorqueObservation> synthesizeTorqueData(const VirtualSubject& subject, const TorqueProtocol& protocol,
-                                                    unsigned noiseSeed, int jobs = 1);
+                                                    unsigned noiseSeed, int jobs = 1,
+                                                    const std::function<void(int, int)>& progress = {});
 
 /// The same efforts read through a transducer of another relative noise sd (the same noise draws:
 /// common random numbers across noise levels).

@@ -107,6 +107,7 @@ SteadyMvcCurve calcSteadyCurve(const std::vector<MuscleSpec>& muscles, const Mvc
     }
     for (std::size_t a = 0; a < na; ++a)
         for (std::size_t i = 0; i < nm; ++i) {
+            if (i == 0 && (a & 63) == 63) checkInterruption();   // a fine sweep (18,001 angles) stops promptly
             SteadyMusclePoint& p = curve.points[a][i];
             p.pathLength = geometry.pathLength[a][i];
             p.momentArm = geometry.momentArm[a][i];

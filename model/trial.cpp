@@ -384,6 +384,7 @@ IsometricTrialResult runIsometricTrial(const ArmSetup& setup, const IsometricTri
         appendMuscleForces(row, activations, forces, t);
         for (int i = 0; i < n; ++i) row.insert(row.end(), y + firstState[i], y + firstState[i] + muscles[i]->getNumStates());
         result.series.appendRow(row);
+        if (settings.progress) settings.progress(t);
     };
 
     if (settings.solver == TrialSolver::LockedOde) {

@@ -80,6 +80,8 @@ struct IsometricTrialSettings {
     /// (docs/benchmarks.md, the motor units' rise/fall switch at fint = feff, which the quotients smooth).
     bool analyticJacobian = false;
     IntegrationSettings integration;
+    /// Optional: called with the time [s] of every sample (a long hold's progress).
+    std::function<void(double)> progress;
 
     /// Throws InputError naming the field unless every value is in range (angle inside the arm's
     /// elbow range, durations positive, activation in [0, 1], window inside the hold).

@@ -778,6 +778,12 @@ TEST(Cli, ProgressReachesALogFileWhileTheWorkRuns) {
                                           (d / "g").string());
     ASSERT_EQ(quiet.exitCode, 0) << quiet.output;
     EXPECT_EQ(quiet.output.find("forward: "), quiet.output.find("forward: arm26")) << quiet.output;
+    // A locked trial's long hold too (issue 34: a 49,000 s hold ran for minutes without a line).
+    const CommandResult hold = armsim::testing::runCommand("ARMSIM_PROGRESS_SECONDS=0.001 " + std::string(ARMSIM_EXE) +
+                                                           " trial --hold 20 --rate 100 --out " + (d / "t.csv").string());
+    ASSERT_EQ(hold.exitCode, 0) << hold.output;
+    EXPECT_TRUE(std::regex_search(hold.output, std::regex(R"(isometric trial: [0-9.]+/20.5 s \([0-9]+ %\) after)"))) << hold.output;
+    EXPECT_NE(hold.output.find("isometric trial: 20.5/20.5 s done"), std::string::npos) << hold.output;
 }
 
 // The trial accuracy's bound is one the integrator meets: at its lowest value the thesis arm's short
