@@ -241,16 +241,22 @@ namespace {
 // One progress report: `amount` is "5/10" or "12.3/100 s"; fraction in [0, 1].
 // A log's progress interval [s]: ARMSIM_PROGRESS_SECONDS (a batch system's cadence; the tests' short one),
 // else 10 s.
+// ARMSIM_PROGRESS_SECONDS as seconds in [1e-3, 86400]; NaN when it is not (10 s when unset).
+double readProgressSeconds() {
+    const char* v = std::getenv("ARMSIM_PROGRESS_SECONDS");
+    if (!v) return 10.0;
+    char* end = nullptr;
+    const double x = std::strtod(v, &end);
+    return end != v && *end == '\0' && x >= 1e-3 && x <= 86400 ? x : kNaN;
+}
+
 double getLogProgressInterval() {
     static const double interval = [] {
-        const char* v = std::getenv("ARMSIM_PROGRESS_SECONDS");
-        char* end = nullptr;
-        const double x = v ? std::strtod(v, &end) : 0;
-        return v && end != v && *end == '\0' && x >= 1e-3 && x <= 86400 ? x : 10.0;
+        const double x = readProgressSeconds();   // checkEnvironment refused a bad value before the command
+        return std::isnan(x) ? 10.0 : x;
     }();
     return interval;
 }
-
 
 // The time left [s] at the rate since a label's first report (done `from` then; the clock starts there).
 double calcTimeLeft(double fraction, double from, double elapsed) {
@@ -356,13 +362,9 @@ void noteUnreachedActivation(const ActivationProfile& activation, double duratio
 }
 
 void checkEnvironment() {
-    if (const char* v = std::getenv("ARMSIM_PROGRESS_SECONDS")) {
-        char* end = nullptr;
-        const double x = std::strtod(v, &end);
-        if (end == v || *end != '\0' || !(x >= 1e-3 && x <= 86400))
-            throw InputError(std::string("environment variable ARMSIM_PROGRESS_SECONDS=") + v +
-                             ": expected seconds between progress lines on a log, in [0.001, 86400] (unset: 10)");
-    }
+    if (std::isnan(readProgressSeconds()))
+        throw InputError(std::string("environment variable ARMSIM_PROGRESS_SECONDS=") + std::getenv("ARMSIM_PROGRESS_SECONDS") +
+                         ": expected seconds between progress lines on a log, in [0.001, 86400] (unset: 10)");
     isQuickRun();   // ARMSIM_QUICK: 1 or 0
 }
 

@@ -8,7 +8,7 @@ namespace armsim::cli {
 
 /// After a successful command: when the command that ran has an --out that names a folder, writes
 /// FOLDER/index.html (command line, version, time, the command's settings, every plot, video and table
-/// of the folder). Only rank 0 under mpirun or srun. Throws std::runtime_error when it cannot write
+/// of the folder). A study's page only from rank 0 under mpirun or srun (its ranks share the folder). Throws std::runtime_error when it cannot write
 /// (the caller warns: the command's own files stand).
 void writeCommandReport(const CLI::App& app, int argc, char** argv);
 /// The folder a command wrote when it is not its --out as typed (a study's `output:` from its file, a

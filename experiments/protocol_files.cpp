@@ -149,8 +149,8 @@ ProtocolFileRun runTorqueProtocolFile(const std::string& path, const ProtocolFil
         manifest["kind"] = "torque";
         manifest["trials"] = r.data.size();
         manifest["channel_measurements"] = r.channels.size();
-        writeFileAtomically(staging + "/manifest.json", manifest.dump(2) + "\n");
-        dir.addStagedFiles();
+        dir.write("manifest.json", manifest.dump(2) + "\n");
+        dir.addStagedFiles();   // writeTorqueProtocolRun's files
         dir.commit();
         run.text += "wrote";
         for (const std::string& f : run.files) run.text += " " + f;

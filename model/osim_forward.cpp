@@ -4,6 +4,7 @@
 #include "basics/errors.h"
 #include "basics/files.h"
 #include "basics/format.h"
+#include "basics/numbers.h"
 #include "model/osim_arm.h"
 #include "muscles/muscle_file.h"
 #include "muscles/simbody_isometric.h"
@@ -428,7 +429,7 @@ OsimForwardSetup readOsimForwardSetup(const std::string& path) {
         // The whole text a finite decimal number ("0.2abc" and hexadecimal "0x1p-2" are not).
         char* end = nullptr;
         const double x = std::strtod(v.c_str(), &end);
-        if (end == v.c_str() || *end != '\0' || !std::isfinite(x) || v.find_first_of("xX") != std::string::npos)
+        if (end == v.c_str() || *end != '\0' || !std::isfinite(x) || isHexadecimalText(v.c_str()))
             throw OsimError(path + ":" + std::to_string(tool->FirstChildElement(tag)->GetLineNum()) + ": <" + tag + "> '" + v +
                             "': expected a number");
         return x;
